@@ -1,0 +1,83 @@
+//! Triangle meshes with one UV layout, their edge topology, OBJ import and
+//! validation.
+//!
+//! Conventions used across Anthesis:
+//! - positions are `f64` (`glam::DVec3`); UVs are `glam::DVec2`;
+//! - triangles wind counter-clockwise around the normal that points to the
+//!   organ's *inner* (adaxial) side, the side facing the flower axis;
+//! - UV `u` runs across the organ (midrib at `u = 0.5`), `v` from the base
+//!   (`0`) to the tip (`1`).
+
+mod error;
+pub mod generate;
+pub mod obj;
+mod topology;
+pub mod validate;
+
+pub use error::MeshError;
+pub use topology::{Edge, EdgeSide, Topology};
+
+use glam::{DVec2, DVec3};
+
+/// A triangle mesh with one UV per vertex.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mesh {
+    pub positions: Vec<DVec3>,
+    pub uvs: Vec<DVec2>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The three corner positions of triangle `t`.
+    pub fn triangle_positions(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|i| self.positions[i as usize])
+    }
+
+    /// The three corner UVs of triangle `t`.
+    pub fn triangle_uvs(&self, t: usize) -> [DVec2; 3] {
+        self.triangles[t].map(|i| self.uvs[i as usize])
+    }
+
+    /// Area of triangle `t` in 3D.
+    pub fn triangle_area(&self, t: usize) -> f64 {
+        let [a, b, c] = self.triangle_positions(t);
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// Total surface area in 3D.
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|t| self.triangle_area(t))
+            .sum()
+    }
+
+    /// Area-weighted vertex normals (unit length, pointing to the inner side).
+    pub fn vertex_normals(&self) -> Vec<DVec3> {
+        vertex_normals(&self.positions, &self.triangles)
+    }
+}
+
+/// Area-weighted vertex normals of `positions` for the given triangles.
+/// Vertices that belong to no triangle get a zero normal.
+pub fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut normals = vec![DVec3::ZERO; positions.len()];
+    for tri in triangles {
+        let [a, b, c] = tri.map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in tri {
+            normals[i as usize] += n;
+        }
+    }
+    for n in &mut normals {
+        *n = n.normalize_or_zero();
+    }
+    normals
+}

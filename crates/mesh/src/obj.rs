@@ -1,0 +1,1 @@
+//! Wavefront OBJ import and export (being written).

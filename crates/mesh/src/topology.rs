@@ -1,0 +1,212 @@
+use std::collections::HashMap;
+
+use crate::{Mesh, MeshError};
+
+/// One side of an edge: the triangle on that side and its corner opposite
+/// the edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EdgeSide {
+    pub triangle: u32,
+    pub opposite: u32,
+}
+
+/// An edge and its (one or two) adjacent triangles.
+///
+/// `vertices` are ordered as they appear in the winding of `left`
+/// (`left` contains the directed edge `vertices[0] -> vertices[1]`); `right`,
+/// if present, contains `vertices[1] -> vertices[0]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Edge {
+    pub vertices: [u32; 2],
+    pub left: EdgeSide,
+    pub right: Option<EdgeSide>,
+}
+
+impl Edge {
+    pub fn is_boundary(&self) -> bool {
+        self.right.is_none()
+    }
+
+    /// The hinge stencil `[i, j, k, l]` of an interior edge: the edge
+    /// `i -> j`, `k` opposite in the left triangle, `l` opposite in the right.
+    pub fn hinge(&self) -> Option<[u32; 4]> {
+        self.right.map(|r| {
+            [
+                self.vertices[0],
+                self.vertices[1],
+                self.left.opposite,
+                r.opposite,
+            ]
+        })
+    }
+}
+
+/// Edge topology of a manifold, consistently oriented triangle mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Topology {
+    pub edges: Vec<Edge>,
+    /// For each triangle, the edge index of its sides `(t0,t1)`, `(t1,t2)`,
+    /// `(t2,t0)`.
+    pub triangle_edges: Vec<[u32; 3]>,
+}
+
+impl Topology {
+    /// Builds the edge list. Fails on an edge with more than two triangles or
+    /// two triangles that traverse a shared edge in the same direction
+    /// (inconsistent orientation).
+    pub fn build(mesh: &Mesh) -> Result<Topology, MeshError> {
+        let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+        let mut edges: Vec<Edge> = Vec::new();
+        let mut index_of: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut triangle_edges = Vec::with_capacity(mesh.triangles.len());
+        let mut faces_on_edge: HashMap<(u32, u32), usize> = HashMap::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let mut te = [0u32; 3];
+            for k in 0..3 {
+                let (a, b, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+                let key = (a.min(b), a.max(b));
+                let count = faces_on_edge.entry(key).or_insert(0);
+                *count += 1;
+                if *count > 2 {
+                    return Err(MeshError::NonManifoldEdge {
+                        a: key.0,
+                        b: key.1,
+                        faces: *count,
+                    });
+                }
+                if let Some(&first) = directed.get(&(a, b)) {
+                    return Err(MeshError::InconsistentOrientation {
+                        a,
+                        b,
+                        first,
+                        second: t,
+                    });
+                }
+                directed.insert((a, b), t);
+                let side = EdgeSide {
+                    triangle: t as u32,
+                    opposite: c,
+                };
+                te[k] = match index_of.get(&key) {
+                    Some(&e) => {
+                        edges[e as usize].right = Some(side);
+                        e
+                    }
+                    None => {
+                        let e = edges.len() as u32;
+                        edges.push(Edge {
+                            vertices: [a, b],
+                            left: side,
+                            right: None,
+                        });
+                        index_of.insert(key, e);
+                        e
+                    }
+                };
+            }
+            triangle_edges.push(te);
+        }
+        Ok(Topology {
+            edges,
+            triangle_edges,
+        })
+    }
+
+    pub fn interior_edge_count(&self) -> usize {
+        self.edges.iter().filter(|e| !e.is_boundary()).count()
+    }
+
+    pub fn boundary_edge_count(&self) -> usize {
+        self.edges.iter().filter(|e| e.is_boundary()).count()
+    }
+
+    /// For each vertex, its neighbours along edges (sorted, deduplicated).
+    pub fn vertex_neighbours(&self, vertex_count: usize) -> Vec<Vec<u32>> {
+        let mut nb = vec![Vec::new(); vertex_count];
+        for e in &self.edges {
+            let [a, b] = e.vertices;
+            nb[a as usize].push(b);
+            nb[b as usize].push(a);
+        }
+        for n in &mut nb {
+            n.sort_unstable();
+            n.dedup();
+        }
+        nb
+    }
+
+    /// Whether each vertex lies on the boundary.
+    pub fn boundary_vertices(&self, vertex_count: usize) -> Vec<bool> {
+        let mut on = vec![false; vertex_count];
+        for e in self.edges.iter().filter(|e| e.is_boundary()) {
+            on[e.vertices[0] as usize] = true;
+            on[e.vertices[1] as usize] = true;
+        }
+        on
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{DVec2, DVec3};
+
+    fn quad() -> Mesh {
+        Mesh {
+            positions: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+            ],
+            uvs: vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(1.0, 0.0),
+                DVec2::new(1.0, 1.0),
+                DVec2::new(0.0, 1.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    #[test]
+    fn quad_has_one_interior_edge_with_its_hinge() {
+        let topo = Topology::build(&quad()).expect("valid quad");
+        assert_eq!(topo.edges.len(), 5);
+        assert_eq!(topo.interior_edge_count(), 1);
+        assert_eq!(topo.boundary_edge_count(), 4);
+        let interior = topo.edges.iter().find(|e| !e.is_boundary()).expect("one");
+        // Left triangle 0 walks 2 -> 0, right triangle 1 walks 0 -> 2.
+        assert_eq!(interior.hinge(), Some([2, 0, 1, 3]));
+        assert_eq!(topo.triangle_edges[0][2], topo.triangle_edges[1][0]);
+    }
+
+    #[test]
+    fn edge_shared_by_three_triangles_is_non_manifold() {
+        let mut m = quad();
+        m.positions.push(DVec3::new(0.5, 0.5, 1.0));
+        m.uvs.push(DVec2::new(0.5, 0.5));
+        m.triangles.push([2, 0, 4]);
+        let err = Topology::build(&m).expect_err("three faces on 0-2");
+        assert_eq!(
+            err,
+            MeshError::NonManifoldEdge {
+                a: 0,
+                b: 2,
+                faces: 3
+            }
+        );
+    }
+
+    #[test]
+    fn flipped_neighbour_is_inconsistent_orientation() {
+        let mut m = quad();
+        m.triangles[1] = [0, 3, 2];
+        let err = Topology::build(&m).expect_err("flipped");
+        assert!(matches!(
+            err,
+            MeshError::InconsistentOrientation { a: 2, b: 0, .. }
+                | MeshError::InconsistentOrientation { a: 0, b: 2, .. }
+        ));
+    }
+}

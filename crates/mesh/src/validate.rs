@@ -1,0 +1,1 @@
+//! Mesh validation (being written).
