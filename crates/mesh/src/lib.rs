@@ -14,8 +14,10 @@ pub mod obj;
 mod topology;
 pub mod validate;
 
-pub use error::MeshError;
+pub use error::{MeshError, Space};
+pub use obj::{load_obj, obj_string, parse_obj, parse_obj_unvalidated, write_obj};
 pub use topology::{Edge, EdgeSide, Topology};
+pub use validate::validate;
 
 use glam::{DVec2, DVec3};
 
