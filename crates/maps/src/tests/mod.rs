@@ -1,0 +1,3 @@
+mod blending;
+mod png_files;
+mod sampling;
