@@ -1,1 +1,37 @@
-//! (being written)
+//! Rendering of flower organs with wgpu: the only Anthesis crate that uses
+//! wgpu.
+//!
+//! Layers, from the inside out:
+//! - [`OrganPipeline`] holds the shader pipelines, the organs' GPU buffers
+//!   and the frame uniforms. It works with any `wgpu::Device`/`Queue` (the
+//!   desktop app passes egui_wgpu's) and draws into a render pass whose
+//!   attachments match its [`TargetFormat`]: [`OrganPipeline::render`]
+//!   records a whole pass into caller-owned colour and depth views,
+//!   [`OrganPipeline::draw`] draws into a pass the caller began.
+//! - [`RenderTarget`] owns a colour (optionally multisampled), a resolved
+//!   single-sample colour texture and a depth texture of one size.
+//! - [`OffscreenRenderer`] creates its own headless device (any backend;
+//!   the software Vulkan adapter lavapipe is fine) and renders organs to an
+//!   [`image::RgbaImage`].
+//!
+//! Depth is reversed (near = 1, infinitely far = 0, compare
+//! `GreaterEqual`): a pass that draws organs must clear its depth to
+//! [`DEPTH_CLEAR_VALUE`].
+
+mod camera;
+mod error;
+mod mesh;
+mod offscreen;
+mod pipeline;
+mod target;
+
+pub use camera::Camera;
+pub use error::RenderError;
+pub use mesh::{OrganMesh, organs_bounds_in_world};
+pub use offscreen::OffscreenRenderer;
+pub use pipeline::{Background, DEPTH_CLEAR_VALUE, OrganPipeline, SHADER_SOURCE, TargetFormat};
+pub use target::RenderTarget;
+
+/// The wgpu this crate is built against, for callers that must name its
+/// types (devices, texture formats) without depending on it themselves.
+pub use wgpu;

@@ -1,0 +1,93 @@
+use glam::DVec3;
+
+/// One organ ready to draw: `f32` world-space vertices with normals, its
+/// triangles and a colour.
+///
+/// Normals point to the organ's inner side (the Anthesis winding
+/// convention); the side they point at is shaded as the front, the other
+/// side slightly darker.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrganMesh {
+    pub positions_in_world: Vec<[f32; 3]>,
+    pub normals_in_world: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// sRGB-encoded RGBA in `[0, 1]` (the colour as a user picks it).
+    pub color_srgb: [f32; 4],
+    /// An optional scalar per vertex in `[0, 1]` (e.g. a growth-map value)
+    /// shown with a blue–yellow–red ramp instead of the organ colour.
+    pub overlay: Option<Vec<f32>>,
+}
+
+impl OrganMesh {
+    /// Builds a mesh from `f64` world positions, computing area-weighted
+    /// vertex normals from the triangles' winding.
+    pub fn from_positions(
+        positions_in_world: &[DVec3],
+        triangles: &[[u32; 3]],
+        color_srgb: [f32; 4],
+    ) -> OrganMesh {
+        let normals = anthesis_mesh::vertex_normals(positions_in_world, triangles);
+        OrganMesh {
+            positions_in_world: positions_in_world
+                .iter()
+                .map(|p| p.as_vec3().to_array())
+                .collect(),
+            normals_in_world: normals.iter().map(|n| n.as_vec3().to_array()).collect(),
+            triangles: triangles.to_vec(),
+            color_srgb,
+            overlay: None,
+        }
+    }
+
+    /// Adds a per-vertex overlay (values in `[0, 1]`).
+    pub fn with_overlay(mut self, overlay: Vec<f32>) -> OrganMesh {
+        self.overlay = Some(overlay);
+        self
+    }
+
+    /// The axis-aligned bounds of the positions, `None` when there are none.
+    pub fn bounds_in_world(&self) -> Option<(DVec3, DVec3)> {
+        organs_bounds_in_world(std::slice::from_ref(self))
+    }
+
+    /// Checks the array lengths and triangle indices; the message names the
+    /// first problem.
+    pub fn check(&self) -> Result<(), String> {
+        let n = self.positions_in_world.len();
+        if self.normals_in_world.len() != n {
+            return Err(format!(
+                "{} normals for {n} positions",
+                self.normals_in_world.len()
+            ));
+        }
+        if let Some(overlay) = &self.overlay
+            && overlay.len() != n
+        {
+            return Err(format!(
+                "{} overlay values for {n} positions",
+                overlay.len()
+            ));
+        }
+        if n > u32::MAX as usize {
+            return Err(format!("{n} vertices do not fit u32 indices"));
+        }
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if let Some(&i) = tri.iter().find(|&&i| i as usize >= n) {
+                return Err(format!(
+                    "triangle {t} uses vertex {i} but there are only {n} vertices"
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The axis-aligned bounds of all organs' positions, `None` when empty.
+pub fn organs_bounds_in_world(organs: &[OrganMesh]) -> Option<(DVec3, DVec3)> {
+    let mut points = organs
+        .iter()
+        .flat_map(|o| o.positions_in_world.iter())
+        .map(|p| DVec3::new(p[0].into(), p[1].into(), p[2].into()));
+    let first = points.next()?;
+    Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}

@@ -1,0 +1,156 @@
+// Lit, two-sided flower organs and the viewport background.
+//
+// Used by `anthesis-render` (crates/render/src/pipeline.rs); the uniform
+// structs below must match `FrameUniform` and `OrganUniform` there byte for
+// byte.
+//
+// Conventions:
+// - world frame: flower axis +Y (the hemisphere light's sky is +Y);
+// - a mesh normal points to the organ's inner side; the side the normal
+//   points at is the "front" (counter-clockwise winding seen from it);
+// - depth is reversed (near = 1, infinitely far = 0), compare GreaterEqual;
+// - colours in the uniforms are linear, except the background colours,
+//   which are sRGB-encoded and blended in sRGB so the gradient looks even.
+
+struct Frame {
+    view_projection: mat4x4<f32>,
+    // xyz: the camera position in world space; w unused.
+    eye_in_world: vec4<f32>,
+    // xyz: unit vector towards the key light, which sits near the camera
+    // (a headlight offset up and to the left so curvature reads); w unused.
+    light_direction_in_world: vec4<f32>,
+    // sRGB-encoded background colours at the top and bottom of the image.
+    background_top_srgb: vec4<f32>,
+    background_bottom_srgb: vec4<f32>,
+    // x: 1 when the colour target is not an sRGB format, so the shader must
+    // encode its output itself; 0 when the hardware encodes (…Srgb formats).
+    // y: brightness of the back (outer) side relative to the front side.
+    // zw: unused.
+    output_flags: vec4<f32>,
+}
+
+struct Organ {
+    // Linear RGB; alpha is written but blending is off.
+    color_linear: vec4<f32>,
+    // x: how much the per-vertex overlay ramp replaces the organ colour
+    // (0 = overlay off, 1 = overlay only). yzw: unused.
+    overlay_mix: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(0) var<uniform> organ: Organ;
+
+struct VertexIn {
+    @location(0) position_in_world: vec3<f32>,
+    @location(1) normal_in_world: vec3<f32>,
+    // A scalar map value per vertex, expected in [0, 1].
+    @location(2) overlay: f32,
+}
+
+struct VertexOut {
+    @builtin(position) position_in_clip: vec4<f32>,
+    @location(0) position_in_world: vec3<f32>,
+    @location(1) normal_in_world: vec3<f32>,
+    @location(2) overlay: f32,
+}
+
+@vertex
+fn vs_organ(in: VertexIn) -> VertexOut {
+    var out: VertexOut;
+    out.position_in_clip = frame.view_projection * vec4<f32>(in.position_in_world, 1.0);
+    out.position_in_world = in.position_in_world;
+    out.normal_in_world = in.normal_in_world;
+    out.overlay = in.overlay;
+    return out;
+}
+
+// Blue (low) through pale yellow (middle) to red (high), linear RGB.
+fn overlay_ramp(value: f32) -> vec3<f32> {
+    let t = clamp(value, 0.0, 1.0);
+    let low = vec3<f32>(0.02, 0.10, 0.55);
+    let middle = vec3<f32>(0.95, 0.90, 0.60);
+    let high = vec3<f32>(0.65, 0.02, 0.02);
+    if t < 0.5 {
+        return mix(low, middle, t * 2.0);
+    }
+    return mix(middle, high, t * 2.0 - 1.0);
+}
+
+fn linear_to_srgb(linear: vec3<f32>) -> vec3<f32> {
+    let c = clamp(linear, vec3<f32>(0.0), vec3<f32>(1.0));
+    let low = c * 12.92;
+    let high = 1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055;
+    return select(high, low, c <= vec3<f32>(0.0031308));
+}
+
+fn srgb_to_linear(encoded: vec3<f32>) -> vec3<f32> {
+    let c = clamp(encoded, vec3<f32>(0.0), vec3<f32>(1.0));
+    let low = c / 12.92;
+    let high = pow((c + 0.055) / 1.055, vec3<f32>(2.4));
+    return select(high, low, c <= vec3<f32>(0.04045));
+}
+
+// Turns a linear colour into what the colour target expects.
+fn to_target(linear: vec3<f32>) -> vec3<f32> {
+    if frame.output_flags.x > 0.5 {
+        return linear_to_srgb(linear);
+    }
+    return linear;
+}
+
+@fragment
+fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
+    var normal = normalize(in.normal_in_world);
+    var side_brightness = 1.0;
+    if !is_front {
+        // The back (outer) side: shade with the flipped normal, a bit darker.
+        normal = -normal;
+        side_brightness = frame.output_flags.y;
+    }
+    let to_eye = normalize(frame.eye_in_world.xyz - in.position_in_world);
+
+    // Key light: a directional light from near the camera.
+    let light = frame.light_direction_in_world.xyz;
+    let key = max(dot(normal, light), 0.0);
+    // Hemisphere ambient: sky above (+Y), warm ground below.
+    let sky = vec3<f32>(0.95, 0.97, 1.0);
+    let ground = vec3<f32>(0.55, 0.50, 0.46);
+    let ambient = mix(ground, sky, 0.5 + 0.5 * normal.y);
+    // A faint broad sheen so curvature reads on pale petals.
+    let halfway = normalize(light + to_eye);
+    let sheen = 0.05 * pow(max(dot(normal, halfway), 0.0), 16.0);
+
+    var base = organ.color_linear.rgb;
+    base = mix(base, overlay_ramp(in.overlay), clamp(organ.overlay_mix.x, 0.0, 1.0));
+
+    let lit = (base * (0.3 * ambient + 0.72 * key) + vec3<f32>(sheen)) * side_brightness;
+    return vec4<f32>(to_target(lit), organ.color_linear.a);
+}
+
+struct BackgroundOut {
+    @builtin(position) position_in_clip: vec4<f32>,
+    // 0 at the top of the image, 1 at the bottom.
+    @location(0) down: f32,
+}
+
+// A full-screen triangle at the far plane (depth 0 with reversed depth).
+@vertex
+fn vs_background(@builtin(vertex_index) index: u32) -> BackgroundOut {
+    let x = f32((index << 1u) & 2u) * 2.0 - 1.0;
+    let y = f32(index & 2u) * 2.0 - 1.0;
+    var out: BackgroundOut;
+    out.position_in_clip = vec4<f32>(x, y, 0.0, 1.0);
+    out.down = 0.5 - 0.5 * y;
+    return out;
+}
+
+@fragment
+fn fs_background(in: BackgroundOut) -> @location(0) vec4<f32> {
+    let srgb = mix(frame.background_top_srgb.rgb, frame.background_bottom_srgb.rgb, clamp(in.down, 0.0, 1.0));
+    var out = srgb;
+    if frame.output_flags.x < 0.5 {
+        // The target encodes to sRGB itself: hand it linear values.
+        out = srgb_to_linear(srgb);
+    }
+    return vec4<f32>(out, 1.0);
+}
