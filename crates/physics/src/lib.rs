@@ -1,1 +1,15 @@
-//! (being written)
+//! The physics of one organ, after Ijiri et al. 2008: regional growth (§4)
+//! sets rest lengths and rest dihedral angles; energy minimisation (§5)
+//! finds the shape that honours them; shape matching (§5.3) attaches the
+//! organ to the receptacle.
+
+pub mod elastic;
+pub mod growth;
+pub mod hinge;
+pub mod pattern;
+pub mod shape_match;
+pub mod solver;
+
+pub use elastic::{Contact, Elastic};
+
+pub use solver::{NewtonSolver, SolverError, SolverSettings, StepReport};

@@ -1,0 +1,220 @@
+//! The elastic energy of one organ (paper §5.1) and its derivatives:
+//!
+//! `E = sum_edges 1/2 ks (|xi - xj| - L0)^2 + sum_hinges 1/2 kb (theta - theta0)^2`
+//!
+//! plus, while organs touch, a one-sided contact penalty
+//! `1/2 kc min(0, (x - p) . n - offset)^2` that keeps a particle on the right
+//! side of its tracking point `p` on a neighbouring organ (see `Contact`).
+//!
+//! The Hessian is made positive semi-definite element by element: a spring
+//! keeps its transverse term only while stretched (`|d| > L0`), and a hinge
+//! uses the Gauss–Newton term `kb grad(theta) grad(theta)^T`, which is exact
+//! where `theta = theta0` and never indefinite.
+
+use glam::{DMat3, DVec3};
+
+use anthesis_mesh::Topology;
+
+use crate::hinge::{dihedral_angle, dihedral_gradient, hinge_is_degenerate};
+use crate::pattern::BlockPattern;
+
+/// A particle held on one side of a neighbouring organ: the particle should
+/// satisfy `(x - point) . normal >= offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    pub particle: u32,
+    pub point: DVec3,
+    pub normal: DVec3,
+    pub offset: f64,
+}
+
+impl Contact {
+    /// How far the particle is short of its allowed side (positive when it
+    /// must move), for particle position `x`.
+    pub fn violation(&self, x: DVec3) -> f64 {
+        self.offset - (x - self.point).dot(self.normal)
+    }
+}
+
+/// Rest state and stiffness of one organ's springs and hinges.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Elastic {
+    /// Particle pairs of every edge (topology order).
+    pub edges: Vec<[u32; 2]>,
+    pub rest_lengths: Vec<f64>,
+    pub stretch_stiffness: Vec<f64>,
+    /// Interior edges as hinges `[i, j, k, l]` with their edge index.
+    pub hinges: Vec<([u32; 4], u32)>,
+    /// Rest dihedral angle per edge (boundary edges hold 0 and are unused).
+    pub rest_angles: Vec<f64>,
+    /// Bend stiffness per edge (boundary edges unused).
+    pub bend_stiffness: Vec<f64>,
+    /// Stiffness of the contact penalty.
+    pub contact_stiffness: f64,
+}
+
+impl Elastic {
+    /// An organ at rest in its current shape: rest lengths and rest angles
+    /// measured from `positions`, unit stiffness, no contact stiffness.
+    pub fn at_rest(positions: &[DVec3], topology: &Topology) -> Elastic {
+        let edges: Vec<[u32; 2]> = topology.edges.iter().map(|e| e.vertices).collect();
+        let hinges: Vec<([u32; 4], u32)> = topology
+            .edges
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| e.hinge().map(|h| (h, i as u32)))
+            .collect();
+        let rest_lengths = edges
+            .iter()
+            .map(|&[a, b]| (positions[a as usize] - positions[b as usize]).length())
+            .collect();
+        let mut rest_angles = vec![0.0; edges.len()];
+        for &(stencil, edge) in &hinges {
+            rest_angles[edge as usize] = dihedral_angle(stencil.map(|p| positions[p as usize]));
+        }
+        Elastic {
+            stretch_stiffness: vec![1.0; edges.len()],
+            bend_stiffness: vec![1.0; edges.len()],
+            edges,
+            rest_lengths,
+            hinges,
+            rest_angles,
+            contact_stiffness: 0.0,
+        }
+    }
+
+    /// Particle pairs coupled by the Hessian (edges and hinge wings).
+    pub fn coupled_pairs(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let edge_pairs = self.edges.iter().map(|&[a, b]| (a, b));
+        let wing_pairs = self.hinges.iter().map(|&([_, _, k, l], _)| (k, l));
+        edge_pairs.chain(wing_pairs)
+    }
+
+    /// A force that sets the scale of the convergence test: the mean over
+    /// edges of `ks * L0`, the force an edge exerts at 100 % strain.
+    pub fn force_scale(&self) -> f64 {
+        let n = self.edges.len().max(1) as f64;
+        let sum: f64 = self
+            .stretch_stiffness
+            .iter()
+            .zip(&self.rest_lengths)
+            .map(|(k, l)| k * l)
+            .sum();
+        (sum / n).max(f64::MIN_POSITIVE)
+    }
+
+    pub fn energy(&self, x: &[DVec3], contacts: &[Contact]) -> f64 {
+        let mut e = 0.0;
+        for (idx, &[a, b]) in self.edges.iter().enumerate() {
+            let stretch = (x[a as usize] - x[b as usize]).length() - self.rest_lengths[idx];
+            e += 0.5 * self.stretch_stiffness[idx] * stretch * stretch;
+        }
+        for &(stencil, edge) in &self.hinges {
+            let xs = stencil.map(|p| x[p as usize]);
+            if hinge_is_degenerate(xs) {
+                // A collapsed triangle has no normal and no angle: refuse the
+                // shape, so a line search backs off instead of stepping here.
+                return f64::INFINITY;
+            }
+            let d = dihedral_angle(xs) - self.rest_angles[edge as usize];
+            e += 0.5 * self.bend_stiffness[edge as usize] * d * d;
+        }
+        for c in contacts {
+            let v = c.violation(x[c.particle as usize]);
+            if v > 0.0 {
+                e += 0.5 * self.contact_stiffness * v * v;
+            }
+        }
+        e
+    }
+
+    /// Writes the gradient into `g` (one vector per particle).
+    pub fn gradient(&self, x: &[DVec3], contacts: &[Contact], g: &mut [DVec3]) {
+        g.iter_mut().for_each(|v| *v = DVec3::ZERO);
+        for (idx, &[a, b]) in self.edges.iter().enumerate() {
+            let d = x[a as usize] - x[b as usize];
+            let len = d.length();
+            let f = d * (self.stretch_stiffness[idx] * (len - self.rest_lengths[idx]) / len);
+            g[a as usize] += f;
+            g[b as usize] -= f;
+        }
+        for &(stencil, edge) in &self.hinges {
+            let xs = stencil.map(|p| x[p as usize]);
+            let theta = dihedral_angle(xs);
+            let scale =
+                self.bend_stiffness[edge as usize] * (theta - self.rest_angles[edge as usize]);
+            let dtheta = dihedral_gradient(xs);
+            for (p, d) in stencil.iter().zip(dtheta) {
+                g[*p as usize] += d * scale;
+            }
+        }
+        for c in contacts {
+            let v = c.violation(x[c.particle as usize]);
+            if v > 0.0 {
+                g[c.particle as usize] -= c.normal * (self.contact_stiffness * v);
+            }
+        }
+    }
+
+    /// Writes the PSD Hessian approximation into `values` (upper CSC layout
+    /// of `pattern`, which must come from [`Elastic::coupled_pairs`]).
+    pub fn hessian(
+        &self,
+        x: &[DVec3],
+        contacts: &[Contact],
+        pattern: &BlockPattern,
+        values: &mut [f64],
+    ) {
+        values.iter_mut().for_each(|v| *v = 0.0);
+        for (idx, &[a, b]) in self.edges.iter().enumerate() {
+            let d = x[a as usize] - x[b as usize];
+            let len = d.length();
+            let n = d / len;
+            let nn = outer(n, n);
+            let transverse = (1.0 - self.rest_lengths[idx] / len).max(0.0);
+            let block = (nn + (DMat3::IDENTITY - nn) * transverse) * self.stretch_stiffness[idx];
+            pattern.add_block(values, a, a, &block);
+            pattern.add_block(values, b, b, &block);
+            pattern.add_block(values, a, b, &(-block));
+        }
+        for &(stencil, edge) in &self.hinges {
+            let dtheta = dihedral_gradient(stencil.map(|p| x[p as usize]));
+            let k = self.bend_stiffness[edge as usize];
+            for r in 0..4 {
+                for c in r..4 {
+                    let block = outer(dtheta[r], dtheta[c]) * k;
+                    pattern.add_block(values, stencil[r], stencil[c], &block);
+                }
+            }
+        }
+        for c in contacts {
+            if c.violation(x[c.particle as usize]) > 0.0 {
+                let block = outer(c.normal, c.normal) * self.contact_stiffness;
+                pattern.add_block(values, c.particle, c.particle, &block);
+            }
+        }
+    }
+}
+
+/// The outer product `u v^T`.
+pub(crate) fn outer(u: DVec3, v: DVec3) -> DMat3 {
+    DMat3::from_cols(u * v.x, u * v.y, u * v.z)
+}
+
+/// The area associated with each edge: the mean area of its (one or two)
+/// triangles. Stiffness is this area times the user's K times the map value
+/// (paper §5.1).
+pub fn edge_areas(positions: &[DVec3], triangles: &[[u32; 3]], topology: &Topology) -> Vec<f64> {
+    let triangle_area = |t: u32| {
+        let [a, b, c] = triangles[t as usize].map(|i| positions[i as usize]);
+        0.5 * (b - a).cross(c - a).length()
+    };
+    topology
+        .edges
+        .iter()
+        .map(|e| match e.right {
+            Some(r) => 0.5 * (triangle_area(e.left.triangle) + triangle_area(r.triangle)),
+            None => triangle_area(e.left.triangle),
+        })
+        .collect()
+}

@@ -1,0 +1,413 @@
+//! Analytic checks of the organ physics: derivatives against finite
+//! differences, monotone energy, and known shapes produced by growth.
+
+use anthesis_mesh::{Mesh, Topology, generate};
+use anthesis_physics::elastic::edge_areas;
+use anthesis_physics::growth::{GrowthRates, RegionalGrowth};
+use anthesis_physics::hinge::dihedral_angle;
+use anthesis_physics::pattern::BlockPattern;
+use anthesis_physics::{Contact, Elastic, NewtonSolver, SolverSettings};
+use glam::{DVec2, DVec3};
+
+/// A small deterministic generator (tests must not depend on a crate's RNG
+/// stream staying the same across versions).
+struct Lcg(u64);
+impl Lcg {
+    fn unit(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn signed(&mut self) -> f64 {
+        2.0 * self.unit() - 1.0
+    }
+    fn vec3(&mut self) -> DVec3 {
+        DVec3::new(self.signed(), self.signed(), self.signed())
+    }
+}
+
+fn random_petal(rng: &mut Lcg) -> (Mesh, Topology) {
+    let mut mesh = generate::test_petal(6.0, 3.0, 6, 9);
+    for p in &mut mesh.positions {
+        *p += rng.vec3() * 0.02;
+    }
+    let topology = Topology::build(&mesh).expect("generated mesh is manifold");
+    (mesh, topology)
+}
+
+fn random_elastic(rng: &mut Lcg, mesh: &Mesh, topology: &Topology, tension_only: bool) -> Elastic {
+    let mut elastic = Elastic::at_rest(&mesh.positions, topology);
+    for l in &mut elastic.rest_lengths {
+        *l *= if tension_only {
+            0.8 + 0.15 * rng.unit()
+        } else {
+            1.0 + 0.1 * rng.signed()
+        };
+    }
+    if !tension_only {
+        for a in &mut elastic.rest_angles {
+            *a += 0.2 * rng.signed();
+        }
+    }
+    for k in &mut elastic.stretch_stiffness {
+        *k = 5.0 + 20.0 * rng.unit();
+    }
+    for k in &mut elastic.bend_stiffness {
+        *k = 1.0 + 10.0 * rng.unit();
+    }
+    elastic.contact_stiffness = 500.0;
+    elastic
+}
+
+fn flatten(v: &[DVec3]) -> Vec<f64> {
+    v.iter().flat_map(|p| p.to_array()).collect()
+}
+
+#[test]
+fn gradient_matches_finite_differences_on_random_meshes() {
+    for seed in 1..=4 {
+        let mut rng = Lcg(seed);
+        let (mesh, topology) = random_petal(&mut rng);
+        let elastic = random_elastic(&mut rng, &mesh, &topology, false);
+        // Two contacts, one violated and one satisfied.
+        let contacts = [
+            Contact {
+                particle: 3,
+                point: mesh.positions[3] + DVec3::Z * 0.05,
+                normal: DVec3::Z,
+                offset: 0.01,
+            },
+            Contact {
+                particle: 7,
+                point: mesh.positions[7] - DVec3::Z * 0.5,
+                normal: DVec3::Z,
+                offset: 0.01,
+            },
+        ];
+        let x = &mesh.positions;
+        let mut g = vec![DVec3::ZERO; x.len()];
+        elastic.gradient(x, &contacts, &mut g);
+        let h = 1e-6;
+        let mut worst: f64 = 0.0;
+        for i in 0..x.len() {
+            for c in 0..3 {
+                let mut xp = x.clone();
+                let mut xm = x.clone();
+                xp[i][c] += h;
+                xm[i][c] -= h;
+                let fd =
+                    (elastic.energy(&xp, &contacts) - elastic.energy(&xm, &contacts)) / (2.0 * h);
+                let err = (fd - g[i][c]).abs() / (1.0 + g[i][c].abs());
+                worst = worst.max(err);
+            }
+        }
+        assert!(
+            worst < 1e-6,
+            "seed {seed}: worst relative gradient error {worst:e}"
+        );
+    }
+}
+
+#[test]
+fn hessian_matches_finite_differences_where_it_is_exact() {
+    // The Hessian is exact for stretched springs and for hinges at their rest
+    // angle (the Gauss–Newton term is then the whole second derivative), and
+    // for active contacts. Build such a state and compare H v with
+    // (g(x + h v) - g(x - h v)) / 2h for random v.
+    for seed in 10..=13 {
+        let mut rng = Lcg(seed);
+        let (mesh, topology) = random_petal(&mut rng);
+        let elastic = random_elastic(&mut rng, &mesh, &topology, true);
+        let contacts = [Contact {
+            particle: 5,
+            point: mesh.positions[5] + DVec3::Y * 0.05,
+            normal: DVec3::Y,
+            offset: 0.0,
+        }];
+        let x = &mesh.positions;
+        let pattern = BlockPattern::new(x.len(), elastic.coupled_pairs());
+        let mut values = vec![0.0; pattern.nonzeros()];
+        elastic.hessian(x, &contacts, &pattern, &mut values);
+        for _ in 0..3 {
+            let v: Vec<DVec3> = (0..x.len()).map(|_| rng.vec3()).collect();
+            let mut hv = vec![0.0; 3 * x.len()];
+            pattern.multiply(&values, &flatten(&v), &mut hv);
+            let h = 1e-6;
+            let xp: Vec<DVec3> = x.iter().zip(&v).map(|(a, b)| *a + *b * h).collect();
+            let xm: Vec<DVec3> = x.iter().zip(&v).map(|(a, b)| *a - *b * h).collect();
+            let mut gp = vec![DVec3::ZERO; x.len()];
+            let mut gm = vec![DVec3::ZERO; x.len()];
+            elastic.gradient(&xp, &contacts, &mut gp);
+            elastic.gradient(&xm, &contacts, &mut gm);
+            let fd: Vec<f64> = flatten(&gp)
+                .iter()
+                .zip(flatten(&gm))
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect();
+            let scale = fd.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            for (i, (a, b)) in hv.iter().zip(&fd).enumerate() {
+                assert!(
+                    (a - b).abs() < 1e-6 * scale,
+                    "seed {seed} row {i}: H v = {a}, fd = {b}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn newton_lowers_the_energy_at_every_step_and_converges() {
+    for seed in 20..=23 {
+        let mut rng = Lcg(seed);
+        let (mesh, topology) = random_petal(&mut rng);
+        // An incompatible rest state a few growth steps' worth away from the
+        // current shape: lengths +-3 %, angles +-0.05 rad.
+        let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
+        for l in &mut elastic.rest_lengths {
+            *l *= 1.0 + 0.03 * rng.signed();
+        }
+        for a in &mut elastic.rest_angles {
+            *a += 0.05 * rng.signed();
+        }
+        for (ks, kb) in elastic
+            .stretch_stiffness
+            .iter_mut()
+            .zip(&mut elastic.bend_stiffness)
+        {
+            *ks = 5.0 + 20.0 * rng.unit();
+            *kb = 1.0 + 10.0 * rng.unit();
+        }
+        let mut x = mesh.positions.clone();
+        let mut solver = NewtonSolver::new(x.len(), &elastic).expect("analysis");
+        let settings = SolverSettings {
+            relative_tolerance: 1e-9,
+            max_iterations: 200,
+        };
+        let mut converged = false;
+        for _ in 0..settings.max_iterations {
+            let report = solver.step(&elastic, &[], &mut x, &settings).expect("step");
+            if report.converged {
+                converged = true;
+                break;
+            }
+            assert!(
+                report.energy_after <= report.energy_before,
+                "seed {seed}: {report:?}"
+            );
+        }
+        assert!(converged, "seed {seed} did not converge");
+        assert!(solver.relative_gradient(&elastic, &[], &x) <= 1e-9);
+    }
+}
+
+/// Grows `mesh` for `steps` steps with the same rates on every triangle and
+/// minimises after each; returns the positions and the Newton iterations.
+fn grow_uniformly(
+    mesh: &Mesh,
+    rates: GrowthRates,
+    thickness: f64,
+    steps: usize,
+    settings: SolverSettings,
+) -> (Vec<DVec3>, Elastic, usize) {
+    let topology = Topology::build(mesh).expect("manifold");
+    let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
+    let mut x = mesh.positions.clone();
+    let mut growth = RegionalGrowth::default();
+    let mut solver = NewtonSolver::new(x.len(), &elastic).expect("analysis");
+    let per_triangle = vec![rates; mesh.triangles.len()];
+    let mut iterations = 0;
+    for _ in 0..steps {
+        growth.grow(
+            &x,
+            &mesh.uvs,
+            &mesh.triangles,
+            &topology,
+            &per_triangle,
+            thickness,
+            &mut elastic.rest_lengths,
+            &mut elastic.rest_angles,
+        );
+        let areas = edge_areas(&x, &mesh.triangles, &topology);
+        for (e, a) in areas.iter().enumerate() {
+            elastic.stretch_stiffness[e] = 20.0 * a;
+            elastic.bend_stiffness[e] = 20.0 * a;
+        }
+        let mut done = false;
+        for _ in 0..settings.max_iterations {
+            let report = solver.step(&elastic, &[], &mut x, &settings).expect("step");
+            if report.converged {
+                done = true;
+                break;
+            }
+            iterations += 1;
+        }
+        assert!(done, "a keyframe did not converge");
+    }
+    (x, elastic, iterations)
+}
+
+#[test]
+fn flat_sheet_under_uniform_growth_stays_flat_and_scales() {
+    let mesh = generate::flat_sheet(4.0, 6.0, 9, 13);
+    let dg = 0.003;
+    let steps = 40;
+    let rate = 1.0 + dg;
+    let rates = GrowthRates {
+        e: rate,
+        w: rate,
+        e_in: rate,
+        w_in: rate,
+        direction_in_uv: DVec2::new(0.3, 1.0),
+    };
+    // Growth copies the *current* triangles, so solver residuals carry over
+    // from step to step; a tight tolerance makes the exact answer checkable.
+    let tight = SolverSettings {
+        relative_tolerance: 1e-11,
+        ..SolverSettings::default()
+    };
+    let (x, _, _) = grow_uniformly(&mesh, rates, 0.2, steps, tight);
+    let expected_scale = rate.powi(steps as i32);
+    let topology = Topology::build(&mesh).expect("manifold");
+    for e in &topology.edges {
+        let [a, b] = e.vertices.map(|v| v as usize);
+        let before = (mesh.positions[a] - mesh.positions[b]).length();
+        let after = (x[a] - x[b]).length();
+        assert!(
+            (after / before - expected_scale).abs() < 1e-8,
+            "edge {a}-{b}: scale {}",
+            after / before
+        );
+    }
+    // Flat: every hinge angle stays zero.
+    for e in &topology.edges {
+        if let Some(h) = e.hinge() {
+            let angle = dihedral_angle(h.map(|p| x[p as usize]));
+            assert!(angle.abs() < 1e-8, "hinge {h:?} bent by {angle}");
+        }
+    }
+}
+
+/// Menger curvature of three points (1 / circumradius).
+fn curvature(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    2.0 * (b - a).cross(c - a).length() / ((b - a).length() * (c - b).length() * (c - a).length())
+}
+
+#[test]
+fn strip_with_faster_inner_growth_bends_outwards_with_constant_curvature() {
+    // A strip along v, flat in XY, inner side +Z, made of equilateral
+    // triangles (rows `h` apart). Only the inner surface elongates, along v:
+    // e = w = w_in = 1, e_in = 1 + dg. In the continuum the inner surface,
+    // `thickness` above the base, outgrows it by (e_in / e)^n after n steps,
+    // so the curvature would be kappa0 = ((e_in / e)^n - 1) / thickness.
+    //
+    // The paper's inner-triangle rule gives, to first order, a rest angle of
+    // kappa0 * 2h/3 on the horizontal hinges and kappa0 * h/6 on the
+    // diagonal ones (offset ~ distance from centroid to edge times
+    // (edge normal . growth direction)^2). Both can be met at once by a
+    // slightly corrugated strip whose normal turns, per row, by the
+    // horizontal angle plus the diagonal angle projected on the bending
+    // plane (cos 60 deg = 1/2): kappa = (2/3 + 1/12) kappa0 = 0.75 kappa0.
+    // (With isotropic inner growth the rule is exact; with anisotropic growth
+    // it realises 3/4 of the continuum bend on this mesh.) We require the
+    // midline curvature within 5 % of 0.75 kappa0 everywhere away from the
+    // ends, and the bend to point away from the inner side.
+    // The paper works on near-isotropic meshes, and the inner-triangle rule
+    // is consistent with the continuum there (on right-angled grids it is
+    // not: rung hinges see only 2/3 of the offset), so the strip is made of
+    // equilateral triangles: 4 particles per row, 41 rows.
+    let (mesh, midline_of) = equilateral_strip(4, 41, 0.25 / (3.0f64.sqrt() / 2.0));
+    let dg = 0.003;
+    let thickness = 0.5;
+    let steps = 30;
+    let rates = GrowthRates {
+        e: 1.0,
+        w: 1.0,
+        e_in: 1.0 + dg,
+        w_in: 1.0,
+        direction_in_uv: DVec2::Y,
+    };
+    let (x, _, iterations) =
+        grow_uniformly(&mesh, rates, thickness, steps, SolverSettings::default());
+    let predicted = 0.75 * ((1.0 + dg).powi(steps as i32) - 1.0) / thickness;
+
+    let midline: Vec<DVec3> = midline_of.iter().map(|&i| x[i]).collect();
+    let stride = 4;
+    let mut curvatures = Vec::new();
+    for i in (2 * stride)..(midline.len() - 2 * stride) {
+        curvatures.push(curvature(
+            midline[i - stride],
+            midline[i],
+            midline[i + stride],
+        ));
+    }
+    for k in &curvatures {
+        assert!(
+            (k / predicted - 1.0).abs() < 0.05,
+            "curvature {k} vs predicted {predicted}"
+        );
+    }
+    // Bends outwards: the middle of the strip's chord lies on the outer side
+    // of the middle particle.
+    let middle = midline[20];
+    let chord_middle = 0.5 * (midline[0] + midline[40]);
+    let normals = anthesis_mesh::vertex_normals(&x, &mesh.triangles);
+    let centre_side = (chord_middle - middle).dot(normals[midline_of[20]]);
+    assert!(
+        centre_side < 0.0,
+        "the strip must curl away from its inner side (+Z normal), got {centre_side}"
+    );
+    assert!(
+        iterations <= 3 * steps,
+        "Newton took {iterations} iterations for {steps} keyframes"
+    );
+}
+
+/// A strip of equilateral triangles (side `side`) in the XY plane, rows
+/// along +Y, winding so the normal is +Z, UVs spanning the unit square.
+/// Returns the mesh and, per row, the index of a particle near the middle
+/// (the same column in every row, so these lie on one line when flat).
+fn equilateral_strip(columns: usize, rows: usize, side: f64) -> (Mesh, Vec<usize>) {
+    let height = side * 3.0f64.sqrt() / 2.0;
+    let width = (columns as f64 - 0.5) * side;
+    let length = (rows - 1) as f64 * height;
+    let mut mesh = Mesh::default();
+    for r in 0..rows {
+        for i in 0..columns {
+            let x = (i as f64 + 0.5 * (r % 2) as f64) * side;
+            let y = r as f64 * height;
+            mesh.positions.push(DVec3::new(x, y, 0.0));
+            mesh.uvs.push(DVec2::new(x / width, y / length));
+        }
+    }
+    let id = |r: usize, i: usize| (r * columns + i) as u32;
+    for r in 0..rows - 1 {
+        for i in 0..columns - 1 {
+            if r % 2 == 0 {
+                // Row r+1 is shifted right.
+                mesh.triangles.push([id(r, i), id(r, i + 1), id(r + 1, i)]);
+                mesh.triangles
+                    .push([id(r, i + 1), id(r + 1, i + 1), id(r + 1, i)]);
+            } else {
+                mesh.triangles
+                    .push([id(r, i), id(r + 1, i + 1), id(r + 1, i)]);
+                mesh.triangles
+                    .push([id(r, i), id(r, i + 1), id(r + 1, i + 1)]);
+            }
+        }
+    }
+    let midline = (0..rows).map(|r| r * columns + columns / 2).collect();
+    (mesh, midline)
+}
+
+#[test]
+fn equilateral_strip_is_valid_and_faces_plus_z() {
+    let (mesh, midline) = equilateral_strip(4, 9, 0.5);
+    anthesis_mesh::validate(&mesh).expect("valid strip");
+    for n in mesh.vertex_normals() {
+        assert!(n.z > 0.99, "normal {n}");
+    }
+    // Rows of the same parity put their midline particles at the same x.
+    assert_eq!(mesh.positions[midline[0]].x, mesh.positions[midline[2]].x);
+}
