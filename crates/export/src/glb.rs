@@ -94,7 +94,7 @@ pub fn glb_bytes(
         let mut material = json!({
             "name": track.name,
             "pbrMetallicRoughness": {
-                "baseColorFactor": track.base_color,
+                "baseColorFactor": track.base_color.map(f32_json),
                 "metallicFactor": 0.0,
                 "roughnessFactor": 0.7,
             },
@@ -136,8 +136,8 @@ pub fn glb_bytes(
 
         let mut node = json!({ "name": track.name, "mesh": index });
         if let Some(box_) = encoded.dequantization {
-            node["translation"] = json!(box_.center);
-            node["scale"] = json!(vec![box_.scale; 3]);
+            node["translation"] = json!(box_.center.map(f32_json));
+            node["scale"] = json!([f32_json(box_.scale), f32_json(box_.scale), f32_json(box_.scale)]);
         }
         nodes.push(node);
     }
@@ -410,6 +410,16 @@ fn to_f32(values: &[DVec3]) -> Vec<[f32; 3]> {
     values.iter().map(|v| v.as_vec3().to_array()).collect()
 }
 
+/// An `f32` as the shortest JSON number that reads back as the same `f32`
+/// (`0.1` rather than `0.10000000149011612`).
+fn f32_json(x: f32) -> Value {
+    x.to_string()
+        .parse::<f64>()
+        .ok()
+        .and_then(serde_json::Number::from_f64)
+        .map_or(Value::Null, Value::Number)
+}
+
 /// Per-component minimum and maximum, as JSON arrays.
 fn min_max<const N: usize, T: Copy + PartialOrd + Into<f64>>(values: &[[T; N]]) -> (Value, Value) {
     let mut min = values[0];
@@ -424,7 +434,8 @@ fn min_max<const N: usize, T: Copy + PartialOrd + Into<f64>>(values: &[[T; N]]) 
             }
         }
     }
-    let as_json = |a: [T; N]| Value::from(a.iter().map(|&x| x.into()).collect::<Vec<f64>>());
+    // Every T used here (f32, i16) is exactly an f32.
+    let as_json = |a: [T; N]| Value::from(a.iter().map(|&x| f32_json(x.into() as f32)).collect::<Vec<_>>());
     (as_json(min), as_json(max))
 }
 
@@ -500,17 +511,23 @@ impl GltfBuilder {
         if encoding != Encoding::Sparse {
             return self.vec3_f32(deltas, with_min_max);
         }
-        let moved: Vec<usize> = deltas
+        let mut moved: Vec<usize> = deltas
             .iter()
             .enumerate()
             .filter(|(_, d)| d.iter().any(|&x| x != 0.0))
             .map(|(i, _)| i)
             .collect();
+        if moved.is_empty() {
+            // Nothing moved. glTF allows an accessor with neither buffer view
+            // nor sparse data (all zeros), but some readers (the `gltf`
+            // crate) reject it, so store one explicit zero instead.
+            moved.push(0);
+        }
         let index_type = index_component_type(deltas.len());
         let index_size = component_size(index_type);
         let dense_bytes = 12 * deltas.len();
         let sparse_bytes = moved.len() * (index_size + 12);
-        if !moved.is_empty() && sparse_bytes >= dense_bytes {
+        if sparse_bytes >= dense_bytes {
             return self.vec3_f32(deltas, with_min_max);
         }
         let mut accessor = json!({
@@ -524,22 +541,20 @@ impl GltfBuilder {
             accessor["max"] = max;
         }
         // No buffer view: the accessor is zeros, overridden by the sparse
-        // values (or all zeros when no vertex moved).
-        if !moved.is_empty() {
-            let indices = index_bytes(&moved, index_type);
-            let indices_view = self.view(&indices, None, None);
-            let values: Vec<u8> = moved
-                .iter()
-                .flat_map(|&i| deltas[i])
-                .flat_map(|x| x.to_le_bytes())
-                .collect();
-            let values_view = self.view(&values, None, None);
-            accessor["sparse"] = json!({
-                "count": moved.len(),
-                "indices": { "bufferView": indices_view, "componentType": index_type },
-                "values": { "bufferView": values_view },
-            });
-        }
+        // values.
+        let indices = index_bytes(&moved, index_type);
+        let indices_view = self.view(&indices, None, None);
+        let values: Vec<u8> = moved
+            .iter()
+            .flat_map(|&i| deltas[i])
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let values_view = self.view(&values, None, None);
+        accessor["sparse"] = json!({
+            "count": moved.len(),
+            "indices": { "bufferView": indices_view, "componentType": index_type },
+            "values": { "bufferView": values_view },
+        });
         self.accessor(accessor)
     }
 
@@ -644,8 +659,8 @@ impl GltfBuilder {
             "componentType": FLOAT,
             "count": times.len(),
             "type": "SCALAR",
-            "min": [first],
-            "max": [last],
+            "min": [f32_json(first)],
+            "max": [f32_json(last)],
         }))
     }
 

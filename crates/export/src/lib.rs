@@ -98,10 +98,11 @@ pub enum Encoding {
     /// supported form.
     Dense,
     /// Like `Dense`, but each morph-target accessor stores only the vertices
-    /// whose delta is not exactly zero (a sparse accessor) when that is
-    /// smaller, or nothing at all for a target where no vertex moved; the
-    /// one-hot animation weights are stored sparsely too. Saves space when
-    /// parts of the flower stay still (pinned bases, a late-opening whorl).
+    /// whose delta is not exactly zero (a sparse accessor without a buffer
+    /// view) when that is smaller than storing every vertex; the one-hot
+    /// animation weights are stored sparsely too. Saves space when parts of
+    /// the flower stay still (pinned bases, a late-opening whorl); with every
+    /// vertex moving it is the same size as `Dense`.
     Sparse,
     /// `KHR_mesh_quantization` (listed in `extensionsRequired`): positions
     /// and position deltas as normalized `i16` in a per-mesh box that the

@@ -1,0 +1,433 @@
+//! Round trips through the `gltf` crate and an independent GLB reader: every
+//! morph target rebuilds its keyframe, normals and UVs come back, and the
+//! animation blends consecutive keyframes linearly.
+
+mod common;
+
+use anthesis_export::{Encoding, ExportError, GlbOptions, Timing, Track, glb_bytes, write_glb};
+use anthesis_mesh::vertex_normals;
+use common::*;
+use glam::DVec3;
+use gltf::animation::util::ReadOutputs;
+
+const KEYFRAMES: usize = 21;
+
+fn export(tracks: &[Track], options: &GlbOptions) -> Vec<u8> {
+    glb_bytes(tracks, options, &mut |_| {}).expect("export")
+}
+
+/// Keyframe positions the exporter should have written for `track`: the
+/// keyframes themselves, or linear interpolation at `j (K-1) / max`.
+fn expected_frames(track: &Track, max_targets: usize) -> Vec<Vec<DVec3>> {
+    let k = track.keyframes.len();
+    if k - 1 <= max_targets {
+        return track.keyframes.clone();
+    }
+    (0..=max_targets)
+        .map(|j| {
+            let x = j as f64 * (k - 1) as f64 / max_targets as f64;
+            let i = (x.floor() as usize).min(k - 2);
+            let f = x - i as f64;
+            track.keyframes[i]
+                .iter()
+                .zip(&track.keyframes[i + 1])
+                .map(|(a, b)| *a * (1.0 - f) + *b * f)
+                .collect()
+        })
+        .collect()
+}
+
+fn normals(positions: &[DVec3], track: &Track) -> Vec<DVec3> {
+    vertex_normals(positions, &track.triangles)
+}
+
+fn assert_close(actual: &[DVec3], expected: &[DVec3], tolerance: f64, what: &str) {
+    assert_eq!(actual.len(), expected.len(), "{what}: vertex count");
+    let worst = actual
+        .iter()
+        .zip(expected)
+        .map(|(a, e)| (*a - *e).abs().max_element())
+        .fold(0.0, f64::max);
+    assert!(worst <= tolerance, "{what}: off by {worst} (tolerance {tolerance})");
+}
+
+fn f32_triples(iter: impl Iterator<Item = [f32; 3]>) -> Vec<DVec3> {
+    iter.map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect()
+}
+
+/// The `gltf` crate reads the Dense and Sparse files: every morph target
+/// plus the base rebuilds its keyframe, normals included.
+#[test]
+fn gltf_crate_rebuilds_every_keyframe_from_its_target() {
+    let tracks = fixture(KEYFRAMES);
+    for encoding in [Encoding::Dense, Encoding::Sparse] {
+        let options = GlbOptions {
+            encoding,
+            ..GlbOptions::default()
+        };
+        let bytes = export(&tracks, &options);
+        let gltf = gltf::Gltf::from_slice(&bytes).expect("the gltf crate accepts the file");
+        let blob = gltf.blob.clone().expect("GLB binary chunk");
+        let buffers = |_: gltf::Buffer| Some(&blob[..]);
+
+        let scene = gltf.default_scene().expect("default scene");
+        assert_eq!(scene.nodes().count(), tracks.len());
+        for (node, track) in scene.nodes().zip(&tracks) {
+            assert_eq!(node.name(), Some(track.name.as_str()));
+            let mesh = node.mesh().expect("node has a mesh");
+            assert_eq!(mesh.name(), Some(track.name.as_str()));
+            let primitives: Vec<_> = mesh.primitives().collect();
+            assert_eq!(primitives.len(), 1);
+            let primitive = &primitives[0];
+            assert_eq!(primitive.mode(), gltf::mesh::Mode::Triangles);
+            let reader = primitive.reader(buffers);
+
+            let indices: Vec<u32> = reader.read_indices().expect("indices").into_u32().collect();
+            let triangles: Vec<u32> = track.triangles.iter().flatten().copied().collect();
+            assert_eq!(indices, triangles);
+
+            let texcoords: Vec<[f32; 2]> =
+                reader.read_tex_coords(0).expect("uvs").into_f32().collect();
+            for (t, uv) in texcoords.iter().zip(&track.uvs) {
+                assert!((t[0] as f64 - uv.x).abs() < 1e-6 && (t[1] as f64 - (1.0 - uv.y)).abs() < 1e-6);
+            }
+
+            let frames = &track.keyframes;
+            let base = f32_triples(reader.read_positions().expect("positions"));
+            assert_close(&base, &frames[0], 1e-5, "base = keyframe 0");
+            let base_normals = f32_triples(reader.read_normals().expect("normals"));
+            assert_close(&base_normals, &normals(&frames[0], track), 1e-6, "base normals");
+
+            let targets: Vec<_> = reader.read_morph_targets().collect();
+            assert_eq!(targets.len(), frames.len() - 1, "{}: one target per later keyframe", track.name);
+            for (k, (positions, normal_deltas, tangents)) in targets.into_iter().enumerate() {
+                let what = format!("{} {encoding} target {k}", track.name);
+                let deltas = f32_triples(positions.expect("POSITION deltas"));
+                let rebuilt: Vec<DVec3> = base.iter().zip(&deltas).map(|(b, d)| *b + *d).collect();
+                assert_close(&rebuilt, &frames[k + 1], 2e-5, &what);
+                let deltas = f32_triples(normal_deltas.expect("NORMAL deltas"));
+                let rebuilt: Vec<DVec3> =
+                    base_normals.iter().zip(&deltas).map(|(b, d)| *b + *d).collect();
+                assert_close(&rebuilt, &normals(&frames[k + 1], track), 1e-6, &what);
+                assert!(tangents.is_none());
+            }
+        }
+
+        // One animation, a LINEAR weights channel per animated mesh, none for
+        // the receptacle.
+        let animations: Vec<_> = gltf.animations().collect();
+        assert_eq!(animations.len(), 1);
+        let channels: Vec<_> = animations[0].channels().collect();
+        let animated: Vec<usize> = channels.iter().map(|c| c.target().node().index()).collect();
+        assert_eq!(animated, vec![0, 1]);
+        for channel in &channels {
+            assert_eq!(channel.target().property(), gltf::animation::Property::MorphTargetWeights);
+            assert_eq!(channel.sampler().interpolation(), gltf::animation::Interpolation::Linear);
+            let reader = channel.reader(buffers);
+            let times: Vec<f32> = reader.read_inputs().expect("times").collect();
+            let expected: Vec<f32> = (0..KEYFRAMES).map(|k| (k as f64 / 24.0) as f32).collect();
+            assert_eq!(times, expected);
+            let Some(ReadOutputs::MorphTargetWeights(weights)) = reader.read_outputs() else {
+                panic!("weights output");
+            };
+            let weights: Vec<f32> = weights.into_f32().collect();
+            assert_one_hot(&weights, KEYFRAMES);
+        }
+    }
+}
+
+/// At t_0 all weights are 0; at t_k (k >= 1) target k-1 is 1 and the rest 0.
+fn assert_one_hot(weights: &[f32], keyframes: usize) {
+    let targets = keyframes - 1;
+    assert_eq!(weights.len(), keyframes * targets);
+    for k in 0..keyframes {
+        for t in 0..targets {
+            let expected = if k >= 1 && t == k - 1 { 1.0 } else { 0.0 };
+            assert_eq!(weights[k * targets + t], expected, "keyframe {k}, target {t}");
+        }
+    }
+}
+
+/// The JSON part that the `gltf` crate does not expose without extra
+/// features: target names, default weights, materials.
+#[test]
+fn meshes_name_their_targets_and_carry_materials() {
+    let tracks = fixture(KEYFRAMES);
+    let glb = parse_glb(&export(&tracks, &GlbOptions::default()));
+    let json = &glb.json;
+    for (i, track) in tracks.iter().enumerate() {
+        let mesh = &json["meshes"][i];
+        let material = &json["materials"][mesh["primitives"][0]["material"].as_u64().expect("material") as usize];
+        let color: Vec<f32> = material["pbrMetallicRoughness"]["baseColorFactor"]
+            .as_array()
+            .expect("base colour")
+            .iter()
+            .map(|c| c.as_f64().expect("number") as f32)
+            .collect();
+        assert_eq!(color, track.base_color.to_vec());
+        assert_eq!(material["doubleSided"], true);
+        if track.keyframes.len() == 1 {
+            assert!(mesh.get("extras").is_none() && mesh["primitives"][0].get("targets").is_none());
+            continue;
+        }
+        let names: Vec<&str> = mesh["extras"]["targetNames"]
+            .as_array()
+            .expect("targetNames")
+            .iter()
+            .map(|n| n.as_str().expect("name"))
+            .collect();
+        let expected: Vec<String> = (1..KEYFRAMES).map(|k| format!("keyframe {k}")).collect();
+        assert_eq!(names, expected);
+        assert_eq!(mesh["weights"].as_array().expect("weights").len(), KEYFRAMES - 1);
+        assert!(mesh["weights"].as_array().expect("weights").iter().all(|w| w == 0.0));
+    }
+}
+
+/// Playing the animation between two keyframe times blends those two
+/// keyframes linearly, as the application's timeline does.
+#[test]
+fn playback_between_keyframes_blends_the_two_neighbours() {
+    let tracks = fixture(KEYFRAMES);
+    let options = GlbOptions {
+        timing: Timing::FramesPerSecond(10.0),
+        ..GlbOptions::default()
+    };
+    let glb = parse_glb(&export(&tracks, &options));
+    let json = &glb.json;
+    let sampler = &json["animations"][0]["samplers"][0];
+    let times: Vec<f64> = read_accessor(&glb, sampler["input"].as_u64().expect("input") as usize)
+        .iter()
+        .map(|t| t[0])
+        .collect();
+    let weights: Vec<f64> = read_accessor(&glb, sampler["output"].as_u64().expect("output") as usize)
+        .iter()
+        .map(|w| w[0])
+        .collect();
+    let targets = KEYFRAMES - 1;
+    let mesh = &json["meshes"][0]["primitives"][0];
+    let base = vec3s(&read_accessor(&glb, mesh["attributes"]["POSITION"].as_u64().expect("p") as usize));
+    let deltas: Vec<Vec<DVec3>> = mesh["targets"]
+        .as_array()
+        .expect("targets")
+        .iter()
+        .map(|t| vec3s(&read_accessor(&glb, t["POSITION"].as_u64().expect("p") as usize)))
+        .collect();
+
+    for (k, fraction) in [(0usize, 0.25f64), (7, 0.5), (19, 0.9)] {
+        // glTF LINEAR sampling of the weights at a time between t_k and t_k+1.
+        let t = times[k] + fraction * (times[k + 1] - times[k]);
+        let f = (t - times[k]) / (times[k + 1] - times[k]);
+        let w: Vec<f64> = (0..targets)
+            .map(|i| (1.0 - f) * weights[k * targets + i] + f * weights[(k + 1) * targets + i])
+            .collect();
+        let played: Vec<DVec3> = (0..base.len())
+            .map(|v| base[v] + (0..targets).map(|i| deltas[i][v] * w[i]).sum::<DVec3>())
+            .collect();
+        let blended: Vec<DVec3> = tracks[0].keyframes[k]
+            .iter()
+            .zip(&tracks[0].keyframes[k + 1])
+            .map(|(a, b)| a.lerp(*b, f))
+            .collect();
+        assert_close(&played, &blended, 5e-5, &format!("between keyframes {k} and {}", k + 1));
+    }
+}
+
+/// Every encoding, read by the independent reader (sparse and quantized
+/// accessors included), rebuilds each keyframe within the encoding's error.
+#[test]
+fn every_encoding_rebuilds_every_keyframe() {
+    let tracks = fixture(KEYFRAMES);
+    for encoding in Encoding::ALL {
+        let bytes = export(&tracks, &GlbOptions { encoding, ..GlbOptions::default() });
+        let glb = parse_glb(&bytes);
+        let json = &glb.json;
+        for (i, track) in tracks.iter().enumerate() {
+            let (translation, scale) = node_transform(&json["nodes"][i]);
+            let to_world = |p: DVec3| translation + p * scale;
+            // Quantized positions are within half a step of the normalized
+            // i16 grid, i.e. scale / 65534, plus f32 rounding.
+            let tolerance = if encoding == Encoding::Quantized {
+                assert!(scale > 1.0, "quantized meshes are scaled from [-1, 1]");
+                scale / 32767.0
+            } else {
+                assert_eq!((translation, scale), (DVec3::ZERO, 1.0));
+                2e-5
+            };
+            let primitive = &json["meshes"][i]["primitives"][0];
+            let read = |index: &serde_json::Value| vec3s(&read_accessor(&glb, index.as_u64().expect("accessor") as usize));
+            let base = read(&primitive["attributes"]["POSITION"]);
+            let base_normals = read(&primitive["attributes"]["NORMAL"]);
+            assert_close(&base.iter().map(|p| to_world(*p)).collect::<Vec<_>>(), &track.keyframes[0], tolerance, "base");
+            let empty = Vec::new();
+            let targets = primitive["targets"].as_array().unwrap_or(&empty);
+            assert_eq!(targets.len(), track.keyframes.len() - 1);
+            for (k, target) in targets.iter().enumerate() {
+                let what = format!("{} {encoding} target {k}", track.name);
+                let deltas = read(&target["POSITION"]);
+                let rebuilt: Vec<DVec3> = base.iter().zip(&deltas).map(|(b, d)| to_world(*b + *d)).collect();
+                assert_close(&rebuilt, &track.keyframes[k + 1], tolerance, &what);
+                // Normals as a renderer sees them: base + delta, renormalized.
+                let normal_deltas = read(&target["NORMAL"]);
+                let rebuilt: Vec<DVec3> = base_normals
+                    .iter()
+                    .zip(&normal_deltas)
+                    .map(|(b, d)| (*b + *d).normalize())
+                    .collect();
+                let normal_tolerance = if encoding == Encoding::Quantized { 0.01 } else { 1e-6 };
+                assert_close(&rebuilt, &normals(&track.keyframes[k + 1], track), normal_tolerance, &what);
+            }
+        }
+        let output = json["animations"][0]["samplers"][0]["output"].as_u64().expect("output") as usize;
+        let weights: Vec<f32> = read_accessor(&glb, output).iter().map(|w| w[0] as f32).collect();
+        assert_one_hot(&weights, KEYFRAMES);
+    }
+}
+
+/// More keyframes than allowed targets: resampled uniformly in time, the
+/// duration kept, targets named by their keyframe position.
+#[test]
+fn too_many_keyframes_are_resampled_to_the_target_limit() {
+    let tracks = fixture(KEYFRAMES);
+    let options = GlbOptions {
+        timing: Timing::Duration(3.5),
+        max_morph_targets: 6,
+        ..GlbOptions::default()
+    };
+    let bytes = export(&tracks, &options);
+    let gltf = gltf::Gltf::from_slice(&bytes).expect("parse");
+    let blob = gltf.blob.clone().expect("blob");
+    let glb = parse_glb(&bytes);
+    for (mesh, track) in gltf.meshes().zip(&tracks).take(2) {
+        let primitive = mesh.primitives().next().expect("primitive");
+        let reader = primitive.reader(|_| Some(&blob[..]));
+        let base = f32_triples(reader.read_positions().expect("positions"));
+        let frames = expected_frames(track, 6);
+        assert_eq!(frames.len(), 7);
+        let targets: Vec<_> = reader.read_morph_targets().collect();
+        assert_eq!(targets.len(), 6);
+        for (k, (positions, _, _)) in targets.into_iter().enumerate() {
+            let deltas = f32_triples(positions.expect("positions"));
+            let rebuilt: Vec<DVec3> = base.iter().zip(&deltas).map(|(b, d)| *b + *d).collect();
+            assert_close(&rebuilt, &frames[k + 1], 2e-5, &format!("resampled target {k}"));
+        }
+        // The last sample is the last keyframe exactly (up to f32).
+        let names: Vec<&str> = glb.json["meshes"][mesh.index()]["extras"]["targetNames"]
+            .as_array()
+            .expect("names")
+            .iter()
+            .map(|n| n.as_str().expect("str"))
+            .collect();
+        assert_eq!(
+            names,
+            ["keyframe 3.33", "keyframe 6.67", "keyframe 10", "keyframe 13.33", "keyframe 16.67", "keyframe 20"]
+        );
+    }
+    let animation = gltf.animations().next().expect("animation");
+    let channel = animation.channels().next().expect("channel");
+    let times: Vec<f32> = channel.reader(|_| Some(&blob[..])).read_inputs().expect("times").collect();
+    let expected: Vec<f32> = (0..7).map(|j| (j as f64 * 3.5 / 6.0) as f32).collect();
+    assert_eq!(times, expected);
+}
+
+#[test]
+fn normals_can_be_left_out() {
+    let tracks = fixture(5);
+    for encoding in Encoding::ALL {
+        let glb = parse_glb(&export(&tracks, &GlbOptions { normals: false, encoding, ..GlbOptions::default() }));
+        for mesh in glb.json["meshes"].as_array().expect("meshes") {
+            let primitive = &mesh["primitives"][0];
+            assert!(primitive["attributes"].get("NORMAL").is_none());
+            for target in primitive["targets"].as_array().into_iter().flatten() {
+                assert!(target.get("NORMAL").is_none() && target.get("POSITION").is_some());
+            }
+        }
+    }
+}
+
+#[test]
+fn sparse_targets_leave_still_vertices_out() {
+    // The sepal's first 45 vertices (its lower rows) stay still, and it does
+    // not move at all between keyframes 0 and 1.
+    let mut tracks = fixture(KEYFRAMES);
+    let sepal = &mut tracks[1];
+    let bud = sepal.keyframes[0].clone();
+    sepal.keyframes[1] = bud.clone();
+    for frame in &mut sepal.keyframes {
+        frame[..45].copy_from_slice(&bud[..45]);
+    }
+    let options = GlbOptions { encoding: Encoding::Sparse, normals: false, ..GlbOptions::default() };
+    let bytes = export(&tracks, &options);
+    assert_valid_glb(&bytes, "sparse-still");
+    let glb = parse_glb(&bytes);
+    let targets = glb.json["meshes"][1]["primitives"][0]["targets"].as_array().expect("targets").clone();
+    for (k, target) in targets.iter().enumerate() {
+        let accessor = &glb.json["accessors"][target["POSITION"].as_u64().expect("p") as usize];
+        assert!(accessor.get("bufferView").is_none(), "{accessor}");
+        if k == 0 {
+            // Nothing moved: a single explicit zero.
+            assert_eq!(accessor["sparse"]["count"], 1, "{accessor}");
+            assert_eq!(accessor["max"], serde_json::json!([0.0, 0.0, 0.0]));
+        } else {
+            assert_eq!(accessor["sparse"]["count"], 91 - 45, "{accessor}");
+        }
+    }
+    let rebuilt = vec3s(&read_accessor(&glb, targets[3]["POSITION"].as_u64().expect("p") as usize));
+    let expected: Vec<DVec3> = tracks[1].keyframes[4].iter().zip(&tracks[1].keyframes[0]).map(|(p, p0)| *p - *p0).collect();
+    assert_close(&rebuilt, &expected, 1e-5, "sparse deltas");
+
+    // The gltf crate reads the sparse accessors the same way.
+    let gltf = gltf::Gltf::from_slice(&bytes).expect("parse");
+    let blob = gltf.blob.clone().expect("blob");
+    let mesh = gltf.meshes().nth(1).expect("sepal");
+    let primitive = mesh.primitives().next().expect("primitive");
+    let reader = primitive.reader(|_| Some(&blob[..]));
+    let (positions, _, _) = reader.read_morph_targets().nth(3).expect("target 3");
+    assert_close(&f32_triples(positions.expect("sparse positions")), &expected, 1e-5, "gltf sparse");
+
+    let dense = export(&tracks, &GlbOptions { normals: false, ..GlbOptions::default() });
+    assert!(bytes.len() < dense.len(), "sparse {} vs dense {}", bytes.len(), dense.len());
+}
+
+#[test]
+fn progress_rises_from_zero_to_one() {
+    let mut seen = Vec::new();
+    glb_bytes(&fixture(KEYFRAMES), &GlbOptions::default(), &mut |p| seen.push(p)).expect("export");
+    assert_eq!(seen.first(), Some(&0.0));
+    assert_eq!(seen.last(), Some(&1.0));
+    assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+    // Reported about once per keyframe of each organ, not just at the ends.
+    assert!(seen.len() > 2 * KEYFRAMES, "{}", seen.len());
+}
+
+#[test]
+fn invalid_input_is_a_typed_error_and_keeps_the_old_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("flower.glb");
+    write_glb(&path, &fixture(3), &GlbOptions::default(), &mut |_| {}).expect("good export");
+    let good = std::fs::read(&path).expect("read");
+
+    let mut broken = fixture(3);
+    broken[1].keyframes[2][5].x = f64::NAN;
+    let error = write_glb(&path, &broken, &GlbOptions::default(), &mut |_| {}).expect_err("NaN");
+    assert!(matches!(error, ExportError::InvalidTrack { track: 1, .. }), "{error:?}");
+    assert!(error.to_string().contains("vertex 5 at keyframe 2"), "{error}");
+
+    let mut broken = fixture(3);
+    broken[0].keyframes[1].pop();
+    let error = write_glb(&path, &broken, &GlbOptions::default(), &mut |_| {}).expect_err("count");
+    assert!(error.to_string().contains("keyframe 1 has 152 vertices but keyframe 0 has 153"), "{error}");
+
+    assert_eq!(std::fs::read(&path).expect("read"), good, "the good file is untouched");
+}
+
+#[test]
+fn write_glb_reports_a_missing_folder_before_exporting() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("renders/flower.glb");
+    let mut calls = 0;
+    let error = write_glb(&path, &fixture(3), &GlbOptions::default(), &mut |_| calls += 1)
+        .expect_err("missing folder");
+    assert!(matches!(error, ExportError::MissingFolder { .. }), "{error:?}");
+    assert!(error.to_string().contains("renders"), "{error}");
+    assert_eq!(calls, 0, "no work done for a destination that cannot exist");
+}
