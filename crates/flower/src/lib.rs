@@ -1,1 +1,218 @@
-//! (being written)
+//! A flower: organ templates (mesh, growth maps, parameters), organs placed
+//! on the receptacle, and which organ lies inside which (for collisions).
+//! The project file format that stores all this is in [`project`].
+
+pub mod project;
+
+use anthesis_maps::KeyedMaps;
+use anthesis_mesh::Mesh;
+use anthesis_physics::SolverSettings;
+use glam::{DQuat, DVec3};
+
+/// Everything an organ type needs: its bud mesh (in the template frame, see
+/// ARCHITECTURE.md), its growth maps over time and its material constants.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Template {
+    pub name: String,
+    pub mesh: Mesh,
+    pub maps: KeyedMaps,
+    /// Maximum growth per step: rate = 1 + dg * map value (paper eq. 2).
+    /// Negative values shrink (decay, wilting).
+    pub dg: f64,
+    /// Distance of the imaginary inner surface (paper §4.2); must be > 0.
+    pub thickness: f64,
+    /// Ks: stretch stiffness scale (paper §5.1).
+    pub stretch_stiffness: f64,
+    /// Kb: bend stiffness scale (paper §5.1).
+    pub bend_stiffness: f64,
+    /// Which particles attach the organ to the receptacle.
+    pub base_region: BaseRegion,
+    /// How the joint angle changes over the steps.
+    pub joint_schedule: Vec<JointRamp>,
+    /// Display and export colour, linear RGBA in [0, 1].
+    pub color: [f32; 4],
+}
+
+/// The base particles: those whose UV lies in this region.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BaseRegion {
+    /// Particles with `v <= v_max` are base particles.
+    pub v_max: f64,
+    /// Optional limits across (`u_min <= u <= u_max`).
+    pub u_min: f64,
+    pub u_max: f64,
+}
+
+impl Default for BaseRegion {
+    fn default() -> Self {
+        BaseRegion {
+            v_max: 0.05,
+            u_min: 0.0,
+            u_max: 1.0,
+        }
+    }
+}
+
+impl BaseRegion {
+    pub fn contains(&self, uv: glam::DVec2) -> bool {
+        uv.y <= self.v_max && uv.x >= self.u_min && uv.x <= self.u_max
+    }
+
+    /// Indices of the base particles of `mesh`.
+    pub fn particles(&self, mesh: &Mesh) -> Vec<u32> {
+        (0..mesh.uvs.len() as u32)
+            .filter(|&i| self.contains(mesh.uvs[i as usize]))
+            .collect()
+    }
+}
+
+/// The joint angle grows by `degrees` spread evenly over steps
+/// `from_step + 1 ..= to_step` (the paper's lily: 23° over steps 1–60, i.e.
+/// `from_step = 0, to_step = 60`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointRamp {
+    pub from_step: u32,
+    pub to_step: u32,
+    pub degrees: f64,
+}
+
+/// The joint angle added by the schedule after `step` steps, in radians.
+pub fn joint_angle_after(schedule: &[JointRamp], step: u32) -> f64 {
+    schedule
+        .iter()
+        .map(|ramp| {
+            let span = ramp.to_step.saturating_sub(ramp.from_step).max(1);
+            let done =
+                step.clamp(ramp.from_step, ramp.to_step.max(ramp.from_step)) - ramp.from_step;
+            ramp.degrees * f64::from(done) / f64::from(span)
+        })
+        .sum::<f64>()
+        .to_radians()
+}
+
+/// Where an organ sits on the receptacle. The template frame is turned by
+/// `azimuth_deg` about the flower axis (+Y), tilted by the joint angle about
+/// its joint axis (the template's +X, turned with it), and moved to
+/// `position`. A positive joint angle tilts the organ outwards.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    pub position: DVec3,
+    pub azimuth_deg: f64,
+    pub joint_angle_deg: f64,
+}
+
+impl Placement {
+    /// The joint axis in the world frame (unit length).
+    pub fn joint_axis(&self) -> DVec3 {
+        DQuat::from_rotation_y(self.azimuth_deg.to_radians()) * DVec3::X
+    }
+
+    /// World position of a template-frame point with `extra_joint` radians
+    /// added to the initial joint angle.
+    pub fn world_from_template(&self, point_in_template: DVec3, extra_joint: f64) -> DVec3 {
+        let rotation = DQuat::from_rotation_y(self.azimuth_deg.to_radians())
+            * DQuat::from_rotation_x(self.joint_angle_deg.to_radians() + extra_joint);
+        self.position + rotation * point_in_template
+    }
+}
+
+/// One organ: an instance of a template on the receptacle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Organ {
+    pub name: String,
+    /// Index into [`Flower::templates`].
+    pub template: usize,
+    pub placement: Placement,
+}
+
+/// `inner` lies inside `outer` (nearer the flower axis) where they overlap:
+/// each particle of `inner` near `outer` must stay on `outer`'s inner side,
+/// and each particle of `outer` near `inner` on `inner`'s outer side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Overlap {
+    pub inner: usize,
+    pub outer: usize,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Flower {
+    pub templates: Vec<Template>,
+    pub organs: Vec<Organ>,
+    pub overlaps: Vec<Overlap>,
+}
+
+impl Flower {
+    pub fn template_of(&self, organ: usize) -> &Template {
+        &self.templates[self.organs[organ].template]
+    }
+
+    pub fn organ_index(&self, name: &str) -> Option<usize> {
+        self.organs.iter().position(|o| o.name == name)
+    }
+}
+
+/// How a project is simulated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimulationSettings {
+    /// Number of keyframes after the bud (paper: N = 100).
+    pub keyframes: u32,
+    pub solver: SolverSettings,
+    /// Distance a colliding particle is pushed past its neighbour (paper:
+    /// 0.01).
+    pub collision_offset: f64,
+}
+
+impl Default for SimulationSettings {
+    fn default() -> Self {
+        SimulationSettings {
+            keyframes: 100,
+            solver: SolverSettings::default(),
+            collision_offset: 0.01,
+        }
+    }
+}
+
+/// A whole project: a flower and how to simulate it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Project {
+    pub name: String,
+    pub flower: Flower,
+    pub settings: SimulationSettings,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn joint_schedule_ramps_linearly_and_holds() {
+        let lily = [JointRamp {
+            from_step: 0,
+            to_step: 60,
+            degrees: 23.0,
+        }];
+        assert_eq!(joint_angle_after(&lily, 0), 0.0);
+        assert!((joint_angle_after(&lily, 30) - 11.5f64.to_radians()).abs() < 1e-12);
+        assert!((joint_angle_after(&lily, 60) - 23f64.to_radians()).abs() < 1e-12);
+        assert!((joint_angle_after(&lily, 100) - 23f64.to_radians()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn positive_joint_angle_tilts_outwards() {
+        let placement = Placement {
+            position: DVec3::new(0.0, 0.0, 1.0),
+            azimuth_deg: 0.0,
+            joint_angle_deg: 10.0,
+        };
+        let tip = placement.world_from_template(DVec3::Y, 0.0);
+        // Outwards from the axis at azimuth 0 is +Z.
+        assert!(tip.z > 1.0 && tip.y > 0.9);
+        let turned = Placement {
+            azimuth_deg: 90.0,
+            ..placement
+        };
+        assert!((turned.joint_axis() - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12);
+        let tip = turned.world_from_template(DVec3::Y, 0.0);
+        assert!(tip.x > 0.1, "azimuth 90 opens towards +X, got {tip}");
+    }
+}
