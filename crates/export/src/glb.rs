@@ -135,9 +135,13 @@ pub fn glb_bytes(
         meshes.push(mesh);
 
         let mut node = json!({ "name": track.name, "mesh": index });
-        if let Some(box_) = encoded.dequantization {
-            node["translation"] = json!(box_.center.map(f32_json));
-            node["scale"] = json!([f32_json(box_.scale), f32_json(box_.scale), f32_json(box_.scale)]);
+        if let Some(qbox) = encoded.dequantization {
+            node["translation"] = json!(qbox.center.map(f32_json));
+            node["scale"] = json!([
+                f32_json(qbox.scale),
+                f32_json(qbox.scale),
+                f32_json(qbox.scale)
+            ]);
         }
         nodes.push(node);
     }
@@ -275,9 +279,9 @@ fn encode_mesh(
     let base_normals = options.normals.then(|| normal_of(base));
 
     let dequantization = quantized.then(|| QuantizationBox::around(frames));
-    let base_units: Option<Vec<[i16; 3]>> = dequantization.map(|box_| {
+    let base_units: Option<Vec<[i16; 3]>> = dequantization.map(|qbox| {
         base.iter()
-            .map(|p| box_.units(*p).to_array().map(to_i16))
+            .map(|p| qbox.units(*p).to_array().map(to_i16))
             .collect()
     });
     let position = match &base_units {
@@ -332,12 +336,12 @@ fn encode_mesh(
     for frame in &frames[1..] {
         let mut target = Map::new();
         let accessor = match (&base_units, dequantization) {
-            (Some(base_units), Some(box_)) => {
+            (Some(base_units), Some(qbox)) => {
                 let deltas: Vec<[i16; 3]> = frame
                     .iter()
                     .zip(base_units)
                     .map(|(p, q0)| {
-                        let q = box_.units(*p).to_array().map(|x| x.round());
+                        let q = qbox.units(*p).to_array().map(|x| x.round());
                         [0, 1, 2].map(|i| to_i16(q[i] - q0[i] as f64))
                     })
                     .collect();
@@ -435,7 +439,13 @@ fn min_max<const N: usize, T: Copy + PartialOrd + Into<f64>>(values: &[[T; N]]) 
         }
     }
     // Every T used here (f32, i16) is exactly an f32.
-    let as_json = |a: [T; N]| Value::from(a.iter().map(|&x| f32_json(x.into() as f32)).collect::<Vec<_>>());
+    let as_json = |a: [T; N]| {
+        Value::from(
+            a.iter()
+                .map(|&x| f32_json(x.into() as f32))
+                .collect::<Vec<_>>(),
+        )
+    };
     (as_json(min), as_json(max))
 }
 

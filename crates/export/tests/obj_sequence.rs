@@ -22,31 +22,57 @@ fn parse(text: &str) -> (Vec<String>, BTreeMap<String, Object>) {
     let mut current = String::new();
     for line in text.lines() {
         let words: Vec<&str> = line.split_whitespace().collect();
-        let numbers = || words[1..].iter().map(|w| w.parse::<f64>().expect("number")).collect::<Vec<_>>();
+        let numbers = || {
+            words[1..]
+                .iter()
+                .map(|w| w.parse::<f64>().expect("number"))
+                .collect::<Vec<_>>()
+        };
         match words.first().copied() {
             Some("o") => {
                 current = words[1].to_owned();
                 order.push(current.clone());
-                objects.insert(current.clone(), Object { positions: vec![], uvs: vec![], normals: 0, faces: vec![] });
+                objects.insert(
+                    current.clone(),
+                    Object {
+                        positions: vec![],
+                        uvs: vec![],
+                        normals: 0,
+                        faces: vec![],
+                    },
+                );
             }
             Some("v") => {
                 let n = numbers();
-                objects.get_mut(&current).expect("o first").positions.push(DVec3::new(n[0], n[1], n[2]));
+                objects
+                    .get_mut(&current)
+                    .expect("o first")
+                    .positions
+                    .push(DVec3::new(n[0], n[1], n[2]));
             }
             Some("vt") => {
                 let n = numbers();
-                objects.get_mut(&current).expect("o first").uvs.push(DVec2::new(n[0], n[1]));
+                objects
+                    .get_mut(&current)
+                    .expect("o first")
+                    .uvs
+                    .push(DVec2::new(n[0], n[1]));
             }
             Some("vn") => objects.get_mut(&current).expect("o first").normals += 1,
             Some("f") => {
                 let corners: Vec<(usize, usize, usize)> = words[1..]
                     .iter()
                     .map(|c| {
-                        let i: Vec<usize> = c.split('/').map(|x| x.parse().expect("index")).collect();
+                        let i: Vec<usize> =
+                            c.split('/').map(|x| x.parse().expect("index")).collect();
                         (i[0], i[1], i[2])
                     })
                     .collect();
-                objects.get_mut(&current).expect("o first").faces.push([corners[0], corners[1], corners[2]]);
+                objects
+                    .get_mut(&current)
+                    .expect("o first")
+                    .faces
+                    .push([corners[0], corners[1], corners[2]]);
             }
             Some(w) if w.starts_with('#') => {}
             other => panic!("unexpected OBJ statement {other:?}"),
@@ -66,7 +92,9 @@ fn one_obj_per_keyframe_with_every_track_as_an_object() {
         .collect();
     assert_eq!(
         names,
-        (0..6).map(|k| format!("keyframe_{k:04}.obj")).collect::<Vec<_>>()
+        (0..6)
+            .map(|k| format!("keyframe_{k:04}.obj"))
+            .collect::<Vec<_>>()
     );
     for (k, path) in paths.iter().enumerate() {
         let (order, objects) = parse(&std::fs::read_to_string(path).expect("read"));
@@ -93,7 +121,11 @@ fn one_obj_per_keyframe_with_every_track_as_an_object() {
             offset += expected.len();
         }
     }
-    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 6, "no temporary files left");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).expect("dir").count(),
+        6,
+        "no temporary files left"
+    );
 }
 
 #[test]
@@ -114,6 +146,9 @@ fn obj_sequence_rejects_invalid_tracks() {
     let mut tracks = fixture(3);
     tracks[2].uvs.pop();
     let error = write_obj_sequence(dir.path(), &tracks).expect_err("uv count");
-    assert!(matches!(error, ExportError::InvalidTrack { track: 2, .. }), "{error:?}");
+    assert!(
+        matches!(error, ExportError::InvalidTrack { track: 2, .. }),
+        "{error:?}"
+    );
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
 }

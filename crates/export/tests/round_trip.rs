@@ -48,11 +48,15 @@ fn assert_close(actual: &[DVec3], expected: &[DVec3], tolerance: f64, what: &str
         .zip(expected)
         .map(|(a, e)| (*a - *e).abs().max_element())
         .fold(0.0, f64::max);
-    assert!(worst <= tolerance, "{what}: off by {worst} (tolerance {tolerance})");
+    assert!(
+        worst <= tolerance,
+        "{what}: off by {worst} (tolerance {tolerance})"
+    );
 }
 
 fn f32_triples(iter: impl Iterator<Item = [f32; 3]>) -> Vec<DVec3> {
-    iter.map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect()
+    iter.map(|v| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64))
+        .collect()
 }
 
 /// The `gltf` crate reads the Dense and Sparse files: every morph target
@@ -89,25 +93,40 @@ fn gltf_crate_rebuilds_every_keyframe_from_its_target() {
             let texcoords: Vec<[f32; 2]> =
                 reader.read_tex_coords(0).expect("uvs").into_f32().collect();
             for (t, uv) in texcoords.iter().zip(&track.uvs) {
-                assert!((t[0] as f64 - uv.x).abs() < 1e-6 && (t[1] as f64 - (1.0 - uv.y)).abs() < 1e-6);
+                assert!(
+                    (t[0] as f64 - uv.x).abs() < 1e-6 && (t[1] as f64 - (1.0 - uv.y)).abs() < 1e-6
+                );
             }
 
             let frames = &track.keyframes;
             let base = f32_triples(reader.read_positions().expect("positions"));
             assert_close(&base, &frames[0], 1e-5, "base = keyframe 0");
             let base_normals = f32_triples(reader.read_normals().expect("normals"));
-            assert_close(&base_normals, &normals(&frames[0], track), 1e-6, "base normals");
+            assert_close(
+                &base_normals,
+                &normals(&frames[0], track),
+                1e-6,
+                "base normals",
+            );
 
             let targets: Vec<_> = reader.read_morph_targets().collect();
-            assert_eq!(targets.len(), frames.len() - 1, "{}: one target per later keyframe", track.name);
+            assert_eq!(
+                targets.len(),
+                frames.len() - 1,
+                "{}: one target per later keyframe",
+                track.name
+            );
             for (k, (positions, normal_deltas, tangents)) in targets.into_iter().enumerate() {
                 let what = format!("{} {encoding} target {k}", track.name);
                 let deltas = f32_triples(positions.expect("POSITION deltas"));
                 let rebuilt: Vec<DVec3> = base.iter().zip(&deltas).map(|(b, d)| *b + *d).collect();
                 assert_close(&rebuilt, &frames[k + 1], 2e-5, &what);
                 let deltas = f32_triples(normal_deltas.expect("NORMAL deltas"));
-                let rebuilt: Vec<DVec3> =
-                    base_normals.iter().zip(&deltas).map(|(b, d)| *b + *d).collect();
+                let rebuilt: Vec<DVec3> = base_normals
+                    .iter()
+                    .zip(&deltas)
+                    .map(|(b, d)| *b + *d)
+                    .collect();
                 assert_close(&rebuilt, &normals(&frames[k + 1], track), 1e-6, &what);
                 assert!(tangents.is_none());
             }
@@ -121,8 +140,14 @@ fn gltf_crate_rebuilds_every_keyframe_from_its_target() {
         let animated: Vec<usize> = channels.iter().map(|c| c.target().node().index()).collect();
         assert_eq!(animated, vec![0, 1]);
         for channel in &channels {
-            assert_eq!(channel.target().property(), gltf::animation::Property::MorphTargetWeights);
-            assert_eq!(channel.sampler().interpolation(), gltf::animation::Interpolation::Linear);
+            assert_eq!(
+                channel.target().property(),
+                gltf::animation::Property::MorphTargetWeights
+            );
+            assert_eq!(
+                channel.sampler().interpolation(),
+                gltf::animation::Interpolation::Linear
+            );
             let reader = channel.reader(buffers);
             let times: Vec<f32> = reader.read_inputs().expect("times").collect();
             let expected: Vec<f32> = (0..KEYFRAMES).map(|k| (k as f64 / 24.0) as f32).collect();
@@ -143,7 +168,11 @@ fn assert_one_hot(weights: &[f32], keyframes: usize) {
     for k in 0..keyframes {
         for t in 0..targets {
             let expected = if k >= 1 && t == k - 1 { 1.0 } else { 0.0 };
-            assert_eq!(weights[k * targets + t], expected, "keyframe {k}, target {t}");
+            assert_eq!(
+                weights[k * targets + t],
+                expected,
+                "keyframe {k}, target {t}"
+            );
         }
     }
 }
@@ -157,7 +186,9 @@ fn meshes_name_their_targets_and_carry_materials() {
     let json = &glb.json;
     for (i, track) in tracks.iter().enumerate() {
         let mesh = &json["meshes"][i];
-        let material = &json["materials"][mesh["primitives"][0]["material"].as_u64().expect("material") as usize];
+        let material = &json["materials"][mesh["primitives"][0]["material"]
+            .as_u64()
+            .expect("material") as usize];
         let color: Vec<f32> = material["pbrMetallicRoughness"]["baseColorFactor"]
             .as_array()
             .expect("base colour")
@@ -178,8 +209,17 @@ fn meshes_name_their_targets_and_carry_materials() {
             .collect();
         let expected: Vec<String> = (1..KEYFRAMES).map(|k| format!("keyframe {k}")).collect();
         assert_eq!(names, expected);
-        assert_eq!(mesh["weights"].as_array().expect("weights").len(), KEYFRAMES - 1);
-        assert!(mesh["weights"].as_array().expect("weights").iter().all(|w| w == 0.0));
+        assert_eq!(
+            mesh["weights"].as_array().expect("weights").len(),
+            KEYFRAMES - 1
+        );
+        assert!(
+            mesh["weights"]
+                .as_array()
+                .expect("weights")
+                .iter()
+                .all(|w| w == 0.0)
+        );
     }
 }
 
@@ -199,18 +239,27 @@ fn playback_between_keyframes_blends_the_two_neighbours() {
         .iter()
         .map(|t| t[0])
         .collect();
-    let weights: Vec<f64> = read_accessor(&glb, sampler["output"].as_u64().expect("output") as usize)
-        .iter()
-        .map(|w| w[0])
-        .collect();
+    let weights: Vec<f64> =
+        read_accessor(&glb, sampler["output"].as_u64().expect("output") as usize)
+            .iter()
+            .map(|w| w[0])
+            .collect();
     let targets = KEYFRAMES - 1;
     let mesh = &json["meshes"][0]["primitives"][0];
-    let base = vec3s(&read_accessor(&glb, mesh["attributes"]["POSITION"].as_u64().expect("p") as usize));
+    let base = vec3s(&read_accessor(
+        &glb,
+        mesh["attributes"]["POSITION"].as_u64().expect("p") as usize,
+    ));
     let deltas: Vec<Vec<DVec3>> = mesh["targets"]
         .as_array()
         .expect("targets")
         .iter()
-        .map(|t| vec3s(&read_accessor(&glb, t["POSITION"].as_u64().expect("p") as usize)))
+        .map(|t| {
+            vec3s(&read_accessor(
+                &glb,
+                t["POSITION"].as_u64().expect("p") as usize,
+            ))
+        })
         .collect();
 
     for (k, fraction) in [(0usize, 0.25f64), (7, 0.5), (19, 0.9)] {
@@ -228,7 +277,12 @@ fn playback_between_keyframes_blends_the_two_neighbours() {
             .zip(&tracks[0].keyframes[k + 1])
             .map(|(a, b)| a.lerp(*b, f))
             .collect();
-        assert_close(&played, &blended, 5e-5, &format!("between keyframes {k} and {}", k + 1));
+        assert_close(
+            &played,
+            &blended,
+            5e-5,
+            &format!("between keyframes {k} and {}", k + 1),
+        );
     }
 }
 
@@ -238,7 +292,13 @@ fn playback_between_keyframes_blends_the_two_neighbours() {
 fn every_encoding_rebuilds_every_keyframe() {
     let tracks = fixture(KEYFRAMES);
     for encoding in Encoding::ALL {
-        let bytes = export(&tracks, &GlbOptions { encoding, ..GlbOptions::default() });
+        let bytes = export(
+            &tracks,
+            &GlbOptions {
+                encoding,
+                ..GlbOptions::default()
+            },
+        );
         let glb = parse_glb(&bytes);
         let json = &glb.json;
         for (i, track) in tracks.iter().enumerate() {
@@ -254,17 +314,42 @@ fn every_encoding_rebuilds_every_keyframe() {
                 2e-5
             };
             let primitive = &json["meshes"][i]["primitives"][0];
-            let read = |index: &serde_json::Value| vec3s(&read_accessor(&glb, index.as_u64().expect("accessor") as usize));
+            let read = |index: &serde_json::Value| {
+                vec3s(&read_accessor(
+                    &glb,
+                    index.as_u64().expect("accessor") as usize,
+                ))
+            };
             let base = read(&primitive["attributes"]["POSITION"]);
             let base_normals = read(&primitive["attributes"]["NORMAL"]);
-            assert_close(&base.iter().map(|p| to_world(*p)).collect::<Vec<_>>(), &track.keyframes[0], tolerance, "base");
+            let texcoords = read_accessor(
+                &glb,
+                primitive["attributes"]["TEXCOORD_0"].as_u64().expect("uv") as usize,
+            );
+            for (t, uv) in texcoords.iter().zip(&track.uvs) {
+                // glTF's v runs down the image: (u, 1 - v), within a u16 step.
+                assert!(
+                    (t[0] - uv.x).abs() < 2e-5 && (t[1] - (1.0 - uv.y)).abs() < 2e-5,
+                    "{t:?} vs {uv}"
+                );
+            }
+            assert_close(
+                &base.iter().map(|p| to_world(*p)).collect::<Vec<_>>(),
+                &track.keyframes[0],
+                tolerance,
+                "base",
+            );
             let empty = Vec::new();
             let targets = primitive["targets"].as_array().unwrap_or(&empty);
             assert_eq!(targets.len(), track.keyframes.len() - 1);
             for (k, target) in targets.iter().enumerate() {
                 let what = format!("{} {encoding} target {k}", track.name);
                 let deltas = read(&target["POSITION"]);
-                let rebuilt: Vec<DVec3> = base.iter().zip(&deltas).map(|(b, d)| to_world(*b + *d)).collect();
+                let rebuilt: Vec<DVec3> = base
+                    .iter()
+                    .zip(&deltas)
+                    .map(|(b, d)| to_world(*b + *d))
+                    .collect();
                 assert_close(&rebuilt, &track.keyframes[k + 1], tolerance, &what);
                 // Normals as a renderer sees them: base + delta, renormalized.
                 let normal_deltas = read(&target["NORMAL"]);
@@ -273,12 +358,26 @@ fn every_encoding_rebuilds_every_keyframe() {
                     .zip(&normal_deltas)
                     .map(|(b, d)| (*b + *d).normalize())
                     .collect();
-                let normal_tolerance = if encoding == Encoding::Quantized { 0.01 } else { 1e-6 };
-                assert_close(&rebuilt, &normals(&track.keyframes[k + 1], track), normal_tolerance, &what);
+                let normal_tolerance = if encoding == Encoding::Quantized {
+                    0.01
+                } else {
+                    1e-6
+                };
+                assert_close(
+                    &rebuilt,
+                    &normals(&track.keyframes[k + 1], track),
+                    normal_tolerance,
+                    &what,
+                );
             }
         }
-        let output = json["animations"][0]["samplers"][0]["output"].as_u64().expect("output") as usize;
-        let weights: Vec<f32> = read_accessor(&glb, output).iter().map(|w| w[0] as f32).collect();
+        let output = json["animations"][0]["samplers"][0]["output"]
+            .as_u64()
+            .expect("output") as usize;
+        let weights: Vec<f32> = read_accessor(&glb, output)
+            .iter()
+            .map(|w| w[0] as f32)
+            .collect();
         assert_one_hot(&weights, KEYFRAMES);
     }
 }
@@ -308,7 +407,12 @@ fn too_many_keyframes_are_resampled_to_the_target_limit() {
         for (k, (positions, _, _)) in targets.into_iter().enumerate() {
             let deltas = f32_triples(positions.expect("positions"));
             let rebuilt: Vec<DVec3> = base.iter().zip(&deltas).map(|(b, d)| *b + *d).collect();
-            assert_close(&rebuilt, &frames[k + 1], 2e-5, &format!("resampled target {k}"));
+            assert_close(
+                &rebuilt,
+                &frames[k + 1],
+                2e-5,
+                &format!("resampled target {k}"),
+            );
         }
         // The last sample is the last keyframe exactly (up to f32).
         let names: Vec<&str> = glb.json["meshes"][mesh.index()]["extras"]["targetNames"]
@@ -319,12 +423,23 @@ fn too_many_keyframes_are_resampled_to_the_target_limit() {
             .collect();
         assert_eq!(
             names,
-            ["keyframe 3.33", "keyframe 6.67", "keyframe 10", "keyframe 13.33", "keyframe 16.67", "keyframe 20"]
+            [
+                "keyframe 3.33",
+                "keyframe 6.67",
+                "keyframe 10",
+                "keyframe 13.33",
+                "keyframe 16.67",
+                "keyframe 20"
+            ]
         );
     }
     let animation = gltf.animations().next().expect("animation");
     let channel = animation.channels().next().expect("channel");
-    let times: Vec<f32> = channel.reader(|_| Some(&blob[..])).read_inputs().expect("times").collect();
+    let times: Vec<f32> = channel
+        .reader(|_| Some(&blob[..]))
+        .read_inputs()
+        .expect("times")
+        .collect();
     let expected: Vec<f32> = (0..7).map(|j| (j as f64 * 3.5 / 6.0) as f32).collect();
     assert_eq!(times, expected);
 }
@@ -333,7 +448,14 @@ fn too_many_keyframes_are_resampled_to_the_target_limit() {
 fn normals_can_be_left_out() {
     let tracks = fixture(5);
     for encoding in Encoding::ALL {
-        let glb = parse_glb(&export(&tracks, &GlbOptions { normals: false, encoding, ..GlbOptions::default() }));
+        let glb = parse_glb(&export(
+            &tracks,
+            &GlbOptions {
+                normals: false,
+                encoding,
+                ..GlbOptions::default()
+            },
+        ));
         for mesh in glb.json["meshes"].as_array().expect("meshes") {
             let primitive = &mesh["primitives"][0];
             assert!(primitive["attributes"].get("NORMAL").is_none());
@@ -355,11 +477,18 @@ fn sparse_targets_leave_still_vertices_out() {
     for frame in &mut sepal.keyframes {
         frame[..45].copy_from_slice(&bud[..45]);
     }
-    let options = GlbOptions { encoding: Encoding::Sparse, normals: false, ..GlbOptions::default() };
+    let options = GlbOptions {
+        encoding: Encoding::Sparse,
+        normals: false,
+        ..GlbOptions::default()
+    };
     let bytes = export(&tracks, &options);
     assert_valid_glb(&bytes, "sparse-still");
     let glb = parse_glb(&bytes);
-    let targets = glb.json["meshes"][1]["primitives"][0]["targets"].as_array().expect("targets").clone();
+    let targets = glb.json["meshes"][1]["primitives"][0]["targets"]
+        .as_array()
+        .expect("targets")
+        .clone();
     for (k, target) in targets.iter().enumerate() {
         let accessor = &glb.json["accessors"][target["POSITION"].as_u64().expect("p") as usize];
         assert!(accessor.get("bufferView").is_none(), "{accessor}");
@@ -371,8 +500,15 @@ fn sparse_targets_leave_still_vertices_out() {
             assert_eq!(accessor["sparse"]["count"], 91 - 45, "{accessor}");
         }
     }
-    let rebuilt = vec3s(&read_accessor(&glb, targets[3]["POSITION"].as_u64().expect("p") as usize));
-    let expected: Vec<DVec3> = tracks[1].keyframes[4].iter().zip(&tracks[1].keyframes[0]).map(|(p, p0)| *p - *p0).collect();
+    let rebuilt = vec3s(&read_accessor(
+        &glb,
+        targets[3]["POSITION"].as_u64().expect("p") as usize,
+    ));
+    let expected: Vec<DVec3> = tracks[1].keyframes[4]
+        .iter()
+        .zip(&tracks[1].keyframes[0])
+        .map(|(p, p0)| *p - *p0)
+        .collect();
     assert_close(&rebuilt, &expected, 1e-5, "sparse deltas");
 
     // The gltf crate reads the sparse accessors the same way.
@@ -382,16 +518,35 @@ fn sparse_targets_leave_still_vertices_out() {
     let primitive = mesh.primitives().next().expect("primitive");
     let reader = primitive.reader(|_| Some(&blob[..]));
     let (positions, _, _) = reader.read_morph_targets().nth(3).expect("target 3");
-    assert_close(&f32_triples(positions.expect("sparse positions")), &expected, 1e-5, "gltf sparse");
+    assert_close(
+        &f32_triples(positions.expect("sparse positions")),
+        &expected,
+        1e-5,
+        "gltf sparse",
+    );
 
-    let dense = export(&tracks, &GlbOptions { normals: false, ..GlbOptions::default() });
-    assert!(bytes.len() < dense.len(), "sparse {} vs dense {}", bytes.len(), dense.len());
+    let dense = export(
+        &tracks,
+        &GlbOptions {
+            normals: false,
+            ..GlbOptions::default()
+        },
+    );
+    assert!(
+        bytes.len() < dense.len(),
+        "sparse {} vs dense {}",
+        bytes.len(),
+        dense.len()
+    );
 }
 
 #[test]
 fn progress_rises_from_zero_to_one() {
     let mut seen = Vec::new();
-    glb_bytes(&fixture(KEYFRAMES), &GlbOptions::default(), &mut |p| seen.push(p)).expect("export");
+    glb_bytes(&fixture(KEYFRAMES), &GlbOptions::default(), &mut |p| {
+        seen.push(p)
+    })
+    .expect("export");
     assert_eq!(seen.first(), Some(&0.0));
     assert_eq!(seen.last(), Some(&1.0));
     assert!(seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
@@ -409,15 +564,30 @@ fn invalid_input_is_a_typed_error_and_keeps_the_old_file() {
     let mut broken = fixture(3);
     broken[1].keyframes[2][5].x = f64::NAN;
     let error = write_glb(&path, &broken, &GlbOptions::default(), &mut |_| {}).expect_err("NaN");
-    assert!(matches!(error, ExportError::InvalidTrack { track: 1, .. }), "{error:?}");
-    assert!(error.to_string().contains("vertex 5 at keyframe 2"), "{error}");
+    assert!(
+        matches!(error, ExportError::InvalidTrack { track: 1, .. }),
+        "{error:?}"
+    );
+    assert!(
+        error.to_string().contains("vertex 5 at keyframe 2"),
+        "{error}"
+    );
 
     let mut broken = fixture(3);
     broken[0].keyframes[1].pop();
     let error = write_glb(&path, &broken, &GlbOptions::default(), &mut |_| {}).expect_err("count");
-    assert!(error.to_string().contains("keyframe 1 has 152 vertices but keyframe 0 has 153"), "{error}");
+    assert!(
+        error
+            .to_string()
+            .contains("keyframe 1 has 152 vertices but keyframe 0 has 153"),
+        "{error}"
+    );
 
-    assert_eq!(std::fs::read(&path).expect("read"), good, "the good file is untouched");
+    assert_eq!(
+        std::fs::read(&path).expect("read"),
+        good,
+        "the good file is untouched"
+    );
 }
 
 #[test]
@@ -425,9 +595,14 @@ fn write_glb_reports_a_missing_folder_before_exporting() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("renders/flower.glb");
     let mut calls = 0;
-    let error = write_glb(&path, &fixture(3), &GlbOptions::default(), &mut |_| calls += 1)
-        .expect_err("missing folder");
-    assert!(matches!(error, ExportError::MissingFolder { .. }), "{error:?}");
+    let error = write_glb(&path, &fixture(3), &GlbOptions::default(), &mut |_| {
+        calls += 1
+    })
+    .expect_err("missing folder");
+    assert!(
+        matches!(error, ExportError::MissingFolder { .. }),
+        "{error:?}"
+    );
     assert!(error.to_string().contains("renders"), "{error}");
     assert_eq!(calls, 0, "no work done for a destination that cannot exist");
 }

@@ -25,7 +25,10 @@ fn lily_sized_export_sizes_in_every_mode() {
     // the JSON (about 1200 accessors) adds a few percent.
     let dense = bytes(Encoding::Dense, true);
     let target_data = 6 * 390 * 99 * 24;
-    assert!(dense > target_data && dense < target_data * 107 / 100, "{dense}");
+    assert!(
+        dense > target_data && dense < target_data * 107 / 100,
+        "{dense}"
+    );
     for encoding in Encoding::ALL {
         assert!(bytes(encoding, false) < bytes(encoding, true), "{encoding}");
     }
@@ -40,7 +43,10 @@ fn lily_sized_export_sizes_in_every_mode() {
 fn lily_sized_exports_pass_the_validator() {
     let tracks = lily_sized_fixture();
     for encoding in Encoding::ALL {
-        let options = GlbOptions { encoding, ..GlbOptions::default() };
+        let options = GlbOptions {
+            encoding,
+            ..GlbOptions::default()
+        };
         let bytes = glb_bytes(&tracks, &options, &mut |_| {}).expect("export");
         assert_valid_glb(&bytes, &format!("lily-{encoding}"));
     }
