@@ -116,7 +116,7 @@ impl Elastic {
                 // shape, so a line search backs off instead of stepping here.
                 return f64::INFINITY;
             }
-            let d = dihedral_angle(xs) - self.rest_angles[edge as usize];
+            let d = angle_difference(dihedral_angle(xs), self.rest_angles[edge as usize]);
             e += 0.5 * self.bend_stiffness[edge as usize] * d * d;
         }
         for c in contacts {
@@ -194,6 +194,13 @@ impl Elastic {
             }
         }
     }
+}
+
+/// `theta - rest`, wrapped into `[-pi, pi)`: a hinge folding through a
+/// half-turn must not make the energy jump.
+pub fn angle_difference(theta: f64, rest: f64) -> f64 {
+    use std::f64::consts::PI;
+    (theta - rest + PI).rem_euclid(2.0 * PI) - PI
 }
 
 /// The outer product `u v^T`.

@@ -7,14 +7,18 @@
 //!   w-rate along `W`; each edge's new rest length is the mean of its
 //!   triangles' grown lengths (eq. 3);
 //! - the inner triangle `T_in` offsets each edge of `T` outwards in its plane
-//!   by `s = thickness * tan(theta0 / 2)` (`theta0` that edge's current rest
-//!   angle), intersects the offset lines and lifts the corners by
+//!   by `s = thickness * tan(theta0 / 2)`, where `theta0` is that edge's
+//!   dihedral angle *as it is now* (like the lengths, which grow from the
+//!   current triangle; the paper's "current rest angle" would let targets
+//!   the shape cannot reach pile up step after step until a triangle folds), intersects the offset lines and lifts the corners by
 //!   `thickness` along the inner normal; `T_in'` grows with the inner rates;
 //!   `s'` is the in-plane distance from the grown base edge to the midpoint of
 //!   the grown inner edge, and the new rest angle of an edge is the sum over
 //!   its triangles of `atan(s' / thickness)` (eq. 4).
 
 use anthesis_mesh::Topology;
+
+use crate::hinge::dihedral_angle;
 use glam::{DVec2, DVec3};
 
 /// Growth rates of one triangle for one step (`1 + dg * map value`, so 1
@@ -38,13 +42,14 @@ pub struct RegionalGrowth {
     length_sum: Vec<f64>,
     length_count: Vec<u8>,
     angle_sum: Vec<f64>,
+    angle_now: Vec<f64>,
 }
 
 impl RegionalGrowth {
     /// Computes new rest lengths and rest angles from the current shape.
     ///
-    /// `rest_angles` holds the current rest angle per edge and is replaced;
-    /// `rest_lengths` is replaced. `rates` has one entry per triangle.
+    /// `rest_lengths` and `rest_angles` (one per edge) are replaced. `rates`
+    /// has one entry per triangle.
     #[allow(clippy::too_many_arguments)]
     pub fn grow(
         &mut self,
@@ -64,12 +69,17 @@ impl RegionalGrowth {
         self.length_count.resize(edges, 0);
         self.angle_sum.clear();
         self.angle_sum.resize(edges, 0.0);
+        self.angle_now.clear();
+        self.angle_now.extend(topology.edges.iter().map(|e| {
+            e.hinge()
+                .map_or(0.0, |h| dihedral_angle(h.map(|p| positions[p as usize])))
+        }));
 
         for (t, tri) in triangles.iter().enumerate() {
             let x = tri.map(|i| positions[i as usize]);
             let uv = tri.map(|i| uvs[i as usize]);
             let edge_ids = topology.triangle_edges[t];
-            let theta0 = edge_ids.map(|e| rest_angles[e as usize]);
+            let theta0 = edge_ids.map(|e| self.angle_now[e as usize]);
             let grown = grow_triangle(x, uv, &rates[t], thickness, theta0);
             for k in 0..3 {
                 let e = edge_ids[k] as usize;

@@ -11,5 +11,6 @@ pub mod shape_match;
 pub mod solver;
 
 pub use elastic::{Contact, Elastic};
+pub use growth::{GrowthRates, RegionalGrowth};
 
 pub use solver::{NewtonSolver, SolverError, SolverSettings, StepReport};

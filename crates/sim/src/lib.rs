@@ -1,1 +1,370 @@
-//! (being written)
+//! The keyframe simulation loop (paper §3): for each of N steps, grow every
+//! organ's triangles (regional growth), then minimise the energy, attaching
+//! each organ to the receptacle by shape matching and keeping organs on
+//! their side of each other after every iteration. Each step gives one
+//! keyframe.
+//!
+//! Organs are solved in parallel (rayon) but each organ's arithmetic is
+//! sequential and collisions read a snapshot, so results are bit-identical
+//! whatever the thread count.
+
+pub mod collide;
+pub mod fixtures;
+mod organ;
+pub mod worker;
+
+use std::time::Instant;
+
+use anthesis_flower::Project;
+use anthesis_mesh::MeshError;
+use anthesis_physics::{Contact, SolverError};
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::collide::{Surface, Tracker, contacts_against, push_back};
+use crate::organ::OrganSim;
+
+/// Which organs to simulate.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Selection {
+    /// The whole flower, with collisions.
+    All,
+    /// One organ on its own (fast preview), by index into the project's organs.
+    Only(usize),
+}
+
+/// Statistics of one keyframe.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct KeyframeStats {
+    pub index: u32,
+    /// Total elastic energy of the simulated organs after minimisation.
+    pub energy: f64,
+    /// Newton iterations taken (the largest over organs).
+    pub iterations: u32,
+    /// Largest relative gradient over organs at convergence (see
+    /// `SolverSettings::relative_tolerance`).
+    pub gradient_norm: f64,
+    /// Wall time for this keyframe.
+    pub seconds: f64,
+    /// Particles the final push-back moved.
+    pub pushed_particles: u32,
+}
+
+/// One keyframe: world positions of every simulated organ.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Keyframe {
+    pub index: u32,
+    /// One position list per simulated organ, in the order of
+    /// [`Simulation::organs`].
+    pub positions: Vec<Vec<DVec3>>,
+    pub stats: KeyframeStats,
+}
+
+/// Why a run stopped early. Each names the keyframe and organ involved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    #[error("template `{template}` has a bad mesh: {error}")]
+    BadMesh { template: String, error: MeshError },
+    #[error("template `{template}`: {message}")]
+    BadTemplate { template: String, message: String },
+    #[error("organ index {0} does not exist")]
+    NoSuchOrgan(usize),
+    #[error("keyframe {keyframe}, organ `{organ}`: the solver diverged: {error}")]
+    Diverged {
+        keyframe: u32,
+        organ: String,
+        error: SolverError,
+    },
+    #[error(
+        "keyframe {keyframe}, organ `{organ}`: the energy blew up to {energy:.3e} (from {previous:.3e})"
+    )]
+    EnergyBlowUp {
+        keyframe: u32,
+        organ: String,
+        energy: f64,
+        previous: f64,
+    },
+    #[error(
+        "keyframe {keyframe}, organ `{organ}`: not converged after {iterations} iterations (relative gradient {relative_gradient:.3e})"
+    )]
+    NotConverged {
+        keyframe: u32,
+        organ: String,
+        iterations: u32,
+        relative_gradient: f64,
+    },
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// Progress inside a keyframe, reported after every iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IterationProgress {
+    pub keyframe: u32,
+    pub iteration: u32,
+    pub relative_gradient: f64,
+}
+
+/// A running simulation of a project (or of one organ of it).
+pub struct Simulation {
+    organs: Vec<OrganSim>,
+    /// Overlaps between simulated organs, as indices into `organs`.
+    overlaps: Vec<(usize, usize)>,
+    settings: anthesis_flower::SimulationSettings,
+    next_step: u32,
+    /// Energy per organ at the previous keyframe, to spot blow-ups.
+    previous_energy: Vec<f64>,
+}
+
+impl Simulation {
+    pub fn new(project: &Project, selection: &Selection) -> Result<Simulation, SimError> {
+        let flower = &project.flower;
+        let chosen: Vec<usize> = match selection {
+            Selection::All => (0..flower.organs.len()).collect(),
+            Selection::Only(i) if *i < flower.organs.len() => vec![*i],
+            Selection::Only(i) => return Err(SimError::NoSuchOrgan(*i)),
+        };
+        let organs = chosen
+            .iter()
+            .map(|&i| OrganSim::new(&flower.organs[i], flower.template_of(i)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let overlaps = flower
+            .overlaps
+            .iter()
+            .filter_map(|o| {
+                let inner = chosen.iter().position(|&c| c == o.inner)?;
+                let outer = chosen.iter().position(|&c| c == o.outer)?;
+                Some((inner, outer))
+            })
+            .collect();
+        let previous_energy = vec![0.0; organs.len()];
+        Ok(Simulation {
+            organs,
+            overlaps,
+            settings: project.settings,
+            next_step: 1,
+            previous_energy,
+        })
+    }
+
+    /// Names of the simulated organs, in keyframe order.
+    pub fn organs(&self) -> Vec<&str> {
+        self.organs.iter().map(|o| o.name.as_str()).collect()
+    }
+
+    /// Triangles of simulated organ `i`.
+    pub fn triangles(&self, i: usize) -> &[[u32; 3]] {
+        &self.organs[i].mesh.triangles
+    }
+
+    /// UVs of simulated organ `i`.
+    pub fn uvs(&self, i: usize) -> &[glam::DVec2] {
+        &self.organs[i].mesh.uvs
+    }
+
+    /// Display colour of simulated organ `i`.
+    pub fn color(&self, i: usize) -> [f32; 4] {
+        self.organs[i].color
+    }
+
+    pub fn keyframe_count(&self) -> u32 {
+        self.settings.keyframes
+    }
+
+    /// Keyframe 0: the bud, placed on the receptacle.
+    pub fn bud(&self) -> Keyframe {
+        Keyframe {
+            index: 0,
+            positions: self.organs.iter().map(|o| o.initial.clone()).collect(),
+            stats: KeyframeStats {
+                index: 0,
+                energy: 0.0,
+                iterations: 0,
+                gradient_norm: 0.0,
+                seconds: 0.0,
+                pushed_particles: 0,
+            },
+        }
+    }
+
+    /// Whether all keyframes have been computed.
+    pub fn finished(&self) -> bool {
+        self.next_step > self.settings.keyframes
+    }
+
+    /// Computes the next keyframe. `cancel` is polled between iterations;
+    /// when it returns true the step stops with [`SimError::Cancelled`] and
+    /// the simulation must not be stepped again.
+    pub fn step(
+        &mut self,
+        cancel: &dyn Fn() -> bool,
+        progress: &mut dyn FnMut(IterationProgress),
+    ) -> Result<Keyframe, SimError> {
+        let started = Instant::now();
+        let step = self.next_step;
+        self.organs.par_iter_mut().for_each(|o| o.grow(step));
+
+        let solver = self.settings.solver;
+        let mut iterations = 0;
+        let mut converged = false;
+        let mut gradient = 0.0;
+        while iterations < solver.max_iterations {
+            if cancel() {
+                return Err(SimError::Cancelled);
+            }
+            let contacts = self.contacts();
+            let reports: Vec<_> = self
+                .organs
+                .par_iter_mut()
+                .zip(contacts.par_iter())
+                .map(|(o, c)| o.iterate(step, c, &solver))
+                .collect();
+            let mut all_converged = true;
+            gradient = 0.0f64;
+            for (organ, report) in self.organs.iter().zip(reports) {
+                let report = report.map_err(|error| SimError::Diverged {
+                    keyframe: step,
+                    organ: organ.name.clone(),
+                    error,
+                })?;
+                all_converged &= report.converged;
+                gradient = gradient.max(report.relative_gradient);
+            }
+            progress(IterationProgress {
+                keyframe: step,
+                iteration: iterations,
+                relative_gradient: gradient,
+            });
+            if all_converged {
+                converged = true;
+                break;
+            }
+            iterations += 1;
+        }
+        if !converged {
+            let (organ, relative_gradient) = self.worst_organ(&self.contacts());
+            return Err(SimError::NotConverged {
+                keyframe: step,
+                organ,
+                iterations,
+                relative_gradient,
+            });
+        }
+
+        // The paper's push-back: nobody ends on the wrong side.
+        let contacts = self.contacts();
+        let mut pushed = 0;
+        for (organ, c) in self.organs.iter_mut().zip(&contacts) {
+            pushed += push_back(&mut organ.positions, c);
+        }
+
+        let mut energy = 0.0;
+        for (i, organ) in self.organs.iter().enumerate() {
+            let e = organ.energy();
+            if !e.is_finite()
+                || (self.previous_energy[i] > 0.0
+                    && e > 1e6 * self.previous_energy[i].max(organ.energy_floor()))
+            {
+                return Err(SimError::EnergyBlowUp {
+                    keyframe: step,
+                    organ: organ.name.clone(),
+                    energy: e,
+                    previous: self.previous_energy[i],
+                });
+            }
+            self.previous_energy[i] = e;
+            energy += e;
+        }
+        self.next_step += 1;
+        Ok(Keyframe {
+            index: step,
+            positions: self.organs.iter().map(|o| o.positions.clone()).collect(),
+            stats: KeyframeStats {
+                index: step,
+                energy,
+                iterations,
+                gradient_norm: gradient,
+                seconds: started.elapsed().as_secs_f64(),
+                pushed_particles: pushed as u32,
+            },
+        })
+    }
+
+    /// Contacts of every organ against the organs it overlaps, from the
+    /// current positions.
+    fn contacts(&self) -> Vec<Vec<Contact>> {
+        let mut contacts = vec![Vec::new(); self.organs.len()];
+        if self.overlaps.is_empty() {
+            return contacts;
+        }
+        let normals: Vec<Vec<DVec3>> = self
+            .organs
+            .par_iter()
+            .map(|o| anthesis_mesh::vertex_normals(&o.positions, &o.mesh.triangles))
+            .collect();
+        let surfaces: Vec<Surface> = self
+            .organs
+            .iter()
+            .zip(&normals)
+            .map(|(o, n)| Surface {
+                positions: &o.positions,
+                normals: n,
+                mean_edge: o.mean_edge,
+            })
+            .collect();
+        let trackers: Vec<Tracker> = surfaces
+            .par_iter()
+            .map(|s| Tracker::new(s.positions, 2.0 * s.mean_edge))
+            .collect();
+        let offset = self.settings.collision_offset;
+        for &(inner, outer) in &self.overlaps {
+            // Inner particles stay on the outer organ's inner side, outer
+            // particles on the inner organ's outer side.
+            contacts_against(
+                &surfaces[inner],
+                &surfaces[outer],
+                &trackers[outer],
+                1.0,
+                offset,
+                &mut contacts[inner],
+            );
+            contacts_against(
+                &surfaces[outer],
+                &surfaces[inner],
+                &trackers[inner],
+                -1.0,
+                offset,
+                &mut contacts[outer],
+            );
+        }
+        contacts
+    }
+
+    fn worst_organ(&mut self, contacts: &[Vec<Contact>]) -> (String, f64) {
+        let mut worst = (String::new(), -1.0);
+        for (organ, c) in self.organs.iter_mut().zip(contacts) {
+            let g = organ.relative_gradient(c);
+            if g > worst.1 {
+                worst = (organ.name.clone(), g);
+            }
+        }
+        worst
+    }
+}
+
+/// Runs a whole project to the end, calling `on_keyframe` for the bud and
+/// each computed keyframe. Convenience for the command line and tests.
+pub fn run(
+    project: &Project,
+    selection: &Selection,
+    on_keyframe: &mut dyn FnMut(&Simulation, &Keyframe),
+) -> Result<Simulation, SimError> {
+    let mut sim = Simulation::new(project, selection)?;
+    let bud = sim.bud();
+    on_keyframe(&sim, &bud);
+    while !sim.finished() {
+        let keyframe = sim.step(&|| false, &mut |_| {})?;
+        on_keyframe(&sim, &keyframe);
+    }
+    Ok(sim)
+}

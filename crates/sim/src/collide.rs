@@ -1,0 +1,183 @@
+//! Collisions between organs (paper §5.3): each particle tracks its nearest
+//! particle on the organs it overlaps; the floral arrangement says on which
+//! side of that organ it belongs.
+//!
+//! During minimisation a violated side becomes a stiff one-sided penalty
+//! (`anthesis_physics::Contact`), so Newton's method sees the contact and
+//! converges; after convergence the paper's push-back moves every particle
+//! still short of its side onto it, `offset` past the neighbour.
+
+use std::collections::HashMap;
+
+use anthesis_physics::Contact;
+use glam::DVec3;
+
+/// One organ's current geometry as collisions see it.
+pub struct Surface<'a> {
+    pub positions: &'a [DVec3],
+    /// Unit normals pointing to the organ's inner side.
+    pub normals: &'a [DVec3],
+    /// Mean edge length, which sets the search radius.
+    pub mean_edge: f64,
+}
+
+/// Nearest-particle lookup on one organ through a uniform grid.
+pub struct Tracker {
+    cell: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl Tracker {
+    pub fn new(positions: &[DVec3], cell: f64) -> Tracker {
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (i, p) in positions.iter().enumerate() {
+            cells.entry(cell_of(*p, cell)).or_default().push(i as u32);
+        }
+        Tracker { cell, cells }
+    }
+
+    /// The nearest particle within one cell size of `x` (ties go to the
+    /// lower index, so the answer does not depend on hashing order).
+    pub fn nearest(&self, x: DVec3, positions: &[DVec3]) -> Option<u32> {
+        let [cx, cy, cz] = cell_of(x, self.cell);
+        let mut best: Option<(f64, u32)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(list) = self.cells.get(&[cx + dx, cy + dy, cz + dz]) else {
+                        continue;
+                    };
+                    for &i in list {
+                        let d = (positions[i as usize] - x).length_squared();
+                        let better = match best {
+                            None => true,
+                            Some((bd, bi)) => d < bd || (d == bd && i < bi),
+                        };
+                        if better {
+                            best = Some((d, i));
+                        }
+                    }
+                }
+            }
+        }
+        best.filter(|(d, _)| *d <= self.cell * self.cell)
+            .map(|(_, i)| i)
+    }
+}
+
+fn cell_of(p: DVec3, cell: f64) -> [i64; 3] {
+    [
+        (p.x / cell).floor() as i64,
+        (p.y / cell).floor() as i64,
+        (p.z / cell).floor() as i64,
+    ]
+}
+
+/// Contacts for the particles of `moving` against `other`: `side` is +1 if
+/// `moving` belongs on `other`'s inner side (it lies inside), -1 if on its
+/// outer side. Only particles within reach of `other` (two of its mean edges
+/// away, and over it rather than beyond its rim) get a contact.
+pub fn contacts_against(
+    moving: &Surface,
+    other: &Surface,
+    tracker: &Tracker,
+    side: f64,
+    offset: f64,
+    out: &mut Vec<Contact>,
+) {
+    let lateral_limit = other.mean_edge;
+    for (i, x) in moving.positions.iter().enumerate() {
+        let Some(q) = tracker.nearest(*x, other.positions) else {
+            continue;
+        };
+        let point = other.positions[q as usize];
+        let normal = other.normals[q as usize] * side;
+        let d = *x - point;
+        let lateral = (d - normal * d.dot(normal)).length();
+        if lateral > lateral_limit {
+            continue;
+        }
+        out.push(Contact {
+            particle: i as u32,
+            point,
+            normal,
+            offset,
+        });
+    }
+}
+
+/// The paper's push-back: moves each particle that is short of its side
+/// onto it. Returns how many particles moved. If a particle has several
+/// contacts, they are applied in order.
+pub fn push_back(positions: &mut [DVec3], contacts: &[Contact]) -> usize {
+    let mut moved = 0;
+    for c in contacts {
+        let x = &mut positions[c.particle as usize];
+        let violation = c.violation(*x);
+        if violation > 0.0 {
+            *x += c.normal * violation;
+            moved += 1;
+        }
+    }
+    moved
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nearest_matches_brute_force() {
+        let points: Vec<DVec3> = (0..200)
+            .map(|i| {
+                let t = i as f64 * 0.37;
+                DVec3::new(t.sin() * 3.0, (t * 1.3).cos() * 2.0, (t * 0.7).sin())
+            })
+            .collect();
+        let tracker = Tracker::new(&points, 0.8);
+        for k in 0..50 {
+            let x = DVec3::new(
+                (k as f64 * 0.21).cos() * 3.0,
+                (k as f64 * 0.5).sin() * 2.0,
+                0.1,
+            );
+            let brute = (0..points.len())
+                .min_by(|&a, &b| {
+                    (points[a] - x)
+                        .length()
+                        .total_cmp(&(points[b] - x).length())
+                })
+                .map(|i| i as u32);
+            let found = tracker.nearest(x, &points);
+            match found {
+                Some(i) => assert_eq!(Some(i), brute),
+                None => {
+                    let d = (points[brute.expect("nonempty") as usize] - x).length();
+                    assert!(d > 0.8, "missed a point at distance {d}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn push_back_puts_particles_offset_past_the_surface() {
+        let mut positions = vec![DVec3::new(0.0, 0.0, -0.3), DVec3::new(1.0, 0.0, 0.5)];
+        let contacts = [
+            Contact {
+                particle: 0,
+                point: DVec3::ZERO,
+                normal: DVec3::Z,
+                offset: 0.01,
+            },
+            Contact {
+                particle: 1,
+                point: DVec3::new(1.0, 0.0, 0.0),
+                normal: DVec3::Z,
+                offset: 0.01,
+            },
+        ];
+        assert_eq!(push_back(&mut positions, &contacts), 1);
+        assert!((positions[0].z - 0.01).abs() < 1e-15);
+        assert_eq!(positions[1].z, 0.5);
+    }
+}

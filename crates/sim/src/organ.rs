@@ -1,0 +1,284 @@
+//! One organ in a running simulation: its growth maps sampled once per time
+//! key, its elastic state, solver and attachment.
+
+use anthesis_flower::{Organ, Placement, Template, joint_angle_after};
+use anthesis_maps::{KeyedMaps, ScalarMap};
+use anthesis_mesh::{Mesh, Topology};
+use anthesis_physics::elastic::edge_areas;
+use anthesis_physics::shape_match::match_shape;
+use anthesis_physics::{
+    Contact, Elastic, GrowthRates, NewtonSolver, RegionalGrowth, SolverError, SolverSettings,
+    StepReport,
+};
+use glam::{DQuat, DVec2, DVec3};
+
+use crate::SimError;
+
+/// Stiffness map values are clamped to at least this, so a black stiffness
+/// map cannot make the system singular.
+const MIN_STIFFNESS_MAP: f64 = 0.01;
+/// Contact penalty stiffness relative to the mean spring stiffness.
+const CONTACT_STIFFNESS_FACTOR: f64 = 1000.0;
+
+/// A time key's maps, sampled where the simulation needs them: growth values
+/// per triangle (paper eq. 1) and stiffness values per edge (mean of the
+/// edge's two particles, paper §5.1). UVs never change, so this is done once.
+struct SampledKey {
+    e: Vec<f64>,
+    w: Vec<f64>,
+    e_in: Vec<f64>,
+    w_in: Vec<f64>,
+    direction: Vec<DVec2>,
+    stretch: Vec<f64>,
+    bend: Vec<f64>,
+}
+
+impl SampledKey {
+    fn new(maps: &anthesis_maps::GrowthMaps, mesh: &Mesh, topology: &Topology) -> SampledKey {
+        let per_triangle = |map: &ScalarMap| -> Vec<f64> {
+            (0..mesh.triangles.len())
+                .map(|t| map.triangle_value(mesh.triangle_uvs(t)))
+                .collect()
+        };
+        let per_edge = |map: &ScalarMap| -> Vec<f64> {
+            topology
+                .edges
+                .iter()
+                .map(|e| {
+                    let [a, b] = e.vertices.map(|v| map.sample(mesh.uvs[v as usize]));
+                    (0.5 * (a + b)).max(MIN_STIFFNESS_MAP)
+                })
+                .collect()
+        };
+        SampledKey {
+            e: per_triangle(&maps.e_growth),
+            w: per_triangle(&maps.w_growth),
+            e_in: per_triangle(&maps.e_growth_in),
+            w_in: per_triangle(&maps.w_growth_in),
+            direction: (0..mesh.triangles.len())
+                .map(|t| maps.direction.triangle_value(mesh.triangle_uvs(t)))
+                .collect(),
+            stretch: per_edge(&maps.stretch),
+            bend: per_edge(&maps.bend),
+        }
+    }
+}
+
+pub(crate) struct OrganSim {
+    pub name: String,
+    pub color: [f32; 4],
+    /// Bud mesh in the template frame (UVs and triangles are used as is).
+    pub mesh: Mesh,
+    topology: Topology,
+    /// Bud positions on the receptacle (keyframe 0).
+    pub initial: Vec<DVec3>,
+    /// Current world positions.
+    pub positions: Vec<DVec3>,
+    pub mean_edge: f64,
+    placement: Placement,
+    schedule: Vec<anthesis_flower::JointRamp>,
+    base: Vec<u32>,
+    maps: KeyedMaps,
+    keys: Vec<SampledKey>,
+    dg: f64,
+    thickness: f64,
+    stretch_stiffness: f64,
+    bend_stiffness: f64,
+    elastic: Elastic,
+    growth: RegionalGrowth,
+    solver: NewtonSolver,
+    rates: Vec<GrowthRates>,
+    rotation_guess: DQuat,
+    base_current: Vec<DVec3>,
+    base_target: Vec<DVec3>,
+}
+
+impl OrganSim {
+    pub fn new(organ: &Organ, template: &Template) -> Result<OrganSim, SimError> {
+        let bad = |message: String| SimError::BadTemplate {
+            template: template.name.clone(),
+            message,
+        };
+        let topology =
+            anthesis_mesh::validate(&template.mesh).map_err(|error| SimError::BadMesh {
+                template: template.name.clone(),
+                error,
+            })?;
+        if !(template.thickness > 0.0 && template.thickness.is_finite()) {
+            return Err(bad(format!(
+                "thickness must be positive, got {}",
+                template.thickness
+            )));
+        }
+        if !(template.stretch_stiffness > 0.0 && template.bend_stiffness > 0.0) {
+            return Err(bad("stretch and bend stiffness must be positive".into()));
+        }
+        if !template.dg.is_finite() || template.dg <= -1.0 {
+            return Err(bad(format!(
+                "dg must be finite and above -1, got {}",
+                template.dg
+            )));
+        }
+        let base = template.base_region.particles(&template.mesh);
+        if base.len() < 3 {
+            return Err(bad(format!(
+                "the base region (v <= {}) holds {} particles; at least 3 are needed to attach the organ",
+                template.base_region.v_max,
+                base.len()
+            )));
+        }
+        let initial: Vec<DVec3> = template
+            .mesh
+            .positions
+            .iter()
+            .map(|p| organ.placement.world_from_template(*p, 0.0))
+            .collect();
+        let elastic = Elastic::at_rest(&initial, &topology);
+        let mean_edge =
+            elastic.rest_lengths.iter().sum::<f64>() / elastic.rest_lengths.len().max(1) as f64;
+        let solver = NewtonSolver::new(initial.len(), &elastic).map_err(|e| bad(e.to_string()))?;
+        let keys = template
+            .maps
+            .keys()
+            .iter()
+            .map(|k| SampledKey::new(&k.maps, &template.mesh, &topology))
+            .collect();
+        let mut sim = OrganSim {
+            name: organ.name.clone(),
+            color: template.color,
+            mesh: template.mesh.clone(),
+            positions: initial.clone(),
+            initial,
+            mean_edge,
+            placement: organ.placement,
+            schedule: template.joint_schedule.clone(),
+            base_current: Vec::with_capacity(base.len()),
+            base_target: Vec::with_capacity(base.len()),
+            base,
+            maps: template.maps.clone(),
+            keys,
+            dg: template.dg,
+            thickness: template.thickness,
+            stretch_stiffness: template.stretch_stiffness,
+            bend_stiffness: template.bend_stiffness,
+            elastic,
+            growth: RegionalGrowth::default(),
+            solver,
+            rates: Vec::new(),
+            rotation_guess: DQuat::IDENTITY,
+            topology,
+        };
+        sim.update_stiffness(0);
+        Ok(sim)
+    }
+
+    /// Regional growth for `step`: new rest lengths, rest angles and
+    /// stiffness from the current shape and the maps blended at `step`.
+    pub fn grow(&mut self, step: u32) {
+        let weights = self.maps.weights_at(f64::from(step));
+        let blend = |values: fn(&SampledKey) -> &Vec<f64>, t: usize| -> f64 {
+            weights
+                .iter()
+                .map(|&(k, w)| w * values(&self.keys[k])[t])
+                .sum()
+        };
+        let dg = self.dg;
+        self.rates = (0..self.mesh.triangles.len())
+            .map(|t| GrowthRates {
+                e: 1.0 + dg * blend(|k| &k.e, t),
+                w: 1.0 + dg * blend(|k| &k.w, t),
+                e_in: 1.0 + dg * blend(|k| &k.e_in, t),
+                w_in: 1.0 + dg * blend(|k| &k.w_in, t),
+                direction_in_uv: weights
+                    .iter()
+                    .map(|&(k, w)| self.keys[k].direction[t] * w)
+                    .sum(),
+            })
+            .collect();
+        self.growth.grow(
+            &self.positions,
+            &self.mesh.uvs,
+            &self.mesh.triangles,
+            &self.topology,
+            &self.rates,
+            self.thickness,
+            &mut self.elastic.rest_lengths,
+            &mut self.elastic.rest_angles,
+        );
+        self.update_stiffness(step);
+    }
+
+    fn update_stiffness(&mut self, step: u32) {
+        let weights = self.maps.weights_at(f64::from(step.max(1)));
+        let areas = edge_areas(&self.positions, &self.mesh.triangles, &self.topology);
+        for (e, area) in areas.iter().enumerate() {
+            let stretch: f64 = weights
+                .iter()
+                .map(|&(k, w)| w * self.keys[k].stretch[e])
+                .sum();
+            let bend: f64 = weights.iter().map(|&(k, w)| w * self.keys[k].bend[e]).sum();
+            self.elastic.stretch_stiffness[e] = area * self.stretch_stiffness * stretch;
+            self.elastic.bend_stiffness[e] = area * self.bend_stiffness * bend;
+        }
+        let mean_ks = self.elastic.stretch_stiffness.iter().sum::<f64>()
+            / self.elastic.stretch_stiffness.len().max(1) as f64;
+        self.elastic.contact_stiffness = CONTACT_STIFFNESS_FACTOR * mean_ks;
+    }
+
+    /// One Newton iteration, then shape matching of the base particles onto
+    /// where the receptacle and the joint schedule put them.
+    pub fn iterate(
+        &mut self,
+        step: u32,
+        contacts: &[Contact],
+        settings: &SolverSettings,
+    ) -> Result<StepReport, SolverError> {
+        let report = self
+            .solver
+            .step(&self.elastic, contacts, &mut self.positions, settings)?;
+        self.attach(step);
+        Ok(report)
+    }
+
+    /// Applies to the whole organ the rigid motion that best carries its
+    /// base particles onto their places on the receptacle at `step`.
+    pub fn attach(&mut self, step: u32) {
+        let extra = joint_angle_after(&self.schedule, step);
+        self.base_current.clear();
+        self.base_target.clear();
+        for &b in &self.base {
+            self.base_current.push(self.positions[b as usize]);
+            self.base_target.push(
+                self.placement
+                    .world_from_template(self.mesh.positions[b as usize], extra),
+            );
+        }
+        let transform = match_shape(&self.base_current, &self.base_target, self.rotation_guess);
+        self.rotation_guess = transform.rotation;
+        for p in &mut self.positions {
+            *p = transform.apply(*p);
+        }
+    }
+
+    pub fn energy(&self) -> f64 {
+        self.elastic.energy(&self.positions, &[])
+    }
+
+    /// An energy below which changes are noise: a billionth of the energy of
+    /// all edges at 100 % strain.
+    pub fn energy_floor(&self) -> f64 {
+        let full: f64 = self
+            .elastic
+            .stretch_stiffness
+            .iter()
+            .zip(&self.elastic.rest_lengths)
+            .map(|(k, l)| 0.5 * k * l * l)
+            .sum();
+        1e-9 * full
+    }
+
+    pub fn relative_gradient(&mut self, contacts: &[Contact]) -> f64 {
+        self.solver
+            .relative_gradient(&self.elastic, contacts, &self.positions)
+    }
+}
