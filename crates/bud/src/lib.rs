@@ -1,1 +1,201 @@
-//! (being written)
+//! Bud builders: organs (petals, sepals) from parametric surfaces — bicubic
+//! Bézier patches and PDE sweep surfaces — remeshed into near-isotropic
+//! triangle meshes with UVs.
+//!
+//! ```
+//! use anthesis_bud::{RemeshOptions, build_organ, lily_petal_surface};
+//!
+//! let bud = build_organ(&lily_petal_surface(), &RemeshOptions::new(1.3))?;
+//! assert!(bud.quality.min_angle_deg >= 30.0);
+//! println!("{} vertices, mean edge {:.2}", bud.quality.vertices, bud.quality.mean_edge);
+//! # Ok::<(), anthesis_bud::BudError>(())
+//! ```
+//!
+//! Conventions (ARCHITECTURE.md): the surface is given in the organ template
+//! frame (base at the origin, growing along +Y, inner side facing −Z). The
+//! mesh UVs are the surface parameters: `u` across (midrib at `u = 0.5` for a
+//! symmetric surface), `v` from the base (`0`) to the tip (`1`). Triangles
+//! wind counter-clockwise around the normal that points to the inner side
+//! (see [`InnerSide`]).
+//!
+//! The mesh is built in three steps: rows of points at constant 3D spacing
+//! along `v`, each spaced evenly in 3D arc length and staggered like a
+//! hexagonal lattice, with the margins sampled separately at the target
+//! spacing; rows and margins stitched into triangle strips; then alternating
+//! edge flips (raising the smallest angle) and tangential smoothing in the
+//! parameter domain, with boundary vertices sliding along their boundary.
+
+mod examples;
+mod quality;
+mod remesh;
+mod surface;
+
+pub use examples::{eustoma_petal_surface, lily_petal_surface};
+pub use quality::{MeshQuality, find_self_intersection, quality};
+pub use surface::{BezierCurve, BezierPatch, MAX_STRETCH_TO_BEND, PdeSweep, Surface, bernstein3};
+
+use anthesis_mesh::{Mesh, MeshError};
+use thiserror::Error;
+
+/// Which side of the surface is the organ's inner (adaxial) side; the mesh
+/// winds counter-clockwise around the normal pointing to it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InnerSide {
+    /// The side the surface faces on average towards −Z (the template
+    /// frame's inner direction): the winding is chosen so the area-weighted
+    /// mean normal has a negative Z component. If the mean normal has no Z
+    /// component at all, the surface normal `dS/du × dS/dv` is kept.
+    #[default]
+    Auto,
+    /// The side `dS/du × dS/dv` points to.
+    AlongSurfaceNormal,
+    /// The side `−(dS/du × dS/dv)` points to.
+    AgainstSurfaceNormal,
+}
+
+/// How to remesh a surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RemeshOptions {
+    /// The mean 3D edge length to aim for (the paper: 1.3 for a lily petal,
+    /// 1.4 for a sepal, 2.0 for an Eustoma petal).
+    pub target_edge: f64,
+    /// Rounds of edge flips + tangential smoothing.
+    pub smoothing_iterations: usize,
+    /// The mesh is refused if its smallest angle (degrees) is below this.
+    pub min_angle_floor_deg: f64,
+    /// The mesh is refused if it would need more vertices than this.
+    pub max_vertices: usize,
+    pub inner_side: InnerSide,
+    /// Check the finished mesh for self-intersections (cheap: a spatial hash).
+    pub check_self_intersection: bool,
+}
+
+impl RemeshOptions {
+    /// Defaults for `target_edge`: 40 smoothing rounds, quality floor 20°,
+    /// at most 200 000 vertices, inner side chosen automatically,
+    /// self-intersection check on.
+    pub fn new(target_edge: f64) -> Self {
+        RemeshOptions {
+            target_edge,
+            smoothing_iterations: 40,
+            min_angle_floor_deg: 20.0,
+            max_vertices: 200_000,
+            inner_side: InnerSide::Auto,
+            check_self_intersection: true,
+        }
+    }
+}
+
+/// A remeshed organ and its quality.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bud {
+    pub mesh: Mesh,
+    pub quality: MeshQuality,
+}
+
+/// Why a surface could not be meshed.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum BudError {
+    #[error("the target edge length must be a positive number, got {0}")]
+    InvalidTargetEdge(f64),
+    #[error("the surface has a non-finite point (NaN or infinite) at (u, v) = ({u:.3}, {v:.3})")]
+    NonFinitePoint { u: f64, v: f64 },
+    #[error(
+        "the surface has no length from base to tip (its lines of constant u are single points)"
+    )]
+    ZeroLength,
+    #[error(
+        "the surface has zero width at v = {v:.3}; only the tip (v = 1) may come to a point, the base and the blade need a width"
+    )]
+    ZeroWidth { v: f64 },
+    #[error(
+        "target edge {target_edge} is too large for this organ ({length:.3} long from base to tip): it would get {rows} rows of vertices, at least 3 are needed"
+    )]
+    TooFewRows {
+        target_edge: f64,
+        length: f64,
+        rows: usize,
+    },
+    #[error(
+        "target edge {target_edge} is too small for this organ (area {area:.3}): it would need about {estimated} vertices, more than the limit of {limit}"
+    )]
+    TooManyVertices {
+        target_edge: f64,
+        area: f64,
+        estimated: usize,
+        limit: usize,
+    },
+    #[error(
+        "the mesh quality is below the floor: triangle {triangle} has a {angle_deg:.1}° angle, the smallest allowed is {floor_deg:.1}° (the shape may have a very sharp tip or corner, or the target edge is too large for its narrow parts)"
+    )]
+    PoorQuality {
+        triangle: usize,
+        angle_deg: f64,
+        floor_deg: f64,
+    },
+    #[error(
+        "the surface intersects itself: triangles {first} and {second} of the mesh cross (near {near_in_template})"
+    )]
+    SelfIntersection {
+        first: usize,
+        second: usize,
+        near_in_template: glam::DVec3,
+    },
+    #[error("the remeshed organ is not a valid mesh: {0}")]
+    InvalidMesh(#[from] MeshError),
+}
+
+/// Remeshes `surface` into a near-isotropic triangle mesh with mean edge
+/// close to `options.target_edge`, UVs equal to the surface parameters and
+/// the winding chosen by `options.inner_side`; reports its quality.
+pub fn build_organ(surface: &dyn Surface, options: &RemeshOptions) -> Result<Bud, BudError> {
+    let mut mesh = remesh::remesh(surface, options)?;
+    orient(&mut mesh, options.inner_side);
+    anthesis_mesh::validate::validate(&mesh)?;
+    let quality = quality(&mesh);
+    if quality.min_angle_deg < options.min_angle_floor_deg {
+        return Err(BudError::PoorQuality {
+            triangle: quality.min_angle_triangle,
+            angle_deg: quality.min_angle_deg,
+            floor_deg: options.min_angle_floor_deg,
+        });
+    }
+    if options.check_self_intersection
+        && let Some([first, second]) = find_self_intersection(&mesh)
+    {
+        let near_in_template = mesh.triangle_positions(first).iter().sum::<glam::DVec3>() / 3.0;
+        return Err(BudError::SelfIntersection {
+            first,
+            second,
+            near_in_template,
+        });
+    }
+    Ok(Bud { mesh, quality })
+}
+
+/// The area-weighted mean normal direction of the mesh as wound (not
+/// normalised; zero for an empty mesh).
+pub fn mean_normal(mesh: &Mesh) -> glam::DVec3 {
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            (b - a).cross(c - a)
+        })
+        .sum()
+}
+
+/// Sets the winding. The remesher winds counter-clockwise in UV, i.e. around
+/// `dS/du × dS/dv`.
+fn orient(mesh: &mut Mesh, inner_side: InnerSide) {
+    let flip = match inner_side {
+        InnerSide::AlongSurfaceNormal => false,
+        InnerSide::AgainstSurfaceNormal => true,
+        InnerSide::Auto => mean_normal(mesh).z > 0.0,
+    };
+    if flip {
+        for t in &mut mesh.triangles {
+            t.swap(1, 2);
+        }
+    }
+}
