@@ -378,3 +378,37 @@ fn self_intersecting_surface_is_refused() {
     o.check_self_intersection = false;
     assert!(build_organ(&loop_strip, &o).is_ok());
 }
+
+#[test]
+fn examples_sit_in_the_template_frame() {
+    for (name, surface) in [
+        ("lily", &lily_petal_surface() as &dyn Surface),
+        ("eustoma", &eustoma_petal_surface() as &dyn Surface),
+    ] {
+        // The base's middle is at the origin and the organ grows along +Y.
+        let base = surface.point(DVec2::new(0.5, 0.0));
+        assert!(base.length() < 1e-12, "{name}: base at {base}");
+        let heights: Vec<f64> = (0..=10)
+            .map(|k| surface.point(DVec2::new(0.5, k as f64 / 10.0)).y)
+            .collect();
+        assert!(
+            heights.windows(2).all(|w| w[1] > w[0]),
+            "{name}: {heights:?}"
+        );
+        // The organ leans out (+Z) and its top bends back in towards the
+        // flower axis (−Z), so the bud closes.
+        let z = |v: f64| surface.point(DVec2::new(0.5, v)).z;
+        assert!(
+            z(0.4) > 1.0 && z(1.0) < 0.0,
+            "{name}: {} {}",
+            z(0.4),
+            z(1.0)
+        );
+        // Symmetric about the YZ plane: u and 1 - u mirror in X.
+        for (u, v) in [(0.1, 0.3), (0.3, 0.7), (0.45, 0.95)] {
+            let a = surface.point(DVec2::new(u, v));
+            let b = surface.point(DVec2::new(1.0 - u, v));
+            assert!((a - DVec3::new(-b.x, b.y, b.z)).length() < 1e-12, "{name}");
+        }
+    }
+}
