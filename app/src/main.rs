@@ -1,3 +1,5 @@
-fn main() {
-    println!("anthesis: being written");
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    anthesis_app::cli::main()
 }
