@@ -15,7 +15,11 @@ use clap::{Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 
 #[derive(Debug, Parser)]
-#[command(name = "anthesis", version, about = "Author flower-opening animations by painting growth.")]
+#[command(
+    name = "anthesis",
+    version,
+    about = "Author flower-opening animations by painting growth."
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
@@ -85,7 +89,11 @@ pub fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => {
             // Help and version are not errors.
-            let code = if e.use_stderr() { ExitCode::from(2) } else { ExitCode::SUCCESS };
+            let code = if e.use_stderr() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::SUCCESS
+            };
             let _ = e.print();
             return code;
         }
@@ -93,10 +101,21 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", one_line(&format!("{e:#}")));
             ExitCode::FAILURE
         }
     }
+}
+
+/// Folds a multi-line message (TOML errors quote the offending line) into
+/// one line.
+fn one_line(message: &str) -> String {
+    message
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && *l != "|")
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 pub fn run(cli: Cli) -> Result<()> {
@@ -135,13 +154,21 @@ pub fn run(cli: Cli) -> Result<()> {
                 normals: !no_normals,
                 encoding: encoding.into(),
             };
-            simulate(&project, organ.as_deref(), keyframes, stats.as_deref(), out.as_deref(), &glb)
+            simulate(
+                &project,
+                organ.as_deref(),
+                keyframes,
+                stats.as_deref(),
+                out.as_deref(),
+                &glb,
+            )
         }
     }
 }
 
 fn load(path: &Path) -> Result<Project> {
-    load_project(path).with_context(|| format!("cannot open project {}", path.display()))
+    // The project error names the file itself.
+    load_project(path).context("cannot open project")
 }
 
 fn info(path: &Path) -> Result<()> {
@@ -192,7 +219,12 @@ fn simulate(
         Some(name) => match project.flower.organ_index(name) {
             Some(i) => Selection::Only(i),
             None => {
-                let names: Vec<&str> = project.flower.organs.iter().map(|o| o.name.as_str()).collect();
+                let names: Vec<&str> = project
+                    .flower
+                    .organs
+                    .iter()
+                    .map(|o| o.name.as_str())
+                    .collect();
                 bail!("no organ named `{name}` (organs: {})", names.join(", "));
             }
         },
@@ -223,7 +255,10 @@ fn simulate(
     if show_progress {
         eprintln!();
     }
-    eprintln!("simulated {total} keyframes of {} organ(s) in {seconds:.2} s", sim.organs().len());
+    eprintln!(
+        "simulated {total} keyframes of {} organ(s) in {seconds:.2} s",
+        sim.organs().len()
+    );
 
     if let Some(stats_path) = stats_path {
         let file = StatsFile {
@@ -252,18 +287,29 @@ fn simulate(
 }
 
 fn is_glb(path: &Path) -> bool {
-    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
 }
 
 /// Fails early, before a long simulation, when the output cannot be written.
 fn check_output(out: &Path) -> Result<()> {
     if is_glb(out) {
-        let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let parent = out
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
         if !parent.is_dir() {
-            bail!("cannot write {}: folder {} does not exist", out.display(), parent.display());
+            bail!(
+                "cannot write {}: folder {} does not exist",
+                out.display(),
+                parent.display()
+            );
         }
     } else if out.exists() && !out.is_dir() {
-        bail!("--out {} must be a .glb file or a folder for OBJ files", out.display());
+        bail!(
+            "--out {} must be a .glb file or a folder for OBJ files",
+            out.display()
+        );
     }
     Ok(())
 }

@@ -69,7 +69,7 @@ pub fn petal_template(name: &str, columns: usize, rows: usize) -> Template {
 
 /// `organs` petals of one template (`columns x rows` particles) in a whorl,
 /// alternating inner and outer so neighbours overlap like a lily's petals
-/// and sepals.
+/// and sepals (overlap rules between neighbours from three organs on).
 pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Project {
     let template = petal_template("petal", columns, rows);
     let organs_list: Vec<Organ> = (0..organs)
@@ -92,7 +92,7 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
             o
         })
         .collect();
-    let overlaps = if organs >= 2 {
+    let overlaps = if organs >= 3 {
         (0..organs)
             .filter(|i| i % 2 == 0)
             .flat_map(|i| [(i, (i + 1) % organs), (i, (i + organs - 1) % organs)])

@@ -75,6 +75,8 @@ pub(crate) struct OrganSim {
     /// Current world positions.
     pub positions: Vec<DVec3>,
     pub mean_edge: f64,
+    /// Whether each particle is a base particle.
+    pub is_base: Vec<bool>,
     placement: Placement,
     schedule: Vec<anthesis_flower::JointRamp>,
     base: Vec<u32>,
@@ -150,6 +152,9 @@ impl OrganSim {
             positions: initial.clone(),
             initial,
             mean_edge,
+            is_base: (0..template.mesh.vertex_count() as u32)
+                .map(|i| base.contains(&i))
+                .collect(),
             placement: organ.placement,
             schedule: template.joint_schedule.clone(),
             base_current: Vec::with_capacity(base.len()),

@@ -1,0 +1,155 @@
+//! The `anthesis` binary end to end: a project on disk in, a one-line
+//! answer or files out, and a non-zero exit with one line on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn anthesis(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn saved_whorl(dir: &Path, organs: usize, keyframes: u32) -> PathBuf {
+    let project = anthesis_sim::fixtures::whorl(organs, 8, 14, keyframes);
+    let path = dir.join("whorl.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    path
+}
+
+#[test]
+fn info_prints_one_line_per_organ_with_counts() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 3);
+    let out = anthesis(&["info", path.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(
+        lines,
+        ["petal-1 petal 112 182 293", "sepal-1 petal 112 182 293"]
+    );
+}
+
+#[test]
+fn simulate_writes_stats_json_and_a_glb() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 4);
+    let stats = dir.path().join("stats.json");
+    let glb = dir.path().join("out.glb");
+    let out = anthesis(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--keyframes",
+        "5",
+        "--stats",
+        stats.to_str().expect("utf-8"),
+        "--out",
+        glb.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).expect("stats")).expect("json");
+    let keyframes = json["keyframes"].as_array().expect("keyframes array");
+    assert_eq!(keyframes.len(), 5);
+    for (i, k) in keyframes.iter().enumerate() {
+        assert_eq!(k["index"], i + 1);
+        for field in ["energy", "iterations", "gradient_norm", "seconds"] {
+            assert!(k[field].is_number(), "keyframe {i} lacks {field}");
+        }
+    }
+    let bytes = std::fs::read(&glb).expect("glb written");
+    assert_eq!(&bytes[..4], b"glTF");
+}
+
+#[test]
+fn simulate_one_organ_and_obj_output() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 2);
+    let objs = dir.path().join("objs");
+    std::fs::create_dir(&objs).expect("mkdir");
+    let out = anthesis(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--organ",
+        "sepal-1",
+        "--out",
+        objs.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let count = std::fs::read_dir(&objs).expect("list").count();
+    assert_eq!(count, 3, "bud + 2 keyframes");
+    let first = std::fs::read_dir(&objs)
+        .expect("list")
+        .next()
+        .expect("a file")
+        .expect("entry")
+        .path();
+    let obj = std::fs::read_to_string(first).expect("read");
+    assert!(obj.contains("o sepal-1") && !obj.contains("petal-1"));
+}
+
+#[test]
+fn bad_input_gives_one_line_and_a_non_zero_exit() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 1, 2);
+    let p = path.to_str().expect("utf-8");
+    let missing = dir.path().join("nope.anthesis.toml");
+    let truncated = dir.path().join("cut.anthesis.toml");
+    let full = std::fs::read_to_string(&path).expect("read");
+    // Cut inside a quoted string, as a crash mid-write would.
+    let cut = full.find("name = \"").expect("a name") + 9;
+    std::fs::write(&truncated, &full[..cut]).expect("write");
+    let cases: Vec<Vec<String>> = vec![
+        vec!["info".into(), missing.display().to_string()],
+        vec!["info".into(), truncated.display().to_string()],
+        vec![
+            "simulate".into(),
+            p.into(),
+            "--organ".into(),
+            "nobody".into(),
+        ],
+        vec![
+            "simulate".into(),
+            p.into(),
+            "--keyframes".into(),
+            "0".into(),
+        ],
+        vec![
+            "simulate".into(),
+            p.into(),
+            "--out".into(),
+            "/no/such/folder/x.glb".into(),
+        ],
+    ];
+    for args in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = anthesis(&args);
+        assert!(!out.status.success(), "{args:?} should fail");
+        let stderr = text(&out.stderr);
+        assert_eq!(
+            stderr.trim_end().lines().count(),
+            1,
+            "{args:?}: one line expected, got:\n{stderr}"
+        );
+        assert!(stderr.starts_with("error: "), "{stderr}");
+    }
+    let out = anthesis(&["simulate"]);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "a missing argument is a usage error"
+    );
+}
+
+#[test]
+fn without_a_subcommand_it_says_the_window_is_not_built_yet() {
+    let out = anthesis(&[]);
+    assert!(out.status.success());
+    assert!(text(&out.stdout).contains("desktop application is not built yet"));
+}
