@@ -1,0 +1,838 @@
+//! The project file format: saving and loading real files, and the errors
+//! for broken ones.
+
+use std::collections::HashMap;
+use std::fs;
+use std::io;
+use std::path::{Path, PathBuf};
+
+use anthesis_flower::project::{
+    FORMAT_VERSION, ProjectError, UNNAMED_PROJECT, load_project, parse_project, project_to_toml,
+    save_project,
+};
+use anthesis_flower::{
+    BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings, Template,
+};
+use anthesis_maps::{
+    BitDepth, Blend, DirectionMap, GrowthMaps, KeyedMaps, MapError, MapKey, MapKind, ScalarMap,
+};
+use anthesis_mesh::MeshError;
+use anthesis_mesh::generate::test_petal;
+use anthesis_physics::SolverSettings;
+use glam::{DVec2, DVec3};
+
+/// A value a 16-bit greyscale PNG holds exactly, as the map loader reads it.
+fn grey16(value: f64) -> f32 {
+    let code = (value.clamp(0.0, 1.0) * 65535.0).round() as u16;
+    f32::from(code) / 65535.0
+}
+
+/// A direction component a 16-bit PNG holds exactly, as the loader reads it.
+fn signed16(value: f64) -> f32 {
+    let code = (32768.0 + value.clamp(-1.0, 1.0) * 32767.0).round() as u16;
+    (f32::from(code) - 32768.0) / 32767.0
+}
+
+/// A scalar raster whose values survive a 16-bit PNG exactly.
+fn exact_raster(width: u32, height: u32, value_at: impl Fn(DVec2) -> f64) -> ScalarMap {
+    ScalarMap::from_fn(width, height, |uv| grey16(value_at(uv)))
+}
+
+fn petal_template() -> Template {
+    let early = GrowthMaps {
+        e_growth: exact_raster(8, 6, |uv| 0.2 + 0.7 * uv.y),
+        w_growth: ScalarMap::constant(0.2),
+        e_growth_in: exact_raster(8, 6, |uv| (uv.x - 0.5).abs() + 0.3 * uv.y),
+        w_growth_in: ScalarMap::constant(0.35),
+        stretch: ScalarMap::constant(1.0),
+        bend: exact_raster(8, 6, |uv| 1.0 - 0.5 * uv.y),
+        direction: DirectionMap::from_fn(8, 6, |uv| {
+            let direction = DVec2::new(0.4 * (uv.x - 0.5), 0.9);
+            DVec2::new(
+                f64::from(signed16(direction.x)),
+                f64::from(signed16(direction.y)),
+            )
+        }),
+    };
+    let late = GrowthMaps {
+        e_growth: ScalarMap::constant(0.05),
+        w_growth: ScalarMap::constant(0.0),
+        e_growth_in: exact_raster(8, 6, |uv| 0.1 * uv.x),
+        w_growth_in: ScalarMap::constant(0.0),
+        stretch: ScalarMap::constant(1.5),
+        bend: ScalarMap::constant(2.0),
+        direction: DirectionMap::constant(DVec2::new(0.25, 0.75)),
+    };
+    let maps = KeyedMaps::new(
+        vec![
+            MapKey {
+                step: 50,
+                maps: late,
+            },
+            MapKey {
+                step: 0,
+                maps: early,
+            },
+        ],
+        Blend::Smooth,
+    )
+    .expect("two keys at distinct steps");
+    Template {
+        name: "Petal".to_string(),
+        mesh: test_petal(10.0, 4.0, 6, 9),
+        maps,
+        dg: 0.003,
+        thickness: 0.2,
+        stretch_stiffness: 20.0,
+        bend_stiffness: 18.5,
+        base_region: BaseRegion {
+            v_max: 0.06,
+            u_min: 0.1,
+            u_max: 0.9,
+        },
+        joint_schedule: vec![
+            JointRamp {
+                from_step: 0,
+                to_step: 60,
+                degrees: 23.0,
+            },
+            JointRamp {
+                from_step: 70,
+                to_step: 90,
+                degrees: -4.5,
+            },
+        ],
+        color: [0.98, 0.62, 0.32, 1.0],
+    }
+}
+
+fn sepal_template() -> Template {
+    let mut maps = GrowthMaps::uniform();
+    maps.e_growth = ScalarMap::constant(0.4);
+    maps.direction = DirectionMap::constant(DVec2::new(-0.1, 1.0));
+    Template {
+        name: "Outer sepal".to_string(),
+        mesh: test_petal(12.0, 3.0, 5, 7),
+        maps: KeyedMaps::new(
+            vec![MapKey { step: 10, maps }],
+            Blend::Logistic { steepness: 7.5 },
+        )
+        .expect("one key"),
+        dg: -0.001,
+        thickness: 0.35,
+        stretch_stiffness: 30.0,
+        bend_stiffness: 25.0,
+        base_region: BaseRegion::default(),
+        joint_schedule: Vec::new(),
+        color: [0.3, 0.55, 0.2, 0.9],
+    }
+}
+
+fn lily() -> Project {
+    let organ = |name: &str, template, azimuth_deg: f64, joint_angle_deg| Organ {
+        name: name.to_string(),
+        template,
+        placement: Placement {
+            position: DVec3::new(
+                0.8 * azimuth_deg.to_radians().sin(),
+                0.1,
+                0.8 * azimuth_deg.to_radians().cos(),
+            ),
+            azimuth_deg,
+            joint_angle_deg,
+        },
+    };
+    Project {
+        name: "Asiatic lily \"test\"".to_string(),
+        flower: Flower {
+            templates: vec![petal_template(), sepal_template()],
+            organs: vec![
+                organ("petal-1", 0, 0.0, 10.0),
+                organ("petal-2", 0, 120.0, 10.0),
+                organ("sepal-1", 1, 60.0, 12.5),
+            ],
+            overlaps: vec![Overlap { inner: 0, outer: 2 }],
+        },
+        settings: SimulationSettings {
+            keyframes: 80,
+            solver: SolverSettings {
+                relative_tolerance: 1e-7,
+                max_iterations: 40,
+            },
+            collision_offset: 0.02,
+        },
+    }
+}
+
+/// The lily saved in a fresh folder: the folder (kept alive) and the file.
+fn saved_lily() -> (tempfile::TempDir, PathBuf) {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily").join("lily.anthesis.toml");
+    save_project(&lily(), &path).expect("the lily saves");
+    (folder, path)
+}
+
+/// Rewrites the project file with `edit` applied to its text.
+fn edit(path: &Path, edit: impl Fn(String) -> String) {
+    let text = fs::read_to_string(path).expect("read project");
+    let edited = edit(text.clone());
+    assert_ne!(edited, text, "the edit changed nothing");
+    fs::write(path, edited).expect("write project");
+}
+
+fn replace_once(text: String, from: &str, to: &str) -> String {
+    assert!(text.contains(from), "`{from}` not in\n{text}");
+    text.replacen(from, to, 1)
+}
+
+/// All files under `folder`, by path relative to it, with their bytes.
+fn files_under(folder: &Path) -> HashMap<PathBuf, Vec<u8>> {
+    let mut files = HashMap::new();
+    let mut pending = vec![folder.to_path_buf()];
+    while let Some(current) = pending.pop() {
+        for entry in fs::read_dir(&current).expect("list folder") {
+            let path = entry.expect("entry").path();
+            if path.is_dir() {
+                pending.push(path);
+            } else {
+                let relative = path.strip_prefix(folder).expect("inside").to_path_buf();
+                files.insert(relative, fs::read(&path).expect("read file"));
+            }
+        }
+    }
+    files
+}
+
+#[test]
+fn saving_then_loading_gives_an_equal_project() {
+    let (_folder, path) = saved_lily();
+    let loaded = load_project(&path).expect("the saved lily loads");
+    assert_eq!(loaded, lily());
+}
+
+#[test]
+fn saved_files_have_stable_names_and_constants_stay_numbers() {
+    let (_folder, path) = saved_lily();
+    let project_folder = path.parent().expect("folder");
+    let mut names: Vec<String> = files_under(project_folder)
+        .keys()
+        .map(|p| p.to_string_lossy().replace('\\', "/"))
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "lily.anthesis.toml",
+            "maps/petal-step0-bend.png",
+            "maps/petal-step0-direction.png",
+            "maps/petal-step0-e_growth.png",
+            "maps/petal-step0-e_growth_in.png",
+            "maps/petal-step50-e_growth_in.png",
+            "meshes/outer_sepal.obj",
+            "meshes/petal.obj",
+        ]
+    );
+    let text = fs::read_to_string(&path).expect("read");
+    for line in [
+        "format = \"anthesis-project\"",
+        "version = 1",
+        "w_growth = 0.2",
+        "direction = [0.25, 0.75]",
+        "e_growth = \"maps/petal-step0-e_growth.png\"",
+        "mesh = \"meshes/outer_sepal.obj\"",
+        "blend = \"smooth\"",
+    ] {
+        assert!(
+            text.lines().any(|l| l.trim() == line),
+            "no line `{line}` in\n{text}"
+        );
+    }
+    // Keys come out in step order.
+    let first = text.find("step = 0").expect("key at step 0");
+    let second = text.find("step = 50").expect("key at step 50");
+    assert!(first < second);
+    // The saved maps are 16-bit PNGs.
+    let bytes = fs::read(project_folder.join("maps/petal-step0-e_growth.png")).expect("read");
+    assert_eq!(bytes[24], 16, "bit depth byte of the IHDR chunk");
+    assert_eq!(
+        project_to_toml(&lily(), &path).expect("same text"),
+        text,
+        "project_to_toml gives the text save_project writes"
+    );
+}
+
+#[test]
+fn arbitrary_map_values_are_quantised_once_and_saves_are_stable() {
+    let mut project = lily();
+    let key_maps = &mut project.flower.templates[0].maps.keys_mut()[0].maps;
+    key_maps.e_growth = ScalarMap::from_fn(8, 6, |uv| (0.123_456_7 + 0.5 * uv.x * uv.y) as f32);
+    key_maps.direction = DirectionMap::from_fn(8, 6, |uv| DVec2::new(0.333 * uv.x, -0.777));
+    let original_e_growth = key_maps.e_growth.clone();
+
+    let folder = tempfile::tempdir().expect("temp dir");
+    let first_path = folder.path().join("a").join("p.anthesis.toml");
+    save_project(&project, &first_path).expect("save");
+    let loaded = load_project(&first_path).expect("load");
+    let loaded_e_growth = &loaded.flower.templates[0].maps.keys()[0].maps.e_growth;
+    for (saved, read) in original_e_growth
+        .values()
+        .iter()
+        .zip(loaded_e_growth.values())
+    {
+        assert!(
+            (saved - read).abs() <= 0.5 / 65535.0 + 1e-7,
+            "{saved} vs {read}"
+        );
+    }
+
+    let second_path = folder.path().join("b").join("p.anthesis.toml");
+    save_project(&loaded, &second_path).expect("save again");
+    assert_eq!(
+        files_under(first_path.parent().expect("a")),
+        files_under(second_path.parent().expect("b")),
+        "saving what was loaded writes the same bytes"
+    );
+    assert_eq!(load_project(&second_path).expect("load again"), loaded);
+}
+
+#[test]
+fn saving_over_a_project_replaces_it() {
+    let (_folder, path) = saved_lily();
+    let mut project = lily();
+    project.name = "Renamed".to_string();
+    project.flower.templates[0].thickness = 0.25;
+    save_project(&project, &path).expect("save over");
+    assert_eq!(load_project(&path).expect("load"), project);
+    let leftovers: Vec<_> = fs::read_dir(path.parent().expect("folder"))
+        .expect("list")
+        .map(|entry| {
+            entry
+                .expect("entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .filter(|name| name.ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn a_truncated_file_is_a_syntax_error_naming_the_file() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        let mut half = text.len() / 2;
+        while !text.is_char_boundary(half) {
+            half -= 1;
+        }
+        text[..half].to_string()
+    });
+    let error = load_project(&path).expect_err("truncated");
+    assert!(matches!(error, ProjectError::Syntax { .. }), "{error:?}");
+    let message = error.to_string();
+    assert!(message.contains("lily.anthesis.toml"), "{message}");
+    assert!(message.contains("line"), "{message}");
+}
+
+#[test]
+fn a_file_cut_inside_a_string_is_a_syntax_error() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        let cut = text.find("meshes/petal").expect("mesh path");
+        text[..cut].to_string()
+    });
+    let error = load_project(&path).expect_err("truncated");
+    assert!(matches!(error, ProjectError::Syntax { .. }), "{error:?}");
+}
+
+#[test]
+fn an_unknown_field_is_named_with_its_line() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "dg = ", "colour = [1, 0, 0]\ndg = ")
+    });
+    let error = load_project(&path).expect_err("unknown field");
+    assert!(matches!(error, ProjectError::Syntax { .. }), "{error:?}");
+    let message = error.to_string();
+    assert!(message.contains("unknown field `colour`"), "{message}");
+    assert!(message.contains("lily.anthesis.toml"), "{message}");
+    assert!(message.contains("line"), "{message}");
+}
+
+#[test]
+fn an_unknown_field_in_a_key_or_blend_is_refused() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "step = 50", "step = 50\nbend_in = 0.5")
+    });
+    let message = load_project(&path).expect_err("unknown").to_string();
+    assert!(message.contains("bend_in"), "{message}");
+
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "steepness = 7.5", "steepness = 7.5, slope = 2")
+    });
+    let message = load_project(&path).expect_err("unknown").to_string();
+    assert!(message.contains("slope"), "{message}");
+}
+
+#[test]
+fn a_newer_version_says_so() {
+    let (_folder, path) = saved_lily();
+    // A newer version may have fields this build does not know: the version
+    // error must win over the unknown field.
+    edit(&path, |text| {
+        replace_once(text, "version = 1", "version = 2\nwind = \"strong\"")
+    });
+    let error = load_project(&path).expect_err("newer");
+    assert_eq!(
+        error,
+        ProjectError::NewerVersion {
+            path: path.clone(),
+            found: 2,
+            supported: FORMAT_VERSION,
+        }
+    );
+    assert_eq!(
+        error.to_string(),
+        format!(
+            "{} was written by a newer Anthesis (format version 2; this build reads up to 1)",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn version_zero_or_text_is_invalid() {
+    for version in ["0", "\"1\""] {
+        let (_folder, path) = saved_lily();
+        edit(&path, |text| {
+            replace_once(text, "version = 1", &format!("version = {version}"))
+        });
+        let error = load_project(&path).expect_err("bad version");
+        assert!(matches!(error, ProjectError::Invalid { .. }), "{error:?}");
+        assert!(error.to_string().contains("version"), "{error}");
+    }
+}
+
+#[test]
+fn a_file_of_another_format_is_refused() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "\"anthesis-project\"", "\"anthesis-brush\"")
+    });
+    let error = load_project(&path).expect_err("wrong format");
+    assert_eq!(
+        error,
+        ProjectError::WrongFormat {
+            path: path.clone(),
+            found: "\"anthesis-brush\"".to_string(),
+        }
+    );
+
+    fs::write(&path, "[package]\nname = \"anthesis\"\n").expect("write");
+    let error = load_project(&path).expect_err("no format");
+    assert!(
+        matches!(&error, ProjectError::WrongFormat { found, .. } if found == "missing"),
+        "{error:?}"
+    );
+}
+
+#[test]
+fn a_missing_png_is_an_io_error_naming_it() {
+    let (_folder, path) = saved_lily();
+    let png = path
+        .parent()
+        .expect("folder")
+        .join("maps/petal-step0-bend.png");
+    fs::remove_file(&png).expect("remove");
+    let error = load_project(&path).expect_err("missing png");
+    assert!(
+        matches!(&error, ProjectError::Io { path, .. } if *path == png),
+        "{error:?}"
+    );
+    assert!(
+        error.to_string().contains("petal-step0-bend.png"),
+        "{error}"
+    );
+}
+
+#[test]
+fn a_corrupt_png_is_a_map_error_naming_it() {
+    let (_folder, path) = saved_lily();
+    let png = path
+        .parent()
+        .expect("folder")
+        .join("maps/petal-step0-e_growth.png");
+    let mut bytes = fs::read(&png).expect("read");
+    bytes.truncate(bytes.len() / 2);
+    fs::write(&png, bytes).expect("write");
+    let error = load_project(&path).expect_err("corrupt png");
+    match &error {
+        ProjectError::Map { path, error } => {
+            assert_eq!(*path, png);
+            assert!(matches!(error, MapError::Decode { .. }), "{error:?}");
+        }
+        other => panic!("expected a map error, got {other:?}"),
+    }
+    assert!(
+        error.to_string().contains("petal-step0-e_growth.png"),
+        "{error}"
+    );
+}
+
+#[test]
+fn maps_of_different_sizes_are_refused() {
+    let (_folder, path) = saved_lily();
+    let png = path
+        .parent()
+        .expect("folder")
+        .join("maps/petal-step0-bend.png");
+    let bytes = ScalarMap::from_fn(5, 5, |uv| uv.x as f32)
+        .to_png_bytes(BitDepth::Eight)
+        .expect("encode");
+    fs::write(&png, bytes).expect("write");
+    let error = load_project(&path).expect_err("wrong size");
+    assert_eq!(
+        error,
+        ProjectError::MapSize {
+            path: png,
+            expected: (8, 6),
+            found: (5, 5),
+        }
+    );
+    assert!(error.to_string().contains("5x5"), "{error}");
+}
+
+#[test]
+fn saving_maps_of_different_sizes_is_refused_before_writing() {
+    let mut project = lily();
+    project.flower.templates[0].maps.keys_mut()[1]
+        .maps
+        .e_growth_in = ScalarMap::from_fn(4, 4, |_| 0.5);
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    let error = save_project(&project, &path).expect_err("sizes differ");
+    assert!(
+        matches!(&error, ProjectError::MapSize { path, expected: (8, 6), found: (4, 4) }
+            if path.ends_with("maps/petal-step50-e_growth_in.png")),
+        "{error:?}"
+    );
+    assert!(files_under(folder.path()).is_empty(), "nothing written");
+}
+
+#[test]
+fn saving_a_raster_outside_what_png_holds_is_refused() {
+    let mut project = lily();
+    project.flower.templates[0].maps.keys_mut()[0].maps.bend =
+        ScalarMap::from_fn(8, 6, |uv| 2.0 * uv.y as f32);
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    let error = save_project(&project, &path).expect_err("values above 1");
+    assert!(matches!(error, ProjectError::Invalid { .. }), "{error:?}");
+    assert!(error.to_string().contains("bend"), "{error}");
+    assert!(files_under(folder.path()).is_empty(), "nothing written");
+}
+
+#[test]
+fn an_organ_with_a_missing_template_is_refused() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(
+            text,
+            "template = \"Outer sepal\"",
+            "template = \"Inner sepal\"",
+        )
+    });
+    let error = load_project(&path).expect_err("unknown template");
+    assert_eq!(
+        error,
+        ProjectError::UnknownTemplate {
+            path: path.clone(),
+            organ: "sepal-1".to_string(),
+            template: "Inner sepal".to_string(),
+        }
+    );
+}
+
+#[test]
+fn an_overlap_with_a_missing_organ_is_refused() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "outer = \"sepal-1\"", "outer = \"sepal-9\"")
+    });
+    let error = load_project(&path).expect_err("unknown organ");
+    assert_eq!(
+        error,
+        ProjectError::UnknownOrgan {
+            path: path.clone(),
+            name: "sepal-9".to_string(),
+        }
+    );
+}
+
+#[test]
+fn duplicate_names_are_refused() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "name = \"petal-2\"", "name = \"petal-1\"")
+    });
+    let error = load_project(&path).expect_err("duplicate organ");
+    assert_eq!(
+        error,
+        ProjectError::DuplicateName {
+            path: path.clone(),
+            what: "organ",
+            name: "petal-1".to_string(),
+        }
+    );
+
+    let mut project = lily();
+    project.flower.templates[1].name = "Petal".to_string();
+    let folder = tempfile::tempdir().expect("temp dir");
+    let error = save_project(&project, &folder.path().join("p.toml")).expect_err("duplicate");
+    assert!(
+        matches!(&error, ProjectError::DuplicateName { what: "template", name, .. } if name == "Petal"),
+        "{error:?}"
+    );
+}
+
+#[test]
+fn a_mesh_without_uvs_is_a_mesh_error_naming_the_obj() {
+    let (_folder, path) = saved_lily();
+    let obj = path.parent().expect("folder").join("meshes/petal.obj");
+    let without_uvs: String = fs::read_to_string(&obj)
+        .expect("read")
+        .lines()
+        .filter(|line| !line.starts_with("vt "))
+        .map(|line| {
+            if let Some(corners) = line.strip_prefix("f ") {
+                let corners: Vec<String> = corners
+                    .split_whitespace()
+                    .map(|corner| corner.split('/').next().unwrap_or("").to_string())
+                    .collect();
+                format!("f {}\n", corners.join(" "))
+            } else {
+                format!("{line}\n")
+            }
+        })
+        .collect();
+    fs::write(&obj, without_uvs).expect("write");
+    let error = load_project(&path).expect_err("no uvs");
+    assert_eq!(
+        error,
+        ProjectError::Mesh {
+            path: obj,
+            error: MeshError::MissingUvs,
+        }
+    );
+    assert!(error.to_string().contains("meshes/petal.obj"), "{error}");
+}
+
+#[test]
+fn out_of_range_values_are_invalid_and_say_which() {
+    let cases: [(&str, &str, &str); 7] = [
+        ("thickness = 0.2", "thickness = 0.0", "thickness"),
+        ("keyframes = 80", "keyframes = 0", "keyframes"),
+        (
+            "bend_stiffness = 18.5",
+            "bend_stiffness = -1.0",
+            "bend_stiffness",
+        ),
+        (
+            "stretch_stiffness = 20.0",
+            "stretch_stiffness = 0",
+            "stretch_stiffness",
+        ),
+        ("v_max = 0.06", "v_max = 1.5", "v_max"),
+        ("step = 50", "step = 0", "two map keys at step 0"),
+        ("w_growth = 0.2", "w_growth = nan", "w_growth"),
+    ];
+    for (from, to, expected) in cases {
+        let (_folder, path) = saved_lily();
+        edit(&path, |text| replace_once(text, from, to));
+        let error = load_project(&path).expect_err(to);
+        assert!(
+            matches!(error, ProjectError::Invalid { .. }),
+            "{to}: {error:?}"
+        );
+        let message = error.to_string();
+        assert!(message.contains(expected), "{to}: {message}");
+        assert!(message.contains("lily.anthesis.toml"), "{to}: {message}");
+    }
+}
+
+#[test]
+fn a_template_without_keys_is_invalid() {
+    let text = r#"
+format = "anthesis-project"
+version = 1
+name = "bare"
+
+[[templates]]
+name = "petal"
+mesh = "petal.obj"
+dg = 0.003
+thickness = 0.2
+stretch_stiffness = 20
+bend_stiffness = 20
+keys = []
+"#;
+    let files = |_: &str| -> Result<Vec<u8>, io::Error> { panic!("no file should be read") };
+    let error = parse_project(text, &files).expect_err("no keys");
+    assert!(matches!(error, ProjectError::Invalid { .. }), "{error:?}");
+    assert!(error.to_string().contains("no map keys"), "{error}");
+}
+
+#[test]
+fn saving_an_invalid_project_writes_nothing() {
+    let mut project = lily();
+    project.flower.templates[1].thickness = 0.0;
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    let error = save_project(&project, &path).expect_err("thickness 0");
+    assert!(
+        error
+            .to_string()
+            .contains("template \"Outer sepal\": thickness"),
+        "{error}"
+    );
+    assert!(files_under(folder.path()).is_empty(), "nothing written");
+}
+
+#[test]
+fn parse_project_reads_files_through_the_resolver() {
+    let mesh = test_petal(8.0, 3.0, 5, 6);
+    let e_growth = exact_raster(4, 3, |uv| uv.y);
+    let direction = DirectionMap::from_fn(4, 3, |_| {
+        DVec2::new(f64::from(signed16(0.5)), f64::from(signed16(-0.25)))
+    });
+    let files: HashMap<String, Vec<u8>> = HashMap::from([
+        (
+            "shapes/petal.obj".to_string(),
+            anthesis_mesh::obj_string(&mesh).into_bytes(),
+        ),
+        (
+            "paint/e.png".to_string(),
+            e_growth.to_png_bytes(BitDepth::Sixteen).expect("encode"),
+        ),
+        (
+            "paint/dir.png".to_string(),
+            direction.to_png_bytes(BitDepth::Sixteen).expect("encode"),
+        ),
+    ]);
+    // A hand-written file: integers for floats, omitted optional fields,
+    // omitted maps, a logistic blend with its default steepness.
+    let text = r#"
+format = "anthesis-project"
+version = 1
+name = "embedded"
+
+[[templates]]
+name = "petal"
+mesh = "shapes/petal.obj"
+dg = 0.003
+thickness = 1
+stretch_stiffness = 20
+bend_stiffness = 20
+base_region = { v_max = 0.1 }
+blend = { logistic = {} }
+joint_schedule = [{ from_step = 0, to_step = 60, degrees = 23 }]
+
+[[templates.keys]]
+step = 0
+e_growth = "paint/e.png"
+stretch = 2
+
+[[templates.keys]]
+step = 30
+direction = "paint/dir.png"
+
+[[organs]]
+name = "petal-1"
+template = "petal"
+"#;
+    let resolver = |relative: &str| {
+        files
+            .get(relative)
+            .cloned()
+            .ok_or_else(|| io::Error::new(io::ErrorKind::NotFound, "not embedded"))
+    };
+    let project = parse_project(text, &resolver).expect("parses");
+
+    assert_eq!(project.name, "embedded");
+    assert_eq!(project.settings, SimulationSettings::default());
+    let template = &project.flower.templates[0];
+    assert_eq!(template.mesh, mesh);
+    assert_eq!(template.thickness, 1.0);
+    assert_eq!(template.color, [1.0; 4]);
+    assert_eq!(
+        template.base_region,
+        BaseRegion {
+            v_max: 0.1,
+            ..BaseRegion::default()
+        }
+    );
+    assert_eq!(template.maps.blend, Blend::logistic());
+    assert_eq!(template.joint_schedule[0].degrees, 23.0);
+    let keys = template.maps.keys();
+    assert_eq!(keys.len(), 2);
+    assert_eq!(keys[0].maps.e_growth, e_growth);
+    assert_eq!(keys[0].maps.stretch, ScalarMap::constant(2.0));
+    for kind in [MapKind::WGrowth, MapKind::EGrowthIn, MapKind::Bend] {
+        assert_eq!(
+            *keys[0].maps.scalar(kind),
+            ScalarMap::constant(kind.default_value()),
+            "{kind:?} defaults"
+        );
+    }
+    assert_eq!(keys[0].maps.direction, DirectionMap::constant(DVec2::Y));
+    assert_eq!(keys[1].maps.direction, direction);
+    assert_eq!(keys[1].maps.e_growth, ScalarMap::constant(0.0));
+    assert_eq!(
+        project.flower.organs[0].placement,
+        Placement {
+            position: DVec3::ZERO,
+            azimuth_deg: 0.0,
+            joint_angle_deg: 0.0,
+        }
+    );
+
+    // A file the resolver lacks is named as written.
+    let missing = text.replace("paint/dir.png", "paint/missing.png");
+    let error = parse_project(&missing, &resolver).expect_err("missing");
+    assert!(
+        matches!(&error, ProjectError::Io { path, message }
+            if path == Path::new("paint/missing.png") && message.contains("not embedded")),
+        "{error:?}"
+    );
+    // Syntax errors name the project text.
+    let error = parse_project("format = ", &resolver).expect_err("syntax");
+    assert!(error.to_string().starts_with(UNNAMED_PROJECT), "{error}");
+}
+
+#[test]
+fn a_direction_needs_two_components() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(
+            text,
+            "direction = [0.25, 0.75]",
+            "direction = [0.25, 0.75, 0.0]",
+        )
+    });
+    let error = load_project(&path).expect_err("three components");
+    assert!(matches!(error, ProjectError::Syntax { .. }), "{error:?}");
+    assert!(error.to_string().contains("[u, v]"), "{error}");
+}
+
+#[test]
+fn a_missing_project_file_is_an_io_error() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("nothing.anthesis.toml");
+    let error = load_project(&path).expect_err("missing");
+    assert!(
+        matches!(&error, ProjectError::Io { path: p, .. } if *p == path),
+        "{error:?}"
+    );
+}
