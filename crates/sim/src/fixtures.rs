@@ -11,12 +11,19 @@ use glam::DVec3;
 /// A petal template of about `columns x rows` particles (mean edge about
 /// 1.3 for the lily-sized 14 x 28), growing with a midrib that reflexes
 /// early and a lamina that widens later, in two time keys.
+///
+/// The base region is `v <= 0.05`, widened on coarse meshes to hold at
+/// least two rows of particles: a single row lies along the joint axis, so
+/// shape matching could not hold the joint angle. Nothing grows in the
+/// base region.
 pub fn petal_template(name: &str, columns: usize, rows: usize) -> Template {
     let length = 1.3 * rows as f64;
     let width = 1.3 * columns as f64;
     let mesh = generate::test_petal(length, width, columns, rows);
+    let row_spacing_in_v = 1.0 / rows.saturating_sub(1).max(1) as f64;
+    let base_v_max = (1.01 * row_spacing_in_v).max(0.05);
     let midrib = |u: f64| (-((u - 0.5) / 0.12).powi(2)).exp();
-    let above_base = |v: f64| ((v - 0.05) / 0.1).clamp(0.0, 1.0);
+    let above_base = |v: f64| ((v - base_v_max) / 0.1).clamp(0.0, 1.0);
     let early = GrowthMaps {
         e_growth: ScalarMap::from_fn(32, 32, |uv| (0.6 * above_base(uv.y)) as f32),
         w_growth: ScalarMap::from_fn(32, 32, |uv| (0.3 * above_base(uv.y)) as f32),
@@ -55,7 +62,7 @@ pub fn petal_template(name: &str, columns: usize, rows: usize) -> Template {
         stretch_stiffness: 20.0,
         bend_stiffness: 20.0,
         base_region: BaseRegion {
-            v_max: 0.05,
+            v_max: base_v_max,
             ..BaseRegion::default()
         },
         joint_schedule: vec![JointRamp {
