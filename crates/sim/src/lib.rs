@@ -337,6 +337,11 @@ impl Simulation {
                 &mut contacts[outer],
             );
         }
+        // Base particles sit on the receptacle, where organs meet by
+        // design; attachment, not collision, decides where they go.
+        for (organ, list) in self.organs.iter().zip(&mut contacts) {
+            list.retain(|c| !organ.is_base[c.particle as usize]);
+        }
         contacts
     }
 
