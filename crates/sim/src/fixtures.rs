@@ -5,12 +5,19 @@ use anthesis_flower::{
     BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings, Template,
 };
 use anthesis_maps::{GrowthMaps, KeyedMaps, MapKey, ScalarMap};
-use anthesis_mesh::generate;
+use std::f64::consts::PI;
+
+use anthesis_mesh::{Mesh, generate};
 use glam::DVec3;
 
+/// Distance between the inner and the outer ring of a [`whorl`]: about one
+/// mean edge, so overlapping margins are close but apart in the bud.
+const RING_GAP: f64 = 1.3;
+
 /// A petal template of about `columns x rows` particles (mean edge about
-/// 1.3 for the lily-sized 14 x 28), growing with a midrib that reflexes
-/// early and a lamina that widens later, in two time keys.
+/// 1.3 for the lily-sized 14 x 28), cupped and slightly incurved, growing
+/// with a midrib that reflexes early and a lamina that widens later, in two
+/// time keys.
 ///
 /// The base region is `v <= 0.05`, widened on coarse meshes to hold at
 /// least two rows of particles: a single row lies along the joint axis, so
@@ -20,6 +27,35 @@ pub fn petal_template(name: &str, columns: usize, rows: usize) -> Template {
     let length = 1.3 * rows as f64;
     let width = 1.3 * columns as f64;
     let mesh = generate::test_petal(length, width, columns, rows);
+    template_with_mesh(name, mesh, rows)
+}
+
+/// Like [`petal_template`], but the bud is bent around the flower axis: with
+/// its base at distance `ring_radius` from the axis (and no joint angle),
+/// every particle lies on a surface of revolution about the axis whose
+/// radius shrinks towards the tip. Organs of different rings are then
+/// nested and cannot cut through each other in the bud.
+pub fn ring_petal_template(name: &str, columns: usize, rows: usize, ring_radius: f64) -> Template {
+    let length = 1.3 * rows as f64;
+    let width = 1.3 * columns as f64;
+    let mesh = generate::parametric_grid(columns, rows, |uv| {
+        let half_width = 0.5 * width * (0.25 + 0.75 * (PI * uv.y).sin().powf(0.7));
+        // Arc length across equals the flat petal's width; u runs towards -x
+        // as in `test_petal`, so the normals face the axis.
+        let angle_in_ring = -(uv.x - 0.5) * 2.0 * half_width / ring_radius;
+        let radius = ring_radius - 0.08 * length * uv.y * uv.y;
+        DVec3::new(
+            radius * angle_in_ring.sin(),
+            uv.y * length,
+            radius * angle_in_ring.cos() - ring_radius,
+        )
+    });
+    template_with_mesh(name, mesh, rows)
+}
+
+/// Growth maps and material of the test petal around `mesh` (a grid of
+/// `rows` rows).
+fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
     let row_spacing_in_v = 1.0 / rows.saturating_sub(1).max(1) as f64;
     let base_v_max = (1.01 * row_spacing_in_v).max(0.05);
     let midrib = |u: f64| (-((u - 0.5) / 0.12).powi(2)).exp();
@@ -74,36 +110,51 @@ pub fn petal_template(name: &str, columns: usize, rows: usize) -> Template {
     }
 }
 
-/// `organs` petals of one template (`columns x rows` particles) in a whorl,
-/// alternating inner and outer so neighbours overlap like a lily's petals
-/// and sepals (overlap rules between neighbours from three organs on).
+/// `organs` organs in a whorl, alternating an inner ring of petals (even
+/// indices) and an outer ring of sepals (odd indices) like a lily: each
+/// organ of `columns x rows` particles spans a little more than its share of
+/// its ring, so the margins of neighbours overlap, the petal's inside the
+/// sepal's, and each such pair gets an overlap rule (from three organs on).
+/// The bud is closed (joint angle 0) and opens by the template's joint
+/// schedule and growth.
 pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Project {
-    let template = petal_template("petal", columns, rows);
+    let width = 1.3 * columns as f64;
+    let per_ring = organs.div_ceil(2).max(1);
+    // Half the angle an organ spans at its widest: 30 % more than its share
+    // of the ring, and never wrapped more than a lily petal.
+    let half_span = (0.65 * PI / per_ring as f64).min(55f64.to_radians());
+    let inner_radius = 0.5 * width / half_span;
+    let outer_radius = inner_radius + RING_GAP;
+    let mut templates = vec![ring_petal_template("petal", columns, rows, inner_radius)];
+    if organs >= 2 {
+        let mut sepal = ring_petal_template("sepal", columns, rows, outer_radius);
+        sepal.color = [0.6, 0.75, 0.35, 1.0];
+        templates.push(sepal);
+    }
     let organs_list: Vec<Organ> = (0..organs)
         .map(|i| {
             let inner = i % 2 == 0;
+            let azimuth_deg = 360.0 * i as f64 / organs as f64;
+            let radius = if inner { inner_radius } else { outer_radius };
+            let a = azimuth_deg.to_radians();
             Organ {
                 name: format!("{}-{}", if inner { "petal" } else { "sepal" }, i / 2 + 1),
-                template: 0,
+                template: if inner { 0 } else { 1 },
                 placement: Placement {
-                    position: DVec3::new(0.0, 0.0, if inner { 1.0 } else { 2.0 }),
-                    azimuth_deg: 360.0 * i as f64 / organs as f64,
-                    joint_angle_deg: if inner { 12.0 } else { 18.0 },
+                    position: DVec3::new(radius * a.sin(), 0.0, radius * a.cos()),
+                    azimuth_deg,
+                    joint_angle_deg: 0.0,
                 },
             }
-        })
-        .map(|mut o| {
-            let a = o.placement.azimuth_deg.to_radians();
-            let r = o.placement.position.z;
-            o.placement.position = DVec3::new(r * a.sin(), 0.0, r * a.cos());
-            o
         })
         .collect();
     let overlaps = if organs >= 3 {
         (0..organs)
             .filter(|i| i % 2 == 0)
             .flat_map(|i| [(i, (i + 1) % organs), (i, (i + organs - 1) % organs)])
-            .filter(|(a, b)| a != b)
+            // With an odd count the last petal neighbours the first petal,
+            // which is in the same ring: no rule.
+            .filter(|&(_, outer)| outer % 2 == 1)
             .map(|(inner, outer)| Overlap { inner, outer })
             .collect()
     } else {
@@ -112,7 +163,7 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
     Project {
         name: format!("test whorl of {organs}"),
         flower: Flower {
-            templates: vec![template],
+            templates,
             organs: organs_list,
             overlaps,
         },
