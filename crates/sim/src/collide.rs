@@ -107,19 +107,20 @@ pub fn contacts_against(
 }
 
 /// The paper's push-back: moves each particle that is short of its side
-/// onto it. Returns how many particles moved. If a particle has several
-/// contacts, they are applied in order.
+/// onto it. Returns how many particles moved (a particle pushed by several
+/// contacts counts once). If a particle has several contacts, they are
+/// applied in order.
 pub fn push_back(positions: &mut [DVec3], contacts: &[Contact]) -> usize {
-    let mut moved = 0;
+    let mut moved = vec![false; positions.len()];
     for c in contacts {
         let x = &mut positions[c.particle as usize];
         let violation = c.violation(*x);
         if violation > 0.0 {
             *x += c.normal * violation;
-            moved += 1;
+            moved[c.particle as usize] = true;
         }
     }
-    moved
+    moved.iter().filter(|&&m| m).count()
 }
 
 #[cfg(test)]
@@ -179,5 +180,27 @@ mod tests {
         assert_eq!(push_back(&mut positions, &contacts), 1);
         assert!((positions[0].z - 0.01).abs() < 1e-15);
         assert_eq!(positions[1].z, 0.5);
+    }
+
+    #[test]
+    fn a_particle_pushed_by_two_neighbours_counts_once() {
+        // Particle 0 lies under two outer organs at once.
+        let mut positions = vec![DVec3::new(0.0, 0.0, -0.3)];
+        let contacts = [
+            Contact {
+                particle: 0,
+                point: DVec3::ZERO,
+                normal: DVec3::Z,
+                offset: 0.01,
+            },
+            Contact {
+                particle: 0,
+                point: DVec3::new(0.0, 0.0, 0.5),
+                normal: DVec3::Z,
+                offset: 0.01,
+            },
+        ];
+        assert_eq!(push_back(&mut positions, &contacts), 1);
+        assert!((positions[0].z - 0.51).abs() < 1e-15);
     }
 }
