@@ -1,0 +1,124 @@
+//! Helpers shared by the simulation's integration tests.
+#![allow(dead_code)]
+
+use anthesis_flower::{Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings};
+use anthesis_sim::fixtures::petal_template;
+use anthesis_sim::{Keyframe, Selection, SimError, run};
+use glam::DVec3;
+
+/// Mean length of the triangle edges (each interior edge counted twice,
+/// which does not matter for a near-uniform mesh).
+pub fn mean_edge(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let mut sum = 0.0;
+    let mut count = 0.0;
+    for t in triangles {
+        for k in 0..3 {
+            sum += (positions[t[k] as usize] - positions[t[(k + 1) % 3] as usize]).length();
+            count += 1.0;
+        }
+    }
+    sum / count
+}
+
+/// Where a particle of one organ lies relative to another organ: measured
+/// from the other organ's nearest particle, along that particle's normal
+/// (the other organ's inner side is positive).
+#[derive(Debug, Clone, Copy)]
+pub struct SideSample {
+    pub particle: usize,
+    pub nearest: usize,
+    /// Signed distance along the other organ's inner normal.
+    pub along_normal: f64,
+}
+
+/// The particles of `moving` that lie over `other` (nearest particle of
+/// `other` within two mean edges, and within one mean edge of that
+/// particle's normal line), with their signed distance along `other`'s
+/// inner normal. Brute force, independent of the simulator's tracker.
+pub fn particles_over(
+    moving_in_world: &[DVec3],
+    other_in_world: &[DVec3],
+    other_triangles: &[[u32; 3]],
+) -> Vec<SideSample> {
+    let normals = anthesis_mesh::vertex_normals(other_in_world, other_triangles);
+    let reach = mean_edge(other_in_world, other_triangles);
+    let mut over = Vec::new();
+    for (particle, x) in moving_in_world.iter().enumerate() {
+        let Some((nearest, distance)) = other_in_world
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (i, (*p - *x).length()))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+        else {
+            continue;
+        };
+        if distance > 2.0 * reach {
+            continue;
+        }
+        let normal = normals[nearest];
+        let d = *x - other_in_world[nearest];
+        let along_normal = d.dot(normal);
+        if (d - normal * along_normal).length() > reach {
+            continue;
+        }
+        over.push(SideSample {
+            particle,
+            nearest,
+            along_normal,
+        });
+    }
+    over
+}
+
+/// Two petals at the same azimuth, one inside the other (bases 1.5 apart,
+/// so that attachment never presses the bases together), whose
+/// joint schedules drive the inner one through the outer one (40 degrees
+/// against 10 over `keyframes` steps). With `overlap`, the flower says the
+/// first lies inside the second.
+pub fn inner_driven_into_outer(keyframes: u32, overlap: bool) -> Project {
+    let ramp = |degrees: f64| {
+        vec![JointRamp {
+            from_step: 0,
+            to_step: keyframes,
+            degrees,
+        }]
+    };
+    let mut inner = petal_template("inner petal", 8, 14);
+    inner.joint_schedule = ramp(40.0);
+    let mut outer = petal_template("outer petal", 8, 14);
+    outer.joint_schedule = ramp(10.0);
+    let organ =
+        |name: &str, template: usize, distance_from_axis: f64, joint_angle_deg: f64| Organ {
+            name: name.to_string(),
+            template,
+            placement: Placement {
+                position: DVec3::new(0.0, 0.0, distance_from_axis),
+                azimuth_deg: 0.0,
+                joint_angle_deg,
+            },
+        };
+    Project {
+        name: "inner driven into outer".into(),
+        flower: Flower {
+            templates: vec![inner, outer],
+            organs: vec![organ("inner", 0, 0.5, 12.0), organ("outer", 1, 2.0, 18.0)],
+            overlaps: if overlap {
+                vec![Overlap { inner: 0, outer: 1 }]
+            } else {
+                Vec::new()
+            },
+        },
+        settings: SimulationSettings {
+            keyframes,
+            ..SimulationSettings::default()
+        },
+    }
+}
+
+/// Every keyframe of a run (the bud first), or the error that stopped it
+/// together with the keyframes computed before it.
+pub fn run_all(project: &Project, selection: &Selection) -> (Vec<Keyframe>, Option<SimError>) {
+    let mut keyframes = Vec::new();
+    let result = run(project, selection, &mut |_, k| keyframes.push(k.clone()));
+    (keyframes, result.err())
+}
