@@ -211,6 +211,7 @@ impl OrganSim {
             &mut self.elastic.rest_angles,
         );
         self.update_stiffness(step);
+        self.solver.begin_keyframe();
     }
 
     fn update_stiffness(&mut self, step: u32) {
