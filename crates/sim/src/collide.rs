@@ -7,8 +7,6 @@
 //! converges; after convergence the paper's push-back moves every particle
 //! still short of its side onto it, `offset` past the neighbour.
 
-use std::collections::HashMap;
-
 use anthesis_physics::Contact;
 use glam::DVec3;
 
@@ -21,33 +19,99 @@ pub struct Surface<'a> {
     pub mean_edge: f64,
 }
 
-/// Nearest-particle lookup on one organ through a uniform grid.
+/// Nearest-particle lookup on one organ through a uniform grid over the
+/// organ's bounding box (cells stored compactly, particles in index order
+/// within a cell, so answers never depend on memory layout).
 pub struct Tracker {
+    /// Search radius: only particles this close count.
+    radius: f64,
     cell: f64,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    origin: DVec3,
+    dims: [i64; 3],
+    /// `cell_start[c]..cell_start[c + 1]` indexes `items` for cell `c`.
+    cell_start: Vec<u32>,
+    items: Vec<u32>,
 }
 
+/// Grids with more cells than this use coarser cells (same answers, more
+/// candidates per query).
+const MAX_CELLS: i64 = 1 << 20;
+
 impl Tracker {
-    pub fn new(positions: &[DVec3], cell: f64) -> Tracker {
-        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        for (i, p) in positions.iter().enumerate() {
-            cells.entry(cell_of(*p, cell)).or_default().push(i as u32);
+    pub fn new(positions: &[DVec3], radius: f64) -> Tracker {
+        let (lo, hi) = positions.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let (lo, hi) = if positions.is_empty() {
+            (DVec3::ZERO, DVec3::ZERO)
+        } else {
+            (lo, hi)
+        };
+        let mut cell = radius.max(1e-9);
+        let dims = loop {
+            let d = ((hi - lo) / cell).floor();
+            let dims = [d.x as i64 + 1, d.y as i64 + 1, d.z as i64 + 1];
+            if dims[0] * dims[1] * dims[2] <= MAX_CELLS {
+                break dims;
+            }
+            cell *= 2.0;
+        };
+        let mut tracker = Tracker {
+            radius,
+            cell,
+            origin: lo,
+            dims,
+            cell_start: Vec::new(),
+            items: Vec::new(),
+        };
+        // Counting sort of particles by cell.
+        let cells = (dims[0] * dims[1] * dims[2]) as usize;
+        let mut counts = vec![0u32; cells + 1];
+        let cell_ids: Vec<usize> = positions
+            .iter()
+            .map(|p| tracker.flat(tracker.cell_of(*p)).unwrap_or(0))
+            .collect();
+        for &c in &cell_ids {
+            counts[c + 1] += 1;
         }
-        Tracker { cell, cells }
+        for c in 0..cells {
+            counts[c + 1] += counts[c];
+        }
+        let mut next = counts.clone();
+        let mut items = vec![0u32; positions.len()];
+        for (i, &c) in cell_ids.iter().enumerate() {
+            items[next[c] as usize] = i as u32;
+            next[c] += 1;
+        }
+        tracker.cell_start = counts;
+        tracker.items = items;
+        tracker
     }
 
-    /// The nearest particle within one cell size of `x` (ties go to the
-    /// lower index, so the answer does not depend on hashing order).
+    fn cell_of(&self, p: DVec3) -> [i64; 3] {
+        let c = ((p - self.origin) / self.cell).floor();
+        [c.x as i64, c.y as i64, c.z as i64]
+    }
+
+    fn flat(&self, c: [i64; 3]) -> Option<usize> {
+        let inside = (0..3).all(|k| c[k] >= 0 && c[k] < self.dims[k]);
+        inside.then(|| ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize)
+    }
+
+    /// The nearest particle within the search radius of `x` (ties go to
+    /// the lower index).
     pub fn nearest(&self, x: DVec3, positions: &[DVec3]) -> Option<u32> {
-        let [cx, cy, cz] = cell_of(x, self.cell);
+        let [cx, cy, cz] = self.cell_of(x);
         let mut best: Option<(f64, u32)> = None;
-        for dx in -1..=1 {
+        for dz in -1..=1 {
             for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let Some(list) = self.cells.get(&[cx + dx, cy + dy, cz + dz]) else {
+                for dx in -1..=1 {
+                    let Some(c) = self.flat([cx + dx, cy + dy, cz + dz]) else {
                         continue;
                     };
-                    for &i in list {
+                    let range = self.cell_start[c] as usize..self.cell_start[c + 1] as usize;
+                    for &i in &self.items[range] {
                         let d = (positions[i as usize] - x).length_squared();
                         let better = match best {
                             None => true,
@@ -60,17 +124,9 @@ impl Tracker {
                 }
             }
         }
-        best.filter(|(d, _)| *d <= self.cell * self.cell)
+        best.filter(|(d, _)| *d <= self.radius * self.radius)
             .map(|(_, i)| i)
     }
-}
-
-fn cell_of(p: DVec3, cell: f64) -> [i64; 3] {
-    [
-        (p.x / cell).floor() as i64,
-        (p.y / cell).floor() as i64,
-        (p.z / cell).floor() as i64,
-    ]
 }
 
 /// Contacts for the particles of `moving` against `other`: `side` is +1 if
