@@ -51,6 +51,11 @@ pub struct Elastic {
     pub bend_stiffness: Vec<f64>,
     /// Stiffness of the contact penalty.
     pub contact_stiffness: f64,
+    /// Particles held at a point by zero-length springs of
+    /// `anchor_stiffness` (the simulation holds an organ's base particles
+    /// where the receptacle and the joint schedule put them).
+    pub anchors: Vec<(u32, DVec3)>,
+    pub anchor_stiffness: f64,
 }
 
 impl Elastic {
@@ -80,6 +85,8 @@ impl Elastic {
             hinges,
             rest_angles,
             contact_stiffness: 0.0,
+            anchors: Vec::new(),
+            anchor_stiffness: 0.0,
         }
     }
 
@@ -125,6 +132,9 @@ impl Elastic {
                 e += 0.5 * self.contact_stiffness * v * v;
             }
         }
+        for &(p, target) in &self.anchors {
+            e += 0.5 * self.anchor_stiffness * (x[p as usize] - target).length_squared();
+        }
         e
     }
 
@@ -141,8 +151,8 @@ impl Elastic {
         for &(stencil, edge) in &self.hinges {
             let xs = stencil.map(|p| x[p as usize]);
             let theta = dihedral_angle(xs);
-            let scale =
-                self.bend_stiffness[edge as usize] * (theta - self.rest_angles[edge as usize]);
+            let scale = self.bend_stiffness[edge as usize]
+                * angle_difference(theta, self.rest_angles[edge as usize]);
             let dtheta = dihedral_gradient(xs);
             for (p, d) in stencil.iter().zip(dtheta) {
                 g[*p as usize] += d * scale;
@@ -153,6 +163,9 @@ impl Elastic {
             if v > 0.0 {
                 g[c.particle as usize] -= c.normal * (self.contact_stiffness * v);
             }
+        }
+        for &(p, target) in &self.anchors {
+            g[p as usize] += (x[p as usize] - target) * self.anchor_stiffness;
         }
     }
 
@@ -192,6 +205,10 @@ impl Elastic {
                 let block = outer(c.normal, c.normal) * self.contact_stiffness;
                 pattern.add_block(values, c.particle, c.particle, &block);
             }
+        }
+        let anchor = DMat3::IDENTITY * self.anchor_stiffness;
+        for &(p, _) in &self.anchors {
+            pattern.add_block(values, p, p, &anchor);
         }
     }
 }

@@ -202,17 +202,24 @@ impl Simulation {
     ) -> Result<Keyframe, SimError> {
         let started = Instant::now();
         let step = self.next_step;
-        self.organs.par_iter_mut().for_each(|o| o.grow(step));
+        self.organs.par_iter_mut().for_each(|o| {
+            o.grow(step);
+            o.attach(step);
+        });
 
         let solver = self.settings.solver;
         let mut iterations = 0;
         let mut converged = false;
         let mut gradient = 0.0;
+        // Contacts are found once per keyframe, right after growth, and held
+        // while the organs relax: rebuilt every iteration from organs that
+        // all move at once, they made neighbours bounce off each other
+        // instead of settling. The push-back below uses fresh ones.
+        let contacts = self.contacts();
         while iterations < solver.max_iterations {
             if cancel() {
                 return Err(SimError::Cancelled);
             }
-            let contacts = self.contacts();
             let reports: Vec<_> = self
                 .organs
                 .par_iter_mut()
@@ -251,6 +258,9 @@ impl Simulation {
             });
         }
 
+        for organ in &mut self.organs {
+            organ.attach(step);
+        }
         // The paper's push-back: nobody ends on the wrong side.
         let contacts = self.contacts();
         let mut pushed = 0;

@@ -17,6 +17,13 @@ use crate::SimError;
 /// Stiffness map values are clamped to at least this, so a black stiffness
 /// map cannot make the system singular.
 const MIN_STIFFNESS_MAP: f64 = 0.01;
+/// Stiffness, relative to the mean spring stiffness, of the springs that
+/// hold each base particle where it is at the start of an iteration. The
+/// energy does not see rigid motions, so without them a contact could push
+/// the whole organ away in a Newton step only for shape matching to put it
+/// back, and the keyframe would cycle. Anchored at the current positions,
+/// they exert no force at convergence: the minimum is the same.
+const ANCHOR_FACTOR: f64 = 0.1;
 /// Contact penalty stiffness relative to the mean spring stiffness.
 const CONTACT_STIFFNESS_FACTOR: f64 = 1000.0;
 
@@ -180,6 +187,8 @@ impl OrganSim {
     /// Regional growth for `step`: new rest lengths, rest angles and
     /// stiffness from the current shape and the maps blended at `step`.
     pub fn grow(&mut self, step: u32) {
+        self.mean_edge = self.elastic.rest_lengths.iter().sum::<f64>()
+            / self.elastic.rest_lengths.len().max(1) as f64;
         let weights = self.maps.weights_at(f64::from(step));
         let blend = |values: fn(&SampledKey) -> &Vec<f64>, t: usize| -> f64 {
             weights
@@ -229,21 +238,33 @@ impl OrganSim {
         let mean_ks = self.elastic.stretch_stiffness.iter().sum::<f64>()
             / self.elastic.stretch_stiffness.len().max(1) as f64;
         self.elastic.contact_stiffness = CONTACT_STIFFNESS_FACTOR * mean_ks;
+        self.elastic.anchor_stiffness = ANCHOR_FACTOR * mean_ks;
     }
 
-    /// One Newton iteration, then shape matching of the base particles onto
-    /// where the receptacle and the joint schedule put them.
+    /// One Newton iteration with the base held where the receptacle and the
+    /// joint schedule put it.
     pub fn iterate(
         &mut self,
         step: u32,
         contacts: &[Contact],
         settings: &SolverSettings,
     ) -> Result<StepReport, SolverError> {
-        let report = self
-            .solver
-            .step(&self.elastic, contacts, &mut self.positions, settings)?;
-        self.attach(step);
-        Ok(report)
+        self.hold_base(step);
+        self.solver
+            .step(&self.elastic, contacts, &mut self.positions, settings)
+    }
+
+    /// Anchors each base particle where the receptacle and the joint
+    /// schedule put it at `step` (see ANCHOR_FACTOR).
+    fn hold_base(&mut self, step: u32) {
+        let extra = joint_angle_after(&self.schedule, step);
+        self.elastic.anchors.clear();
+        for &b in &self.base {
+            let target = self
+                .placement
+                .world_from_template(self.mesh.positions[b as usize], extra);
+            self.elastic.anchors.push((b, target));
+        }
     }
 
     /// Applies to the whole organ the rigid motion that best carries its

@@ -282,6 +282,12 @@ mod tests {
             events.last(),
             Some(Event::Finished { keyframes: 5, .. })
         ));
+        // The wake follows each send, so the last one may still be on its
+        // way when the last event arrives.
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while wakes.load(Ordering::SeqCst) < events.len() && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(1));
+        }
         assert_eq!(wakes.load(Ordering::SeqCst), events.len());
     }
 
@@ -293,10 +299,9 @@ mod tests {
         loop {
             if let Some(Event::Keyframe { keyframe, .. }) =
                 worker.wait_event(Duration::from_secs(60))
+                && keyframe.index >= 1
             {
-                if keyframe.index >= 1 {
-                    break;
-                }
+                break;
             }
         }
         let short = worker.start(Arc::new(whorl(1, 6, 10, 3)), Selection::All);

