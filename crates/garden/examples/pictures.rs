@@ -1,0 +1,153 @@
+//! Simulates a default flower, prints its shape descriptors at chosen
+//! keyframes and renders those keyframes, side view above 3/4 view, tiled
+//! into one PNG.
+//!
+//! `cargo run --release -p anthesis-garden --example pictures -- NAME OUT.png [--frames 1,25,50,75,100] [--tile 300] [--side-only]`
+
+use std::time::Instant;
+
+use anthesis_garden::{flowers, receptacle_mesh, shape};
+use anthesis_render::{Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
+use anthesis_sim::{Selection, run};
+use glam::DVec3;
+use image::{GenericImage, RgbaImage};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let name = args.next().ok_or("give a flower name")?;
+    let out = args.next().ok_or("give an output PNG")?;
+    let mut frames: Vec<u32> = vec![1, 25, 50, 75, 100];
+    let mut tile = 300u32;
+    let mut zoom = 0.8;
+    let mut views: Vec<(f64, f64)> = vec![(0.0, 5.0), (30.0, 40.0)];
+    while let Some(flag) = args.next() {
+        match flag.as_str() {
+            "--frames" => {
+                frames = args
+                    .next()
+                    .ok_or("--frames needs a list")?
+                    .split(',')
+                    .map(str::parse)
+                    .collect::<Result<_, _>>()?;
+            }
+            "--tile" => tile = args.next().ok_or("--tile needs a size")?.parse()?,
+            "--zoom" => zoom = args.next().ok_or("--zoom needs a factor")?.parse()?,
+            "--side-only" => views = vec![(0.0, 5.0)],
+            "--top" => views.push((0.0, 85.0)),
+            other => return Err(format!("unknown flag {other}").into()),
+        }
+    }
+    println!(
+        "half spans: lily petal {:.1} sepal {:.1} eustoma {:.1}",
+        flowers::lily_petal_bud().half_span_deg(),
+        flowers::lily_sepal_bud().half_span_deg(),
+        flowers::eustoma_petal_bud().half_span_deg()
+    );
+    let project = flowers::flower(&name).ok_or("unknown flower")??;
+    for t in &project.flower.templates {
+        let q = anthesis_bud::quality(&t.mesh);
+        println!(
+            "template {}: {} particles, {} triangles, {} edges, mean edge {:.2}, min angle {:.1}, base v <= {:.3}",
+            t.name, q.vertices, q.triangles, q.edges, q.mean_edge, q.min_angle_deg, t.base_region.v_max
+        );
+    }
+    println!("overlaps: {:?}", project.flower.overlaps);
+    let last = frames.iter().copied().max().unwrap_or(0);
+    let mut project = project;
+    project.settings.keyframes = last;
+    let started = Instant::now();
+    let mut kept: Vec<(u32, Vec<Vec<DVec3>>)> = Vec::new();
+    let meshes: Vec<_> = (0..project.flower.organs.len())
+        .map(|i| project.flower.template_of(i).mesh.clone())
+        .collect();
+    let result = run(&project, &Selection::All, &mut |_, keyframe| {
+        if keyframe.index == 0 || frames.contains(&keyframe.index) {
+            let s = shape::flower_shape(
+                meshes
+                    .iter()
+                    .zip(&keyframe.positions)
+                    .map(|(m, p)| (m, p.as_slice())),
+            );
+            if let Err(e) = &s {
+                println!("kf {}: {e}", keyframe.index);
+            }
+            if let Ok(s) = s {
+                let m = s.mean;
+                println!(
+                    "kf {:3}: angles {:6.1} {:6.1} {:6.1} turn mid {:6.1} lam {:6.1} cup {:6.3} radius {:5.1} {:5.1} {:5.1} {:5.1} height {:5.1} {:5.1} {:5.1} {:5.1} len {:5.1} it {} pushed {}",
+                    keyframe.index,
+                    m.midrib_angles_deg[0],
+                    m.midrib_angles_deg[1],
+                    m.midrib_angles_deg[2],
+                    m.midrib_turning_deg,
+                    m.lamina_turning_deg,
+                    m.cupping,
+                    m.radius_profile[0],
+                    m.radius_profile[1],
+                    m.radius_profile[2],
+                    m.radius_profile[3],
+                    m.height_profile[0],
+                    m.height_profile[1],
+                    m.height_profile[2],
+                    m.height_profile[3],
+                    m.midrib_length,
+                    keyframe.stats.iterations,
+                    keyframe.stats.pushed_particles
+                );
+            }
+            kept.push((keyframe.index, keyframe.positions.clone()));
+        }
+    });
+    println!("simulated {last} keyframes in {:.1} s", started.elapsed().as_secs_f64());
+    if let Err(e) = &result {
+        println!("simulation stopped: {e}");
+    }
+    let receptacle = receptacle_mesh(2.2, 1.5);
+    let mut renderer = OffscreenRenderer::new()?;
+    let columns = kept.len() as u32;
+    let mut sheet = RgbaImage::new(tile * columns, tile * views.len() as u32);
+    let scenes: Vec<Vec<OrganMesh>> = kept
+        .iter()
+        .map(|(_, positions)| {
+            let mut organs: Vec<OrganMesh> = positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    OrganMesh::from_positions(
+                        p,
+                        &meshes[i].triangles,
+                        project.flower.template_of(i).color,
+                    )
+                })
+                .collect();
+            organs.push(OrganMesh::from_positions(
+                &receptacle.positions,
+                &receptacle.triangles,
+                [0.45, 0.62, 0.3, 1.0],
+            ));
+            organs
+        })
+        .collect();
+    // Frame every keyframe the same way: a box about the axis that holds
+    // them all.
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for organs in &scenes {
+        let (l, h) = organs_bounds_in_world(organs).ok_or("empty")?;
+        lo = lo.min(l);
+        hi = hi.max(h);
+    }
+    let reach = lo.x.abs().max(hi.x.abs()).max(lo.z.abs()).max(hi.z.abs());
+    let (lo, hi) = (DVec3::new(-reach, lo.y, -reach), DVec3::new(reach, hi.y, reach));
+    for (column, organs) in scenes.iter().enumerate() {
+        for (row, &(azimuth, elevation)) in views.iter().enumerate() {
+            let mut camera = Camera::framing(lo, hi, azimuth, elevation);
+            // The framing fits the whole box; the flower fills less of it.
+            camera.fov_y_deg *= zoom;
+            let picture = renderer.render(organs, &camera, tile, tile)?;
+            sheet.copy_from(&picture, tile * column as u32, tile * row as u32)?;
+        }
+    }
+    sheet.save(&out)?;
+    println!("wrote {out}");
+    result.map(|_| ()).map_err(Into::into)
+}

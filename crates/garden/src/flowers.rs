@@ -1,0 +1,481 @@
+//! The four default projects: the Asiatic lily (paper §6.1) and three
+//! cultivars of *Eustoma grandiflorum* grown from one bud (§6.2), with the
+//! parameters of Table 1.
+
+use anthesis_bud::BudError;
+use anthesis_flower::{
+    BaseRegion, Flower, JointRamp, Project, SimulationSettings, Template,
+};
+use anthesis_maps::{Blend, GrowthMaps, KeyedMaps, MapError, MapKey};
+use anthesis_mesh::Mesh;
+use glam::DVec2;
+
+use crate::arrangement::{Whorl, contorted_whorl, nested_whorls};
+use crate::buds::RingOrgan;
+use crate::paint::{Painting, above_base, midrib_band, smoothstep};
+
+/// Why a default flower could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GardenError {
+    #[error("the {organ} bud: {error}")]
+    Bud { organ: &'static str, error: BudError },
+    #[error("the {organ} maps: {error}")]
+    Maps { organ: &'static str, error: MapError },
+    #[error("{0}")]
+    Arrangement(String),
+}
+
+/// The names of the default flowers (folder names under `assets/flowers/`).
+pub const FLOWER_NAMES: [&str; 4] = [
+    "lily",
+    "eustoma-mellow-yellow",
+    "eustoma-maite-lady",
+    "eustoma-pinocchio",
+];
+
+/// Builds the default flower called `name` (one of [`FLOWER_NAMES`]).
+pub fn flower(name: &str) -> Option<Result<Project, GardenError>> {
+    Some(match name {
+        "lily" => lily(),
+        "eustoma-mellow-yellow" => eustoma(Cultivar::MellowYellow),
+        "eustoma-maite-lady" => eustoma(Cultivar::MaiteLady),
+        "eustoma-pinocchio" => eustoma(Cultivar::Pinocchio),
+        _ => return None,
+    })
+}
+
+// ---------------------------------------------------------------------------
+// Lily
+
+/// Table 1: the lily's growth scale, thickness and stiffness.
+pub const LILY_DG: f64 = 0.003;
+pub const LILY_THICKNESS: f64 = 0.2;
+pub const LILY_STIFFNESS: f64 = 20.0;
+/// Table 1: mean edge of the lily's petal and sepal meshes.
+pub const LILY_PETAL_EDGE: f64 = 1.3;
+pub const LILY_SEPAL_EDGE: f64 = 1.4;
+/// Distance between the petal and sepal surfaces in the bud.
+pub const LILY_SEPAL_GAP: f64 = 1.2;
+
+/// The lily's inner tepal (petal) in the closed bud: 44 high, widest
+/// (about 15) a little below the middle, pointed, its tip near the axis.
+pub fn lily_petal_bud() -> RingOrgan {
+    RingOrgan {
+        midrib: [
+            DVec2::new(2.0, 0.0),
+            DVec2::new(11.0, 8.0),
+            DVec2::new(10.0, 34.0),
+            DVec2::new(0.9, 44.0),
+        ],
+        half_width: [1.0, 10.2, 9.6, 0.0],
+        offset: 0.0,
+        contortion: 0.0,
+        top_rounding: 0.0,
+    }
+}
+
+/// The lily's outer tepal (sepal): the petal's profile pushed out by
+/// [`LILY_SEPAL_GAP`], a little narrower, so it is longer around the
+/// outside of the bud and narrower.
+pub fn lily_sepal_bud() -> RingOrgan {
+    RingOrgan {
+        half_width: [0.8, 8.8, 9.3, 0.0],
+        offset: LILY_SEPAL_GAP,
+        ..lily_petal_bud()
+    }
+}
+
+/// Where the lily's maps change: the attachment (`v` up to this) does not
+/// grow.
+const LILY_BASE_V: f64 = 0.06;
+
+/// The lily's growth maps (paper §6.1, Fig. 2), shared by petals and
+/// sepals ("the opening behavior of a sepal is almost the same as that of
+/// a petal"):
+///
+/// - three regions: the *midrib* (a band around `u = 0.5`), the *bottom*
+///   (`v` below about 0.15) and the *lamina* (the rest);
+/// - e-growth elongates midrib and lamina equally, the bottom less;
+/// - early (steps 1–40) e-growth-in exceeds e-growth strongly on the midrib
+///   and slightly on the lamina; late (50–100) they are equal on the midrib
+///   and the lamina keeps its slight excess; linear blend in between;
+/// - w-growth and w-growth-in are slightly larger on the lamina;
+/// - direction along the parallel venation, fanning a little to the
+///   margins; the midrib is stiffer than the lamina.
+pub fn lily_maps() -> Result<KeyedMaps, MapError> {
+    const E: f64 = 0.6;
+    const E_BOTTOM: f64 = 0.25;
+    const MIDRIB_EXCESS_EARLY: f64 = 0.3;
+    const LAMINA_EXCESS: f64 = 0.035;
+    const W_MIDRIB: f64 = 0.15;
+    const W_LAMINA: f64 = 0.3;
+    const W_IN_EXCESS: f64 = 0.12;
+    let midrib = |uv: DVec2| midrib_band(uv.x, 0.15);
+    let bottom = |uv: DVec2| 1.0 - smoothstep(0.1, 0.2, uv.y);
+    let grows = |uv: DVec2| above_base(uv.y, LILY_BASE_V, 0.04);
+    let e = move |uv: DVec2| grows(uv) * (E + (E_BOTTOM - E) * bottom(uv));
+    let w = move |uv: DVec2| {
+        grows(uv) * (W_MIDRIB + (W_LAMINA - W_MIDRIB) * (1.0 - midrib(uv))) * (1.0 - 0.5 * bottom(uv))
+    };
+    let w_in = move |uv: DVec2| w(uv) + grows(uv) * (1.0 - bottom(uv)) * W_IN_EXCESS * (1.0 - midrib(uv));
+    let excess = move |uv: DVec2, midrib_excess: f64| {
+        let m = midrib(uv);
+        grows(uv) * (1.0 - bottom(uv)) * (midrib_excess * m + LAMINA_EXCESS * (1.0 - m))
+    };
+    let e_in_early = move |uv: DVec2| e(uv) + excess(uv, MIDRIB_EXCESS_EARLY);
+    let e_in_late = move |uv: DVec2| e(uv) + excess(uv, 0.0);
+    let stiffness = move |uv: DVec2| 0.5 + 0.5 * midrib(uv);
+    let direction = |uv: DVec2| DVec2::new(0.15 * (uv.x - 0.5) * uv.y, 1.0);
+    let key = |e_in: &dyn Fn(DVec2) -> f64| {
+        Painting {
+            e_growth: &e,
+            w_growth: &w,
+            e_growth_in: e_in,
+            w_growth_in: &w_in,
+            stretch: &stiffness,
+            bend: &stiffness,
+            direction: &direction,
+        }
+        .paint()
+    };
+    keyed(vec![(40, key(&e_in_early)), (50, key(&e_in_late))])
+}
+
+fn keyed(keys: Vec<(u32, GrowthMaps)>) -> Result<KeyedMaps, MapError> {
+    KeyedMaps::new(
+        keys.into_iter()
+            .map(|(step, maps)| MapKey { step, maps })
+            .collect(),
+        Blend::Linear,
+    )
+}
+
+/// A base region of `v <= v_max`, widened to hold at least two rows of
+/// particles of `mesh` (one row lies along the joint axis and could not
+/// hold the joint angle).
+fn base_region(mesh: &Mesh, v_max: f64) -> BaseRegion {
+    let mut vs: Vec<f64> = mesh.uvs.iter().map(|uv| uv.y).collect();
+    vs.sort_by(f64::total_cmp);
+    vs.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    let second_row = vs.get(1).copied().unwrap_or(v_max);
+    BaseRegion {
+        v_max: v_max.max(second_row + 1e-6),
+        ..BaseRegion::default()
+    }
+}
+
+/// What a template is made of, besides its name.
+struct TemplateSpec {
+    /// Names the organ in errors.
+    organ: &'static str,
+    bud: RingOrgan,
+    edge: f64,
+    dg: f64,
+    thickness: f64,
+    stiffness: f64,
+    base_v: f64,
+    joint: JointRamp,
+    color: [f32; 4],
+}
+
+fn template(
+    name: &str,
+    spec: &TemplateSpec,
+    maps: Result<KeyedMaps, MapError>,
+) -> Result<Template, GardenError> {
+    let organ = spec.organ;
+    let mesh = spec
+        .bud
+        .build(spec.edge)
+        .map_err(|error| GardenError::Bud { organ, error })?;
+    let maps = maps.map_err(|error| GardenError::Maps { organ, error })?;
+    Ok(Template {
+        name: name.to_string(),
+        base_region: base_region(&mesh, spec.base_v),
+        mesh,
+        maps,
+        dg: spec.dg,
+        thickness: spec.thickness,
+        stretch_stiffness: spec.stiffness,
+        bend_stiffness: spec.stiffness,
+        joint_schedule: vec![spec.joint],
+        color: spec.color,
+    })
+}
+
+/// The lily's joint: +23° over steps 1–60 (paper §6.1).
+pub const LILY_JOINT: JointRamp = JointRamp {
+    from_step: 0,
+    to_step: 60,
+    degrees: 23.0,
+};
+
+fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, color: [f32; 4]) -> TemplateSpec {
+    TemplateSpec {
+        organ,
+        bud,
+        edge,
+        dg: LILY_DG,
+        thickness: LILY_THICKNESS,
+        stiffness: LILY_STIFFNESS,
+        base_v: LILY_BASE_V,
+        joint: LILY_JOINT,
+        color,
+    }
+}
+
+/// The lily petal template: [`lily_petal_bud`] meshed at edge 1.3 (about
+/// the paper's 388 particles), [`lily_maps`], Table 1's material.
+pub fn lily_petal_template() -> Result<Template, GardenError> {
+    let spec = lily_spec("lily petal", lily_petal_bud(), LILY_PETAL_EDGE, [0.98, 0.55, 0.22, 1.0]);
+    template("petal", &spec, lily_maps())
+}
+
+/// The lily sepal template: [`lily_sepal_bud`] meshed at edge 1.4 (about
+/// the paper's 323 particles), the petal's maps.
+pub fn lily_sepal_template() -> Result<Template, GardenError> {
+    let spec = lily_spec("lily sepal", lily_sepal_bud(), LILY_SEPAL_EDGE, [0.96, 0.5, 0.2, 1.0]);
+    template("sepal", &spec, lily_maps())
+}
+
+/// The whorls of a bud of `organs` of shape `bud`, `count` of them from
+/// azimuth `offset_deg`.
+fn ring_whorl(name: &str, template: usize, bud: &RingOrgan, count: usize, offset_deg: f64) -> Whorl {
+    let base = bud.base_in_meridian();
+    Whorl {
+        name: name.to_string(),
+        template,
+        count,
+        offset_deg,
+        radius: base.x,
+        height: base.y,
+        joint_angle_deg: 0.0,
+        half_span_deg: bud.half_span_deg(),
+    }
+}
+
+/// The Asiatic lily: three petals inside three sepals.
+pub fn lily() -> Result<Project, GardenError> {
+    let templates = vec![lily_petal_template()?, lily_sepal_template()?];
+    let arrangement = nested_whorls(&[
+        ring_whorl("petal", 0, &lily_petal_bud(), 3, 0.0),
+        ring_whorl("sepal", 1, &lily_sepal_bud(), 3, 60.0),
+    ]);
+    Ok(Project {
+        name: "Asiatic lily".to_string(),
+        flower: Flower {
+            templates,
+            organs: arrangement.organs,
+            overlaps: arrangement.overlaps,
+        },
+        settings: SimulationSettings::default(),
+    })
+}
+
+// ---------------------------------------------------------------------------
+// Eustoma
+
+/// The three cultivars of paper §6.2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cultivar {
+    /// Bell group.
+    MellowYellow,
+    /// Funnel group.
+    MaiteLady,
+    /// Shallow-ball group.
+    Pinocchio,
+}
+
+impl Cultivar {
+    pub const ALL: [Cultivar; 3] = [Cultivar::MellowYellow, Cultivar::MaiteLady, Cultivar::Pinocchio];
+
+    pub fn project_name(self) -> &'static str {
+        match self {
+            Cultivar::MellowYellow => "Eustoma 'Mellow Yellow'",
+            Cultivar::MaiteLady => "Eustoma 'Maite Lady'",
+            Cultivar::Pinocchio => "Eustoma 'Pinocchio'",
+        }
+    }
+
+    pub fn folder_name(self) -> &'static str {
+        match self {
+            Cultivar::MellowYellow => "eustoma-mellow-yellow",
+            Cultivar::MaiteLady => "eustoma-maite-lady",
+            Cultivar::Pinocchio => "eustoma-pinocchio",
+        }
+    }
+
+    fn color(self) -> [f32; 4] {
+        match self {
+            Cultivar::MellowYellow => [0.97, 0.9, 0.5, 1.0],
+            Cultivar::MaiteLady => [0.93, 0.7, 0.86, 1.0],
+            Cultivar::Pinocchio => [0.62, 0.42, 0.82, 1.0],
+        }
+    }
+}
+
+/// Table 1: Eustoma's growth scale, thickness, stiffness and mean edge.
+pub const EUSTOMA_DG: f64 = 0.003;
+pub const EUSTOMA_THICKNESS: f64 = 0.1;
+pub const EUSTOMA_STIFFNESS: f64 = 10.0;
+pub const EUSTOMA_EDGE: f64 = 2.0;
+/// How much further out each petal's left margin lies than its right one.
+pub const EUSTOMA_CONTORTION: f64 = 2.4;
+
+/// The Eustoma petal of the closed, contorted bud shared by the three
+/// cultivars: a narrow claw, an obovate blade widest at about two thirds of
+/// its length, a rounded top turned in over the bud's apex.
+pub fn eustoma_petal_bud() -> RingOrgan {
+    RingOrgan {
+        midrib: [
+            DVec2::new(1.8, 0.0),
+            DVec2::new(12.0, 9.6),
+            DVec2::new(16.2, 33.6),
+            DVec2::new(4.2, 44.4),
+        ],
+        half_width: [1.5, 7.2, 16.8, 4.8],
+        offset: 0.0,
+        contortion: EUSTOMA_CONTORTION,
+        top_rounding: 0.2,
+    }
+}
+
+const EUSTOMA_BASE_V: f64 = 0.05;
+
+/// The Eustoma joint: +15° over steps 1–50 (paper §6.2).
+pub const EUSTOMA_JOINT: JointRamp = JointRamp {
+    from_step: 0,
+    to_step: 50,
+    degrees: 15.0,
+};
+
+/// Lower, middle and upper regions of an Eustoma petal (weights that sum
+/// to 1), by `v`.
+fn eustoma_regions(v: f64) -> [f64; 3] {
+    let upper = smoothstep(0.55, 0.75, v);
+    let lower = 1.0 - smoothstep(0.25, 0.45, v);
+    [lower, 1.0 - lower - upper, upper]
+}
+
+/// One cultivar's growth: per stage (early, late), per region (lower,
+/// middle, upper): e-growth, e-growth-in excess; and the w-growth and
+/// w-growth-in excess, per stage.
+struct EustomaGrowth {
+    e: [[f64; 3]; 2],
+    e_in_excess: [[f64; 3]; 2],
+    w: [f64; 2],
+    w_in_excess: [[f64; 3]; 2],
+    /// How much the growth direction fans out towards the margins.
+    fan: f64,
+}
+
+fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
+    match cultivar {
+        // Bell: growth is larger late, when the inner upper region expands
+        // much more than the outer lower and middle: the tips reflex while
+        // the lower part stays a tube.
+        Cultivar::MellowYellow => EustomaGrowth {
+            e: [[0.3, 0.3, 0.3], [0.6, 0.6, 0.7]],
+            e_in_excess: [[0.0, 0.02, 0.06], [0.0, 0.02, 0.25]],
+            w: [0.2, 0.4],
+            w_in_excess: [[0.0, 0.0, 0.05], [0.0, 0.0, 0.15]],
+            fan: 0.0,
+        },
+        // Funnel: uniform growth, larger early; the petal straightens and
+        // flattens and opens as a cone.
+        Cultivar::MaiteLady => EustomaGrowth {
+            e: [[0.7, 0.7, 0.7], [0.3, 0.3, 0.3]],
+            e_in_excess: [[0.018, 0.018, 0.018], [0.004, 0.004, 0.004]],
+            w: [0.5, 0.2],
+            w_in_excess: [[0.06, 0.06, 0.06], [0.02, 0.02, 0.02]],
+            fan: 0.6,
+        },
+        // Shallow ball: uniform growth, but the inner lower and middle
+        // regions elongate more than the outer: the base opens wide and the
+        // cupped upper petal stays turned in.
+        Cultivar::Pinocchio => EustomaGrowth {
+            e: [[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]],
+            e_in_excess: [[0.02, 0.008, 0.0], [0.012, 0.004, 0.0]],
+            w: [0.35, 0.35],
+            w_in_excess: [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
+            fan: 0.0,
+        },
+    }
+}
+
+/// The growth maps of one cultivar (paper §6.2, Fig. 16): regions by `v`
+/// (lower, middle, upper) with each cultivar's observations, early maps up
+/// to step 40 and late maps from step 60, blended in between (Fig. 16's
+/// caption); the same stretch and bend maps for all three (the bottom
+/// harder than the top); direction along the venation, Maite Lady's
+/// fanning out more than the others'.
+pub fn eustoma_maps(cultivar: Cultivar) -> Result<KeyedMaps, MapError> {
+    let growth = eustoma_growth(cultivar);
+    let grows = |uv: DVec2| above_base(uv.y, EUSTOMA_BASE_V, 0.05);
+    let by_region = |values: [f64; 3], v: f64| {
+        let r = eustoma_regions(v);
+        r[0] * values[0] + r[1] * values[1] + r[2] * values[2]
+    };
+    let stiffness = |uv: DVec2| 1.0 - 0.5 * smoothstep(0.2, 0.8, uv.y);
+    let fan = growth.fan;
+    let direction = move |uv: DVec2| DVec2::new(fan * (uv.x - 0.5) * uv.y, 1.0);
+    let mut keys = Vec::new();
+    for (stage, step) in [(0, 40), (1, 60)] {
+        let e = |uv: DVec2| grows(uv) * by_region(growth.e[stage], uv.y);
+        let e_in = |uv: DVec2| e(uv) + grows(uv) * by_region(growth.e_in_excess[stage], uv.y);
+        let w = |uv: DVec2| grows(uv) * growth.w[stage];
+        let w_in = |uv: DVec2| w(uv) + grows(uv) * by_region(growth.w_in_excess[stage], uv.y);
+        let maps = Painting {
+            e_growth: &e,
+            w_growth: &w,
+            e_growth_in: &e_in,
+            w_growth_in: &w_in,
+            stretch: &stiffness,
+            bend: &stiffness,
+            direction: &direction,
+        }
+        .paint();
+        keys.push((step, maps));
+    }
+    keyed(keys)
+}
+
+/// The Eustoma petal template of `cultivar`: [`eustoma_petal_bud`] meshed
+/// at edge 2.0 (about the paper's 261 particles), the cultivar's maps,
+/// Table 1's material.
+pub fn eustoma_petal_template(cultivar: Cultivar) -> Result<Template, GardenError> {
+    let spec = TemplateSpec {
+        organ: "Eustoma petal",
+        bud: eustoma_petal_bud(),
+        edge: EUSTOMA_EDGE,
+        dg: EUSTOMA_DG,
+        thickness: EUSTOMA_THICKNESS,
+        stiffness: EUSTOMA_STIFFNESS,
+        base_v: EUSTOMA_BASE_V,
+        joint: EUSTOMA_JOINT,
+        color: cultivar.color(),
+    };
+    template("petal", &spec, eustoma_maps(cultivar))
+}
+
+/// One Eustoma cultivar: five contorted petals, each one's right side
+/// beneath its neighbour.
+pub fn eustoma(cultivar: Cultivar) -> Result<Project, GardenError> {
+    let bud = eustoma_petal_bud();
+    let arrangement = contorted_whorl(&ring_whorl("petal", 0, &bud, 5, 0.0)).ok_or_else(|| {
+        GardenError::Arrangement(format!(
+            "the Eustoma petals span ±{:.0}° each: five of them must overlap their neighbours \
+             and no more",
+            bud.half_span_deg()
+        ))
+    })?;
+    Ok(Project {
+        name: cultivar.project_name().to_string(),
+        flower: Flower {
+            templates: vec![eustoma_petal_template(cultivar)?],
+            organs: arrangement.organs,
+            overlaps: arrangement.overlaps,
+        },
+        settings: SimulationSettings::default(),
+    })
+}

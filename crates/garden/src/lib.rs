@@ -1,0 +1,96 @@
+//! The default flowers of Anthesis (Ijiri et al. 2008, §6): the Asiatic
+//! lily and three cultivars of *Eustoma grandiflorum* grown from one bud,
+//! with everything they are made of:
+//!
+//! - [`buds`]: bud organs shaped around the flower axis ([`buds::RingOrgan`]),
+//!   remeshed by `anthesis-bud`;
+//! - [`arrangement`]: whorls, contorted whorls and phyllotactic spirals on
+//!   the receptacle, with the overlap rules collisions need;
+//! - [`paint`]: growth maps painted as functions of UV;
+//! - [`flowers`]: the four projects ([`flowers::lily`], [`flowers::eustoma`]);
+//! - [`shape`]: numeric shape descriptors (opening angles, turning,
+//!   cupping, corolla profile) that tests use to check each flower's
+//!   character;
+//! - [`receptacle_mesh`]: a receptacle for pictures and exports;
+//! - [`builtin`]: the committed projects of `assets/flowers/`, embedded in
+//!   the binary.
+//!
+//! The projects under `assets/flowers/` are written by
+//! `cargo run -p anthesis-garden --bin make-flowers` and a test checks that
+//! they equal what the builders here make.
+
+pub mod arrangement;
+pub mod buds;
+pub mod flowers;
+pub mod paint;
+mod receptacle;
+pub mod shape;
+
+use std::io;
+
+use anthesis_flower::Project;
+use anthesis_flower::project::{ProjectError, parse_project};
+
+pub use flowers::{Cultivar, FLOWER_NAMES, GardenError};
+pub use receptacle::receptacle_mesh;
+
+include!(concat!(env!("OUT_DIR"), "/builtin_files.rs"));
+
+/// The file name of flower `name`'s project inside its folder.
+pub fn project_file_name(name: &str) -> String {
+    format!("{name}.anthesis.toml")
+}
+
+/// The names of the flowers embedded in this build (the folders under
+/// `assets/flowers/` when it was compiled).
+pub fn builtin_names() -> Vec<&'static str> {
+    BUILTIN_FILES.iter().map(|(name, _)| *name).collect()
+}
+
+/// The embedded project `name` (e.g. `"lily"`), read from the files that
+/// were committed under `assets/flowers/<name>/` when this binary was built;
+/// `None` for a name that is not built in. The files are checked by the same
+/// rules as any project file.
+pub fn builtin(name: &str) -> Option<Result<Project, ProjectError>> {
+    let (_, files) = BUILTIN_FILES.iter().find(|(n, _)| *n == name)?;
+    let file = |path: &str| -> Option<&'static [u8]> {
+        files.iter().find(|(p, _)| *p == path).map(|(_, bytes)| *bytes)
+    };
+    let toml_name = project_file_name(name);
+    let Some(toml) = file(&toml_name) else {
+        return Some(Err(ProjectError::Io {
+            path: toml_name.into(),
+            message: "the embedded flower has no project file".to_string(),
+        }));
+    };
+    let text = match std::str::from_utf8(toml) {
+        Ok(text) => text,
+        Err(_) => {
+            return Some(Err(ProjectError::Syntax {
+                path: toml_name.into(),
+                message: "the file is not UTF-8 text".to_string(),
+            }));
+        }
+    };
+    let read = |path: &str| -> Result<Vec<u8>, io::Error> {
+        let normalised = path.trim_start_matches("./");
+        file(normalised).map(<[u8]>::to_vec).ok_or_else(|| {
+            io::Error::new(
+                io::ErrorKind::NotFound,
+                format!("{path} is not among the embedded files of `{name}`"),
+            )
+        })
+    };
+    Some(parse_project(text, &read))
+}
+
+/// The embedded Asiatic lily (see [`builtin`]).
+pub fn builtin_lily() -> Result<Project, ProjectError> {
+    builtin("lily").unwrap_or_else(|| {
+        Err(ProjectError::Io {
+            path: project_file_name("lily").into(),
+            message: "this build has no embedded lily (assets/flowers/lily was missing)"
+                .to_string(),
+        })
+    })
+}

@@ -1,0 +1,255 @@
+//! Numbers that say what shape a flower has at a keyframe, so tests can
+//! tell a reflexed lily from a closed bud and a bell from a funnel or a
+//! shallow ball.
+//!
+//! All descriptors are measured on the organ surfaces through their UVs:
+//! a point at a given `(u, v)` is found by interpolating the keyframe
+//! positions over the triangle that contains it in UV. The *midrib* is the
+//! line `u = 0.5` from `v = 0` (base) to `v = 1` (tip); *lamina lines* are
+//! `u = 0.25` and `u = 0.75` from `v = 0` to [`LAMINA_END_V`].
+//!
+//! # Angles
+//!
+//! The *opening angle* of a piece of a line is the angle of its chord from
+//! the flower axis (+Y), measured in the meridional plane through the
+//! chord's midpoint: 0° points straight up along the axis, 90° horizontally
+//! away from it, more than 90° downwards (a *reflexed* piece), and negative
+//! angles lean in towards the axis (a closed bud's tip). The *turning* of a
+//! line is how much that angle grows from its first piece to its last:
+//! positive when the organ bends outwards (towards reflexing) along its
+//! length, negative when it curls in.
+//!
+//! # Cross-sections
+//!
+//! *Cupping* is the sagitta of the cross-section `v = 0.5` (the distance of
+//! the midrib from the chord joining the two points at `u = 0.1` and
+//! `u = 0.9`) divided by that chord, signed along the organ's inner normal:
+//! positive when the margins lie towards the inner side (a cup open to the
+//! flower axis), negative when the lamina bulges towards the inner side.
+
+use anthesis_mesh::Mesh;
+use glam::{DVec2, DVec3};
+
+/// Where the lamina lines end: a pointed organ has no lamina at its tip.
+pub const LAMINA_END_V: f64 = 0.9;
+
+/// Finds surface points by UV on one organ.
+pub struct UvSampler<'a> {
+    mesh: &'a Mesh,
+}
+
+impl<'a> UvSampler<'a> {
+    /// `mesh` supplies UVs and triangles (the organ's template mesh).
+    pub fn new(mesh: &'a Mesh) -> Self {
+        UvSampler { mesh }
+    }
+
+    /// The point at `point_in_uv` on the organ whose particles are at
+    /// `positions_in_world`, or `None` if no triangle covers that UV.
+    /// Points just outside the UV layout (within a small tolerance) are
+    /// taken from the nearest triangle.
+    pub fn point(&self, positions_in_world: &[DVec3], point_in_uv: DVec2) -> Option<DVec3> {
+        let mut best: Option<(f64, usize, [f64; 3])> = None;
+        for (t, tri) in self.mesh.triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|i| self.mesh.uvs[i as usize]);
+            let Some(w) = barycentric(point_in_uv, a, b, c) else {
+                continue;
+            };
+            // How far outside the triangle the point is (0 inside).
+            let outside = -w.iter().copied().fold(0.0, f64::min);
+            if best.is_none_or(|(o, _, _)| outside < o) {
+                best = Some((outside, t, w));
+            }
+            if outside == 0.0 {
+                break;
+            }
+        }
+        let (outside, t, w) = best?;
+        if outside > 0.05 {
+            return None;
+        }
+        let tri = self.mesh.triangles[t];
+        Some((0..3).map(|k| w[k] * positions_in_world[tri[k] as usize]).sum())
+    }
+
+    /// Points along the line `u` from `v_from` to `v_to`, `count` of them
+    /// (at least 2), skipping any that fall outside the layout.
+    pub fn line(
+        &self,
+        positions_in_world: &[DVec3],
+        u: f64,
+        v_from: f64,
+        v_to: f64,
+        count: usize,
+    ) -> Vec<DVec3> {
+        let count = count.max(2);
+        (0..count)
+            .filter_map(|k| {
+                let v = v_from + (v_to - v_from) * k as f64 / (count - 1) as f64;
+                self.point(positions_in_world, DVec2::new(u, v))
+            })
+            .collect()
+    }
+}
+
+fn barycentric(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> Option<[f64; 3]> {
+    let (v0, v1, v2) = (b - a, c - a, p - a);
+    let det = v0.perp_dot(v1);
+    if det.abs() < 1e-18 {
+        return None;
+    }
+    let wb = v2.perp_dot(v1) / det;
+    let wc = v0.perp_dot(v2) / det;
+    Some([1.0 - wb - wc, wb, wc])
+}
+
+/// The opening angle of the chord from `from` to `to` (see the module
+/// documentation), in degrees.
+pub fn opening_angle_deg(from: DVec3, to: DVec3) -> f64 {
+    let d = to - from;
+    let mid = 0.5 * (from + to);
+    let radial = DVec2::new(mid.x, mid.z).normalize_or(DVec2::Y);
+    let outwards = d.x * radial.x + d.z * radial.y;
+    outwards.atan2(d.y).to_degrees()
+}
+
+/// The turning of a polyline in degrees: how much the opening angle of its
+/// pieces grows from the first piece to the last, summed piece by piece so
+/// that a line curling past straight down keeps counting; 0 for fewer than
+/// 3 points.
+pub fn turning_deg(line: &[DVec3]) -> f64 {
+    let angles: Vec<f64> = line
+        .windows(2)
+        .filter(|w| w[0].distance_squared(w[1]) > 0.0)
+        .map(|w| opening_angle_deg(w[0], w[1]))
+        .collect();
+    angles
+        .windows(2)
+        .map(|w| (w[1] - w[0] + 180.0).rem_euclid(360.0) - 180.0)
+        .sum()
+}
+
+/// What one organ looks like at one keyframe.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OrganShape {
+    /// Opening angles (degrees) of the midrib's base, middle and tip thirds.
+    pub midrib_angles_deg: [f64; 3],
+    /// Turning of the midrib, degrees.
+    pub midrib_turning_deg: f64,
+    /// Mean turning of the two lamina lines (`u = 0.25`, `u = 0.75`).
+    pub lamina_turning_deg: f64,
+    /// Cupping of the cross-section at `v = 0.5` (see the module docs).
+    pub cupping: f64,
+    /// Distance from the flower axis of the midrib at `v` = 0.25, 0.5,
+    /// 0.75 and 1.
+    pub radius_profile: [f64; 4],
+    /// Height of the midrib at the same `v`.
+    pub height_profile: [f64; 4],
+    /// Length of the midrib.
+    pub midrib_length: f64,
+}
+
+/// Why a shape could not be measured.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ShapeError {
+    #[error("the organ's UV layout does not cover (u, v) = ({u:.2}, {v:.2})")]
+    UvNotCovered { u: f64, v: f64 },
+    #[error("{positions} positions for a mesh of {vertices} vertices")]
+    WrongCount { positions: usize, vertices: usize },
+}
+
+/// Measures one organ: `mesh` is its template mesh (for UVs and
+/// triangles), `positions_in_world` its particles at the keyframe.
+pub fn organ_shape(mesh: &Mesh, positions_in_world: &[DVec3]) -> Result<OrganShape, ShapeError> {
+    if positions_in_world.len() != mesh.vertex_count() {
+        return Err(ShapeError::WrongCount {
+            positions: positions_in_world.len(),
+            vertices: mesh.vertex_count(),
+        });
+    }
+    let sampler = UvSampler::new(mesh);
+    let at = |u: f64, v: f64| {
+        sampler
+            .point(positions_in_world, DVec2::new(u, v))
+            .ok_or(ShapeError::UvNotCovered { u, v })
+    };
+    let line = |u: f64, v_end: f64| -> Result<Vec<DVec3>, ShapeError> {
+        (0..=40)
+            .map(|k| at(u, v_end * f64::from(k) / 40.0))
+            .collect::<Result<Vec<_>, _>>()
+    };
+    let midrib = line(0.5, 1.0)?;
+    let third = |a: usize, b: usize| opening_angle_deg(midrib[a], midrib[b]);
+    let midrib_angles_deg = [third(0, 13), third(13, 27), third(27, 40)];
+    let lamina_turning_deg =
+        0.5 * (turning_deg(&line(0.25, LAMINA_END_V)?) + turning_deg(&line(0.75, LAMINA_END_V)?));
+
+    let (left, right, centre) = (at(0.9, 0.5)?, at(0.1, 0.5)?, at(0.5, 0.5)?);
+    let chord = right - left;
+    let to_centre = centre - left;
+    let along = chord.normalize_or_zero();
+    let off_chord = to_centre - along * to_centre.dot(along);
+    let inner_normal = inner_normal_near(mesh, positions_in_world, DVec2::new(0.5, 0.5));
+    let cupping = if chord.length() > 0.0 {
+        -off_chord.dot(inner_normal) / chord.length()
+    } else {
+        0.0
+    };
+
+    let radius = |p: DVec3| DVec2::new(p.x, p.z).length();
+    let profile_points = [10, 20, 30, 40].map(|k| midrib[k]);
+    Ok(OrganShape {
+        midrib_angles_deg,
+        midrib_turning_deg: turning_deg(&midrib),
+        lamina_turning_deg,
+        cupping,
+        radius_profile: profile_points.map(radius),
+        height_profile: profile_points.map(|p| p.y),
+        midrib_length: midrib.windows(2).map(|w| w[0].distance(w[1])).sum(),
+    })
+}
+
+/// The unit inner normal of the triangle nearest `point_in_uv`.
+fn inner_normal_near(mesh: &Mesh, positions_in_world: &[DVec3], point_in_uv: DVec2) -> DVec3 {
+    let nearest = (0..mesh.triangles.len()).min_by(|&a, &b| {
+        let centre = |t: usize| mesh.triangle_uvs(t).iter().sum::<DVec2>() / 3.0;
+        centre(a)
+            .distance_squared(point_in_uv)
+            .total_cmp(&centre(b).distance_squared(point_in_uv))
+    });
+    nearest.map_or(DVec3::ZERO, |t| {
+        let [a, b, c] = mesh.triangles[t].map(|i| positions_in_world[i as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    })
+}
+
+/// The shape of a whole flower (or of a group of its organs, e.g. the
+/// lily's petals): each organ's shape and their means.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowerShape {
+    pub organs: Vec<OrganShape>,
+    /// Means over the organs of each [`OrganShape`] field.
+    pub mean: OrganShape,
+}
+
+/// Measures the organs given as `(template mesh, positions)` pairs.
+pub fn flower_shape<'a>(
+    organs: impl IntoIterator<Item = (&'a Mesh, &'a [DVec3])>,
+) -> Result<FlowerShape, ShapeError> {
+    let organs = organs
+        .into_iter()
+        .map(|(mesh, positions)| organ_shape(mesh, positions))
+        .collect::<Result<Vec<_>, _>>()?;
+    let n = organs.len().max(1) as f64;
+    let mean_of = |f: &dyn Fn(&OrganShape) -> f64| organs.iter().map(f).sum::<f64>() / n;
+    let mean = OrganShape {
+        midrib_angles_deg: [0, 1, 2].map(|k| mean_of(&|o| o.midrib_angles_deg[k])),
+        midrib_turning_deg: mean_of(&|o| o.midrib_turning_deg),
+        lamina_turning_deg: mean_of(&|o| o.lamina_turning_deg),
+        cupping: mean_of(&|o| o.cupping),
+        radius_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.radius_profile[k])),
+        height_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.height_profile[k])),
+        midrib_length: mean_of(&|o| o.midrib_length),
+    };
+    Ok(FlowerShape { organs, mean })
+}
