@@ -35,7 +35,7 @@ fn main() {
     println!("cargo:rerun-if-changed={}", flowers.display());
     let mut code = String::from(
         "/// Files of each embedded flower: (flower name, [(path in its folder, bytes)]).\n\
-         pub(crate) static BUILTIN_FILES: &[(&str, &[(&str, &[u8])])] = &[\n",
+         pub(crate) static BUILTIN_FILES: &[(&str, &[EmbeddedFile])] = &[\n",
     );
     let mut names: Vec<_> = fs::read_dir(&flowers)
         .map(|entries| {
@@ -53,7 +53,11 @@ fn main() {
         let _ = writeln!(code, "    ({name:?}, &[");
         for (relative, path) in files {
             println!("cargo:rerun-if-changed={}", path.display());
-            let _ = writeln!(code, "        ({relative:?}, include_bytes!({:?})),", path.display().to_string());
+            let _ = writeln!(
+                code,
+                "        ({relative:?}, include_bytes!({:?})),",
+                path.display().to_string()
+            );
         }
         let _ = writeln!(code, "    ]),");
     }

@@ -19,6 +19,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut frames: Vec<u32> = vec![1, 25, 50, 75, 100];
     let mut tile = 300u32;
     let mut zoom = 0.8;
+    let mut only: Option<usize> = None;
+    let mut no_midrib = false;
     let mut views: Vec<(f64, f64)> = vec![(0.0, 5.0), (30.0, 40.0)];
     while let Some(flag) = args.next() {
         match flag.as_str() {
@@ -32,6 +34,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             "--tile" => tile = args.next().ok_or("--tile needs a size")?.parse()?,
             "--zoom" => zoom = args.next().ok_or("--zoom needs a factor")?.parse()?,
+            "--only" => only = Some(args.next().ok_or("--only needs an organ index")?.parse()?),
+            "--no-midrib-warping" => no_midrib = true,
             "--side-only" => views = vec![(0.0, 5.0)],
             "--top" => views.push((0.0, 85.0)),
             other => return Err(format!("unknown flag {other}").into()),
@@ -48,19 +52,41 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let q = anthesis_bud::quality(&t.mesh);
         println!(
             "template {}: {} particles, {} triangles, {} edges, mean edge {:.2}, min angle {:.1}, base v <= {:.3}",
-            t.name, q.vertices, q.triangles, q.edges, q.mean_edge, q.min_angle_deg, t.base_region.v_max
+            t.name,
+            q.vertices,
+            q.triangles,
+            q.edges,
+            q.mean_edge,
+            q.min_angle_deg,
+            t.base_region.v_max
         );
     }
     println!("overlaps: {:?}", project.flower.overlaps);
     let last = frames.iter().copied().max().unwrap_or(0);
     let mut project = project;
+    if no_midrib {
+        for t in &mut project.flower.templates {
+            t.maps = flowers::lily_maps(flowers::LilyExcess {
+                midrib_early: 0.0,
+                ..flowers::LilyExcess::PETAL
+            })?;
+        }
+    }
+    let selection = only.map_or(Selection::All, Selection::Only);
+    let simulated: Vec<usize> =
+        only.map_or_else(|| (0..project.flower.organs.len()).collect(), |i| vec![i]);
     project.settings.keyframes = last;
     let started = Instant::now();
     let mut kept: Vec<(u32, Vec<Vec<DVec3>>)> = Vec::new();
-    let meshes: Vec<_> = (0..project.flower.organs.len())
-        .map(|i| project.flower.template_of(i).mesh.clone())
+    let meshes: Vec<_> = simulated
+        .iter()
+        .map(|&i| project.flower.template_of(i).mesh.clone())
         .collect();
-    let result = run(&project, &Selection::All, &mut |_, keyframe| {
+    let colors: Vec<_> = simulated
+        .iter()
+        .map(|&i| project.flower.template_of(i).color)
+        .collect();
+    let result = run(&project, &selection, &mut |_, keyframe| {
         if keyframe.index == 0 || frames.contains(&keyframe.index) {
             let s = shape::flower_shape(
                 meshes
@@ -74,7 +100,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if let Ok(s) = s {
                 let m = s.mean;
                 println!(
-                    "kf {:3}: angles {:6.1} {:6.1} {:6.1} turn mid {:6.1} lam {:6.1} cup {:6.3} radius {:5.1} {:5.1} {:5.1} {:5.1} height {:5.1} {:5.1} {:5.1} {:5.1} len {:5.1} it {} pushed {}",
+                    "kf {:3}: angles {:6.1} {:6.1} {:6.1} turn mid {:6.1} lam {:6.1} cup {:6.3} swell {:6.3} radius {:5.1} {:5.1} {:5.1} {:5.1} height {:5.1} {:5.1} {:5.1} {:5.1} len {:5.1} it {} pushed {}",
                     keyframe.index,
                     m.midrib_angles_deg[0],
                     m.midrib_angles_deg[1],
@@ -82,6 +108,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     m.midrib_turning_deg,
                     m.lamina_turning_deg,
                     m.cupping,
+                    m.swelling,
                     m.radius_profile[0],
                     m.radius_profile[1],
                     m.radius_profile[2],
@@ -98,27 +125,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             kept.push((keyframe.index, keyframe.positions.clone()));
         }
     });
-    println!("simulated {last} keyframes in {:.1} s", started.elapsed().as_secs_f64());
+    println!(
+        "simulated {last} keyframes in {:.1} s",
+        started.elapsed().as_secs_f64()
+    );
     if let Err(e) = &result {
         println!("simulation stopped: {e}");
     }
     let receptacle = receptacle_mesh(2.2, 1.5);
     let mut renderer = OffscreenRenderer::new()?;
     let columns = kept.len() as u32;
-    let mut sheet = RgbaImage::new(tile * columns, tile * views.len() as u32);
+    let rows = if only.is_some() {
+        3
+    } else {
+        views.len() as u32
+    };
+    let mut sheet = RgbaImage::new(tile * columns, tile * rows);
     let scenes: Vec<Vec<OrganMesh>> = kept
         .iter()
         .map(|(_, positions)| {
             let mut organs: Vec<OrganMesh> = positions
                 .iter()
                 .enumerate()
-                .map(|(i, p)| {
-                    OrganMesh::from_positions(
-                        p,
-                        &meshes[i].triangles,
-                        project.flower.template_of(i).color,
-                    )
-                })
+                .map(|(i, p)| OrganMesh::from_positions(p, &meshes[i].triangles, colors[i]))
                 .collect();
             organs.push(OrganMesh::from_positions(
                 &receptacle.positions,
@@ -136,8 +165,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         lo = lo.min(l);
         hi = hi.max(h);
     }
-    let reach = lo.x.abs().max(hi.x.abs()).max(lo.z.abs()).max(hi.z.abs());
-    let (lo, hi) = (DVec3::new(-reach, lo.y, -reach), DVec3::new(reach, hi.y, reach));
+    let (lo, hi) = if only.is_some() {
+        // One organ: frame it tightly, seen from the side of its bending
+        // plane, from above and from the front.
+        views = vec![(90.0, 5.0), (0.0, 85.0), (0.0, 5.0)];
+        (lo, hi)
+    } else {
+        let reach = lo.x.abs().max(hi.x.abs()).max(lo.z.abs()).max(hi.z.abs());
+        (
+            DVec3::new(-reach, lo.y, -reach),
+            DVec3::new(reach, hi.y, reach),
+        )
+    };
     for (column, organs) in scenes.iter().enumerate() {
         for (row, &(azimuth, elevation)) in views.iter().enumerate() {
             let mut camera = Camera::framing(lo, hi, azimuth, elevation);

@@ -47,7 +47,12 @@ impl Whorl {
             .map(|k| Organ {
                 name: format!("{}-{}", self.name, k + 1),
                 template: self.template,
-                placement: placement(self.azimuth_deg(k), self.radius, self.height, self.joint_angle_deg),
+                placement: placement(
+                    self.azimuth_deg(k),
+                    self.radius,
+                    self.height,
+                    self.joint_angle_deg,
+                ),
             })
             .collect()
     }
@@ -97,8 +102,7 @@ pub fn nested_whorls(whorls: &[Whorl]) -> Arrangement {
         for (j, outer) in whorls.iter().enumerate().skip(i + 1) {
             for a in 0..inner.count {
                 for b in 0..outer.count {
-                    let distance =
-                        angular_distance_deg(inner.azimuth_deg(a), outer.azimuth_deg(b));
+                    let distance = angular_distance_deg(inner.azimuth_deg(a), outer.azimuth_deg(b));
                     if distance < inner.half_span_deg + outer.half_span_deg {
                         overlaps.push(Overlap {
                             inner: first_index[i] + a,
@@ -172,8 +176,7 @@ pub fn spiral(spiral: &Spiral) -> Arrangement {
     let mut overlaps = Vec::new();
     for later in 0..spiral.count {
         for earlier in 0..later {
-            if angular_distance_deg(azimuth(earlier), azimuth(later)) < 2.0 * spiral.half_span_deg
-            {
+            if angular_distance_deg(azimuth(earlier), azimuth(later)) < 2.0 * spiral.half_span_deg {
                 overlaps.push(Overlap {
                     inner: later,
                     outer: earlier,

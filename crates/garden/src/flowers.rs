@@ -3,9 +3,7 @@
 //! parameters of Table 1.
 
 use anthesis_bud::BudError;
-use anthesis_flower::{
-    BaseRegion, Flower, JointRamp, Project, SimulationSettings, Template,
-};
+use anthesis_flower::{BaseRegion, Flower, JointRamp, Project, SimulationSettings, Template};
 use anthesis_maps::{Blend, GrowthMaps, KeyedMaps, MapError, MapKey};
 use anthesis_mesh::Mesh;
 use glam::DVec2;
@@ -18,9 +16,15 @@ use crate::paint::{Painting, above_base, midrib_band, smoothstep};
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GardenError {
     #[error("the {organ} bud: {error}")]
-    Bud { organ: &'static str, error: BudError },
+    Bud {
+        organ: &'static str,
+        error: BudError,
+    },
     #[error("the {organ} maps: {error}")]
-    Maps { organ: &'static str, error: MapError },
+    Maps {
+        organ: &'static str,
+        error: MapError,
+    },
     #[error("{0}")]
     Arrangement(String),
 }
@@ -85,13 +89,41 @@ pub fn lily_sepal_bud() -> RingOrgan {
     }
 }
 
+/// Half the width of the lily's midrib band, in `u`.
+const LILY_MIDRIB_HALF_WIDTH: f64 = 0.12;
+
 /// Where the lily's maps change: the attachment (`v` up to this) does not
 /// grow.
 const LILY_BASE_V: f64 = 0.06;
 
-/// The lily's growth maps (paper §6.1, Fig. 2), shared by petals and
-/// sepals ("the opening behavior of a sepal is almost the same as that of
-/// a petal"):
+/// How much e-growth-in exceeds e-growth on the lily's tepals.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LilyExcess {
+    /// On the midrib, early (steps 1–40); late it is 0.
+    pub midrib_early: f64,
+    /// On the lamina, early and late.
+    pub lamina: f64,
+}
+
+impl LilyExcess {
+    /// The petal's.
+    pub const PETAL: LilyExcess = LilyExcess {
+        midrib_early: 0.4,
+        lamina: 0.035,
+    };
+    /// The sepal's: a little less, since the narrower sepal is less cupped
+    /// and bends back more easily; with the petal's excess it would end
+    /// curled right under while the petals only reflex.
+    pub const SEPAL: LilyExcess = LilyExcess {
+        midrib_early: 0.3,
+        lamina: 0.025,
+    };
+}
+
+/// The lily's growth maps (paper §6.1, Fig. 2), painted alike for petals
+/// and sepals ("the opening behavior of a sepal is almost the same as that
+/// of a petal") but for how much the inner side outgrows the base
+/// ([`LilyExcess`]):
 ///
 /// - three regions: the *midrib* (a band around `u = 0.5`), the *bottom*
 ///   (`v` below about 0.15) and the *lamina* (the rest);
@@ -102,29 +134,31 @@ const LILY_BASE_V: f64 = 0.06;
 /// - w-growth and w-growth-in are slightly larger on the lamina;
 /// - direction along the parallel venation, fanning a little to the
 ///   margins; the midrib is stiffer than the lamina.
-pub fn lily_maps() -> Result<KeyedMaps, MapError> {
+pub fn lily_maps(midrib_excess: LilyExcess) -> Result<KeyedMaps, MapError> {
     const E: f64 = 0.6;
     const E_BOTTOM: f64 = 0.25;
-    const MIDRIB_EXCESS_EARLY: f64 = 0.3;
-    const LAMINA_EXCESS: f64 = 0.035;
     const W_MIDRIB: f64 = 0.15;
     const W_LAMINA: f64 = 0.3;
     const W_IN_EXCESS: f64 = 0.12;
-    let midrib = |uv: DVec2| midrib_band(uv.x, 0.15);
+    let midrib = |uv: DVec2| midrib_band(uv.x, LILY_MIDRIB_HALF_WIDTH);
     let bottom = |uv: DVec2| 1.0 - smoothstep(0.1, 0.2, uv.y);
     let grows = |uv: DVec2| above_base(uv.y, LILY_BASE_V, 0.04);
     let e = move |uv: DVec2| grows(uv) * (E + (E_BOTTOM - E) * bottom(uv));
     let w = move |uv: DVec2| {
-        grows(uv) * (W_MIDRIB + (W_LAMINA - W_MIDRIB) * (1.0 - midrib(uv))) * (1.0 - 0.5 * bottom(uv))
+        grows(uv)
+            * (W_MIDRIB + (W_LAMINA - W_MIDRIB) * (1.0 - midrib(uv)))
+            * (1.0 - 0.5 * bottom(uv))
     };
-    let w_in = move |uv: DVec2| w(uv) + grows(uv) * (1.0 - bottom(uv)) * W_IN_EXCESS * (1.0 - midrib(uv));
-    let excess = move |uv: DVec2, midrib_excess: f64| {
-        let m = midrib(uv);
-        grows(uv) * (1.0 - bottom(uv)) * (midrib_excess * m + LAMINA_EXCESS * (1.0 - m))
+    let w_in =
+        move |uv: DVec2| w(uv) + grows(uv) * (1.0 - bottom(uv)) * W_IN_EXCESS * (1.0 - midrib(uv));
+    let lamina_excess = midrib_excess.lamina;
+    let excess = move |uv: DVec2, midrib: f64| {
+        let m = midrib_band(uv.x, LILY_MIDRIB_HALF_WIDTH);
+        grows(uv) * (1.0 - bottom(uv)) * (midrib * m + lamina_excess * (1.0 - m))
     };
-    let e_in_early = move |uv: DVec2| e(uv) + excess(uv, MIDRIB_EXCESS_EARLY);
+    let e_in_early = move |uv: DVec2| e(uv) + excess(uv, midrib_excess.midrib_early);
     let e_in_late = move |uv: DVec2| e(uv) + excess(uv, 0.0);
-    let stiffness = move |uv: DVec2| 0.5 + 0.5 * midrib(uv);
+    let stiffness = move |uv: DVec2| 0.3 + (1.0 - 0.3) * midrib(uv);
     let direction = |uv: DVec2| DVec2::new(0.15 * (uv.x - 0.5) * uv.y, 1.0);
     let key = |e_in: &dyn Fn(DVec2) -> f64| {
         Painting {
@@ -227,20 +261,36 @@ fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, color: [f32; 4]) ->
 /// The lily petal template: [`lily_petal_bud`] meshed at edge 1.3 (about
 /// the paper's 388 particles), [`lily_maps`], Table 1's material.
 pub fn lily_petal_template() -> Result<Template, GardenError> {
-    let spec = lily_spec("lily petal", lily_petal_bud(), LILY_PETAL_EDGE, [0.98, 0.55, 0.22, 1.0]);
-    template("petal", &spec, lily_maps())
+    let spec = lily_spec(
+        "lily petal",
+        lily_petal_bud(),
+        LILY_PETAL_EDGE,
+        [0.98, 0.55, 0.22, 1.0],
+    );
+    template("petal", &spec, lily_maps(LilyExcess::PETAL))
 }
 
 /// The lily sepal template: [`lily_sepal_bud`] meshed at edge 1.4 (about
 /// the paper's 323 particles), the petal's maps.
 pub fn lily_sepal_template() -> Result<Template, GardenError> {
-    let spec = lily_spec("lily sepal", lily_sepal_bud(), LILY_SEPAL_EDGE, [0.96, 0.5, 0.2, 1.0]);
-    template("sepal", &spec, lily_maps())
+    let spec = lily_spec(
+        "lily sepal",
+        lily_sepal_bud(),
+        LILY_SEPAL_EDGE,
+        [0.96, 0.5, 0.2, 1.0],
+    );
+    template("sepal", &spec, lily_maps(LilyExcess::SEPAL))
 }
 
 /// The whorls of a bud of `organs` of shape `bud`, `count` of them from
 /// azimuth `offset_deg`.
-fn ring_whorl(name: &str, template: usize, bud: &RingOrgan, count: usize, offset_deg: f64) -> Whorl {
+fn ring_whorl(
+    name: &str,
+    template: usize,
+    bud: &RingOrgan,
+    count: usize,
+    offset_deg: f64,
+) -> Whorl {
     let base = bud.base_in_meridian();
     Whorl {
         name: name.to_string(),
@@ -287,7 +337,11 @@ pub enum Cultivar {
 }
 
 impl Cultivar {
-    pub const ALL: [Cultivar; 3] = [Cultivar::MellowYellow, Cultivar::MaiteLady, Cultivar::Pinocchio];
+    pub const ALL: [Cultivar; 3] = [
+        Cultivar::MellowYellow,
+        Cultivar::MaiteLady,
+        Cultivar::Pinocchio,
+    ];
 
     pub fn project_name(self) -> &'static str {
         match self {
@@ -385,9 +439,9 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
         // flattens and opens as a cone.
         Cultivar::MaiteLady => EustomaGrowth {
             e: [[0.7, 0.7, 0.7], [0.3, 0.3, 0.3]],
-            e_in_excess: [[0.018, 0.018, 0.018], [0.004, 0.004, 0.004]],
+            e_in_excess: [[0.0, 0.022, 0.04], [0.0, 0.007, 0.012]],
             w: [0.5, 0.2],
-            w_in_excess: [[0.06, 0.06, 0.06], [0.02, 0.02, 0.02]],
+            w_in_excess: [[0.09, 0.09, 0.09], [0.03, 0.03, 0.03]],
             fan: 0.6,
         },
         // Shallow ball: uniform growth, but the inner lower and middle
@@ -395,7 +449,7 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
         // cupped upper petal stays turned in.
         Cultivar::Pinocchio => EustomaGrowth {
             e: [[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]],
-            e_in_excess: [[0.02, 0.008, 0.0], [0.012, 0.004, 0.0]],
+            e_in_excess: [[0.09, 0.0, 0.0], [0.03, 0.0, 0.0]],
             w: [0.35, 0.35],
             w_in_excess: [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
             fan: 0.0,

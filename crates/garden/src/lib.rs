@@ -34,6 +34,9 @@ use anthesis_flower::project::{ProjectError, parse_project};
 pub use flowers::{Cultivar, FLOWER_NAMES, GardenError};
 pub use receptacle::receptacle_mesh;
 
+/// One embedded file: its path inside its flower's folder and its bytes.
+type EmbeddedFile = (&'static str, &'static [u8]);
+
 include!(concat!(env!("OUT_DIR"), "/builtin_files.rs"));
 
 /// The file name of flower `name`'s project inside its folder.
@@ -54,7 +57,10 @@ pub fn builtin_names() -> Vec<&'static str> {
 pub fn builtin(name: &str) -> Option<Result<Project, ProjectError>> {
     let (_, files) = BUILTIN_FILES.iter().find(|(n, _)| *n == name)?;
     let file = |path: &str| -> Option<&'static [u8]> {
-        files.iter().find(|(p, _)| *p == path).map(|(_, bytes)| *bytes)
+        files
+            .iter()
+            .find(|(p, _)| *p == path)
+            .map(|(_, bytes)| *bytes)
     };
     let toml_name = project_file_name(name);
     let Some(toml) = file(&toml_name) else {

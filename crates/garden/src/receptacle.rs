@@ -92,7 +92,10 @@ mod tests {
             let [a, b, c] = mesh.triangle_positions(t);
             let normal = (b - a).cross(c - a);
             let centre = (a + b + c) / 3.0;
-            assert!(normal.dot(centre - DVec3::new(0.0, -0.5, 0.0)) > 0.0, "triangle {t}");
+            assert!(
+                normal.dot(centre - DVec3::new(0.0, -0.5, 0.0)) > 0.0,
+                "triangle {t}"
+            );
             assert!(normal.length() > 1e-12, "triangle {t} is degenerate");
         }
     }

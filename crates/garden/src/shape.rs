@@ -69,7 +69,11 @@ impl<'a> UvSampler<'a> {
             return None;
         }
         let tri = self.mesh.triangles[t];
-        Some((0..3).map(|k| w[k] * positions_in_world[tri[k] as usize]).sum())
+        Some(
+            (0..3)
+                .map(|k| w[k] * positions_in_world[tri[k] as usize])
+                .sum(),
+        )
     }
 
     /// Points along the line `u` from `v_from` to `v_to`, `count` of them
@@ -140,6 +144,13 @@ pub struct OrganShape {
     pub lamina_turning_deg: f64,
     /// Cupping of the cross-section at `v = 0.5` (see the module docs).
     pub cupping: f64,
+    /// Swelling of the lamina at `v = 0.5`: how far each half of the
+    /// cross-section (midrib to `u = 0.1`, midrib to `u = 0.9`) bulges
+    /// towards the inner side at its middle (`u = 0.3`, `u = 0.7`), over the
+    /// half's chord; the mean of both halves. Positive when the lamina halves
+    /// swell inwards either side of a midrib that lies behind them (paper
+    /// Fig. 13), negative when each half is cupped.
+    pub swelling: f64,
     /// Distance from the flower axis of the midrib at `v` = 0.25, 0.5,
     /// 0.75 and 1.
     pub radius_profile: [f64; 4],
@@ -196,6 +207,19 @@ pub fn organ_shape(mesh: &Mesh, positions_in_world: &[DVec3]) -> Result<OrganSha
         0.0
     };
 
+    let bulge = |midrib_u: f64, half_u: f64, margin_u: f64| -> Result<f64, ShapeError> {
+        let (a, b, c) = (at(midrib_u, 0.5)?, at(margin_u, 0.5)?, at(half_u, 0.5)?);
+        let chord = b - a;
+        let length = chord.length();
+        if length == 0.0 {
+            return Ok(0.0);
+        }
+        let along = chord / length;
+        let to_c = c - a;
+        Ok((to_c - along * to_c.dot(along)).dot(inner_normal) / length)
+    };
+    let swelling = 0.5 * (bulge(0.5, 0.3, 0.1)? + bulge(0.5, 0.7, 0.9)?);
+
     let radius = |p: DVec3| DVec2::new(p.x, p.z).length();
     let profile_points = [10, 20, 30, 40].map(|k| midrib[k]);
     Ok(OrganShape {
@@ -203,6 +227,7 @@ pub fn organ_shape(mesh: &Mesh, positions_in_world: &[DVec3]) -> Result<OrganSha
         midrib_turning_deg: turning_deg(&midrib),
         lamina_turning_deg,
         cupping,
+        swelling,
         radius_profile: profile_points.map(radius),
         height_profile: profile_points.map(|p| p.y),
         midrib_length: midrib.windows(2).map(|w| w[0].distance(w[1])).sum(),
@@ -247,6 +272,7 @@ pub fn flower_shape<'a>(
         midrib_turning_deg: mean_of(&|o| o.midrib_turning_deg),
         lamina_turning_deg: mean_of(&|o| o.lamina_turning_deg),
         cupping: mean_of(&|o| o.cupping),
+        swelling: mean_of(&|o| o.swelling),
         radius_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.radius_profile[k])),
         height_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.height_profile[k])),
         midrib_length: mean_of(&|o| o.midrib_length),

@@ -1,0 +1,257 @@
+//! The paper's results (§6.1, §6.2), reproduced by simulating the default
+//! projects for 100 keyframes and measuring them with
+//! `anthesis_garden::shape`: the lily's tepals reflex, led by the midrib,
+//! swollen near keyframe 75; one Eustoma bud opens to a bell, a funnel or a
+//! shallow ball depending on the cultivar's maps.
+
+use std::time::Instant;
+
+use anthesis_flower::Project;
+use anthesis_garden::flowers::{self, Cultivar};
+use anthesis_garden::shape::{FlowerShape, OrganShape, flower_shape};
+use anthesis_sim::{Selection, run};
+
+/// The keyframes the tests look at.
+const FRAMES: [u32; 5] = [0, 25, 50, 75, 100];
+
+/// Shapes of the organs `organs` (indices into the project's organs, all
+/// simulated together with `selection`) at [`FRAMES`].
+fn shapes(project: &Project, selection: &Selection, organs: &[usize]) -> Vec<FlowerShape> {
+    let started = Instant::now();
+    let simulated: Vec<usize> = match selection {
+        Selection::All => (0..project.flower.organs.len()).collect(),
+        Selection::Only(i) => vec![*i],
+    };
+    let mut found = Vec::new();
+    let result = run(project, selection, &mut |_, keyframe| {
+        if FRAMES.contains(&keyframe.index) {
+            let measured = flower_shape(organs.iter().map(|&organ| {
+                let slot = simulated
+                    .iter()
+                    .position(|&s| s == organ)
+                    .expect("organ simulated");
+                (
+                    &project.flower.template_of(organ).mesh,
+                    keyframe.positions[slot].as_slice(),
+                )
+            }))
+            .expect("measurable");
+            found.push(measured);
+        }
+    });
+    if let Err(error) = result {
+        panic!("{}: {error}", project.name);
+    }
+    eprintln!(
+        "{}: {} keyframes in {:.1} s",
+        project.name,
+        project.settings.keyframes,
+        started.elapsed().as_secs_f64()
+    );
+    assert_eq!(found.len(), FRAMES.len());
+    found
+}
+
+fn frame(shapes: &[FlowerShape], keyframe: u32) -> &OrganShape {
+    let i = FRAMES.iter().position(|&f| f == keyframe).expect("kept");
+    &shapes[i].mean
+}
+
+fn print(name: &str, shapes: &[FlowerShape]) {
+    for (k, s) in FRAMES.iter().zip(shapes) {
+        let m = &s.mean;
+        eprintln!(
+            "{name} kf {k:3}: angles {:6.1} {:6.1} {:6.1}  turning midrib {:6.1} lamina {:6.1}  cupping {:6.3} swelling {:6.3}  radius {:5.1} {:5.1} {:5.1} {:5.1}",
+            m.midrib_angles_deg[0],
+            m.midrib_angles_deg[1],
+            m.midrib_angles_deg[2],
+            m.midrib_turning_deg,
+            m.lamina_turning_deg,
+            m.cupping,
+            m.swelling,
+            m.radius_profile[0],
+            m.radius_profile[1],
+            m.radius_profile[2],
+            m.radius_profile[3],
+        );
+    }
+}
+
+fn lily() -> Project {
+    flowers::lily().expect("lily")
+}
+
+fn eustoma(cultivar: Cultivar) -> Vec<FlowerShape> {
+    let project = flowers::eustoma(cultivar).expect("Eustoma");
+    let shapes = shapes(&project, &Selection::All, &[0, 1, 2, 3, 4]);
+    print(cultivar.folder_name(), &shapes);
+    shapes
+}
+
+#[test]
+fn lily_tepals_open_and_reflex_backwards() {
+    let project = lily();
+    let all = shapes(&project, &Selection::All, &[0, 1, 2, 3, 4, 5]);
+    let petals: Vec<FlowerShape> = all.iter().map(|s| flower_shape_of(s, &[0, 1, 2])).collect();
+    let sepals: Vec<FlowerShape> = all.iter().map(|s| flower_shape_of(s, &[3, 4, 5])).collect();
+    print("lily petals", &petals);
+    print("lily sepals", &sepals);
+    for (what, shapes) in [("petals", &petals), ("sepals", &sepals)] {
+        let bud = frame(shapes, 0);
+        let open = frame(shapes, 100);
+        // The bud is closed: tips lean in towards the axis.
+        assert!(bud.midrib_angles_deg[2] < -10.0, "{what}: {bud:?}");
+        // Open: every tepal's tip third points below horizontal.
+        for organ in &shapes[FRAMES.len() - 1].organs {
+            assert!(organ.midrib_angles_deg[2] > 110.0, "{what}: {organ:?}");
+        }
+        // Reflexed backwards: the midrib turns outwards along its length
+        // (in the bud it curls in).
+        assert!(bud.midrib_turning_deg < -60.0, "{what}: {bud:?}");
+        assert!(open.midrib_turning_deg > 45.0, "{what}: {open:?}");
+        // Laterally flat by then (the bud is cupped).
+        assert!(open.cupping < 0.5 * bud.cupping, "{what}: {open:?}");
+        // Opening is gradual: the tip angle grows keyframe by keyframe.
+        let tips: Vec<f64> = shapes.iter().map(|s| s.mean.midrib_angles_deg[2]).collect();
+        assert!(
+            tips.windows(2).all(|w| w[1] > w[0]),
+            "{what}: tips {tips:?}"
+        );
+    }
+    // Petals and sepals open alike (§6.1).
+    let (p, s) = (frame(&petals, 100), frame(&sepals, 100));
+    assert!((p.midrib_angles_deg[2] - s.midrib_angles_deg[2]).abs() < 30.0);
+}
+
+/// The shape of some organs of a measured flower.
+fn flower_shape_of(shape: &FlowerShape, organs: &[usize]) -> FlowerShape {
+    let picked: Vec<OrganShape> = organs.iter().map(|&i| shape.organs[i]).collect();
+    let n = picked.len() as f64;
+    let mean_of = |f: &dyn Fn(&OrganShape) -> f64| picked.iter().map(f).sum::<f64>() / n;
+    FlowerShape {
+        mean: OrganShape {
+            midrib_angles_deg: [0, 1, 2].map(|k| mean_of(&|o| o.midrib_angles_deg[k])),
+            midrib_turning_deg: mean_of(&|o| o.midrib_turning_deg),
+            lamina_turning_deg: mean_of(&|o| o.lamina_turning_deg),
+            cupping: mean_of(&|o| o.cupping),
+            swelling: mean_of(&|o| o.swelling),
+            radius_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.radius_profile[k])),
+            height_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.height_profile[k])),
+            midrib_length: mean_of(&|o| o.midrib_length),
+        },
+        organs: picked,
+    }
+}
+
+#[test]
+fn lily_midrib_leads_and_swells_the_petal() {
+    // One petal, as the paper's authors tuned a single petal first (§6.3),
+    // against the same petal whose midrib grows like its lamina.
+    let project = lily();
+    let mut control = project.clone();
+    control.flower.templates[0].maps = flowers::lily_maps(flowers::LilyExcess {
+        midrib_early: 0.0,
+        ..flowers::LilyExcess::PETAL
+    })
+    .expect("control maps");
+    let lily = shapes(&project, &Selection::Only(0), &[0]);
+    let flat_midrib = shapes(&control, &Selection::Only(0), &[0]);
+    print("lily petal", &lily);
+    print("petal without midrib warping", &flat_midrib);
+    // Early on the midrib warps more than the lamina beside it and pulls it
+    // back ("midrib leads"): its turning has grown more since the bud.
+    let bud = frame(&lily, 0);
+    let early = frame(&lily, 25);
+    let midrib_gain = early.midrib_turning_deg - bud.midrib_turning_deg;
+    let lamina_gain = early.lamina_turning_deg - bud.lamina_turning_deg;
+    assert!(
+        midrib_gain > lamina_gain + 3.0,
+        "midrib +{midrib_gain:.1}°, lamina +{lamina_gain:.1}°"
+    );
+    // The midrib's warping is what opens the petal early.
+    let control_early = frame(&flat_midrib, 25);
+    assert!(
+        early.midrib_turning_deg > control_early.midrib_turning_deg + 15.0,
+        "{early:?} vs {control_early:?}"
+    );
+    // Fig. 13: at keyframe 75 the petal is swollen by the midrib's
+    // warping: the midrib has curled back further than the lamina either
+    // side of it (without the warping the lamina leads), and the lamina
+    // halves bulge inwards more than without it.
+    let (at_75, control_75) = (frame(&lily, 75), frame(&flat_midrib, 75));
+    let lead = |s: &OrganShape| s.midrib_turning_deg - s.lamina_turning_deg;
+    assert!(lead(at_75) > 0.0, "{at_75:?}");
+    assert!(
+        lead(at_75) > lead(control_75) + 5.0,
+        "{at_75:?} vs {control_75:?}"
+    );
+    assert!(
+        at_75.swelling > control_75.swelling + 0.005,
+        "swelling {:.3} vs {:.3} without the midrib",
+        at_75.swelling,
+        control_75.swelling
+    );
+}
+
+#[test]
+fn one_eustoma_bud_opens_to_a_bell_a_funnel_and_a_shallow_ball() {
+    let bell = eustoma(Cultivar::MellowYellow);
+    let funnel = eustoma(Cultivar::MaiteLady);
+    let ball = eustoma(Cultivar::Pinocchio);
+    // One bud.
+    assert_eq!(frame(&bell, 0), frame(&funnel, 0));
+    assert_eq!(frame(&bell, 0), frame(&ball, 0));
+    let (b, f, p) = (frame(&bell, 100), frame(&funnel, 100), frame(&ball, 100));
+
+    // Mellow Yellow, a bell: the lower petal stays a steep tube and the
+    // tips flare out and reflex below horizontal.
+    assert!(
+        b.midrib_angles_deg[0] < 50.0 && b.midrib_angles_deg[1] < 40.0,
+        "{b:?}"
+    );
+    assert!(b.midrib_angles_deg[2] > 100.0, "{b:?}");
+    for petal in &bell[FRAMES.len() - 1].organs {
+        assert!(petal.midrib_angles_deg[2] > 90.0, "{petal:?}");
+    }
+    // Its reflexing comes late (§6.2: the upper inner region grows late).
+    assert!(frame(&bell, 50).midrib_angles_deg[2] < 30.0);
+
+    // Maite Lady, a funnel: flat, straight petals opening as a cone.
+    let spread = f
+        .midrib_angles_deg
+        .iter()
+        .fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+        - f.midrib_angles_deg
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b));
+    assert!(spread < 20.0, "not straight: {f:?}");
+    assert!(f.midrib_turning_deg.abs() < 25.0, "{f:?}");
+    assert!(
+        (40.0..80.0).contains(&f.midrib_angles_deg[1]),
+        "cone angle: {f:?}"
+    );
+    assert!(f.cupping.abs() < 0.05, "not flat: {f:?}");
+
+    // Pinocchio, a shallow ball: the base opens widest, the cupped petals
+    // turn their tips back in.
+    assert!(
+        p.midrib_angles_deg[0] > f.midrib_angles_deg[0] + 5.0,
+        "{p:?} vs {f:?}"
+    );
+    assert!(
+        p.midrib_angles_deg[0] > b.midrib_angles_deg[0] + 20.0,
+        "{p:?} vs {b:?}"
+    );
+    assert!(p.cupping > 0.12, "not cupped: {p:?}");
+    assert!(
+        p.midrib_angles_deg[2] < p.midrib_angles_deg[1] - 20.0,
+        "tips not incurved: {p:?}"
+    );
+    assert!(p.midrib_turning_deg < -20.0, "{p:?}");
+
+    // And they differ from each other as the paper's forms do.
+    assert!(b.midrib_angles_deg[2] > f.midrib_angles_deg[2] + 40.0);
+    assert!(b.midrib_angles_deg[2] > p.midrib_angles_deg[2] + 40.0);
+    assert!(p.cupping > f.cupping + 0.1);
+    assert!(b.midrib_angles_deg[1] < f.midrib_angles_deg[1] - 20.0);
+}
