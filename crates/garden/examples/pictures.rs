@@ -2,7 +2,10 @@
 //! keyframes and renders those keyframes, side view above 3/4 view, tiled
 //! into one PNG.
 //!
-//! `cargo run --release -p anthesis-garden --example pictures -- NAME OUT.png [--frames 1,25,50,75,100] [--tile 300] [--side-only]`
+//! `cargo run --release -p anthesis-garden --example pictures -- NAME OUT.png [--frames 0,1,25,50,75,100] [--tile 300] [--zoom 0.8] [--views 0:5,30:40] [--side-only] [--top] [--only ORGAN] [--no-midrib-warping]`
+//!
+//! The README's pictures are made with
+//! `--frames 1,25,50,75,100 --views 25:20 --tile 300`.
 
 use std::time::Instant;
 
@@ -38,6 +41,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--no-midrib-warping" => no_midrib = true,
             "--side-only" => views = vec![(0.0, 5.0)],
             "--top" => views.push((0.0, 85.0)),
+            "--views" => {
+                // AZIMUTH:ELEVATION,… in degrees, one row each.
+                views = args
+                    .next()
+                    .ok_or("--views needs a list")?
+                    .split(',')
+                    .map(|view| -> Result<(f64, f64), Box<dyn std::error::Error>> {
+                        let (azimuth, elevation) =
+                            view.split_once(':').ok_or("a view is AZIMUTH:ELEVATION")?;
+                        Ok((azimuth.parse()?, elevation.parse()?))
+                    })
+                    .collect::<Result<_, _>>()?;
+            }
             other => return Err(format!("unknown flag {other}").into()),
         }
     }
@@ -87,7 +103,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|&i| project.flower.template_of(i).color)
         .collect();
     let result = run(&project, &selection, &mut |_, keyframe| {
-        if keyframe.index == 0 || frames.contains(&keyframe.index) {
+        if frames.contains(&keyframe.index) {
             let s = shape::flower_shape(
                 meshes
                     .iter()

@@ -439,8 +439,8 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
         // flattens and opens as a cone.
         Cultivar::MaiteLady => EustomaGrowth {
             e: [[0.7, 0.7, 0.7], [0.3, 0.3, 0.3]],
-            e_in_excess: [[0.0, 0.022, 0.04], [0.0, 0.007, 0.012]],
-            w: [0.5, 0.2],
+            e_in_excess: [[0.0, 0.025, 0.05], [0.0, 0.008, 0.016]],
+            w: [0.8, 0.4],
             w_in_excess: [[0.09, 0.09, 0.09], [0.03, 0.03, 0.03]],
             fan: 0.6,
         },
@@ -449,8 +449,8 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
         // cupped upper petal stays turned in.
         Cultivar::Pinocchio => EustomaGrowth {
             e: [[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]],
-            e_in_excess: [[0.09, 0.0, 0.0], [0.03, 0.0, 0.0]],
-            w: [0.35, 0.35],
+            e_in_excess: [[0.11, 0.0, -0.02], [0.03, 0.0, -0.02]],
+            w: [0.8, 0.8],
             w_in_excess: [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
             fan: 0.0,
         },
