@@ -435,8 +435,10 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
             w_in_excess: [[0.0, 0.0, 0.05], [0.0, 0.0, 0.15]],
             fan: 0.0,
         },
-        // Funnel: uniform growth, larger early; the petal straightens and
-        // flattens and opens as a cone.
+        // Funnel: growth larger early, no inner excess in the lower region
+        // and a small, nearly uniform one above it that just undoes the
+        // bud's inward curl: the petal straightens and flattens (w-growth-in
+        // excess across) and opens as a cone. Veins fan out more.
         Cultivar::MaiteLady => EustomaGrowth {
             e: [[0.7, 0.7, 0.7], [0.3, 0.3, 0.3]],
             e_in_excess: [[0.0, 0.025, 0.05], [0.0, 0.008, 0.016]],
@@ -444,9 +446,13 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
             w_in_excess: [[0.09, 0.09, 0.09], [0.03, 0.03, 0.03]],
             fan: 0.6,
         },
-        // Shallow ball: uniform growth, but the inner lower and middle
-        // regions elongate more than the outer: the base opens wide and the
-        // cupped upper petal stays turned in.
+        // Shallow ball: uniform growth, but the inner lower regions
+        // elongate more than the outer (the paper: inner lower and middle,
+        // not significantly): the base opens wide. No inner excess across
+        // (the petal stays cupped) and in the upper region the outer side
+        // grows a little more (a difference well within "not significant"),
+        // so the cupped tips keep turning in and up: a shallow ball rather
+        // than a saucer.
         Cultivar::Pinocchio => EustomaGrowth {
             e: [[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]],
             e_in_excess: [[0.11, 0.0, -0.02], [0.03, 0.0, -0.02]],

@@ -104,3 +104,47 @@ impl Painting<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn painted_maps_survive_a_16_bit_png_round_trip_exactly() {
+        let scalar = scalar_map(|uv| 0.3 + 0.4 * uv.x * uv.y + 0.01 * (uv.x * 37.0).sin());
+        let bytes = scalar.to_png_bytes(BitDepth::Sixteen).expect("encodable");
+        assert_eq!(
+            ScalarMap::from_png_bytes(&bytes).expect("decodable"),
+            scalar
+        );
+        let direction = direction_map(|uv| DVec2::new(0.6 * (uv.x - 0.5) * uv.y, 1.0));
+        let bytes = direction
+            .to_png_bytes(BitDepth::Sixteen)
+            .expect("encodable");
+        assert_eq!(
+            DirectionMap::from_png_bytes(&bytes).expect("decodable"),
+            direction
+        );
+    }
+
+    #[test]
+    fn uniform_paint_becomes_a_constant_and_values_are_clamped() {
+        let map = scalar_map(|_| 0.25);
+        assert_eq!(map.size(), (1, 1));
+        // Quantised like a 16-bit PNG code.
+        assert!((map.values()[0] - 0.25).abs() <= 1.0 / 65535.0);
+        let clamped = scalar_map(|uv| 2.0 * uv.x - 0.5);
+        assert!(clamped.values().iter().all(|v| (0.0..=1.0).contains(v)));
+        assert_eq!(direction_map(|_| DVec2::new(0.0, 3.0)).size(), (1, 1));
+    }
+
+    #[test]
+    fn regions_fall_off_smoothly() {
+        assert_eq!(midrib_band(0.5, 0.1), 1.0);
+        assert_eq!(midrib_band(0.39, 0.1), 0.0);
+        assert!((midrib_band(0.45, 0.1) - 0.5).abs() < 1e-12);
+        assert_eq!(above_base(0.04, 0.05, 0.05), 0.0);
+        assert_eq!(above_base(0.2, 0.05, 0.05), 1.0);
+        assert!((smoothstep(1.0, 0.0, 0.25) - smoothstep(0.0, 1.0, 0.75)).abs() < 1e-12);
+    }
+}

@@ -279,3 +279,100 @@ pub fn flower_shape<'a>(
     };
     Ok(FlowerShape { organs, mean })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use anthesis_mesh::generate::parametric_grid;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn opening_angles_read_from_the_axis_outwards() {
+        let base = DVec3::new(0.0, 0.0, 5.0);
+        let up = opening_angle_deg(base, base + DVec3::Y);
+        let out = opening_angle_deg(base, base + DVec3::Z);
+        let down = opening_angle_deg(base, base - DVec3::Y);
+        let inwards = opening_angle_deg(base, base + DVec3::new(0.0, 1.0, -1.0));
+        assert!(up.abs() < 1e-9 && (out - 90.0).abs() < 1e-9, "{up} {out}");
+        assert!((down - 180.0).abs() < 1e-9 && (inwards + 45.0).abs() < 1e-9);
+        // Any azimuth: outwards is away from the axis.
+        let side = DVec3::new(5.0, 0.0, 0.0);
+        assert!((opening_angle_deg(side, side + DVec3::X) - 90.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn turning_of_a_reflexing_arc_is_its_angle_even_past_straight_down() {
+        // A quarter circle then more: from pointing up to pointing down and
+        // back in (270°), bending outwards all along.
+        let arc: Vec<DVec3> = (0..=90)
+            .map(|k| {
+                let a = 1.5 * PI * f64::from(k) / 90.0;
+                DVec3::new(0.0, 10.0 * a.sin(), 5.0 + 10.0 * (1.0 - a.cos()))
+            })
+            .collect();
+        // Measured between the first and last chords, whose directions are
+        // 89 of the 90 segments apart.
+        let expected = 270.0 * 89.0 / 90.0;
+        assert!(
+            (turning_deg(&arc) - expected).abs() < 1e-6,
+            "{}",
+            turning_deg(&arc)
+        );
+        let reversed: Vec<DVec3> = arc.iter().rev().copied().collect();
+        assert!(turning_deg(&reversed) < -260.0);
+    }
+
+    /// An upright organ at azimuth 0, 5 from the axis, `u` along −X so its
+    /// winding normal faces the axis (−Z); `cup` pulls the margins towards
+    /// the axis.
+    fn upright(cup: f64) -> Mesh {
+        parametric_grid(12, 24, |uv| {
+            let x = -(uv.x - 0.5) * 10.0;
+            DVec3::new(x, 30.0 * uv.y, 5.0 - cup * x * x)
+        })
+    }
+
+    #[test]
+    fn flat_upright_organ_has_zero_angles_turning_and_cupping() {
+        let mesh = upright(0.0);
+        let shape = organ_shape(&mesh, &mesh.positions).expect("measurable");
+        for angle in shape.midrib_angles_deg {
+            assert!(angle.abs() < 1e-6, "{shape:?}");
+        }
+        assert!(shape.midrib_turning_deg.abs() < 1e-6);
+        assert!(shape.cupping.abs() < 1e-9 && shape.swelling.abs() < 1e-9);
+        assert!((shape.midrib_length - 30.0).abs() < 1e-9);
+        assert!((shape.radius_profile[3] - 5.0).abs() < 1e-9);
+        assert!((shape.height_profile[1] - 15.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn cupped_organ_has_positive_cupping_and_cupped_halves() {
+        let mesh = upright(0.1);
+        // The mesh winds around +Z or −Z depending on the grid; the
+        // measures use the winding normal, so check it faces the axis.
+        let normal = anthesis_mesh::vertex_normals(&mesh.positions, &mesh.triangles)[0];
+        assert!(normal.z < 0.0, "test mesh must face the axis: {normal}");
+        let shape = organ_shape(&mesh, &mesh.positions).expect("measurable");
+        assert!(shape.cupping > 0.05, "{shape:?}");
+        assert!(shape.swelling < 0.0, "each half is cupped: {shape:?}");
+        let bulged = upright(-0.1);
+        let inverted = organ_shape(&bulged, &bulged.positions).expect("measurable");
+        assert!(
+            inverted.cupping < -0.05 && inverted.swelling > 0.0,
+            "{inverted:?}"
+        );
+    }
+
+    #[test]
+    fn wrong_position_count_is_refused() {
+        let mesh = upright(0.0);
+        assert_eq!(
+            organ_shape(&mesh, &mesh.positions[1..]),
+            Err(ShapeError::WrongCount {
+                positions: mesh.vertex_count() - 1,
+                vertices: mesh.vertex_count()
+            })
+        );
+    }
+}
