@@ -18,12 +18,15 @@ use crate::SimError;
 /// map cannot make the system singular.
 const MIN_STIFFNESS_MAP: f64 = 0.01;
 /// Stiffness, relative to the mean spring stiffness, of the springs that
-/// hold each base particle where it is at the start of an iteration. The
-/// energy does not see rigid motions, so without them a contact could push
-/// the whole organ away in a Newton step only for shape matching to put it
-/// back, and the keyframe would cycle. Anchored at the current positions,
-/// they exert no force at convergence: the minimum is the same.
-const ANCHOR_FACTOR: f64 = 0.1;
+/// hold each base particle where the receptacle and the joint schedule put
+/// it, during minimisation. The elastic energy does not see rigid motions:
+/// without these springs a contact pushed the whole organ away in a Newton
+/// step, shape matching put it back, and the keyframe cycled instead of
+/// converging. Shape matching (paper §5.3) carries the organ to the new
+/// joint angle when a keyframe starts and removes, when it ends, the little
+/// rigid slip the springs allow; snapping the organ after every iteration
+/// jolted it against its frozen contacts and kept keyframes from settling.
+const ANCHOR_FACTOR: f64 = 1000.0;
 /// Contact penalty stiffness relative to the mean spring stiffness.
 const CONTACT_STIFFNESS_FACTOR: f64 = 1000.0;
 

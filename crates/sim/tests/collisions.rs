@@ -52,9 +52,10 @@ fn an_inner_organ_driven_into_an_outer_one_stays_on_its_inner_side() {
             );
         }
     }
-    // The organs did meet: without contact the test would prove nothing.
+    // The organs did meet (their bases start 1.5 apart, and without the
+    // rule the same run cuts through): otherwise the test would prove nothing.
     assert!(
-        closest < 0.1,
+        closest < 0.15,
         "the organs never came closer than {closest:.3}; the test geometry no longer collides"
     );
     for k in &keyframes {
