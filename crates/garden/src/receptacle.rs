@@ -98,5 +98,7 @@ mod tests {
             );
             assert!(normal.length() > 1e-12, "triangle {t} is degenerate");
         }
+        // A valid mesh: manifold, no degenerate or unused vertices.
+        anthesis_mesh::validate(&mesh).expect("valid receptacle mesh");
     }
 }

@@ -16,6 +16,7 @@ fn main() -> ExitCode {
         || PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/flowers"),
         PathBuf::from,
     );
+    let out = std::fs::canonicalize(&out).unwrap_or(out);
     for name in FLOWER_NAMES {
         let project = match flowers::flower(name) {
             Some(Ok(project)) => project,
