@@ -32,7 +32,7 @@ fn info_prints_one_line_per_organ_with_counts() {
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(
         lines,
-        ["petal-1 petal 112 182 293", "sepal-1 petal 112 182 293"]
+        ["petal-1 petal 112 182 293", "sepal-1 sepal 112 182 293"]
     );
 }
 
