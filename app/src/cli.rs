@@ -1,18 +1,23 @@
-//! `anthesis info|simulate`: the engine without a window, for batch work,
-//! CI and benchmarks. Errors print as one line and exit non-zero.
+//! `anthesis info|simulate|render|bud`: the engine without a window, for
+//! batch work, CI and benchmarks. Errors print as one line and exit
+//! non-zero. Each subcommand lives in a module of `cli/`.
 
-use std::io::{IsTerminal, Write};
+mod bud;
+mod render;
+mod simulate;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
-use anthesis_export::{Encoding, GlbOptions, Timing, Track};
+use anthesis_export::{Encoding, GlbOptions, Timing};
 use anthesis_flower::Project;
 use anthesis_flower::project::load_project;
-use anthesis_sim::{KeyframeStats, Selection, Simulation};
+use anthesis_sim::Selection;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use glam::DVec3;
+
+pub use bud::{BudArgs, Example, InnerSideArg};
+pub use render::RenderArgs;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -65,6 +70,12 @@ pub enum Command {
         #[arg(long, value_enum, default_value_t = EncodingArg::Dense)]
         encoding: EncodingArg,
     },
+    /// Simulate a project and render chosen keyframes to PNG pictures, all
+    /// seen by one camera.
+    Render(RenderArgs),
+    /// Mesh an organ from a parametric surface (a built-in petal, a Bézier
+    /// patch or a PDE sweep surface), write it as OBJ and print its quality.
+    Bud(BudArgs),
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -128,7 +139,7 @@ pub fn run(cli: Cli) -> Result<()> {
             );
             Ok(())
         }
-        Some(Command::Info { project }) => info(&project),
+        Some(Command::Info { project }) => simulate::info(&project),
         Some(Command::Simulate {
             project,
             organ,
@@ -154,7 +165,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 normals: !no_normals,
                 encoding: encoding.into(),
             };
-            simulate(
+            simulate::simulate(
                 &project,
                 organ.as_deref(),
                 keyframes,
@@ -163,6 +174,8 @@ pub fn run(cli: Cli) -> Result<()> {
                 &glb,
             )
         }
+        Some(Command::Render(args)) => render::render(&args),
+        Some(Command::Bud(args)) => bud::bud(&args),
     }
 }
 
@@ -171,164 +184,21 @@ fn load(path: &Path) -> Result<Project> {
     load_project(path).context("cannot open project")
 }
 
-fn info(path: &Path) -> Result<()> {
-    let project = load(path)?;
-    let flower = &project.flower;
-    for (i, organ) in flower.organs.iter().enumerate() {
-        let template = flower.template_of(i);
-        let topology = anthesis_mesh::validate(&template.mesh)
-            .with_context(|| format!("template `{}` has a bad mesh", template.name))?;
-        println!(
-            "{} {} {} {} {}",
-            organ.name,
-            template.name,
-            template.mesh.vertex_count(),
-            template.mesh.triangle_count(),
-            topology.edges.len()
-        );
-    }
-    Ok(())
-}
-
-#[derive(serde::Serialize)]
-struct StatsFile<'a> {
-    project: &'a str,
-    organs: Vec<String>,
-    keyframes: &'a [KeyframeStats],
-    total_seconds: f64,
-    threads: usize,
-}
-
-fn simulate(
-    path: &Path,
-    organ: Option<&str>,
-    keyframes: Option<u32>,
-    stats_path: Option<&Path>,
-    out: Option<&Path>,
-    glb: &GlbOptions,
-) -> Result<()> {
-    let mut project = load(path)?;
-    if let Some(n) = keyframes {
-        if n == 0 {
-            bail!("--keyframes must be at least 1");
-        }
-        project.settings.keyframes = n;
-    }
-    let selection = match organ {
-        None => Selection::All,
-        Some(name) => match project.flower.organ_index(name) {
-            Some(i) => Selection::Only(i),
-            None => {
-                let names: Vec<&str> = project
-                    .flower
-                    .organs
-                    .iter()
-                    .map(|o| o.name.as_str())
-                    .collect();
-                bail!("no organ named `{name}` (organs: {})", names.join(", "));
-            }
-        },
+/// All organs, or the one named `organ` (an error lists the names).
+fn selection(project: &Project, organ: Option<&str>) -> Result<Selection> {
+    let Some(name) = organ else {
+        return Ok(Selection::All);
     };
-    if let Some(out) = out {
-        check_output(out)?;
-    }
-
-    let started = Instant::now();
-    let mut sim = Simulation::new(&project, &selection)?;
-    let total = sim.keyframe_count();
-    let mut frames: Vec<Vec<Vec<DVec3>>> = vec![sim.bud().positions];
-    let mut stats = Vec::with_capacity(total as usize);
-    let show_progress = std::io::stderr().is_terminal();
-    while !sim.finished() {
-        let keyframe = sim.step(&|| false, &mut |_| {})?;
-        if show_progress {
-            let done = keyframe.index;
-            let elapsed = started.elapsed().as_secs_f64();
-            let left = elapsed / f64::from(done) * f64::from(total - done);
-            eprint!("\rkeyframe {done}/{total}  {elapsed:.1} s, about {left:.1} s left   ");
-            let _ = std::io::stderr().flush();
+    match project.flower.organ_index(name) {
+        Some(i) => Ok(Selection::Only(i)),
+        None => {
+            let names: Vec<&str> = project
+                .flower
+                .organs
+                .iter()
+                .map(|o| o.name.as_str())
+                .collect();
+            bail!("no organ named `{name}` (organs: {})", names.join(", "));
         }
-        stats.push(keyframe.stats);
-        frames.push(keyframe.positions);
     }
-    let seconds = started.elapsed().as_secs_f64();
-    if show_progress {
-        eprintln!();
-    }
-    eprintln!(
-        "simulated {total} keyframes of {} organ(s) in {seconds:.2} s",
-        sim.organs().len()
-    );
-
-    if let Some(stats_path) = stats_path {
-        let file = StatsFile {
-            project: &project.name,
-            organs: sim.organs().iter().map(|s| s.to_string()).collect(),
-            keyframes: &stats,
-            total_seconds: seconds,
-            threads: rayon_threads(),
-        };
-        let json = serde_json::to_string_pretty(&file)?;
-        anthesis_export::write_atomic(stats_path, json.as_bytes())
-            .with_context(|| format!("cannot write statistics to {}", stats_path.display()))?;
-    }
-    if let Some(out) = out {
-        let tracks = tracks(&sim, &frames);
-        if is_glb(out) {
-            anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
-                .with_context(|| format!("cannot write {}", out.display()))?;
-        } else {
-            anthesis_export::write_obj_sequence(out, &tracks)
-                .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
-        }
-        eprintln!("wrote {}", out.display());
-    }
-    Ok(())
-}
-
-fn is_glb(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
-}
-
-/// Fails early, before a long simulation, when the output cannot be written.
-fn check_output(out: &Path) -> Result<()> {
-    if is_glb(out) {
-        let parent = out
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        if !parent.is_dir() {
-            bail!(
-                "cannot write {}: folder {} does not exist",
-                out.display(),
-                parent.display()
-            );
-        }
-    } else if out.exists() && !out.is_dir() {
-        bail!(
-            "--out {} must be a .glb file or a folder for OBJ files",
-            out.display()
-        );
-    }
-    Ok(())
-}
-
-fn tracks(sim: &Simulation, frames: &[Vec<Vec<DVec3>>]) -> Vec<Track> {
-    sim.organs()
-        .iter()
-        .enumerate()
-        .map(|(i, name)| Track {
-            name: name.to_string(),
-            triangles: sim.triangles(i).to_vec(),
-            uvs: sim.uvs(i).to_vec(),
-            base_color: sim.color(i),
-            keyframes: frames.iter().map(|f| f[i].clone()).collect(),
-            base_color_png: None,
-        })
-        .collect()
-}
-
-fn rayon_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }

@@ -1,0 +1,178 @@
+//! `anthesis info` and `anthesis simulate`, and the keyframe loop with
+//! progress that `anthesis render` shares.
+
+use std::io::{IsTerminal, Write};
+use std::path::Path;
+use std::time::Instant;
+
+use anthesis_export::{GlbOptions, Track};
+use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
+use anyhow::{Context, Result, bail};
+use glam::DVec3;
+
+use super::{load, selection};
+
+pub(super) fn info(path: &Path) -> Result<()> {
+    let project = load(path)?;
+    let flower = &project.flower;
+    for (i, organ) in flower.organs.iter().enumerate() {
+        let template = flower.template_of(i);
+        let topology = anthesis_mesh::validate(&template.mesh)
+            .with_context(|| format!("template `{}` has a bad mesh", template.name))?;
+        println!(
+            "{} {} {} {} {}",
+            organ.name,
+            template.name,
+            template.mesh.vertex_count(),
+            template.mesh.triangle_count(),
+            topology.edges.len()
+        );
+    }
+    Ok(())
+}
+
+#[derive(serde::Serialize)]
+struct StatsFile<'a> {
+    project: &'a str,
+    organs: Vec<String>,
+    keyframes: &'a [KeyframeStats],
+    total_seconds: f64,
+    threads: usize,
+}
+
+pub(super) fn simulate(
+    path: &Path,
+    organ: Option<&str>,
+    keyframes: Option<u32>,
+    stats_path: Option<&Path>,
+    out: Option<&Path>,
+    glb: &GlbOptions,
+) -> Result<()> {
+    let mut project = load(path)?;
+    if let Some(n) = keyframes {
+        if n == 0 {
+            bail!("--keyframes must be at least 1");
+        }
+        project.settings.keyframes = n;
+    }
+    let selection = selection(&project, organ)?;
+    if let Some(out) = out {
+        check_output(out)?;
+    }
+
+    let mut sim = Simulation::new(&project, &selection)?;
+    let total = sim.keyframe_count();
+    let mut frames: Vec<Vec<Vec<DVec3>>> = vec![sim.bud().positions];
+    let mut stats = Vec::with_capacity(total as usize);
+    let seconds = run_keyframes(&mut sim, total, &mut |keyframe| {
+        stats.push(keyframe.stats);
+        frames.push(keyframe.positions);
+    })?;
+
+    if let Some(stats_path) = stats_path {
+        let file = StatsFile {
+            project: &project.name,
+            organs: sim.organs().iter().map(|s| s.to_string()).collect(),
+            keyframes: &stats,
+            total_seconds: seconds,
+            threads: rayon_threads(),
+        };
+        let json = serde_json::to_string_pretty(&file)?;
+        anthesis_export::write_atomic(stats_path, json.as_bytes())
+            .with_context(|| format!("cannot write statistics to {}", stats_path.display()))?;
+    }
+    if let Some(out) = out {
+        let tracks = tracks(&sim, &frames);
+        if is_glb(out) {
+            anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
+                .with_context(|| format!("cannot write {}", out.display()))?;
+        } else {
+            anthesis_export::write_obj_sequence(out, &tracks)
+                .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
+        }
+        eprintln!("wrote {}", out.display());
+    }
+    Ok(())
+}
+
+/// Steps `sim` through keyframe `last` (at most its keyframe count), handing
+/// each keyframe to `on_keyframe`. Shows progress with the time left when
+/// stderr is a terminal and ends with a summary line on stderr. Returns the
+/// wall time in seconds.
+pub(super) fn run_keyframes(
+    sim: &mut Simulation,
+    last: u32,
+    on_keyframe: &mut dyn FnMut(Keyframe),
+) -> Result<f64> {
+    let last = last.min(sim.keyframe_count());
+    let started = Instant::now();
+    let show_progress = std::io::stderr().is_terminal();
+    let mut done = 0;
+    while done < last && !sim.finished() {
+        let keyframe = sim.step(&|| false, &mut |_| {})?;
+        done = keyframe.index;
+        if show_progress {
+            let elapsed = started.elapsed().as_secs_f64();
+            let left = elapsed / f64::from(done) * f64::from(last - done);
+            eprint!("\rkeyframe {done}/{last}  {elapsed:.1} s, about {left:.1} s left   ");
+            let _ = std::io::stderr().flush();
+        }
+        on_keyframe(keyframe);
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    if show_progress && done > 0 {
+        eprintln!();
+    }
+    eprintln!(
+        "simulated {done} keyframes of {} organ(s) in {seconds:.2} s",
+        sim.organs().len()
+    );
+    Ok(seconds)
+}
+
+fn is_glb(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+}
+
+/// Fails early, before a long simulation, when the output cannot be written.
+fn check_output(out: &Path) -> Result<()> {
+    if is_glb(out) {
+        let parent = out
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        if !parent.is_dir() {
+            bail!(
+                "cannot write {}: folder {} does not exist",
+                out.display(),
+                parent.display()
+            );
+        }
+    } else if out.exists() && !out.is_dir() {
+        bail!(
+            "--out {} must be a .glb file or a folder for OBJ files",
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+fn tracks(sim: &Simulation, frames: &[Vec<Vec<DVec3>>]) -> Vec<Track> {
+    sim.organs()
+        .iter()
+        .enumerate()
+        .map(|(i, name)| Track {
+            name: name.to_string(),
+            triangles: sim.triangles(i).to_vec(),
+            uvs: sim.uvs(i).to_vec(),
+            base_color: sim.color(i),
+            keyframes: frames.iter().map(|f| f[i].clone()).collect(),
+            base_color_png: None,
+        })
+        .collect()
+}
+
+fn rayon_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}

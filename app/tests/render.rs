@@ -1,0 +1,212 @@
+//! `anthesis render` end to end on the software renderer (Mesa's lavapipe
+//! here and in CI): a project in, PNG pictures of chosen keyframes out; bad
+//! input gives one line and a non-zero exit. Without a graphics adapter the
+//! rendering test fails: it is not skipped.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use image::RgbaImage;
+
+fn anthesis(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn utf8(path: &Path) -> &str {
+    path.to_str().expect("utf-8 path")
+}
+
+fn saved_whorl(dir: &Path) -> PathBuf {
+    let project = anthesis_sim::fixtures::whorl(3, 8, 14, 4);
+    let path = dir.join("whorl.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    path
+}
+
+fn load_png(path: &Path) -> RgbaImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8()
+}
+
+fn differs(a: &image::Rgba<u8>, b: &image::Rgba<u8>) -> bool {
+    a.0.iter().zip(b.0.iter()).any(|(x, y)| x.abs_diff(*y) > 8)
+}
+
+/// Pixels that differ from the background. The background is a vertical
+/// gradient and the framing keeps a margin, so the left column of each row
+/// is background.
+fn organ_pixels(picture: &RgbaImage) -> Vec<(u32, u32)> {
+    picture
+        .enumerate_pixels()
+        .filter(|(_, y, p)| differs(p, picture.get_pixel(0, *y)))
+        .map(|(x, y, _)| (x, y))
+        .collect()
+}
+
+#[test]
+fn render_writes_the_requested_frames_and_a_tile() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let project = saved_whorl(dir.path());
+    let pictures = dir.path().join("pictures");
+    std::fs::create_dir(&pictures).expect("mkdir");
+    let out = anthesis(&[
+        "render",
+        utf8(&project),
+        "--frames",
+        "4,0,2",
+        "--out",
+        utf8(&pictures),
+        "--size",
+        "160x120",
+        "--tile",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+
+    let mut names: Vec<String> = std::fs::read_dir(&pictures)
+        .expect("list")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "frame-000.png",
+            "frame-002.png",
+            "frame-004.png",
+            "tiled.png"
+        ],
+        "only the pictures, no temporary files"
+    );
+    let frames: Vec<RgbaImage> = ["frame-000.png", "frame-002.png", "frame-004.png"]
+        .iter()
+        .map(|name| load_png(&pictures.join(name)))
+        .collect();
+    for (frame, picture) in [0, 2, 4].iter().zip(&frames) {
+        assert_eq!(picture.dimensions(), (160, 120), "frame {frame}");
+        let organ = organ_pixels(picture);
+        let share = organ.len() as f64 / (160.0 * 120.0);
+        assert!(
+            (0.03..0.9).contains(&share),
+            "frame {frame}: {:.1} % of the picture is flower",
+            100.0 * share
+        );
+        // The petal template is orange, the sepal template green; the
+        // background is blue-grey.
+        let orange = picture
+            .pixels()
+            .filter(|p| p[0] > p[2].saturating_add(60) && p[0] > p[1].saturating_add(20))
+            .count();
+        let green = picture
+            .pixels()
+            .filter(|p| p[1] > p[0].saturating_add(5) && p[1] > p[2].saturating_add(40))
+            .count();
+        assert!(
+            orange > 50 && green > 50,
+            "frame {frame}: {orange} orange and {green} green pixels"
+        );
+    }
+    // The flower moves between keyframes, in one camera.
+    for (a, b) in [(0, 1), (1, 2), (0, 2)] {
+        let changed = frames[a]
+            .pixels()
+            .zip(frames[b].pixels())
+            .filter(|(p, q)| differs(p, q))
+            .count();
+        assert!(
+            changed > 100,
+            "frames {a} and {b} differ in {changed} pixels"
+        );
+    }
+    let tiled = load_png(&pictures.join("tiled.png"));
+    assert_eq!(tiled.dimensions(), (480, 120));
+    for (i, frame) in frames.iter().enumerate() {
+        let x0 = 160 * i as u32;
+        let tile = image::imageops::crop_imm(&tiled, x0, 0, 160, 120).to_image();
+        assert!(tile == *frame, "tile {i} is frame {i}");
+    }
+}
+
+#[test]
+fn render_refuses_bad_input_with_one_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let project = saved_whorl(dir.path());
+    let p = utf8(&project);
+    let folder = dir.path().join("pictures");
+    std::fs::create_dir(&folder).expect("mkdir");
+    let out_dir = utf8(&folder);
+    let missing_folder = dir.path().join("missing").display().to_string();
+    let a_file = project.display().to_string();
+    let missing_project = dir.path().join("nope.anthesis.toml").display().to_string();
+    let mut cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec![p, "--frames", "1,x", "--out", out_dir], "`x`"),
+        (vec![p, "--frames", "", "--out", out_dir], "--frames"),
+        (vec![p, "--frames", "0,-1", "--out", out_dir], "`-1`"),
+        (vec![p, "--frames", "5", "--out", out_dir], "keyframe 5"),
+        (
+            vec![p, "--frames", "5", "--keyframes", "3", "--out", out_dir],
+            "3 keyframes",
+        ),
+        (vec![p, "--out", &missing_folder], "does not exist"),
+        (vec![p, "--out", &a_file], "not a folder"),
+        (vec![p, "--out", out_dir, "--size", "0x10"], "--size"),
+        (vec![p, "--out", out_dir, "--size", "big"], "--size"),
+        (vec![p, "--out", out_dir, "--organ", "nobody"], "nobody"),
+        (
+            vec![p, "--out", out_dir, "--elevation", "120"],
+            "--elevation",
+        ),
+        (
+            vec![&missing_project, "--out", out_dir],
+            "nope.anthesis.toml",
+        ),
+    ];
+    // Not writable even for root.
+    if cfg!(target_os = "linux") {
+        cases.push((vec![p, "--out", "/proc"], "cannot write"));
+    }
+    for (args, expected) in cases {
+        let args: Vec<&str> = std::iter::once("render").chain(args).collect();
+        let out = anthesis(&args);
+        assert!(!out.status.success(), "{args:?} should fail");
+        let stderr = text(&out.stderr);
+        assert_eq!(
+            stderr.trim_end().lines().count(),
+            1,
+            "{args:?}: one line expected, got:\n{stderr}"
+        );
+        assert!(stderr.starts_with("error: "), "{stderr}");
+        assert!(
+            stderr.contains(expected),
+            "{args:?}: `{expected}` missing from {stderr}"
+        );
+    }
+    assert_eq!(
+        std::fs::read_dir(&folder).expect("list").count(),
+        0,
+        "nothing written"
+    );
+}
+
+#[test]
+fn render_without_a_graphics_adapter_says_so_in_one_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let project = saved_whorl(dir.path());
+    // Direct3D 12 does not exist on this platform: no adapter.
+    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        .args(["render", utf8(&project), "--out", utf8(dir.path())])
+        .env("WGPU_BACKEND", if cfg!(windows) { "metal" } else { "dx12" })
+        .output()
+        .expect("the binary runs");
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("no graphics adapter"), "{stderr}");
+}
