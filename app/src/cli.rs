@@ -131,14 +131,8 @@ fn one_line(message: &str) -> String {
 
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        None => {
-            println!(
-                "anthesis: the desktop application is not built yet. The command line works:\n  \
-                 anthesis info PROJECT\n  anthesis simulate PROJECT [--organ NAME] [--keyframes N] [--stats FILE.json] [--out FILE.glb|DIR]\n\
-                 (see `anthesis --help`)"
-            );
-            Ok(())
-        }
+        // No subcommand: the desktop window.
+        None => crate::desktop::run(),
         Some(Command::Info { project }) => simulate::info(&project),
         Some(Command::Simulate {
             project,

@@ -1,4 +1,5 @@
-//! The Anthesis application: for now the command line over the engine; the
-//! desktop window comes with the "desktop app" issue.
+//! The Anthesis application: the desktop window ([`desktop`]) and the
+//! command line ([`cli`]) over the engine crates.
 
 pub mod cli;
+pub mod desktop;

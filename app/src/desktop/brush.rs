@@ -1,0 +1,464 @@
+//! Brushes on growth-map rasters, in UV space: set / add / subtract /
+//! smooth / reset with radius, strength and hardness, mirrored about the
+//! midrib (u = 0.5), and direction painting. Pure functions over
+//! `anthesis_maps` rasters, no UI.
+//!
+//! (This is engine logic that belongs in `anthesis-maps`; it lives here
+//! until that crate takes it.)
+
+use anthesis_flower::Template;
+use anthesis_maps::{DirectionMap, MapKind, ScalarMap};
+use glam::DVec2;
+
+/// Resolution given to a constant (1x1) map when it is first painted and
+/// the template has no raster map to match.
+pub const DEFAULT_PAINT_SIZE: u32 = 128;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum BrushMode {
+    /// Moves values towards the brush value.
+    Set,
+    /// Adds the brush value.
+    Add,
+    /// Subtracts the brush value.
+    Subtract,
+    /// Moves values towards the mean of their neighbours.
+    Smooth,
+    /// Moves values towards the map's default (growth 0, stiffness 1,
+    /// direction along v).
+    Reset,
+}
+
+impl BrushMode {
+    pub const ALL: [BrushMode; 5] = [
+        BrushMode::Set,
+        BrushMode::Add,
+        BrushMode::Subtract,
+        BrushMode::Smooth,
+        BrushMode::Reset,
+    ];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            BrushMode::Set => "set",
+            BrushMode::Add => "add",
+            BrushMode::Subtract => "subtract",
+            BrushMode::Smooth => "smooth",
+            BrushMode::Reset => "reset",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Brush {
+    pub mode: BrushMode,
+    /// Radius in UV units (the UV square is 1 wide).
+    pub radius_in_uv: f64,
+    /// How much one dab moves a value at the centre, in `[0, 1]`.
+    pub strength: f32,
+    /// Fraction of the radius painted at full strength; the rest falls off
+    /// smoothly to 0 at the rim.
+    pub hardness: f32,
+    /// The value set, added or subtracted.
+    pub value: f32,
+    /// Also paint the mirror image about the midrib (u = 0.5).
+    pub mirror: bool,
+}
+
+impl Default for Brush {
+    fn default() -> Self {
+        Brush {
+            mode: BrushMode::Set,
+            radius_in_uv: 0.08,
+            strength: 0.5,
+            hardness: 0.5,
+            value: 0.8,
+            mirror: true,
+        }
+    }
+}
+
+impl Brush {
+    /// Weight of the brush at `distance_in_uv` from its centre, in `[0, 1]`.
+    pub fn weight(&self, distance_in_uv: f64) -> f32 {
+        let r = self.radius_in_uv.max(1e-9);
+        let t = (distance_in_uv / r) as f32;
+        if t >= 1.0 {
+            return 0.0;
+        }
+        let hard = self.hardness.clamp(0.0, 1.0);
+        let falloff = if t <= hard {
+            1.0
+        } else {
+            let s = (t - hard) / (1.0 - hard).max(1e-6);
+            1.0 - s * s * (3.0 - 2.0 * s)
+        };
+        falloff * self.strength.clamp(0.0, 1.0)
+    }
+
+    /// The dab centres: the point and, with mirroring, its mirror image
+    /// (once, when the point is on the midrib).
+    fn centres(&self, centre_in_uv: DVec2) -> Vec<(DVec2, bool)> {
+        let mirrored = DVec2::new(1.0 - centre_in_uv.x, centre_in_uv.y);
+        if self.mirror && (mirrored.x - centre_in_uv.x).abs() > 1e-9 {
+            vec![(centre_in_uv, false), (mirrored, true)]
+        } else {
+            vec![(centre_in_uv, false)]
+        }
+    }
+}
+
+/// Calls `visit(index, weight)` for every pixel of a `width x height`
+/// raster under one dab, taking the larger weight where mirrored dabs
+/// overlap. `mirrored` is true when the stronger dab is the mirrored one.
+fn for_pixels_under(
+    width: u32,
+    height: u32,
+    brush: &Brush,
+    centre_in_uv: DVec2,
+    mut visit: impl FnMut(usize, f32, bool),
+) {
+    let mut weights = std::collections::BTreeMap::new();
+    for (centre, mirrored) in brush.centres(centre_in_uv) {
+        let r = brush.radius_in_uv;
+        // Pixel centres are at ((x + 0.5) / w, 1 - (y + 0.5) / h).
+        let x_range = |lo: f64, hi: f64, n: u32| {
+            let a = ((lo * f64::from(n)) - 0.5).floor().max(0.0) as u32;
+            let b = ((hi * f64::from(n)) - 0.5)
+                .ceil()
+                .min(f64::from(n) - 1.0)
+                .max(0.0) as u32;
+            a..=b
+        };
+        let ys = x_range(1.0 - (centre.y + r), 1.0 - (centre.y - r), height);
+        for y in ys {
+            for x in x_range(centre.x - r, centre.x + r, width) {
+                let pixel = DVec2::new(
+                    (f64::from(x) + 0.5) / f64::from(width),
+                    1.0 - (f64::from(y) + 0.5) / f64::from(height),
+                );
+                let w = brush.weight(pixel.distance(centre));
+                if w > 0.0 {
+                    let index = (y * width + x) as usize;
+                    let entry = weights.entry(index).or_insert((0.0_f32, false));
+                    if w > entry.0 {
+                        *entry = (w, mirrored);
+                    }
+                }
+            }
+        }
+    }
+    for (index, (w, mirrored)) in weights {
+        visit(index, w, mirrored);
+    }
+}
+
+/// Mean of the 3x3 neighbourhood of pixel `index` (edges clamped).
+fn neighbour_mean<T: Copy>(
+    values: &[T],
+    width: u32,
+    height: u32,
+    index: usize,
+    zero: T,
+    add: impl Fn(T, T) -> T,
+    scale: impl Fn(T, f32) -> T,
+) -> T {
+    let (x, y) = ((index as u32) % width, (index as u32) / width);
+    let mut sum = zero;
+    let mut n = 0.0;
+    for dy in -1_i64..=1 {
+        for dx in -1_i64..=1 {
+            let nx = (i64::from(x) + dx).clamp(0, i64::from(width) - 1) as u32;
+            let ny = (i64::from(y) + dy).clamp(0, i64::from(height) - 1) as u32;
+            sum = add(sum, values[(ny * width + nx) as usize]);
+            n += 1.0;
+        }
+    }
+    scale(sum, 1.0 / n)
+}
+
+/// One dab of `brush` on a scalar map at `centre_in_uv`. `default` is the
+/// value `Reset` moves towards. Values stay in `[0, 1]`.
+pub fn dab_scalar(map: &mut ScalarMap, brush: &Brush, centre_in_uv: DVec2, default: f32) {
+    let (width, height) = map.size();
+    let before = map.values().to_vec();
+    let values = map.values_mut();
+    for_pixels_under(width, height, brush, centre_in_uv, |i, w, _| {
+        let v = before[i];
+        let next = match brush.mode {
+            BrushMode::Set => v + (brush.value - v) * w,
+            BrushMode::Add => v + brush.value * w,
+            BrushMode::Subtract => v - brush.value * w,
+            BrushMode::Reset => v + (default - v) * w,
+            BrushMode::Smooth => {
+                let mean =
+                    neighbour_mean(&before, width, height, i, 0.0, |a, b| a + b, |a, s| a * s);
+                v + (mean - v) * w
+            }
+        };
+        values[i] = next.clamp(0.0, 1.0);
+    });
+}
+
+/// One dab on a direction map. `direction_in_uv` (any length, zero for
+/// none) is what `Set`/`Add` paint; the mirrored dab paints its mirror image
+/// `(-u, v)`. `Reset` moves towards `(0, 1)`; `Subtract` towards zero.
+pub fn dab_direction(
+    map: &mut DirectionMap,
+    brush: &Brush,
+    centre_in_uv: DVec2,
+    direction_in_uv: DVec2,
+) {
+    let (width, height) = map.size();
+    let before = map.values().to_vec();
+    let values = map.values_mut();
+    let d = direction_in_uv.normalize_or_zero();
+    for_pixels_under(width, height, brush, centre_in_uv, |i, w, mirrored| {
+        let v = before[i];
+        let painted = if mirrored {
+            [-d.x as f32, d.y as f32]
+        } else {
+            [d.x as f32, d.y as f32]
+        };
+        let towards =
+            |target: [f32; 2]| [v[0] + (target[0] - v[0]) * w, v[1] + (target[1] - v[1]) * w];
+        let next = match brush.mode {
+            BrushMode::Set | BrushMode::Add => {
+                if d == DVec2::ZERO {
+                    v
+                } else {
+                    towards(painted)
+                }
+            }
+            BrushMode::Subtract => towards([0.0, 0.0]),
+            BrushMode::Reset => towards([0.0, 1.0]),
+            BrushMode::Smooth => {
+                let mean = neighbour_mean(
+                    &before,
+                    width,
+                    height,
+                    i,
+                    [0.0, 0.0],
+                    |a, b| [a[0] + b[0], a[1] + b[1]],
+                    |a, s| [a[0] * s, a[1] * s],
+                );
+                towards(mean)
+            }
+        };
+        values[i] = [next[0].clamp(-1.0, 1.0), next[1].clamp(-1.0, 1.0)];
+    });
+}
+
+/// The raster size shared by the template's painted maps, if any is a
+/// raster (the project format wants one size per template).
+pub fn template_raster_size(template: &Template) -> Option<(u32, u32)> {
+    template.maps.keys().iter().find_map(|key| {
+        let maps = &key.maps;
+        MapKind::ALL
+            .iter()
+            .map(|&k| maps.scalar(k).size())
+            .chain(std::iter::once(maps.direction.size()))
+            .find(|&size| size != (1, 1))
+    })
+}
+
+/// Makes a constant map paintable: a 1x1 map becomes a raster of `size`
+/// with the same value everywhere.
+pub fn ensure_scalar_raster(map: &mut ScalarMap, size: (u32, u32)) {
+    if map.size() == (1, 1) && size != (1, 1) {
+        let value = map.values()[0];
+        *map = ScalarMap::from_fn(size.0, size.1, |_| value);
+    }
+}
+
+/// Like [`ensure_scalar_raster`] for direction maps.
+pub fn ensure_direction_raster(map: &mut DirectionMap, size: (u32, u32)) {
+    if map.size() == (1, 1) && size != (1, 1) {
+        let [u, v] = map.values()[0];
+        *map = DirectionMap::from_fn(size.0, size.1, |_| DVec2::new(f64::from(u), f64::from(v)));
+    }
+}
+
+/// Which map a stroke paints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum PaintTarget {
+    Scalar(MapKind),
+    Direction,
+}
+
+impl PaintTarget {
+    pub fn label(self) -> &'static str {
+        match self {
+            PaintTarget::Scalar(kind) => kind.label(),
+            PaintTarget::Direction => "direction",
+        }
+    }
+}
+
+/// One dab of `brush` on map `target` of time key `key` of `template`:
+/// constant maps become rasters first (of the template's size, so all its
+/// maps keep one size). `direction_in_uv` is the stroke direction, used
+/// by the direction map.
+pub fn dab_template(
+    template: &mut Template,
+    key: usize,
+    target: PaintTarget,
+    brush: &Brush,
+    centre_in_uv: DVec2,
+    direction_in_uv: DVec2,
+) {
+    let size = template_raster_size(template).unwrap_or((DEFAULT_PAINT_SIZE, DEFAULT_PAINT_SIZE));
+    let keys = template.maps.keys_mut();
+    let Some(map_key) = keys.get_mut(key) else {
+        return;
+    };
+    match target {
+        PaintTarget::Scalar(kind) => {
+            let map = map_key.maps.scalar_mut(kind);
+            ensure_scalar_raster(map, size);
+            dab_scalar(map, brush, centre_in_uv, kind.default_value());
+        }
+        PaintTarget::Direction => {
+            let map = &mut map_key.maps.direction;
+            ensure_direction_raster(map, size);
+            dab_direction(map, brush, centre_in_uv, direction_in_uv);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn flat(value: f32) -> ScalarMap {
+        ScalarMap::from_fn(20, 20, |_| value)
+    }
+
+    fn hard(mode: BrushMode, value: f32) -> Brush {
+        Brush {
+            mode,
+            radius_in_uv: 0.15,
+            strength: 1.0,
+            hardness: 1.0,
+            value,
+            mirror: false,
+        }
+    }
+
+    #[test]
+    fn weight_is_full_inside_the_hard_core_and_zero_at_the_rim() {
+        let brush = Brush {
+            radius_in_uv: 0.1,
+            hardness: 0.5,
+            strength: 0.8,
+            ..Brush::default()
+        };
+        assert_eq!(brush.weight(0.0), 0.8);
+        assert_eq!(brush.weight(0.05), 0.8);
+        assert!(brush.weight(0.075) < 0.8 && brush.weight(0.075) > 0.0);
+        assert_eq!(brush.weight(0.1), 0.0);
+    }
+
+    #[test]
+    fn set_paints_under_the_brush_only_and_mirror_paints_the_other_side() {
+        let mut map = flat(0.0);
+        dab_scalar(
+            &mut map,
+            &hard(BrushMode::Set, 1.0),
+            DVec2::new(0.25, 0.5),
+            0.0,
+        );
+        assert_eq!(map.sample(DVec2::new(0.25, 0.5)), 1.0);
+        assert_eq!(map.sample(DVec2::new(0.75, 0.5)), 0.0);
+        assert_eq!(map.sample(DVec2::new(0.25, 0.9)), 0.0);
+        let mut brush = hard(BrushMode::Set, 1.0);
+        brush.mirror = true;
+        dab_scalar(&mut map, &brush, DVec2::new(0.25, 0.2), 0.0);
+        assert_eq!(map.sample(DVec2::new(0.25, 0.2)), 1.0);
+        assert_eq!(
+            map.sample(DVec2::new(0.75, 0.2)),
+            1.0,
+            "mirrored about u = 0.5"
+        );
+    }
+
+    #[test]
+    fn add_subtract_clamp_and_reset_restores_the_default() {
+        let mut map = flat(0.5);
+        let centre = DVec2::new(0.5, 0.5);
+        dab_scalar(&mut map, &hard(BrushMode::Add, 0.3), centre, 1.0);
+        assert!((map.sample(centre) - 0.8).abs() < 1e-6);
+        dab_scalar(&mut map, &hard(BrushMode::Add, 0.3), centre, 1.0);
+        assert_eq!(map.sample(centre), 1.0, "clamped to 1");
+        dab_scalar(&mut map, &hard(BrushMode::Subtract, 0.25), centre, 1.0);
+        assert!((map.sample(centre) - 0.75).abs() < 1e-6);
+        dab_scalar(&mut map, &hard(BrushMode::Reset, 0.0), centre, 1.0);
+        assert_eq!(map.sample(centre), 1.0, "stiffness default");
+    }
+
+    #[test]
+    fn smooth_flattens_a_spike() {
+        let mut map = flat(0.0);
+        let spike = 10 * 20 + 10;
+        map.values_mut()[spike] = 1.0;
+        dab_scalar(
+            &mut map,
+            &hard(BrushMode::Smooth, 0.0),
+            DVec2::new(0.5, 0.5),
+            0.0,
+        );
+        let after = map.values()[spike];
+        assert!(after < 0.2 && after > 0.0, "{after}");
+        let total: f32 = map.values().iter().sum();
+        assert!(
+            total > 0.5,
+            "the spike spreads, it does not vanish: {total}"
+        );
+    }
+
+    #[test]
+    fn direction_paints_the_stroke_direction_mirrored_on_the_other_side() {
+        let mut map = DirectionMap::from_fn(20, 20, |_| DVec2::Y);
+        let mut brush = hard(BrushMode::Set, 0.0);
+        brush.mirror = true;
+        dab_direction(
+            &mut map,
+            &brush,
+            DVec2::new(0.25, 0.5),
+            DVec2::new(3.0, 3.0),
+        );
+        let left = map.sample(DVec2::new(0.25, 0.5));
+        let right = map.sample(DVec2::new(0.75, 0.5));
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        assert!((left - DVec2::new(s, s)).length() < 1e-6, "{left}");
+        assert!((right - DVec2::new(-s, s)).length() < 1e-6, "{right}");
+        dab_direction(
+            &mut map,
+            &hard(BrushMode::Reset, 0.0),
+            DVec2::new(0.25, 0.5),
+            DVec2::ZERO,
+        );
+        assert!((map.sample(DVec2::new(0.25, 0.5)) - DVec2::Y).length() < 1e-6);
+    }
+
+    #[test]
+    fn painting_a_constant_map_makes_a_raster_of_the_templates_size() {
+        let project = anthesis_sim::fixtures::whorl(1, 4, 6, 3);
+        let mut template = project.flower.templates[0].clone();
+        // The fixture paints e-growth etc. as 32x32; stretch is constant.
+        assert_eq!(template.maps.keys()[0].maps.stretch.size(), (1, 1));
+        let brush = hard(BrushMode::Set, 0.2);
+        dab_template(
+            &mut template,
+            0,
+            PaintTarget::Scalar(MapKind::Stretch),
+            &brush,
+            DVec2::new(0.5, 0.5),
+            DVec2::ZERO,
+        );
+        let stretch = &template.maps.keys()[0].maps.stretch;
+        assert_eq!(stretch.size(), (32, 32));
+        assert!((stretch.sample(DVec2::new(0.5, 0.5)) - 0.2).abs() < 1e-6);
+        assert_eq!(stretch.sample(DVec2::new(0.05, 0.95)), 1.0);
+    }
+}

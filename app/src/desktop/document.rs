@@ -1,0 +1,202 @@
+//! The open project: the model being edited, where it lives on disk, whether
+//! it has unsaved changes, and undo/redo of every edit.
+
+use std::path::PathBuf;
+
+use anthesis_flower::Project;
+
+/// Most undo steps kept (each holds a copy of the project before the edit).
+pub const UNDO_LIMIT: usize = 200;
+
+/// One undoable step: the project as it was before, and what the edit was.
+#[derive(Debug, Clone)]
+struct Step {
+    label: String,
+    before: Project,
+}
+
+/// The project being edited, with its history.
+#[derive(Debug, Clone)]
+pub struct Document {
+    project: Project,
+    /// Where it was opened from or last saved to; `None` for a new project.
+    pub path: Option<PathBuf>,
+    undo: Vec<Step>,
+    redo: Vec<Step>,
+    /// The last step may still absorb edits with the same label (a drag,
+    /// a brush stroke) until [`Document::seal`].
+    open_step: bool,
+    /// Edits since the last save (the history position of the saved state).
+    saved_at: Option<usize>,
+}
+
+impl Document {
+    /// A document for `project`, unchanged since `path` (if any).
+    pub fn new(project: Project, path: Option<PathBuf>) -> Document {
+        Document {
+            project,
+            path,
+            undo: Vec::new(),
+            redo: Vec::new(),
+            open_step: false,
+            saved_at: Some(0),
+        }
+    }
+
+    pub fn project(&self) -> &Project {
+        &self.project
+    }
+
+    /// Applies `change` to the project as one undoable edit named `label`.
+    /// Consecutive edits with the same label merge into one step until
+    /// [`Document::seal`] is called (the UI seals when the pointer is
+    /// released, so a drag is one step). Returns whether the project changed.
+    pub fn edit(&mut self, label: &str, change: impl FnOnce(&mut Project)) -> bool {
+        let before = self.project.clone();
+        change(&mut self.project);
+        if self.project == before {
+            return false;
+        }
+        let merge = self.open_step && self.undo.last().is_some_and(|s| s.label == label);
+        if !merge {
+            self.undo.push(Step {
+                label: label.to_string(),
+                before,
+            });
+            if self.undo.len() > UNDO_LIMIT {
+                self.undo.remove(0);
+                self.saved_at = self.saved_at.and_then(|s| s.checked_sub(1));
+            }
+            if self.saved_at.is_some_and(|s| s >= self.undo.len()) {
+                // The saved state was in the redo branch we drop now.
+                self.saved_at = None;
+            }
+            self.redo.clear();
+        }
+        self.open_step = true;
+        true
+    }
+
+    /// Ends the open step: the next edit starts a new undo step.
+    pub fn seal(&mut self) {
+        self.open_step = false;
+    }
+
+    /// Undoes the last step; returns its label.
+    pub fn undo(&mut self) -> Option<String> {
+        let step = self.undo.pop()?;
+        let after = std::mem::replace(&mut self.project, step.before);
+        self.redo.push(Step {
+            label: step.label.clone(),
+            before: after,
+        });
+        self.open_step = false;
+        Some(step.label)
+    }
+
+    /// Redoes the last undone step; returns its label.
+    pub fn redo(&mut self) -> Option<String> {
+        let step = self.redo.pop()?;
+        let before = std::mem::replace(&mut self.project, step.before);
+        self.undo.push(Step {
+            label: step.label.clone(),
+            before,
+        });
+        self.open_step = false;
+        Some(step.label)
+    }
+
+    pub fn undo_label(&self) -> Option<&str> {
+        self.undo.last().map(|s| s.label.as_str())
+    }
+
+    pub fn redo_label(&self) -> Option<&str> {
+        self.redo.last().map(|s| s.label.as_str())
+    }
+
+    /// Whether there are changes since the project was opened or saved.
+    pub fn is_dirty(&self) -> bool {
+        self.saved_at != Some(self.undo.len())
+    }
+
+    /// Records that the project is now saved at `path`.
+    pub fn mark_saved(&mut self, path: PathBuf) {
+        self.path = Some(path);
+        self.saved_at = Some(self.undo.len());
+        self.open_step = false;
+    }
+
+    /// The name shown in the title bar.
+    pub fn title(&self) -> String {
+        let file = self
+            .path
+            .as_ref()
+            .and_then(|p| p.file_name())
+            .map(|n| n.to_string_lossy().into_owned());
+        let name = file.unwrap_or_else(|| format!("{} (not saved)", self.project.name));
+        if self.is_dirty() {
+            format!("{name} *")
+        } else {
+            name
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn doc() -> Document {
+        Document::new(anthesis_sim::fixtures::whorl(1, 4, 6, 3), None)
+    }
+
+    #[test]
+    fn undo_and_redo_restore_each_edit_and_the_dirty_flag() {
+        let mut doc = doc();
+        let original = doc.project().clone();
+        assert!(!doc.is_dirty());
+        doc.edit("dg", |p| p.flower.templates[0].dg = 0.01);
+        doc.seal();
+        doc.edit("thickness", |p| p.flower.templates[0].thickness = 0.5);
+        assert!(doc.is_dirty());
+        assert_eq!(doc.undo().as_deref(), Some("thickness"));
+        assert_eq!(doc.project().flower.templates[0].thickness, 0.2);
+        assert_eq!(doc.project().flower.templates[0].dg, 0.01);
+        assert_eq!(doc.undo().as_deref(), Some("dg"));
+        assert_eq!(doc.project(), &original);
+        assert!(!doc.is_dirty(), "back at the opened state");
+        assert_eq!(doc.redo().as_deref(), Some("dg"));
+        assert_eq!(doc.project().flower.templates[0].dg, 0.01);
+        assert!(doc.is_dirty());
+    }
+
+    #[test]
+    fn a_drag_is_one_step_until_sealed_and_no_op_edits_are_not_steps() {
+        let mut doc = doc();
+        for i in 1..=5 {
+            doc.edit("dg", |p| p.flower.templates[0].dg = 0.001 * f64::from(i));
+        }
+        assert!(!doc.edit("dg", |p| p.flower.templates[0].dg = 0.005));
+        doc.seal();
+        doc.edit("dg", |p| p.flower.templates[0].dg = 0.5);
+        doc.undo();
+        assert_eq!(doc.project().flower.templates[0].dg, 0.005);
+        doc.undo();
+        assert_eq!(doc.project().flower.templates[0].dg, 0.003);
+        assert!(doc.undo().is_none());
+    }
+
+    #[test]
+    fn saving_clears_dirty_and_a_new_edit_after_undo_drops_the_saved_branch() {
+        let mut doc = doc();
+        doc.edit("dg", |p| p.flower.templates[0].dg = 0.01);
+        doc.mark_saved(PathBuf::from("/tmp/x.anthesis.toml"));
+        assert!(!doc.is_dirty());
+        doc.undo();
+        assert!(doc.is_dirty());
+        doc.edit("thickness", |p| p.flower.templates[0].thickness = 0.3);
+        assert!(doc.is_dirty());
+        assert!(doc.redo().is_none());
+        assert_eq!(doc.title(), "x.anthesis.toml *");
+    }
+}

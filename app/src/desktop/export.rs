@@ -1,0 +1,401 @@
+//! The export dialog: a .glb path (typed or picked with the native dialog)
+//! and the glTF options; the export runs on a thread named
+//! `anthesis-export` and reports progress, then the result or the error.
+
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, channel};
+use std::sync::{Arc, Mutex};
+
+use anthesis_export::{Encoding, GlbOptions, Timing, Track};
+use anthesis_flower::Project;
+use anthesis_sim::Keyframe;
+use eframe::egui;
+
+/// How the dialog asks for the animation's timing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TimingMode {
+    FramesPerSecond,
+    Duration,
+}
+
+/// Where an export stands.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExportState {
+    Idle,
+    Running { progress: f32 },
+    Done { path: PathBuf, bytes: u64 },
+    Failed { message: String },
+}
+
+enum Message {
+    Progress(f32),
+    Done(Result<u64, String>),
+}
+
+/// The dialog's fields and the running export.
+pub struct ExportDialog {
+    pub open: bool,
+    pub path: String,
+    pub timing_mode: TimingMode,
+    pub frames_per_second: f64,
+    pub duration_seconds: f64,
+    pub max_morph_targets: usize,
+    pub normals: bool,
+    pub encoding: Encoding,
+    state: ExportState,
+    job: Option<(PathBuf, Receiver<Message>)>,
+}
+
+impl Default for ExportDialog {
+    fn default() -> Self {
+        let defaults = GlbOptions::default();
+        ExportDialog {
+            open: false,
+            path: String::new(),
+            timing_mode: TimingMode::FramesPerSecond,
+            frames_per_second: anthesis_export::DEFAULT_FRAMES_PER_SECOND,
+            duration_seconds: 4.0,
+            max_morph_targets: defaults.max_morph_targets,
+            normals: defaults.normals,
+            encoding: defaults.encoding,
+            state: ExportState::Idle,
+            job: None,
+        }
+    }
+}
+
+/// What the user asked the dialog for.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct ExportRequests {
+    pub browse: bool,
+    pub export: bool,
+}
+
+/// The animation tracks of the computed keyframes: one per simulated organ.
+pub fn tracks(project: &Project, organs: &[usize], keyframes: &[Arc<Keyframe>]) -> Vec<Track> {
+    organs
+        .iter()
+        .enumerate()
+        .map(|(slot, &organ)| {
+            let template = project.flower.template_of(organ);
+            Track {
+                name: project.flower.organs[organ].name.clone(),
+                triangles: template.mesh.triangles.clone(),
+                uvs: template.mesh.uvs.clone(),
+                base_color: template.color,
+                keyframes: keyframes
+                    .iter()
+                    .map(|k| k.positions[slot].clone())
+                    .collect(),
+                base_color_png: None,
+            }
+        })
+        .collect()
+}
+
+impl ExportDialog {
+    pub fn state(&self) -> &ExportState {
+        &self.state
+    }
+
+    pub fn options(&self) -> GlbOptions {
+        GlbOptions {
+            timing: match self.timing_mode {
+                TimingMode::FramesPerSecond => Timing::FramesPerSecond(self.frames_per_second),
+                TimingMode::Duration => Timing::Duration(self.duration_seconds),
+            },
+            max_morph_targets: self.max_morph_targets,
+            normals: self.normals,
+            encoding: self.encoding,
+        }
+    }
+
+    /// Starts writing `tracks` to the dialog's path on a thread; `wake` is
+    /// called on progress and at the end.
+    pub fn start(&mut self, tracks: Vec<Track>, wake: impl Fn() + Send + Sync + 'static) {
+        let path = PathBuf::from(self.path.trim());
+        if path.as_os_str().is_empty() {
+            self.state = ExportState::Failed {
+                message: "choose a file to export to".to_string(),
+            };
+            return;
+        }
+        if tracks.iter().all(|t| t.keyframes.is_empty()) {
+            self.state = ExportState::Failed {
+                message: "there are no keyframes to export yet".to_string(),
+            };
+            return;
+        }
+        let options = self.options();
+        let (send, receive) = channel();
+        let target = path.clone();
+        let wake = Arc::new(wake);
+        let progress_wake = Arc::clone(&wake);
+        let progress_send = Mutex::new(send.clone());
+        let spawned = std::thread::Builder::new()
+            .name("anthesis-export".into())
+            .spawn(move || {
+                let mut last = -1.0_f32;
+                let result = anthesis_export::write_glb(&target, &tracks, &options, &mut |p| {
+                    // Report in steps of 1 %.
+                    if p - last >= 0.01 {
+                        last = p;
+                        if let Ok(send) = progress_send.lock() {
+                            let _ = send.send(Message::Progress(p));
+                        }
+                        (*progress_wake)();
+                    }
+                })
+                .map_err(|e| e.to_string())
+                .and_then(|()| {
+                    std::fs::metadata(&target)
+                        .map(|m| m.len())
+                        .map_err(|e| format!("{}: {e}", target.display()))
+                });
+                let _ = send.send(Message::Done(result));
+                (*wake)();
+            });
+        match spawned {
+            Ok(_) => {
+                self.state = ExportState::Running { progress: 0.0 };
+                self.job = Some((path, receive));
+            }
+            Err(e) => {
+                self.state = ExportState::Failed {
+                    message: format!("cannot start the export: {e}"),
+                }
+            }
+        }
+    }
+
+    /// Takes the export thread's messages; returns the final state once
+    /// when the export ends.
+    pub fn poll(&mut self) -> Option<ExportState> {
+        let (path, receive) = self.job.as_ref()?;
+        let path = path.clone();
+        let mut ended = None;
+        while let Ok(message) = receive.try_recv() {
+            match message {
+                Message::Progress(progress) => {
+                    self.state = ExportState::Running { progress };
+                }
+                Message::Done(result) => {
+                    self.state = match result {
+                        Ok(bytes) => ExportState::Done {
+                            path: path.clone(),
+                            bytes,
+                        },
+                        Err(message) => ExportState::Failed { message },
+                    };
+                    ended = Some(self.state.clone());
+                }
+            }
+        }
+        if ended.is_some() {
+            self.job = None;
+        }
+        ended
+    }
+
+    pub fn is_running(&self) -> bool {
+        self.job.is_some()
+    }
+
+    /// The dialog window. `keyframes_ready` and `keyframes_total` describe
+    /// what would be exported.
+    pub fn ui(
+        &mut self,
+        ctx: &egui::Context,
+        keyframes_ready: usize,
+        keyframes_total: u32,
+    ) -> ExportRequests {
+        let mut requests = ExportRequests::default();
+        let mut open = self.open;
+        egui::Window::new("Export glTF")
+            .open(&mut open)
+            .resizable(false)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                ui.horizontal(|ui| {
+                    let label = ui.label("Export to").id;
+                    ui.add(
+                        egui::TextEdit::singleline(&mut self.path)
+                            .hint_text("/path/to/flower.glb")
+                            .desired_width(300.0),
+                    )
+                    .labelled_by(label)
+                    .on_hover_text("Where the animated .glb goes (replaced atomically)");
+                    if ui.button("Browse…").clicked() {
+                        requests.browse = true;
+                    }
+                });
+                egui::Grid::new("export options")
+                    .num_columns(2)
+                    .show(ui, |ui| {
+                        ui.label("Timing");
+                        ui.horizontal(|ui| {
+                            ui.radio_value(
+                                &mut self.timing_mode,
+                                TimingMode::FramesPerSecond,
+                                "keyframes per second",
+                            );
+                            ui.radio_value(
+                                &mut self.timing_mode,
+                                TimingMode::Duration,
+                                "total seconds",
+                            );
+                        });
+                        ui.end_row();
+                        match self.timing_mode {
+                            TimingMode::FramesPerSecond => {
+                                let label = ui.label("Keyframes per second").id;
+                                ui.add(
+                                    egui::DragValue::new(&mut self.frames_per_second)
+                                        .range(0.1..=240.0)
+                                        .speed(0.5),
+                                )
+                                .labelled_by(label);
+                            }
+                            TimingMode::Duration => {
+                                let label = ui.label("Duration").id;
+                                ui.add(
+                                    egui::DragValue::new(&mut self.duration_seconds)
+                                        .range(0.1..=3600.0)
+                                        .speed(0.1)
+                                        .suffix(" s"),
+                                )
+                                .labelled_by(label);
+                            }
+                        }
+                        ui.end_row();
+                        let label = ui
+                            .label("Most morph targets")
+                            .on_hover_text(
+                                "Per mesh; longer runs are resampled to this many keyframes \
+                                 (clients slow down with very many targets)",
+                            )
+                            .id;
+                        ui.add(egui::DragValue::new(&mut self.max_morph_targets).range(2..=2000))
+                            .labelled_by(label);
+                        ui.end_row();
+                        ui.label("Normals");
+                        ui.checkbox(&mut self.normals, "store normals")
+                            .on_hover_text("Without them the file is about half as large");
+                        ui.end_row();
+                        ui.label("Encoding");
+                        ui.horizontal(|ui| {
+                            for encoding in Encoding::ALL {
+                                ui.radio_value(&mut self.encoding, encoding, encoding.to_string());
+                            }
+                        })
+                        .response
+                        .on_hover_text(
+                            "dense: plain floats, read everywhere; sparse: only moving vertices; \
+                             quantized: KHR_mesh_quantization, about half the size",
+                        );
+                        ui.end_row();
+                    });
+                let after_bud = keyframes_ready.saturating_sub(1);
+                ui.label(format!(
+                    "{after_bud} of {keyframes_total} keyframes computed{}",
+                    if (after_bud as u32) < keyframes_total {
+                        " — the export holds the computed ones"
+                    } else {
+                        ""
+                    }
+                ));
+                ui.horizontal(|ui| {
+                    let running = self.is_running();
+                    if ui
+                        .add_enabled(!running, egui::Button::new("Export"))
+                        .clicked()
+                    {
+                        requests.export = true;
+                    }
+                    match &self.state {
+                        ExportState::Idle => {}
+                        ExportState::Running { progress } => {
+                            ui.add(
+                                egui::ProgressBar::new(*progress)
+                                    .show_percentage()
+                                    .desired_width(200.0),
+                            );
+                        }
+                        ExportState::Done { path, bytes } => {
+                            ui.label(format!(
+                                "Wrote {} ({:.1} MB)",
+                                path.display(),
+                                *bytes as f64 / 1.0e6
+                            ));
+                        }
+                        ExportState::Failed { message } => {
+                            ui.colored_label(egui::Color32::from_rgb(210, 50, 40), message);
+                        }
+                    }
+                });
+            });
+        self.open = open;
+        requests
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::{Duration, Instant};
+
+    #[test]
+    fn an_export_writes_a_glb_and_reports_done_with_its_size() {
+        let project = anthesis_sim::fixtures::whorl(2, 4, 6, 2);
+        let mut frames = Vec::new();
+        anthesis_sim::run(&project, &anthesis_sim::Selection::All, &mut |_, k| {
+            frames.push(Arc::new(k.clone()))
+        })
+        .expect("simulates");
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut dialog = ExportDialog {
+            path: dir.path().join("out.glb").display().to_string(),
+            ..ExportDialog::default()
+        };
+        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        let started = Instant::now();
+        let end = loop {
+            if let Some(end) = dialog.poll() {
+                break end;
+            }
+            assert!(started.elapsed() < Duration::from_secs(60), "export hangs");
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        let ExportState::Done { bytes, .. } = end else {
+            panic!("export failed: {end:?}");
+        };
+        let on_disk = std::fs::read(dir.path().join("out.glb")).expect("file");
+        assert_eq!(on_disk.len() as u64, bytes);
+        assert_eq!(&on_disk[..4], b"glTF");
+    }
+
+    #[test]
+    fn a_missing_folder_is_reported_not_panicked() {
+        let project = anthesis_sim::fixtures::whorl(1, 4, 6, 1);
+        let bud = anthesis_sim::Simulation::new(&project, &anthesis_sim::Selection::All)
+            .expect("sim")
+            .bud();
+        let mut dialog = ExportDialog {
+            path: "/no/such/folder/out.glb".to_string(),
+            ..ExportDialog::default()
+        };
+        dialog.start(tracks(&project, &[0], &[Arc::new(bud)]), || {});
+        let started = Instant::now();
+        let end = loop {
+            if let Some(end) = dialog.poll() {
+                break end;
+            }
+            assert!(started.elapsed() < Duration::from_secs(30), "export hangs");
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        assert!(
+            matches!(&end, ExportState::Failed { message } if message.contains("/no/such/folder")),
+            "{end:?}"
+        );
+    }
+}

@@ -1,0 +1,241 @@
+//! The parameters panel: the selected organ's template (dg, thickness,
+//! Ks, Kb, joint schedule, base region) and the project's keyframe count,
+//! each with a tooltip saying what it does. Edits go through
+//! [`Document::edit`], so each is undoable and restarts the simulation.
+
+use anthesis_flower::{JointRamp, Template};
+use eframe::egui::{self, DragValue};
+
+use super::document::Document;
+
+/// A labelled number row; returns whether it changed.
+fn number(
+    ui: &mut egui::Ui,
+    label: &str,
+    tooltip: &str,
+    value: &mut f64,
+    speed: f64,
+    range: std::ops::RangeInclusive<f64>,
+) -> bool {
+    let label = ui.label(label).on_hover_text(tooltip);
+    let changed = ui
+        .add(
+            DragValue::new(value)
+                .speed(speed)
+                .range(range)
+                .max_decimals(5),
+        )
+        .labelled_by(label.id)
+        .on_hover_text(tooltip)
+        .changed();
+    ui.end_row();
+    changed
+}
+
+/// Shows the panel for template `template` and applies edits to `doc`.
+/// Returns whether the project changed.
+pub fn parameters_ui(ui: &mut egui::Ui, doc: &mut Document, template: usize) -> bool {
+    let project = doc.project();
+    let Some(original) = project.flower.templates.get(template) else {
+        ui.label("No organ selected.");
+        return false;
+    };
+    let mut draft: Template = original.clone();
+    let mut keyframes = project.settings.keyframes;
+    let name = draft.name.clone();
+    let mut changed_field: Option<&str> = None;
+    let mut mark = |changed: bool, field: &'static str| {
+        if changed && changed_field.is_none() {
+            changed_field = Some(field);
+        }
+    };
+
+    ui.heading(format!("Template “{name}”"));
+    egui::Grid::new("template parameters")
+        .num_columns(2)
+        .spacing([12.0, 6.0])
+        .show(ui, |ui| {
+            mark(
+                number(
+                    ui,
+                    "dg",
+                    "Maximum growth per step: each triangle grows by a factor 1 + dg × map \
+                     value every step. Negative values shrink (wilting). Paper: 0.003.",
+                    &mut draft.dg,
+                    0.0001,
+                    -0.5..=0.5,
+                ),
+                "dg",
+            );
+            mark(
+                number(
+                    ui,
+                    "thickness",
+                    "Distance to the imaginary inner surface. Inner growth larger than base \
+                     growth bends the petal outwards; a thinner petal bends more for the same \
+                     difference. Paper: lily 0.2, Eustoma 0.1.",
+                    &mut draft.thickness,
+                    0.005,
+                    0.001..=100.0,
+                ),
+                "thickness",
+            );
+            mark(
+                number(
+                    ui,
+                    "Ks (stretch)",
+                    "Stretch stiffness: how strongly edges keep their grown rest length. \
+                     Multiplied by the stretch map. Paper: 20 (lily), 10 (Eustoma).",
+                    &mut draft.stretch_stiffness,
+                    0.1,
+                    0.001..=1.0e6,
+                ),
+                "Ks",
+            );
+            mark(
+                number(
+                    ui,
+                    "Kb (bend)",
+                    "Bend stiffness: how strongly hinges keep their grown rest angle. \
+                     Multiplied by the bend map. Paper: 20 (lily), 10 (Eustoma).",
+                    &mut draft.bend_stiffness,
+                    0.1,
+                    0.001..=1.0e6,
+                ),
+                "Kb",
+            );
+            let label = ui.label("keyframes").on_hover_text(
+                "Simulation steps after the bud, one keyframe each (whole project). Paper: 100.",
+            );
+            mark(
+                ui.add(DragValue::new(&mut keyframes).range(1..=10_000))
+                    .labelled_by(label.id)
+                    .on_hover_text(
+                        "Simulation steps after the bud, one keyframe each (whole project).",
+                    )
+                    .changed(),
+                "keyframes",
+            );
+            ui.end_row();
+        });
+
+    ui.separator();
+    ui.strong("Base region")
+        .on_hover_text("Particles whose UV lies here attach the organ to the receptacle.");
+    egui::Grid::new("base region")
+        .num_columns(2)
+        .show(ui, |ui| {
+            let base = &mut draft.base_region;
+            mark(
+                number(
+                    ui,
+                    "v max",
+                    "Particles with v ≤ this (v runs from the base, 0, to the tip, 1) are base \
+                 particles, shape-matched onto the receptacle each iteration.",
+                    &mut base.v_max,
+                    0.002,
+                    0.0..=1.0,
+                ),
+                "base v max",
+            );
+            mark(
+                number(
+                    ui,
+                    "u min",
+                    "Leftmost u of the base region (u runs across the organ, midrib at 0.5).",
+                    &mut base.u_min,
+                    0.005,
+                    0.0..=1.0,
+                ),
+                "base u min",
+            );
+            mark(
+                number(
+                    ui,
+                    "u max",
+                    "Rightmost u of the base region.",
+                    &mut base.u_max,
+                    0.005,
+                    0.0..=1.0,
+                ),
+                "base u max",
+            );
+        });
+
+    ui.separator();
+    ui.strong("Joint schedule").on_hover_text(
+        "How the organ tilts outwards at its base over the steps: each ramp adds its degrees \
+         evenly over its steps. Paper: lily +23° over steps 1–60.",
+    );
+    let mut remove = None;
+    egui::Grid::new("joint schedule")
+        .num_columns(4)
+        .show(ui, |ui| {
+            let from_label = ui.label("from step").id;
+            let to_label = ui.label("to step").id;
+            let degrees_label = ui.label("degrees").id;
+            ui.end_row();
+            for (i, ramp) in draft.joint_schedule.iter_mut().enumerate() {
+                mark(
+                    ui.add(DragValue::new(&mut ramp.from_step).range(0..=100_000))
+                        .labelled_by(from_label)
+                        .on_hover_text("The ramp starts after this step")
+                        .changed(),
+                    "joint from",
+                );
+                mark(
+                    ui.add(DragValue::new(&mut ramp.to_step).range(0..=100_000))
+                        .labelled_by(to_label)
+                        .on_hover_text("The ramp has added all its degrees at this step")
+                        .changed(),
+                    "joint to",
+                );
+                mark(
+                    ui.add(
+                        DragValue::new(&mut ramp.degrees)
+                            .speed(0.1)
+                            .range(-180.0..=180.0)
+                            .suffix("°"),
+                    )
+                    .labelled_by(degrees_label)
+                    .on_hover_text("Degrees added; positive tilts the organ outwards")
+                    .changed(),
+                    "joint degrees",
+                );
+                if ui
+                    .small_button("Remove")
+                    .on_hover_text("Remove this ramp")
+                    .clicked()
+                {
+                    remove = Some(i);
+                }
+                ui.end_row();
+            }
+        });
+    if let Some(i) = remove {
+        draft.joint_schedule.remove(i);
+        mark(true, "remove joint ramp");
+    }
+    if ui
+        .button("Add ramp")
+        .on_hover_text("Add a joint ramp after the last one")
+        .clicked()
+    {
+        let from = draft.joint_schedule.last().map_or(0, |r| r.to_step);
+        draft.joint_schedule.push(JointRamp {
+            from_step: from,
+            to_step: from + 20,
+            degrees: 5.0,
+        });
+        mark(true, "add joint ramp");
+    }
+
+    let Some(field) = changed_field else {
+        return false;
+    };
+    let label = format!("{field} of {name}");
+    doc.edit(&label, |p| {
+        p.flower.templates[template] = draft;
+        p.settings.keyframes = keyframes;
+    })
+}

@@ -1,0 +1,323 @@
+//! The simulation as the window sees it: the engine's worker (or, in tests,
+//! keyframes fed in by hand), the keyframes of the current run and its
+//! status. Events of superseded runs are dropped by their run id.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anthesis_flower::Project;
+use anthesis_sim::worker::{Event, RunId, Worker};
+use anthesis_sim::{Keyframe, KeyframeStats, Selection};
+
+/// Where keyframes come from.
+enum Source {
+    /// The engine's simulation thread.
+    Worker(Worker),
+    /// Nothing runs; keyframes arrive through [`SimSession::accept`] (tests
+    /// and snapshot recordings). Run ids are counted here.
+    Recorded { next_run: RunId },
+}
+
+/// The state of the current run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunStatus {
+    /// No run asked for yet.
+    Idle,
+    /// Asked for, no `Started` event yet.
+    Queued,
+    Running,
+    Finished {
+        seconds: f64,
+    },
+    Failed {
+        message: String,
+    },
+}
+
+/// Keyframes and status of the newest run.
+pub struct SimSession {
+    source: Source,
+    run: RunId,
+    /// What the current run simulates: indices into the project's organs, in
+    /// keyframe order.
+    organs: Vec<usize>,
+    /// Keyframes the run will produce after the bud.
+    total: u32,
+    /// Keyframes received so far, contiguous from the bud (index 0).
+    keyframes: Vec<Arc<Keyframe>>,
+    status: RunStatus,
+    started_at: Option<Instant>,
+    /// Newton iteration inside the keyframe being computed.
+    iteration: Option<(u32, u32)>,
+}
+
+/// Longest time one frame spends taking events from the worker.
+pub const DRAIN_BUDGET: Duration = Duration::from_millis(4);
+
+impl SimSession {
+    /// A session over the engine's worker; `wake` is called from the worker
+    /// thread after each event (pass the UI's repaint request).
+    pub fn with_worker(wake: impl Fn() + Send + Sync + 'static) -> std::io::Result<SimSession> {
+        Ok(Self::new(Source::Worker(Worker::spawn(wake)?)))
+    }
+
+    /// A session without a worker: keyframes come only through
+    /// [`SimSession::accept`].
+    pub fn recorded() -> SimSession {
+        Self::new(Source::Recorded { next_run: 0 })
+    }
+
+    fn new(source: Source) -> SimSession {
+        SimSession {
+            source,
+            run: 0,
+            organs: Vec::new(),
+            total: 0,
+            keyframes: Vec::new(),
+            status: RunStatus::Idle,
+            started_at: None,
+            iteration: None,
+        }
+    }
+
+    /// Whether a worker computes the keyframes.
+    pub fn is_live(&self) -> bool {
+        matches!(self.source, Source::Worker(_))
+    }
+
+    /// Starts a new run of `project`, superseding (and cancelling) the
+    /// current one. The keyframes shown so far are kept until the new run's
+    /// bud arrives, so the view does not flash empty.
+    pub fn start(&mut self, project: Arc<Project>, selection: Selection) -> RunId {
+        self.organs = match &selection {
+            Selection::All => (0..project.flower.organs.len()).collect(),
+            Selection::Only(i) => vec![*i],
+        };
+        self.total = project.settings.keyframes;
+        self.run = match &mut self.source {
+            Source::Worker(worker) => worker.start(project, selection),
+            Source::Recorded { next_run } => {
+                *next_run += 1;
+                *next_run
+            }
+        };
+        self.status = RunStatus::Queued;
+        self.started_at = Some(Instant::now());
+        self.iteration = None;
+        self.run
+    }
+
+    /// Cancels the current run, if any; the keyframes so far stay.
+    pub fn cancel(&mut self) {
+        if let Source::Worker(worker) = &self.source {
+            worker.cancel();
+        }
+        if matches!(self.status, RunStatus::Queued | RunStatus::Running) {
+            self.status = RunStatus::Failed {
+                message: "stopped".to_string(),
+            };
+        }
+    }
+
+    /// Takes the worker's waiting events for at most `budget`. Returns the
+    /// messages of failed runs (for the log) and whether anything changed.
+    pub fn drain(&mut self, budget: Duration) -> Drained {
+        let mut drained = Drained::default();
+        let Source::Worker(worker) = &self.source else {
+            return drained;
+        };
+        let started = Instant::now();
+        let mut events = Vec::new();
+        while started.elapsed() < budget {
+            match worker.try_event() {
+                Some(event) => events.push(event),
+                None => break,
+            }
+        }
+        for event in events {
+            drained.changed |= self.accept(event, &mut drained.failures);
+        }
+        drained
+    }
+
+    /// Applies one event; events of other runs are ignored (returns false).
+    /// Failure messages are appended to `failures`.
+    pub fn accept(&mut self, event: Event, failures: &mut Vec<String>) -> bool {
+        if event.run() != self.run {
+            return false;
+        }
+        match event {
+            Event::Started { keyframes, .. } => {
+                self.total = keyframes;
+                self.status = RunStatus::Running;
+            }
+            Event::Keyframe { keyframe, .. } => {
+                if keyframe.index == 0 {
+                    self.keyframes.clear();
+                }
+                if keyframe.index as usize == self.keyframes.len() {
+                    self.keyframes.push(keyframe);
+                }
+                self.iteration = None;
+            }
+            Event::Progress { progress, .. } => {
+                self.iteration = Some((progress.keyframe, progress.iteration));
+            }
+            Event::Finished { seconds, .. } => {
+                self.status = RunStatus::Finished { seconds };
+                self.iteration = None;
+            }
+            Event::Failed { error, .. } => {
+                let message = error.to_string();
+                failures.push(message.clone());
+                self.status = RunStatus::Failed { message };
+                self.iteration = None;
+            }
+            Event::Cancelled { .. } => {
+                self.iteration = None;
+            }
+        }
+        true
+    }
+
+    /// The current run's id (events of other runs are ignored).
+    pub fn run(&self) -> RunId {
+        self.run
+    }
+
+    pub fn status(&self) -> &RunStatus {
+        &self.status
+    }
+
+    pub fn is_running(&self) -> bool {
+        matches!(self.status, RunStatus::Queued | RunStatus::Running)
+    }
+
+    /// Project organ indices of the keyframes' position lists.
+    pub fn organs(&self) -> &[usize] {
+        &self.organs
+    }
+
+    /// Keyframes the run produces after the bud.
+    pub fn total(&self) -> u32 {
+        self.total
+    }
+
+    /// Keyframes received, the bud first.
+    pub fn keyframes(&self) -> &[Arc<Keyframe>] {
+        &self.keyframes
+    }
+
+    /// Index of the newest keyframe received, if any.
+    pub fn last_index(&self) -> Option<u32> {
+        self.keyframes.last().map(|k| k.index)
+    }
+
+    /// Statistics of the computed keyframes after the bud.
+    pub fn stats(&self) -> impl Iterator<Item = &KeyframeStats> {
+        self.keyframes.iter().skip(1).map(|k| &k.stats)
+    }
+
+    /// `(keyframe, iteration)` being computed now.
+    pub fn iteration(&self) -> Option<(u32, u32)> {
+        self.iteration
+    }
+
+    /// Seconds since the run was asked for.
+    pub fn elapsed(&self) -> Option<Duration> {
+        self.started_at.map(|t| t.elapsed())
+    }
+
+    /// Estimated seconds left, from the mean time per keyframe so far.
+    pub fn seconds_left(&self) -> Option<f64> {
+        if !self.is_running() {
+            return None;
+        }
+        let done = self.last_index()?;
+        if done == 0 {
+            return None;
+        }
+        let elapsed: f64 = self.stats().map(|s| s.seconds).sum();
+        Some(elapsed / f64::from(done) * f64::from(self.total.saturating_sub(done)))
+    }
+
+    /// Positions of every simulated organ at `time` (in keyframes),
+    /// interpolated linearly between the two keyframes around it; times
+    /// past the newest keyframe show the newest. `None` before the bud.
+    pub fn positions_at(&self, time: f64) -> Option<Vec<Vec<glam::DVec3>>> {
+        let last = self.keyframes.len().checked_sub(1)?;
+        let time = time.clamp(0.0, last as f64);
+        let below = (time.floor() as usize).min(last);
+        let above = (below + 1).min(last);
+        let t = time - below as f64;
+        let (a, b) = (&self.keyframes[below], &self.keyframes[above]);
+        Some(
+            a.positions
+                .iter()
+                .zip(&b.positions)
+                .map(|(pa, pb)| pa.iter().zip(pb).map(|(p, q)| p.lerp(*q, t)).collect())
+                .collect(),
+        )
+    }
+}
+
+/// What [`SimSession::drain`] took.
+#[derive(Debug, Default)]
+pub struct Drained {
+    pub changed: bool,
+    pub failures: Vec<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn keyframe(index: u32, x: f64) -> Arc<Keyframe> {
+        Arc::new(Keyframe {
+            index,
+            positions: vec![vec![DVec3::new(x, 0.0, 0.0)]],
+            stats: KeyframeStats {
+                index,
+                energy: 1.0,
+                iterations: 2,
+                gradient_norm: 0.0,
+                seconds: 0.5,
+                pushed_particles: 0,
+            },
+        })
+    }
+
+    #[test]
+    fn interpolates_linearly_and_drops_superseded_runs() {
+        let project = Arc::new(anthesis_sim::fixtures::whorl(1, 4, 6, 4));
+        let mut session = SimSession::recorded();
+        let old = session.start(Arc::clone(&project), Selection::All);
+        let run = session.start(project, Selection::All);
+        let mut failures = Vec::new();
+        assert!(!session.accept(
+            Event::Keyframe {
+                run: old,
+                keyframe: keyframe(0, 99.0)
+            },
+            &mut failures
+        ));
+        for (i, x) in [(0, 0.0), (1, 2.0)] {
+            assert!(session.accept(
+                Event::Keyframe {
+                    run,
+                    keyframe: keyframe(i, x)
+                },
+                &mut failures
+            ));
+        }
+        let at = |t| session.positions_at(t).expect("frames")[0][0].x;
+        assert_eq!(at(0.25), 0.5);
+        assert_eq!(at(1.0), 2.0);
+        // Past the newest keyframe: the newest.
+        assert_eq!(at(3.5), 2.0);
+        assert_eq!(session.last_index(), Some(1));
+        // Half a second per keyframe, one done, three to go.
+        assert_eq!(session.seconds_left(), Some(1.5));
+    }
+}

@@ -1,0 +1,412 @@
+//! The opening timeline: playback state (a time in keyframes that plays,
+//! loops and is scrubbed) and its panel — scrubber with computed and
+//! pending keyframes, transport buttons, progress, and a small plot of
+//! energy and iterations per keyframe.
+
+use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, StrokeKind, Vec2};
+
+use super::session::{RunStatus, SimSession};
+
+/// Keyframes per second at speed 1 (the glTF export's default frame rate).
+pub const BASE_KEYFRAMES_PER_SECOND: f64 = 24.0;
+
+/// Speeds offered in the speed menu.
+pub const SPEEDS: [f64; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
+
+/// Playback state. `time` is in keyframes (0 = the bud, fractional times
+/// are interpolated).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Playback {
+    pub time: f64,
+    pub playing: bool,
+    pub looping: bool,
+    pub speed: f64,
+    /// Show the newest keyframe as it arrives (on until the user scrubs,
+    /// steps or plays).
+    pub follow: bool,
+}
+
+impl Default for Playback {
+    fn default() -> Self {
+        Playback {
+            time: 0.0,
+            playing: false,
+            looping: true,
+            speed: 1.0,
+            follow: true,
+        }
+    }
+}
+
+impl Playback {
+    /// Advances by `seconds` of wall time. `computed` is the newest
+    /// keyframe available and `total` the last keyframe of the run.
+    /// Playing stops at the newest computed keyframe and waits there;
+    /// with loop on, a finished run starts again from the bud.
+    pub fn advance(&mut self, seconds: f64, computed: Option<u32>, total: u32) {
+        let Some(computed) = computed else {
+            self.time = 0.0;
+            return;
+        };
+        let end = f64::from(computed);
+        if self.follow {
+            self.time = end;
+            return;
+        }
+        if self.playing {
+            self.time += seconds * self.speed * BASE_KEYFRAMES_PER_SECOND;
+            if self.time >= end {
+                if self.looping && computed >= total && total > 0 {
+                    self.time %= end.max(1.0);
+                } else {
+                    self.time = end;
+                    if computed >= total {
+                        self.playing = false;
+                    }
+                }
+            }
+        }
+        self.time = self.time.clamp(0.0, end);
+    }
+
+    pub fn toggle_play(&mut self, computed: Option<u32>) {
+        self.follow = false;
+        self.playing = !self.playing;
+        // Play from the start when at the end.
+        if self.playing && computed.is_some_and(|c| self.time >= f64::from(c)) {
+            self.time = 0.0;
+        }
+    }
+
+    /// Moves to the previous (`-1`) or next (`+1`) whole keyframe.
+    pub fn step(&mut self, direction: i32, computed: Option<u32>) {
+        self.follow = false;
+        self.playing = false;
+        let end = f64::from(computed.unwrap_or(0));
+        let next = if direction < 0 {
+            (self.time - 1e-9).ceil() - 1.0
+        } else {
+            (self.time + 1e-9).floor() + 1.0
+        };
+        self.time = next.clamp(0.0, end);
+    }
+
+    pub fn go_to_start(&mut self) {
+        self.follow = false;
+        self.time = 0.0;
+    }
+
+    /// To the newest keyframe, and follow new ones.
+    pub fn go_to_end(&mut self, computed: Option<u32>) {
+        self.playing = false;
+        self.follow = true;
+        self.time = f64::from(computed.unwrap_or(0));
+    }
+
+    /// Jumps to `time` (clamped to the computed keyframes).
+    pub fn scrub_to(&mut self, time: f64, computed: Option<u32>) {
+        self.follow = false;
+        self.playing = false;
+        self.time = time.clamp(0.0, f64::from(computed.unwrap_or(0)));
+    }
+}
+
+/// Human-readable seconds: `42 s`, `3 min 5 s`.
+pub fn format_seconds(seconds: f64) -> String {
+    if seconds < 60.0 {
+        format!("{seconds:.0} s")
+    } else {
+        format!("{} min {:.0} s", (seconds / 60.0).floor(), seconds % 60.0)
+    }
+}
+
+/// One line on the state of the run.
+pub fn status_line(session: &SimSession) -> String {
+    let done = session.last_index().unwrap_or(0);
+    let total = session.total();
+    match session.status() {
+        RunStatus::Idle => "not simulated".to_string(),
+        RunStatus::Queued => "starting…".to_string(),
+        RunStatus::Running => {
+            let mut line = format!("simulating keyframe {}/{total}", (done + 1).min(total));
+            if let Some(elapsed) = session.elapsed() {
+                line += &format!(" · {} elapsed", format_seconds(elapsed.as_secs_f64()));
+            }
+            if let Some(left) = session.seconds_left() {
+                line += &format!(" · about {} left", format_seconds(left));
+            }
+            line
+        }
+        RunStatus::Finished { seconds } => {
+            format!("{total} keyframes in {}", format_seconds(*seconds))
+        }
+        RunStatus::Failed { message } => format!("stopped at keyframe {done}: {message}"),
+    }
+}
+
+/// What the user asked the timeline for this frame.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct TimelineRequests {
+    pub stop: bool,
+    pub resimulate: bool,
+}
+
+/// The timeline panel.
+pub fn timeline_ui(
+    ui: &mut egui::Ui,
+    playback: &mut Playback,
+    session: &SimSession,
+) -> TimelineRequests {
+    let mut requests = TimelineRequests::default();
+    let computed = session.last_index();
+    let total = session.total().max(1);
+    ui.horizontal(|ui| {
+        if ui
+            .button("Start")
+            .on_hover_text("First keyframe (Home)")
+            .clicked()
+        {
+            playback.go_to_start();
+        }
+        if ui
+            .button("Prev")
+            .on_hover_text("Previous keyframe (←)")
+            .clicked()
+        {
+            playback.step(-1, computed);
+        }
+        let play_label = if playback.playing { "Pause" } else { "Play" };
+        if ui
+            .button(play_label)
+            .on_hover_text("Play or pause (Space)")
+            .clicked()
+        {
+            playback.toggle_play(computed);
+        }
+        if ui
+            .button("Next")
+            .on_hover_text("Next keyframe (→)")
+            .clicked()
+        {
+            playback.step(1, computed);
+        }
+        if ui
+            .button("End")
+            .on_hover_text("Newest keyframe, and follow new ones (End)")
+            .clicked()
+        {
+            playback.go_to_end(computed);
+        }
+        ui.toggle_value(&mut playback.looping, "Loop")
+            .on_hover_text("Start again from the bud at the end");
+        egui::ComboBox::new("speed", "speed")
+            .width(70.0)
+            .selected_text(format!("{}×", playback.speed))
+            .show_ui(ui, |ui| {
+                for speed in SPEEDS {
+                    ui.selectable_value(&mut playback.speed, speed, format!("{speed}×"));
+                }
+            })
+            .response
+            .on_hover_text(format!(
+                "Playback speed; 1× plays {BASE_KEYFRAMES_PER_SECOND} keyframes per second"
+            ));
+        ui.separator();
+        ui.label(format!(
+            "keyframe {:.1} / {}",
+            playback.time,
+            session.total()
+        ));
+        ui.separator();
+        ui.label(status_line(session));
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+            if session.is_running() {
+                if ui
+                    .button("Stop")
+                    .on_hover_text("Stop simulating; the keyframes so far stay")
+                    .clicked()
+                {
+                    requests.stop = true;
+                }
+            } else if ui
+                .button("Simulate")
+                .on_hover_text("Simulate again from the bud")
+                .clicked()
+            {
+                requests.resimulate = true;
+            }
+        });
+    });
+    scrubber(ui, playback, computed, total);
+    stats_plot(ui, session, playback.time);
+    requests
+}
+
+/// The scrubber: one cell per keyframe, filled where computed; the
+/// playhead; click or drag to scrub.
+fn scrubber(ui: &mut egui::Ui, playback: &mut Playback, computed: Option<u32>, total: u32) {
+    let size = Vec2::new(ui.available_width(), 22.0);
+    let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "Timeline"));
+    let response = response.on_hover_text(
+        "Timeline: filled cells are computed keyframes, hollow ones pending. Click or drag to scrub.",
+    );
+    let x_of = |time: f64| rect.left() + (time / f64::from(total)) as f32 * rect.width();
+    if (response.dragged() || response.clicked())
+        && let Some(pointer) = response.interact_pointer_pos()
+    {
+        let time = f64::from((pointer.x - rect.left()) / rect.width()) * f64::from(total);
+        playback.scrub_to(time, computed);
+    }
+    let painter = ui.painter_at(rect);
+    let visuals = ui.visuals();
+    painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
+    let done = computed.map_or(0.0, f64::from);
+    let computed_rect = Rect::from_min_max(rect.min, Pos2::new(x_of(done), rect.bottom()));
+    painter.rect_filled(computed_rect, 3.0, Color32::from_rgb(90, 140, 90));
+    // Keyframe ticks: every keyframe when they are far enough apart,
+    // otherwise every 10th.
+    let every = if rect.width() / total as f32 > 4.0 {
+        1
+    } else {
+        10
+    };
+    for k in (0..=total).step_by(every) {
+        let x = x_of(f64::from(k));
+        let tall = k % 10 == 0;
+        let top = if tall { rect.top() } else { rect.center().y };
+        painter.line_segment(
+            [Pos2::new(x, top), Pos2::new(x, rect.bottom())],
+            Stroke::new(1.0, visuals.weak_text_color().gamma_multiply(0.6)),
+        );
+    }
+    painter.rect_stroke(
+        rect,
+        3.0,
+        Stroke::new(1.0, visuals.widgets.noninteractive.bg_stroke.color),
+        StrokeKind::Inside,
+    );
+    let x = x_of(playback.time);
+    painter.line_segment(
+        [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
+        Stroke::new(2.5, Color32::from_rgb(230, 120, 40)),
+    );
+}
+
+/// Energy (line) and Newton iterations (bars) per keyframe.
+fn stats_plot(ui: &mut egui::Ui, session: &SimSession, time: f64) {
+    let total = session.total().max(1);
+    let size = Vec2::new(ui.available_width(), 48.0);
+    let (rect, response) = ui.allocate_exact_size(size, Sense::hover());
+    response.widget_info(|| {
+        egui::WidgetInfo::labeled(
+            egui::Role::Image,
+            true,
+            "Energy and iterations per keyframe",
+        )
+    });
+    let painter = ui.painter_at(rect);
+    let visuals = ui.visuals();
+    painter.rect_filled(rect, 2.0, visuals.faint_bg_color);
+    let stats: Vec<_> = session.stats().copied().collect();
+    let x_of = |k: u32| rect.left() + k as f32 / total as f32 * rect.width();
+    let max_iterations = stats.iter().map(|s| s.iterations).max().unwrap_or(1).max(1);
+    let bar_width = (rect.width() / total as f32 * 0.6).max(1.0);
+    for s in &stats {
+        let h = s.iterations as f32 / max_iterations as f32 * (rect.height() - 4.0);
+        let x = x_of(s.index);
+        painter.rect_filled(
+            Rect::from_min_max(
+                Pos2::new(x - bar_width, rect.bottom() - h),
+                Pos2::new(x, rect.bottom()),
+            ),
+            0.0,
+            Color32::from_rgb(110, 130, 190).gamma_multiply(0.6),
+        );
+    }
+    let max_energy = stats.iter().map(|s| s.energy).fold(0.0_f64, f64::max);
+    if max_energy > 0.0 {
+        let points: Vec<Pos2> = stats
+            .iter()
+            .map(|s| {
+                let y =
+                    rect.bottom() - 2.0 - (s.energy / max_energy) as f32 * (rect.height() - 6.0);
+                Pos2::new(x_of(s.index), y)
+            })
+            .collect();
+        painter.line(points, Stroke::new(1.5, Color32::from_rgb(220, 90, 60)));
+    }
+    let x = rect.left() + (time / f64::from(total)) as f32 * rect.width();
+    painter.line_segment(
+        [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
+        Stroke::new(1.0, Color32::from_rgb(230, 120, 40)),
+    );
+    painter.text(
+        rect.left_top() + Vec2::new(4.0, 2.0),
+        egui::Align2::LEFT_TOP,
+        format!(
+            "energy (line, max {max_energy:.3e}) · Newton iterations (bars, max {max_iterations})"
+        ),
+        egui::FontId::proportional(10.0),
+        visuals.weak_text_color(),
+    );
+    let hovered = stats
+        .iter()
+        .min_by_key(|s| {
+            response
+                .hover_pos()
+                .map_or(u32::MAX, |p| (p.x - x_of(s.index)).abs() as u32)
+        })
+        .filter(|_| response.hovered());
+    if let Some(s) = hovered {
+        response.on_hover_text(format!(
+            "keyframe {}: energy {:.4e}, {} iterations, {:.2} s",
+            s.index, s.energy, s.iterations, s.seconds
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn playing_waits_at_the_newest_keyframe_and_loops_only_a_finished_run() {
+        let mut p = Playback {
+            follow: false,
+            playing: true,
+            ..Playback::default()
+        };
+        // One second at 1x is 24 keyframes; only 10 are computed of 100.
+        p.advance(1.0, Some(10), 100);
+        assert_eq!(p.time, 10.0);
+        assert!(p.playing, "waits for more keyframes");
+        p.time = 95.0;
+        p.advance(0.5, Some(100), 100);
+        assert!((p.time - 7.0).abs() < 1e-9, "looped to {}", p.time);
+        p.looping = false;
+        p.time = 95.0;
+        p.advance(0.5, Some(100), 100);
+        assert_eq!(p.time, 100.0);
+        assert!(!p.playing);
+    }
+
+    #[test]
+    fn stepping_lands_on_whole_keyframes_and_follow_tracks_the_newest() {
+        let mut p = Playback::default();
+        p.advance(0.1, Some(7), 100);
+        assert_eq!(p.time, 7.0, "follows new keyframes");
+        p.scrub_to(3.4, Some(7));
+        p.step(1, Some(7));
+        assert_eq!(p.time, 4.0);
+        p.step(-1, Some(7));
+        assert_eq!(p.time, 3.0);
+        p.step(-1, Some(7));
+        assert_eq!(p.time, 2.0);
+        p.advance(0.1, Some(8), 100);
+        assert_eq!(p.time, 2.0, "scrubbing stops following");
+        p.go_to_end(Some(8));
+        p.advance(0.1, Some(9), 100);
+        assert_eq!(p.time, 9.0);
+    }
+}

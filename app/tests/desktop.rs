@@ -1,0 +1,484 @@
+//! The whole desktop app in egui_kittest with the wgpu renderer (software
+//! Vulkan is enough): clicking through the panels, keyboard shortcuts,
+//! undo/redo, the unsaved-changes prompt, export, errors, and image
+//! snapshots. Keyframes are RECORDED (a fixed, analytic opening fed to the
+//! app as worker events), not computed by the live solver, so snapshots do
+//! not move when the physics changes.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use anthesis_app::desktop::{AnthesisApp, Pending, Startup};
+use anthesis_flower::{Project, joint_angle_after};
+use anthesis_sim::worker::Event;
+use anthesis_sim::{Keyframe, KeyframeStats, Selection};
+use eframe::egui;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+
+/// A small flower (six organs, coarse meshes) with 20 keyframes.
+fn small_flower() -> Project {
+    let mut project = anthesis_sim::fixtures::whorl(6, 8, 14, 20);
+    project.name = "Recorded test flower".to_string();
+    project
+}
+
+/// A recorded opening: keyframe `k` tilts every simulated organ by the
+/// template's joint schedule plus 2° per keyframe and curls it outwards a
+/// little with height, with made-up statistics.
+fn recorded_keyframes(project: &Project, selection: &Selection) -> Vec<Keyframe> {
+    let organs: Vec<usize> = match selection {
+        Selection::All => (0..project.flower.organs.len()).collect(),
+        Selection::Only(i) => vec![*i],
+    };
+    (0..=project.settings.keyframes)
+        .map(|k| {
+            let positions = organs
+                .iter()
+                .map(|&i| {
+                    let organ = &project.flower.organs[i];
+                    let template = project.flower.template_of(i);
+                    let extra = joint_angle_after(&template.joint_schedule, k)
+                        + f64::from(k) * 2f64.to_radians();
+                    template
+                        .mesh
+                        .positions
+                        .iter()
+                        .map(|p| {
+                            let curl = 0.004 * f64::from(k) * p.y * p.y;
+                            let bent = glam::DVec3::new(p.x, p.y, p.z + curl);
+                            organ.placement.world_from_template(bent, extra)
+                        })
+                        .collect()
+                })
+                .collect();
+            Keyframe {
+                index: k,
+                positions,
+                stats: KeyframeStats {
+                    index: k,
+                    energy: f64::from(k * k) * 0.01,
+                    iterations: 2 + k % 3,
+                    gradient_norm: 1e-7,
+                    seconds: 0.05,
+                    pushed_particles: 0,
+                },
+            }
+        })
+        .collect()
+}
+
+fn harness(project: Project) -> Harness<'static, AnthesisApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .wgpu()
+        .build_eframe(move |cc| {
+            AnthesisApp::new(
+                cc,
+                Startup {
+                    project: Some((project, None)),
+                    live: false,
+                    restore: false,
+                },
+            )
+        })
+}
+
+/// Feeds the current run `up_to` keyframes (all when `None`) and, when
+/// all, its end.
+fn feed(harness: &mut Harness<'_, AnthesisApp>, up_to: Option<u32>) {
+    let app = harness.state_mut();
+    let project = app.project().clone();
+    let selection = app.selection();
+    let run = app.session().run();
+    let keyframes = recorded_keyframes(&project, &selection);
+    let total = project.settings.keyframes;
+    let last = up_to.unwrap_or(total);
+    let mut failures = Vec::new();
+    let session = app.session_mut();
+    session.accept(
+        Event::Started {
+            run,
+            organs: Vec::new(),
+            keyframes: total,
+        },
+        &mut failures,
+    );
+    for keyframe in keyframes.into_iter().take(last as usize + 1) {
+        session.accept(
+            Event::Keyframe {
+                run,
+                keyframe: Arc::new(keyframe),
+            },
+            &mut failures,
+        );
+    }
+    if last == total {
+        session.accept(
+            Event::Finished {
+                run,
+                keyframes: total,
+                seconds: 1.0,
+            },
+            &mut failures,
+        );
+    }
+    assert!(failures.is_empty());
+}
+
+#[test]
+fn first_frame_shows_the_flower_opening_and_the_timeline() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    assert_eq!(harness.state().session().run(), 1, "a run starts at launch");
+    feed(&mut harness, Some(8));
+    harness.run();
+    assert_eq!(
+        harness.state().playback().time,
+        8.0,
+        "follows new keyframes"
+    );
+    harness.get_by_label_contains("simulating keyframe 9/20");
+    harness.snapshot("app_simulating");
+
+    feed(&mut harness, None);
+    harness.run();
+    harness.get_by_label("20 keyframes in 1 s");
+    assert_eq!(harness.state().playback().time, 20.0);
+    harness.snapshot("app_open_flower");
+}
+
+#[test]
+fn timeline_buttons_and_shortcuts_scrub_step_and_play() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+
+    harness.get_by_label("Start").click();
+    harness.run();
+    assert_eq!(harness.state().playback().time, 0.0);
+    harness.get_by_label("Next").click();
+    harness.run();
+    assert_eq!(harness.state().playback().time, 1.0);
+
+    harness.key_press(egui::Key::ArrowRight);
+    harness.key_press(egui::Key::ArrowRight);
+    harness.run();
+    assert_eq!(harness.state().playback().time, 3.0);
+    harness.key_press(egui::Key::ArrowLeft);
+    harness.run();
+    assert_eq!(harness.state().playback().time, 2.0);
+    harness.key_press(egui::Key::End);
+    harness.run();
+    assert_eq!(harness.state().playback().time, 20.0);
+    harness.key_press(egui::Key::Home);
+    harness.run();
+    assert_eq!(harness.state().playback().time, 0.0);
+
+    // Space plays: a few frames later the time has moved on.
+    harness.key_press(egui::Key::Space);
+    harness.step();
+    harness.step();
+    harness.step();
+    assert!(harness.state().playback().playing);
+    assert!(harness.state().playback().time > 0.0);
+    harness.key_press(egui::Key::Space);
+    harness.step();
+    assert!(!harness.state().playback().playing);
+
+    // A scrub half-way along the timeline, between keyframes, is shown
+    // interpolated.
+    let timeline = harness.get_by_label("Timeline").rect();
+    harness.state_mut().playback_mut().scrub_to(9.5, Some(20));
+    harness.run();
+    assert_eq!(harness.state().playback().time, 9.5);
+    harness.snapshot("app_scrubbed_between_keyframes");
+    assert!(timeline.width() > 500.0);
+}
+
+#[test]
+fn parameter_edits_restart_the_run_and_undo_redo_with_shortcuts() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    let first_run = harness.state().session().run();
+    let ramps = harness.state().project().flower.templates[0]
+        .joint_schedule
+        .len();
+
+    harness.get_by_label("Add ramp").click();
+    harness.run();
+    let app = harness.state();
+    assert_eq!(
+        app.project().flower.templates[0].joint_schedule.len(),
+        ramps + 1
+    );
+    assert!(app.document().is_dirty());
+    assert!(app.session().run() > first_run, "the edit restarts the run");
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().project().flower.templates[0]
+            .joint_schedule
+            .len(),
+        ramps
+    );
+    assert!(!harness.state().document().is_dirty());
+    harness.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
+    harness.run();
+    assert_eq!(
+        harness.state().project().flower.templates[0]
+            .joint_schedule
+            .len(),
+        ramps + 1
+    );
+}
+
+#[test]
+fn selecting_an_organ_and_single_organ_preview_simulate_only_that_organ() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.get_by_label("sepal-2").click();
+    harness.run();
+    assert_eq!(harness.state().selected_organ(), 3);
+    let before = harness.state().session().run();
+    harness.get_by_label("Single-organ preview  (P)").click();
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.selection(), Selection::Only(3));
+    assert!(app.session().run() > before);
+    assert_eq!(app.session().organs(), &[3]);
+    feed(&mut harness, None);
+    harness.run();
+    harness.snapshot("app_single_organ_preview");
+    // P leaves the preview: the whole flower again.
+    harness.key_press(egui::Key::P);
+    harness.run();
+    assert_eq!(harness.state().selection(), Selection::All);
+}
+
+#[test]
+fn view_menu_turns_on_the_wireframe_and_a_map_overlay() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    harness.get_by_label("View").click();
+    harness.run();
+    harness.get_by_label("Wireframe  (W)").click();
+    harness.run();
+    harness.get_by_label("View").click();
+    harness.run();
+    harness.get_by_label("Map overlay").hover();
+    harness.run();
+    harness.get_by_label("e-growth-in").click();
+    harness.run();
+    harness.key_press(egui::Key::Escape);
+    harness.run();
+    harness.snapshot("app_wireframe_overlay");
+}
+
+#[test]
+fn new_with_unsaved_changes_asks_first_and_dont_save_discards() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.get_by_label("Add ramp").click();
+    harness.run();
+    assert!(harness.state().document().is_dirty());
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label("New").click();
+    harness.run();
+    assert_eq!(harness.state().pending(), Some(&Pending::New));
+    harness.get_by_label("Unsaved changes");
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert_eq!(harness.state().pending(), None);
+    assert!(
+        harness.state().document().is_dirty(),
+        "cancel keeps the work"
+    );
+
+    harness.state_mut().request(Pending::New);
+    harness.run();
+    harness.get_by_label("Don't save").click();
+    harness.run();
+    let app = harness.state();
+    assert!(!app.document().is_dirty());
+    assert_eq!(app.project(), &anthesis_app::desktop::default_project());
+}
+
+#[test]
+fn save_then_open_round_trips_and_a_bad_file_is_an_error_that_keeps_the_work() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("flower.anthesis.toml");
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.get_by_label("Add ramp").click();
+    harness.run();
+    assert!(harness.state_mut().save_to(&path));
+    harness.run();
+    assert!(!harness.state().document().is_dirty());
+    let saved = harness.state().project().clone();
+
+    let bad = dir.path().join("bad.anthesis.toml");
+    std::fs::write(&bad, "format = \"anthesis-project\"\nversion = 99\n").expect("write");
+    harness.state_mut().open_path(&bad);
+    harness.run();
+    assert_eq!(harness.state().project(), &saved, "the work stays");
+    let banner = harness.state().log().banner().expect("an error is shown");
+    assert!(banner.contains("newer Anthesis"), "{banner}");
+    harness.get_by_label("Dismiss").click();
+    harness.run();
+    assert!(harness.state().log().banner().is_none());
+
+    harness.state_mut().open_path(&path);
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.project().flower.templates[0].joint_schedule.len(), 2);
+    assert_eq!(app.document().path.as_deref(), Some(path.as_path()));
+}
+
+#[test]
+fn a_failed_run_is_shown_and_the_app_keeps_going() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    let run = harness.state().session().run();
+    let mut failures = Vec::new();
+    harness.state_mut().session_mut().accept(
+        Event::Failed {
+            run,
+            error: anthesis_sim::SimError::NoSuchOrgan(9),
+        },
+        &mut failures,
+    );
+    assert_eq!(failures.len(), 1);
+    harness.run();
+    harness.get_by_label_contains("stopped at keyframe 0");
+    harness.get_by_label("Simulate").click();
+    harness.run();
+    assert!(harness.state().session().run() > run);
+}
+
+#[test]
+fn the_export_dialog_writes_a_glb_and_reports_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("flower.glb");
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label("Export glTF…  (Ctrl+E)").click();
+    harness.run();
+    harness.get_by_label("Export to").click();
+    harness.run();
+    harness
+        .get_by_label("Export to")
+        .type_text(&out.display().to_string());
+    harness.run();
+    harness.get_by_label("quantized").click();
+    harness.run();
+    harness.get_by_label("Export").click();
+    let started = Instant::now();
+    while !out.exists() || harness.query_by_label_contains("Wrote ").is_none() {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "export hangs; state {:?}, path {:?}, log: {:?}",
+            harness.state().export_dialog().state(),
+            harness.state().export_dialog().path,
+            harness.state().log().entries()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        harness.step();
+    }
+    let bytes = std::fs::read(&out).expect("exported file");
+    assert_eq!(&bytes[..4], b"glTF");
+    let json_length = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
+    let json = std::str::from_utf8(&bytes[20..20 + json_length]).expect("JSON chunk");
+    assert!(
+        json.contains("KHR_mesh_quantization"),
+        "the option was used"
+    );
+}
+
+/// Drags across the UV canvas from `from` to `to` (fractions of its size).
+fn stroke_on_canvas(harness: &mut Harness<'_, AnthesisApp>, from: egui::Vec2, to: egui::Vec2) {
+    let canvas = harness.get_by_label("UV paint canvas").rect();
+    let at = |f: egui::Vec2| canvas.min + f * canvas.size();
+    harness.hover_at(at(from));
+    harness.run();
+    harness.drag_at(at(from));
+    harness.run();
+    for i in 1..=8 {
+        let t = i as f32 / 8.0;
+        harness.hover_at(at(from + (to - from) * t));
+        harness.run();
+    }
+    harness.drop_at(at(to));
+    harness.run();
+}
+
+#[test]
+fn a_stroke_on_the_uv_canvas_paints_the_map_restarts_and_undoes_in_one_step() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    let before = harness.state().project().clone();
+    let run = harness.state().session().run();
+    harness.get_by_label("subtract").click();
+    harness.run();
+    stroke_on_canvas(&mut harness, egui::vec2(0.3, 0.3), egui::vec2(0.4, 0.6));
+    let app = harness.state();
+    assert_ne!(app.project(), &before, "the stroke painted");
+    assert!(app.session().run() > run, "the stroke restarted the run");
+    // Mirrored: both sides of the midrib changed alike.
+    let map = &app.project().flower.templates[0].maps.keys()[0]
+        .maps
+        .e_growth_in;
+    let left = map.sample(glam::DVec2::new(0.35, 0.55));
+    let right = map.sample(glam::DVec2::new(0.65, 0.55));
+    let was = before.flower.templates[0].maps.keys()[0]
+        .maps
+        .e_growth_in
+        .sample(glam::DVec2::new(0.35, 0.55));
+    assert!(left < was, "subtracted: {left} < {was}");
+    assert!((left - right).abs() < 1e-6, "mirrored: {left} vs {right}");
+    feed(&mut harness, None);
+    harness.run();
+    harness.snapshot("app_after_stroke");
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().project(), &before, "one stroke, one undo");
+}
+
+#[test]
+fn dragging_on_the_direction_map_paints_the_stroke_direction() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.state_mut().paint_mut().target = anthesis_app::desktop::brush::PaintTarget::Direction;
+    harness.run();
+    stroke_on_canvas(&mut harness, egui::vec2(0.2, 0.5), egui::vec2(0.4, 0.5));
+    let keys = harness.state().project().flower.templates[0].maps.keys();
+    let d = keys[0].maps.direction.sample(glam::DVec2::new(0.3, 0.5));
+    assert!(d.x > 0.2, "painted along +u: {d}");
+    let mirrored = keys[0].maps.direction.sample(glam::DVec2::new(0.7, 0.5));
+    assert!(mirrored.x < -0.2, "mirrored to -u: {mirrored}");
+    harness.snapshot("app_direction_painting");
+}
+
+#[test]
+fn the_default_project_is_the_built_in_lily() {
+    let lily = anthesis_app::desktop::default_project();
+    assert!(lily.name.to_lowercase().contains("lily"), "{}", lily.name);
+    assert!(lily.flower.organs.len() >= 6);
+}
