@@ -103,6 +103,10 @@ pub struct AnthesisApp {
     camera: OrbitCamera,
     /// The camera has been framed on the flower once.
     framed: bool,
+    /// The camera as the first framing left it, until the run finishes:
+    /// if the user has not moved it by then, it is framed on the open
+    /// flower.
+    auto_camera: Option<OrbitCamera>,
     view: ViewOptions,
     settings: Settings,
     /// Index into the project's organs.
@@ -183,6 +187,7 @@ impl AnthesisApp {
             playback,
             camera: settings.camera.unwrap_or_default(),
             framed: settings.camera.is_some(),
+            auto_camera: None,
             view: settings.view,
             single_organ_preview: settings.single_organ_preview,
             settings,
@@ -769,6 +774,27 @@ impl AnthesisApp {
             let room = glam::DVec3::new(half.y.max(half.x), half.y, half.y.max(half.z)) * 1.3;
             self.camera.frame((centre - room, centre + room));
             self.framed = true;
+            self.auto_camera = Some(self.camera);
+        }
+        if let Some(auto) = self.auto_camera
+            && matches!(self.session.status(), session::RunStatus::Finished { .. })
+        {
+            if auto == self.camera {
+                let last = f64::from(self.session.last_index().unwrap_or(0));
+                let open =
+                    viewport::build_scene(self.doc.project(), &self.session, last, show_others);
+                let bounds = [
+                    viewport::scene_bounds(&scene),
+                    viewport::scene_bounds(&open),
+                ]
+                .into_iter()
+                .flatten()
+                .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+                if let Some(bounds) = bounds {
+                    self.camera.frame(bounds);
+                }
+            }
+            self.auto_camera = None;
         }
         let overlay = self.view.overlay.map(|kind| (kind, self.paint.key));
         let meshes = Arc::new(viewport::scene_meshes(

@@ -296,7 +296,7 @@ fn scrubber(ui: &mut egui::Ui, playback: &mut Playback, computed: Option<u32>, t
 /// Energy (line) and Newton iterations (bars) per keyframe.
 fn stats_plot(ui: &mut egui::Ui, session: &SimSession, time: f64) {
     let total = session.total().max(1);
-    let size = Vec2::new(ui.available_width(), 48.0);
+    let size = Vec2::new(ui.available_width(), 56.0);
     let (rect, response) = ui.allocate_exact_size(size, Sense::hover());
     response.widget_info(|| {
         egui::WidgetInfo::labeled(
@@ -313,7 +313,8 @@ fn stats_plot(ui: &mut egui::Ui, session: &SimSession, time: f64) {
     let max_iterations = stats.iter().map(|s| s.iterations).max().unwrap_or(1).max(1);
     let bar_width = (rect.width() / total as f32 * 0.6).max(1.0);
     for s in &stats {
-        let h = s.iterations as f32 / max_iterations as f32 * (rect.height() - 4.0);
+        // The top 14 points hold the caption.
+        let h = s.iterations as f32 / max_iterations as f32 * (rect.height() - 16.0);
         let x = x_of(s.index);
         painter.rect_filled(
             Rect::from_min_max(
@@ -330,7 +331,7 @@ fn stats_plot(ui: &mut egui::Ui, session: &SimSession, time: f64) {
             .iter()
             .map(|s| {
                 let y =
-                    rect.bottom() - 2.0 - (s.energy / max_energy) as f32 * (rect.height() - 6.0);
+                    rect.bottom() - 2.0 - (s.energy / max_energy) as f32 * (rect.height() - 18.0);
                 Pos2::new(x_of(s.index), y)
             })
             .collect();

@@ -128,7 +128,6 @@ pub struct ViewOptions {
     pub show_others: bool,
 }
 
-
 /// The organs at keyframe time `time`: simulated organs from the run,
 /// the others (when `show_others`) in their bud placement. An organ whose
 /// keyframes no longer fit its template (the mesh was replaced) is shown as
