@@ -482,3 +482,89 @@ fn the_default_project_is_the_built_in_lily() {
     assert!(lily.name.to_lowercase().contains("lily"), "{}", lily.name);
     assert!(lily.flower.organs.len() >= 6);
 }
+
+/// A file as the window system hands it over.
+#[derive(Debug)]
+struct DroppedOnDisk(std::path::PathBuf);
+
+impl egui::DroppedFile for DroppedOnDisk {
+    fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+fn drop(harness: &mut Harness<'_, AnthesisApp>, path: &std::path::Path) {
+    harness
+        .input_mut()
+        .dropped_files
+        .push(Arc::new(DroppedOnDisk(path.to_path_buf())));
+    harness.run();
+}
+
+#[test]
+fn dropped_maps_meshes_and_projects_are_used_or_refused_with_a_message() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut harness = harness(small_flower());
+    harness.run();
+    let run = harness.state().session().run();
+
+    // A PNG of the template's map size replaces the map being painted.
+    let png = dir.path().join("ramp.png");
+    anthesis_maps::ScalarMap::from_fn(32, 32, |uv| uv.y as f32)
+        .save_png(&png, anthesis_maps::BitDepth::Sixteen)
+        .expect("write png");
+    drop(&mut harness, &png);
+    let app = harness.state();
+    let map = &app.project().flower.templates[0].maps.keys()[0]
+        .maps
+        .e_growth_in;
+    assert!((map.sample(glam::DVec2::new(0.5, 0.9)) - 0.9).abs() < 1e-3);
+    assert!(app.session().run() > run, "a new map restarts the run");
+    assert_eq!(
+        app.document().undo_label(),
+        Some("e-growth-in map of petal")
+    );
+
+    // The wrong size is refused, the map stays.
+    let before = harness.state().project().clone();
+    let small = dir.path().join("small.png");
+    anthesis_maps::ScalarMap::from_fn(8, 8, |_| 0.5)
+        .save_png(&small, anthesis_maps::BitDepth::Eight)
+        .expect("write png");
+    drop(&mut harness, &small);
+    assert_eq!(harness.state().project(), &before);
+    let banner = harness.state().log().banner().expect("error shown");
+    assert!(
+        banner.contains("8x8") && banner.contains("32x32"),
+        "{banner}"
+    );
+
+    // A mesh without UVs is refused.
+    let obj = dir.path().join("flat.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("write obj");
+    drop(&mut harness, &obj);
+    assert_eq!(harness.state().project(), &before);
+    assert!(
+        harness
+            .state()
+            .log()
+            .banner()
+            .is_some_and(|b| b.contains("flat.obj")),
+        "{:?}",
+        harness.state().log().banner()
+    );
+
+    // A project opens (after the prompt, since the map drop was an edit).
+    let project_path = dir.path().join("other.anthesis.toml");
+    let mut other = small_flower();
+    other.name = "Dropped flower".to_string();
+    anthesis_flower::project::save_project(&other, &project_path).expect("save");
+    drop(&mut harness, &project_path);
+    harness.get_by_label("Don't save").click();
+    harness.run();
+    assert_eq!(harness.state().project().name, "Dropped flower");
+}

@@ -392,6 +392,93 @@ impl AnthesisApp {
         }
     }
 
+    /// A file dropped on the window: a project (`.toml`) opens after the
+    /// unsaved-changes prompt, an OBJ mesh replaces the selected organ's
+    /// template mesh, a PNG replaces the map being painted. Anything that
+    /// cannot be used is reported and changes nothing.
+    pub fn drop_file(&mut self, path: &Path) {
+        let extension = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_lowercase())
+            .unwrap_or_default();
+        match extension.as_str() {
+            "toml" => self.request(Pending::Open(Some(path.to_path_buf()))),
+            "obj" => self.replace_mesh(path),
+            "png" => self.load_map(path),
+            _ => self.log.warn(format!(
+                "cannot use {}: drop a project (.toml), a mesh (.obj) or a map (.png)",
+                path.display()
+            )),
+        }
+    }
+
+    fn replace_mesh(&mut self, path: &Path) {
+        let template = self.selected_template();
+        match anthesis_mesh::load_obj(path) {
+            Ok(mesh) => {
+                let name = self.project().flower.templates[template].name.clone();
+                self.edit(&format!("mesh of {name}"), |p| {
+                    p.flower.templates[template].mesh = mesh;
+                });
+                self.doc.seal();
+                self.log
+                    .info(format!("{name} now uses the mesh of {}", path.display()));
+            }
+            Err(e) => self
+                .log
+                .error(format!("cannot use {} as a mesh: {e}", path.display())),
+        }
+    }
+
+    fn load_map(&mut self, path: &Path) {
+        let template = self.selected_template();
+        let (key, target) = (self.paint.key, self.paint.target);
+        let size = brush::template_raster_size(&self.project().flower.templates[template]);
+        let fits = |found: (u32, u32)| match size {
+            Some(expected) if found != expected && found != (1, 1) => Err(format!(
+                "the map is {}x{} pixels but the template's maps are {}x{}",
+                found.0, found.1, expected.0, expected.1
+            )),
+            _ => Ok(()),
+        };
+        let loaded = match target {
+            brush::PaintTarget::Scalar(kind) => anthesis_maps::ScalarMap::load_png(path)
+                .map_err(|e| e.to_string())
+                .and_then(|map| fits(map.size()).map(|()| map))
+                .map(|map| {
+                    Box::new(move |maps: &mut anthesis_maps::GrowthMaps| {
+                        *maps.scalar_mut(kind) = map;
+                    }) as Box<dyn FnOnce(&mut anthesis_maps::GrowthMaps)>
+                }),
+            brush::PaintTarget::Direction => anthesis_maps::DirectionMap::load_png(path)
+                .map_err(|e| e.to_string())
+                .and_then(|map| fits(map.size()).map(|()| map))
+                .map(|map| {
+                    Box::new(move |maps: &mut anthesis_maps::GrowthMaps| maps.direction = map)
+                        as Box<dyn FnOnce(&mut anthesis_maps::GrowthMaps)>
+                }),
+        };
+        match loaded {
+            Ok(apply) => {
+                let name = self.project().flower.templates[template].name.clone();
+                self.edit(&format!("{} map of {name}", target.label()), |p| {
+                    if let Some(k) = p.flower.templates[template].maps.keys_mut().get_mut(key) {
+                        apply(&mut k.maps);
+                    }
+                });
+                self.doc.seal();
+                self.log.info(format!(
+                    "loaded the {} map of {name} from {}",
+                    target.label(),
+                    path.display()
+                ));
+            }
+            Err(e) => self
+                .log
+                .error(format!("cannot use {} as a map: {e}", path.display())),
+        }
+    }
+
     fn replace_document(&mut self, doc: Document) {
         self.doc = doc;
         self.selected_organ = 0;
@@ -855,6 +942,17 @@ impl eframe::App for AnthesisApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.handle_dialog_answers();
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        for path in dropped {
+            self.drop_file(&path);
+        }
         self.drain_worker();
         self.handle_close_request(&ctx);
         self.shortcuts(&ctx);
