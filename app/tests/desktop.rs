@@ -568,3 +568,115 @@ fn dropped_maps_meshes_and_projects_are_used_or_refused_with_a_message() {
     harness.run();
     assert_eq!(harness.state().project().name, "Dropped flower");
 }
+
+/// eframe's key-value store, in memory.
+#[derive(Default)]
+struct MemoryStorage(std::collections::HashMap<String, String>);
+
+impl eframe::Storage for MemoryStorage {
+    fn get_string(&self, key: &str) -> Option<String> {
+        self.0.get(key).cloned()
+    }
+
+    fn set_string(&mut self, key: &str, value: String) {
+        self.0.insert(key.to_string(), value);
+    }
+
+    fn remove_string(&mut self, key: &str) {
+        self.0.remove(key);
+    }
+
+    fn flush(&mut self) {}
+}
+
+#[test]
+fn the_last_project_and_view_are_remembered_between_launches() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("kept.anthesis.toml");
+    let mut kept = small_flower();
+    kept.name = "Kept flower".to_string();
+    anthesis_flower::project::save_project(&kept, &path).expect("save");
+
+    let mut first = harness(small_flower());
+    first.run();
+    first.state_mut().open_path(&path);
+    first.state_mut().view_options_mut().wireframe = true;
+    first.run();
+    let mut storage = MemoryStorage::default();
+    eframe::App::save(first.state_mut(), &mut storage);
+
+    let storage: &'static MemoryStorage = Box::leak(Box::new(storage));
+    let second = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .wgpu()
+        .build_eframe(move |cc| {
+            cc.storage = Some(storage);
+            AnthesisApp::new(
+                cc,
+                Startup {
+                    project: None,
+                    live: false,
+                    restore: true,
+                },
+            )
+        });
+    let app = second.state();
+    assert_eq!(app.project().name, "Kept flower");
+    assert_eq!(app.document().path.as_deref(), Some(path.as_path()));
+    assert!(app.view_options().wireframe);
+}
+
+#[test]
+fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    // Aim the camera at the middle of petal-1 as it is shown now.
+    let app = harness.state_mut();
+    let template = &app.project().flower.templates[0];
+    let middle = template
+        .mesh
+        .uvs
+        .iter()
+        .enumerate()
+        .min_by(|a, b| {
+            let d = |uv: &glam::DVec2| uv.distance(glam::DVec2::new(0.5, 0.6));
+            d(a.1).total_cmp(&d(b.1))
+        })
+        .map(|(i, _)| i)
+        .expect("vertices");
+    let shown = app
+        .session()
+        .keyframes()
+        .last()
+        .expect("keyframes")
+        .positions[0][middle];
+    app.camera_mut().target = shown;
+    app.camera_mut().distance = 40.0;
+    app.paint_mut().on_3d = true;
+    app.paint_mut().target =
+        anthesis_app::desktop::brush::PaintTarget::Scalar(anthesis_maps::MapKind::Bend);
+    harness.run();
+    let before = harness.state().project().clone();
+    let centre = harness.get_by_label("3D viewport").rect().center();
+    harness.hover_at(centre);
+    harness.run();
+    harness.drag_at(centre);
+    harness.run();
+    harness.hover_at(centre + egui::vec2(4.0, 3.0));
+    harness.run();
+    harness.drop_at(centre + egui::vec2(4.0, 3.0));
+    harness.run();
+    let app = harness.state();
+    assert_ne!(app.project(), &before, "the 3D stroke painted");
+    let bend = &app.project().flower.templates[0].maps.keys()[0].maps.bend;
+    assert_eq!(bend.size(), (32, 32), "the constant map became a raster");
+    assert!(
+        app.document()
+            .undo_label()
+            .is_some_and(|l| l.contains("bend of petal")),
+        "{:?}",
+        app.document().undo_label()
+    );
+}

@@ -233,6 +233,10 @@ impl AnthesisApp {
         &mut self.playback
     }
 
+    pub fn view_options(&self) -> &ViewOptions {
+        &self.view
+    }
+
     pub fn view_options_mut(&mut self) -> &mut ViewOptions {
         &mut self.view
     }
