@@ -680,3 +680,49 @@ fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
         app.document().undo_label()
     );
 }
+
+#[test]
+fn time_keys_are_added_picked_removed_and_blended_from_the_paint_panel() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    let keys = |h: &Harness<'_, AnthesisApp>| {
+        h.state().project().flower.templates[0]
+            .maps
+            .keys()
+            .iter()
+            .map(|k| k.step)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(keys(&harness), vec![40, 50]);
+    harness.state_mut().paint_mut().new_key_step = 70;
+    harness.run();
+    harness.get_by_label("Add key").click();
+    harness.run();
+    assert_eq!(keys(&harness), vec![40, 50, 70]);
+    assert_eq!(
+        harness.state_mut().paint_mut().key,
+        2,
+        "the new key is picked"
+    );
+    harness.get_by_label("step 40").click();
+    harness.run();
+    assert_eq!(harness.state_mut().paint_mut().key, 0);
+    harness.get_by_label("Remove key").click();
+    harness.run();
+    assert_eq!(keys(&harness), vec![50, 70]);
+
+    harness.get_by_label("Blend").click();
+    harness.run();
+    harness.get_by_label("smooth (3s² − 2s³)").click();
+    harness.run();
+    assert_eq!(
+        harness.state().project().flower.templates[0].maps.blend,
+        anthesis_maps::Blend::Smooth
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().project().flower.templates[0].maps.blend,
+        anthesis_maps::Blend::Linear
+    );
+}

@@ -36,15 +36,21 @@ xvfb-run -a -s "-screen 0 1600x1000x24" bash -c '
   xdotool windowsize "$window" 1600 1000 windowmove "$window" 0 0
   sleep 4
   "$import" -window root "$out/app-start.png"
-  sleep 20
-  "$import" -window root "$out/app-opening.png"
-  # A stroke on the UV canvas (right panel, lower half).
-  xdotool mousemove 1380 760 mousedown 1
-  for step in $(seq 0 12); do
-    xdotool mousemove $((1380 + step * 4)) $((760 - step * 12)); sleep 0.05
+  sleep 25
+  "$import" -window root "$out/app-open.png"
+  # A stroke on the UV canvas (the right panel, below the map choice; in
+  # a 1600x1000 window it spans about x 1270-1590, y 145-465).
+  xdotool mousemove 1340 400 mousedown 1
+  for step in $(seq 0 15); do
+    xdotool mousemove $((1340 + step * 3)) $((400 - step * 12)); sleep 0.08
   done
   xdotool mouseup 1
-  sleep 8
+  sleep 12
   "$import" -window root "$out/app-after-stroke.png"
+  # Wireframe (W) and single-organ preview (P).
+  xdotool windowfocus "$window"; sleep 0.5
+  xdotool mousemove 800 400 key --window "$window" w key --window "$window" p
+  sleep 10
+  "$import" -window root "$out/app-preview-wireframe.png"
 ' bash "$out" "$binary" "$import"
 echo "screenshots in $out"
