@@ -473,6 +473,10 @@ fn dragging_on_the_direction_map_paints_the_stroke_direction() {
     assert!(d.x > 0.2, "painted along +u: {d}");
     let mirrored = keys[0].maps.direction.sample(glam::DVec2::new(0.7, 0.5));
     assert!(mirrored.x < -0.2, "mirrored to -u: {mirrored}");
+    // The painted directions as arrows on the 3D organ too.
+    feed(&mut harness, None);
+    harness.state_mut().view_options_mut().direction_arrows = true;
+    harness.run();
     harness.snapshot("app_direction_painting");
 }
 

@@ -482,8 +482,9 @@ fn direction_arrows(
     let template = project.flower.template_of(organ.organ);
     let keys = template.maps.keys();
     let map = &keys[key.min(keys.len() - 1)].maps.direction;
-    let stride = (organ.triangles.len() / 120).max(1);
-    let stroke = Stroke::new(1.5, Color32::from_rgb(20, 60, 160));
+    // About 60 arrows per organ, each a little shorter than an edge.
+    let stride = (organ.triangles.len() / 60).max(2);
+    let stroke = Stroke::new(1.2, Color32::from_rgb(20, 60, 160));
     for tri in organ.triangles.iter().step_by(stride) {
         let [p0, p1, p2] = tri.map(|i| organ.positions_in_world[i as usize]);
         let [u0, u1, u2] = tri.map(|i| organ.uvs[i as usize]);
@@ -499,7 +500,7 @@ fn direction_arrows(
         let b = (du1.x * d.y - d.x * du1.y) / det;
         let world = a * (p1 - p0) + b * (p2 - p0);
         let mean_edge = ((p1 - p0).length() + (p2 - p0).length()) * 0.5;
-        let direction = world.normalize_or_zero() * mean_edge * 1.2 * d.length().min(1.0);
+        let direction = world.normalize_or_zero() * mean_edge * 0.8 * d.length().min(1.0);
         let centre = (p0 + p1 + p2) / 3.0;
         if let (Some(from), Some(to)) = (to_screen(centre), to_screen(centre + direction)) {
             painter.arrow(from, to - from, stroke);
