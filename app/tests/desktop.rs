@@ -378,8 +378,15 @@ fn the_export_dialog_writes_a_glb_and_reports_it() {
     harness.run();
     harness.get_by_label("Export glTF…  (Ctrl+E)").click();
     harness.run();
+    assert_eq!(
+        harness.state().export_dialog().path,
+        "Recorded_test_flower.glb",
+        "a file name is suggested"
+    );
+    harness.state_mut().open_export();
     harness.get_by_label("Export to").click();
     harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
     harness
         .get_by_label("Export to")
         .type_text(&out.display().to_string());

@@ -563,6 +563,27 @@ impl AnthesisApp {
         }
     }
 
+    /// Shows the export dialog, suggesting a .glb beside the project.
+    pub fn open_export(&mut self) {
+        self.export.open = true;
+        if self.export.path.trim().is_empty() {
+            let folder = self.project_folder().unwrap_or_default();
+            let stem: String = self
+                .project()
+                .name
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            self.export.path = folder.join(format!("{stem}.glb")).display().to_string();
+        }
+    }
+
     fn start_export(&mut self) {
         let tracks = export::tracks(
             self.doc.project(),
@@ -621,7 +642,7 @@ impl AnthesisApp {
             self.request(Pending::New);
         }
         if consume(command(Key::E)) {
-            self.export.open = true;
+            self.open_export();
         }
         if ctx.egui_wants_keyboard_input() {
             return;
@@ -694,7 +715,7 @@ impl AnthesisApp {
                 }
                 ui.separator();
                 if ui.button("Export glTF…  (Ctrl+E)").clicked() {
-                    self.export.open = true;
+                    self.open_export();
                 }
                 ui.separator();
                 if ui.button("Quit").clicked() {
