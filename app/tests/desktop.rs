@@ -737,3 +737,34 @@ fn time_keys_are_added_picked_removed_and_blended_from_the_paint_panel() {
         anthesis_maps::Blend::Linear
     );
 }
+
+#[test]
+fn closing_the_window_with_unsaved_changes_asks_first() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.get_by_label("Add ramp").click();
+    harness.run();
+    harness
+        .input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    harness.step();
+    let cancelled = harness
+        .output()
+        .viewport_output
+        .get(&egui::ViewportId::ROOT)
+        .is_some_and(|v| v.commands.contains(&egui::ViewportCommand::CancelClose));
+    assert!(cancelled, "the close is held back");
+    harness.run();
+    assert_eq!(harness.state().pending(), Some(&Pending::Quit));
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert_eq!(harness.state().pending(), None);
+    assert!(
+        harness.state().document().is_dirty(),
+        "the work is still there"
+    );
+}
