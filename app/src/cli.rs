@@ -173,7 +173,18 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Loads a project file, or a flower built into the binary when the path
+/// is `builtin:NAME` (`builtin:lily`, `builtin:eustoma-maite-lady`, …).
 fn load(path: &Path) -> Result<Project> {
+    if let Some(name) = path.to_str().and_then(|p| p.strip_prefix("builtin:")) {
+        return match anthesis_garden::builtin(name) {
+            Some(project) => project.context("the built-in flower does not load"),
+            None => bail!(
+                "no built-in flower `{name}` (there are: {})",
+                anthesis_garden::builtin_names().join(", ")
+            ),
+        };
+    }
     // The project error names the file itself.
     load_project(path).context("cannot open project")
 }

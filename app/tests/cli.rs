@@ -65,6 +65,22 @@ fn simulate_writes_stats_json_and_a_glb() {
     }
     let bytes = std::fs::read(&glb).expect("glb written");
     assert_eq!(&bytes[..4], b"glTF");
+    // The receptacle rides along as a static mesh.
+    assert!(String::from_utf8_lossy(&bytes).contains("\"receptacle\""));
+    // And the Khronos validator accepts the file (installed by .ci/run:
+    // `npm ci --prefix tests/gltf-validator`).
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/gltf-validator/validate.mjs");
+    let report = Command::new("node").arg(&script).arg(&glb).output().expect(
+        "node runs the glTF validator (install node and run `npm ci --prefix tests/gltf-validator`)",
+    );
+    assert!(
+        report.status.success(),
+        "validator failed: {}",
+        text(&report.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&report.stdout).expect("validator JSON");
+    assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
+    assert_eq!(report["issues"]["numWarnings"], 0, "{report:#}");
 }
 
 #[test]
@@ -152,4 +168,37 @@ fn without_a_subcommand_it_says_the_window_is_not_built_yet() {
     let out = anthesis(&[]);
     assert!(out.status.success());
     assert!(text(&out.stdout).contains("desktop application is not built yet"));
+}
+
+#[test]
+fn the_built_in_lily_needs_no_files() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        .args(["info", "builtin:lily"])
+        .current_dir(dir.path())
+        .output()
+        .expect("the binary runs");
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 6, "{stdout}");
+    assert_eq!(
+        lines
+            .iter()
+            .filter(|l| l.split(' ').nth(1) == Some("petal"))
+            .count(),
+        3
+    );
+    assert_eq!(
+        lines
+            .iter()
+            .filter(|l| l.split(' ').nth(1) == Some("sepal"))
+            .count(),
+        3
+    );
+    let out = anthesis(&["info", "builtin:tulip"]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains("no built-in flower `tulip`"), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1);
 }

@@ -6,6 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anthesis_export::{GlbOptions, Track};
+use anthesis_flower::Project;
 use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
@@ -82,8 +83,9 @@ pub(super) fn simulate(
             .with_context(|| format!("cannot write statistics to {}", stats_path.display()))?;
     }
     if let Some(out) = out {
-        let tracks = tracks(&sim, &frames);
+        let mut tracks = tracks(&sim, &frames);
         if is_glb(out) {
+            tracks.push(receptacle_track(&project));
             anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
                 .with_context(|| format!("cannot write {}", out.display()))?;
         } else {
@@ -171,6 +173,25 @@ fn tracks(sim: &Simulation, frames: &[Vec<Vec<DVec3>>]) -> Vec<Track> {
             base_color_png: None,
         })
         .collect()
+}
+
+/// The receptacle as a static mesh, sized to the ring the organs sit on.
+fn receptacle_track(project: &Project) -> Track {
+    let ring = project
+        .flower
+        .organs
+        .iter()
+        .map(|o| o.placement.position.x.hypot(o.placement.position.z))
+        .fold(0.5, f64::max);
+    let mesh = anthesis_garden::receptacle_mesh(1.1 * ring, 0.7 * ring);
+    Track {
+        name: "receptacle".into(),
+        triangles: mesh.triangles,
+        uvs: mesh.uvs,
+        base_color: [0.36, 0.55, 0.24, 1.0],
+        keyframes: vec![mesh.positions],
+        base_color_png: None,
+    }
 }
 
 fn rayon_threads() -> usize {
