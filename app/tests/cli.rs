@@ -164,10 +164,25 @@ fn bad_input_gives_one_line_and_a_non_zero_exit() {
 }
 
 #[test]
-fn without_a_subcommand_it_says_the_window_is_not_built_yet() {
-    let out = anthesis(&[]);
-    assert!(out.status.success());
-    assert!(text(&out.stdout).contains("desktop application is not built yet"));
+fn without_a_subcommand_it_opens_the_window_or_says_why_not() {
+    // No display here: the window cannot open, and that is one clear line.
+    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .output()
+        .expect("the binary runs");
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    let ours: Vec<&str> = stderr
+        .lines()
+        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
+        .collect();
+    assert_eq!(ours.len(), 1, "{stderr}");
+    assert!(
+        ours[0].starts_with("error: cannot open the window"),
+        "{stderr}"
+    );
 }
 
 #[test]
