@@ -1,9 +1,16 @@
+//! Times one run of the benchmark fixtures and prints iteration counts:
+//! `cargo run --release -p anthesis-sim --example time_run -- ORGANS [ROWS COLS]`
+//! (defaults: 1 organ, 14 x 28, the lily-sized petal; `1 45 90` is the
+//! 4k-particle petal of the benchmark).
 fn main() {
-    let organs: usize = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1);
-    let project = anthesis_sim::fixtures::whorl(organs, 14, 28, 100);
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let organs = args.first().copied().unwrap_or(1);
+    let rows = args.get(1).copied().unwrap_or(14);
+    let cols = args.get(2).copied().unwrap_or(28);
+    let project = anthesis_sim::fixtures::whorl(organs, rows, cols, 100);
     let t = std::time::Instant::now();
     let mut iters = 0;
     let result = anthesis_sim::run(&project, &anthesis_sim::Selection::All, &mut |_, k| {
@@ -19,8 +26,9 @@ fn main() {
             );
         }
     });
+    let factorisations = result.as_ref().map(|s| s.factorisations()).unwrap_or(0);
     println!(
-        "{organs} organs: {:?} in {:.3}s, {iters} iterations",
+        "{organs} organs {rows}x{cols}: {:?} in {:.3}s, {iters} iterations, {factorisations} factorisations",
         result.err(),
         t.elapsed().as_secs_f64()
     );

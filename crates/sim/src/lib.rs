@@ -167,6 +167,12 @@ impl Simulation {
         self.organs[i].color
     }
 
+    /// Numeric Hessian factorisations done so far, over all organs (the
+    /// dominant cost of a run; see the benchmark notes in the README).
+    pub fn factorisations(&self) -> u64 {
+        self.organs.iter().map(|o| o.factorisations()).sum()
+    }
+
     pub fn keyframe_count(&self) -> u32 {
         self.settings.keyframes
     }
