@@ -140,33 +140,52 @@ impl Elastic {
 
     /// Writes the gradient into `g` (one vector per particle).
     pub fn gradient(&self, x: &[DVec3], contacts: &[Contact], g: &mut [DVec3]) {
+        self.energy_and_gradient(x, contacts, g);
+    }
+
+    /// The energy at `x`, with the gradient written into `g`, in one pass
+    /// over the elements (the springs' lengths and the hinges' angles are
+    /// computed once for both). The energy is infinite, as in
+    /// [`Elastic::energy`], when a triangle has collapsed; `g` is then
+    /// meaningless.
+    pub fn energy_and_gradient(&self, x: &[DVec3], contacts: &[Contact], g: &mut [DVec3]) -> f64 {
         g.iter_mut().for_each(|v| *v = DVec3::ZERO);
+        let mut e = 0.0;
         for (idx, &[a, b]) in self.edges.iter().enumerate() {
             let d = x[a as usize] - x[b as usize];
             let len = d.length();
-            let f = d * (self.stretch_stiffness[idx] * (len - self.rest_lengths[idx]) / len);
+            let stretch = len - self.rest_lengths[idx];
+            let k = self.stretch_stiffness[idx];
+            e += 0.5 * k * stretch * stretch;
+            let f = d * (k * stretch / len);
             g[a as usize] += f;
             g[b as usize] -= f;
         }
+        let mut degenerate = false;
         for &(stencil, edge) in &self.hinges {
             let xs = stencil.map(|p| x[p as usize]);
-            let theta = dihedral_angle(xs);
-            let scale = self.bend_stiffness[edge as usize]
-                * angle_difference(theta, self.rest_angles[edge as usize]);
+            degenerate |= hinge_is_degenerate(xs);
+            let k = self.bend_stiffness[edge as usize];
+            let d = angle_difference(dihedral_angle(xs), self.rest_angles[edge as usize]);
+            e += 0.5 * k * d * d;
             let dtheta = dihedral_gradient(xs);
-            for (p, d) in stencil.iter().zip(dtheta) {
-                g[*p as usize] += d * scale;
+            for (p, grad) in stencil.iter().zip(dtheta) {
+                g[*p as usize] += grad * (k * d);
             }
         }
         for c in contacts {
             let v = c.violation(x[c.particle as usize]);
             if v > 0.0 {
+                e += 0.5 * self.contact_stiffness * v * v;
                 g[c.particle as usize] -= c.normal * (self.contact_stiffness * v);
             }
         }
         for &(p, target) in &self.anchors {
-            g[p as usize] += (x[p as usize] - target) * self.anchor_stiffness;
+            let offset = x[p as usize] - target;
+            e += 0.5 * self.anchor_stiffness * offset.length_squared();
+            g[p as usize] += offset * self.anchor_stiffness;
         }
+        if degenerate { f64::INFINITY } else { e }
     }
 
     /// Writes the PSD Hessian approximation into `values` (upper CSC layout

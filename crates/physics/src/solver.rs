@@ -179,11 +179,11 @@ impl NewtonSolver {
         positions: &mut [DVec3],
         settings: &SolverSettings,
     ) -> Result<StepReport, SolverError> {
-        let energy_before = elastic.energy(positions, contacts);
+        let energy_before = elastic.energy_and_gradient(positions, contacts, &mut self.gradient);
         if !energy_before.is_finite() {
             return Err(SolverError::NonFinite);
         }
-        let relative_gradient = self.relative_gradient(elastic, contacts, positions);
+        let relative_gradient = max_norm(&self.gradient) / elastic.force_scale();
         if !relative_gradient.is_finite() {
             return Err(SolverError::NonFinite);
         }
