@@ -129,6 +129,19 @@ impl Tracker {
     }
 }
 
+/// How a contact that is already violated is placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Violated {
+    /// The particle must move all the way to its side of the tracking
+    /// point (the final push-back).
+    MoveAll,
+    /// The particle must move half the way: the other organ's particle
+    /// tracks this one and moves the other half, so the two meet in the
+    /// middle. Held each against the other's current place, both would move
+    /// the full way and swap sides.
+    MoveHalf,
+}
+
 /// Contacts for the particles of `moving` against `other`: `side` is +1 if
 /// `moving` belongs on `other`'s inner side (it lies inside), -1 if on its
 /// outer side. Only particles within reach of `other` (two of its mean edges
@@ -139,6 +152,7 @@ pub fn contacts_against(
     tracker: &Tracker,
     side: f64,
     offset: f64,
+    violated: Violated,
     out: &mut Vec<Contact>,
 ) {
     let lateral_limit = other.mean_edge;
@@ -153,30 +167,50 @@ pub fn contacts_against(
         if lateral > lateral_limit {
             continue;
         }
-        out.push(Contact {
+        let mut contact = Contact {
             particle: i as u32,
             point,
             normal,
             offset,
-        });
+        };
+        let violation = contact.violation(*x);
+        if violation > 0.0 && violated == Violated::MoveHalf {
+            contact.point -= normal * (0.5 * violation);
+        }
+        out.push(contact);
     }
 }
 
+/// The largest violation over `contacts` (0 when none is violated).
+pub fn max_violation(positions: &[DVec3], contacts: &[Contact]) -> f64 {
+    contacts
+        .iter()
+        .map(|c| c.violation(positions[c.particle as usize]))
+        .fold(0.0, f64::max)
+}
+
 /// The paper's push-back: moves each particle that is short of its side
-/// onto it. Returns how many particles moved (a particle pushed by several
-/// contacts counts once). If a particle has several contacts, they are
-/// applied in order.
-pub fn push_back(positions: &mut [DVec3], contacts: &[Contact]) -> usize {
-    let mut moved = vec![false; positions.len()];
+/// onto it, and marks it in `moved`. Returns how many particles this call
+/// moved (a particle pushed by several contacts counts once). If a particle
+/// has several contacts, they are applied in order.
+pub fn push_back(positions: &mut [DVec3], contacts: &[Contact], moved: &mut [bool]) -> usize {
+    let mut count = 0;
+    let mut last_counted = None;
     for c in contacts {
         let x = &mut positions[c.particle as usize];
         let violation = c.violation(*x);
         if violation > 0.0 {
             *x += c.normal * violation;
             moved[c.particle as usize] = true;
+            // Contacts of one particle are adjacent (built particle by
+            // particle), so counting changes of particle counts each once.
+            if last_counted != Some(c.particle) {
+                count += 1;
+                last_counted = Some(c.particle);
+            }
         }
     }
-    moved.iter().filter(|&&m| m).count()
+    count
 }
 
 #[cfg(test)]
@@ -233,7 +267,9 @@ mod tests {
                 offset: 0.01,
             },
         ];
-        assert_eq!(push_back(&mut positions, &contacts), 1);
+        let mut moved = vec![false; positions.len()];
+        assert_eq!(push_back(&mut positions, &contacts, &mut moved), 1);
+        assert_eq!(moved.iter().filter(|&&m| m).count(), 1);
         assert!((positions[0].z - 0.01).abs() < 1e-15);
         assert_eq!(positions[1].z, 0.5);
     }
@@ -256,7 +292,9 @@ mod tests {
                 offset: 0.01,
             },
         ];
-        assert_eq!(push_back(&mut positions, &contacts), 1);
+        let mut moved = vec![false; positions.len()];
+        assert_eq!(push_back(&mut positions, &contacts, &mut moved), 1);
+        assert_eq!(moved.iter().filter(|&&m| m).count(), 1);
         assert!((positions[0].z - 0.51).abs() < 1e-15);
     }
 }

@@ -21,7 +21,7 @@ use anthesis_physics::{Contact, SolverError};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::collide::{Surface, Tracker, contacts_against, push_back};
+use crate::collide::{Surface, Tracker, Violated, contacts_against, max_violation, push_back};
 use crate::organ::OrganSim;
 
 /// Which organs to simulate.
@@ -104,6 +104,19 @@ pub struct IterationProgress {
     pub iteration: u32,
     pub relative_gradient: f64,
 }
+
+/// How many times per keyframe the organs settle, at most: once against the
+/// contacts found after growth, then again against contacts found where
+/// they settled (see `Simulation::step`).
+const MAX_CONTACT_ROUNDS: u32 = 4;
+/// Organs settle again while some particle lies deeper than this, in mean
+/// edges of its organ, on the wrong side of a neighbour: the final push-back
+/// then moves particles by about this at most (unless the rounds ran out),
+/// too little to show as a dent.
+const RESETTLE_DEPTH: f64 = 0.01;
+
+/// Passes of the final push-back at most.
+const PUSH_BACK_PASSES: u32 = 3;
 
 /// A running simulation of a project (or of one organ of it).
 pub struct Simulation {
@@ -215,64 +228,96 @@ impl Simulation {
 
         let solver = self.settings.solver;
         let mut iterations = 0;
-        let mut converged = false;
         let mut gradient = 0.0;
-        // Contacts are found once per keyframe, right after growth, and held
-        // while the organs relax: rebuilt every iteration from organs that
-        // all move at once, they made neighbours bounce off each other
-        // instead of settling. The push-back below uses fresh ones.
-        let contacts = self.contacts();
-        while iterations < solver.max_iterations {
-            if cancel() {
-                return Err(SimError::Cancelled);
-            }
-            let reports: Vec<_> = self
-                .organs
-                .par_iter_mut()
-                .zip(contacts.par_iter())
-                .map(|(o, c)| o.iterate(step, c, &solver))
-                .collect();
-            let mut all_converged = true;
-            gradient = 0.0f64;
-            for (organ, report) in self.organs.iter().zip(reports) {
-                let report = report.map_err(|error| SimError::Diverged {
-                    keyframe: step,
-                    organ: organ.name.clone(),
-                    error,
-                })?;
-                all_converged &= report.converged;
-                gradient = gradient.max(report.relative_gradient);
-            }
-            progress(IterationProgress {
-                keyframe: step,
-                iteration: iterations,
-                relative_gradient: gradient,
-            });
-            if all_converged {
-                converged = true;
-                break;
-            }
-            iterations += 1;
-        }
-        if !converged {
-            let (organ, relative_gradient) = self.worst_organ(&self.contacts());
-            return Err(SimError::NotConverged {
-                keyframe: step,
-                organ,
-                iterations,
-                relative_gradient,
-            });
-        }
-
-        for organ in &mut self.organs {
-            organ.attach(step);
-        }
-        // The paper's push-back: nobody ends on the wrong side.
-        let contacts = self.contacts();
-        let mut pushed = 0;
+        // Contacts are found right after growth and held while the organs
+        // relax: rebuilt every iteration from organs that all move at once,
+        // they made neighbours bounce off each other instead of settling.
+        let mut contacts = self.contacts(Violated::MoveHalf);
+        // Growth and the joint schedule may have carried particles onto the
+        // wrong side. Newton's method started there sees deep, stiff
+        // penalties and its first steps crumpled organs (a tip folded until
+        // a triangle collapsed); put them on their side first, each pair of
+        // particles meeting in the middle, and let the organs relax around
+        // the dents.
         for (organ, c) in self.organs.iter_mut().zip(&contacts) {
-            pushed += push_back(&mut organ.positions, c);
+            let mut moved = vec![false; organ.positions.len()];
+            push_back(&mut organ.positions, c, &mut moved);
         }
+        let mut round = 1;
+        let pushed = loop {
+            let mut round_iterations = 0;
+            let mut converged = false;
+            while round_iterations < solver.max_iterations {
+                if cancel() {
+                    return Err(SimError::Cancelled);
+                }
+                let reports: Vec<_> = self
+                    .organs
+                    .par_iter_mut()
+                    .zip(contacts.par_iter())
+                    .map(|(o, c)| o.iterate(step, c, &solver))
+                    .collect();
+                let mut all_converged = true;
+                gradient = 0.0f64;
+                for (organ, report) in self.organs.iter().zip(reports) {
+                    let report = report.map_err(|error| SimError::Diverged {
+                        keyframe: step,
+                        organ: organ.name.clone(),
+                        error,
+                    })?;
+                    all_converged &= report.converged;
+                    gradient = gradient.max(report.relative_gradient);
+                }
+                progress(IterationProgress {
+                    keyframe: step,
+                    iteration: iterations,
+                    relative_gradient: gradient,
+                });
+                if all_converged {
+                    converged = true;
+                    break;
+                }
+                iterations += 1;
+                round_iterations += 1;
+            }
+            if !converged {
+                let (organ, relative_gradient) = self.worst_organ(&contacts);
+                return Err(SimError::NotConverged {
+                    keyframe: step,
+                    organ,
+                    iterations,
+                    relative_gradient,
+                });
+            }
+            for organ in &mut self.organs {
+                organ.attach(step);
+            }
+            if self.overlaps.is_empty() {
+                break 0;
+            }
+            // Each organ kept off where its neighbours were when the
+            // contacts were found, but the neighbours moved too: where
+            // organs press on each other they now overlap. Pushed back from
+            // there, particles jumped and left spikes; instead, while some
+            // particle lies deep on the wrong side, the organs settle again
+            // against contacts found where they are now.
+            let fresh = self.contacts(Violated::MoveHalf);
+            let deepest = self
+                .organs
+                .iter()
+                .zip(&fresh)
+                .map(|(o, c)| max_violation(&o.positions, c) / o.mean_edge)
+                .fold(0.0, f64::max);
+            if deepest == 0.0 {
+                break 0;
+            }
+            if deepest <= RESETTLE_DEPTH || round == MAX_CONTACT_ROUNDS {
+                // The paper's push-back: nobody ends on the wrong side.
+                break self.push_back();
+            }
+            contacts = fresh;
+            round += 1;
+        };
 
         let mut energy = 0.0;
         for (i, organ) in self.organs.iter().enumerate() {
@@ -308,7 +353,7 @@ impl Simulation {
 
     /// Contacts of every organ against the organs it overlaps, from the
     /// current positions.
-    fn contacts(&self) -> Vec<Vec<Contact>> {
+    fn contacts(&self, violated: Violated) -> Vec<Vec<Contact>> {
         let mut contacts = vec![Vec::new(); self.organs.len()];
         if self.overlaps.is_empty() {
             return contacts;
@@ -342,6 +387,7 @@ impl Simulation {
                 &trackers[outer],
                 1.0,
                 offset,
+                violated,
                 &mut contacts[inner],
             );
             contacts_against(
@@ -350,6 +396,7 @@ impl Simulation {
                 &trackers[inner],
                 -1.0,
                 offset,
+                violated,
                 &mut contacts[outer],
             );
         }
@@ -358,6 +405,71 @@ impl Simulation {
         for (organ, list) in self.organs.iter().zip(&mut contacts) {
             list.retain(|c| !organ.is_base[c.particle as usize]);
         }
+        contacts
+    }
+
+    /// The paper's push-back: nobody ends on the wrong side. Organs are
+    /// pushed one overlap side at a time, each against where the other is
+    /// now (pushed both at once, two particles on the wrong side of each
+    /// other would swap places and stay wrong). Returns how many particles
+    /// moved.
+    fn push_back(&mut self) -> usize {
+        let mut moved: Vec<Vec<bool>> = self
+            .organs
+            .iter()
+            .map(|o| vec![false; o.positions.len()])
+            .collect();
+        // A pushed particle turns its neighbours' normals a little, which
+        // can leave a particle of the other organ just short of its side:
+        // pass again while that happens.
+        for _ in 0..PUSH_BACK_PASSES {
+            let mut pushed_in_pass = 0;
+            for index in 0..self.overlaps.len() {
+                let (inner, outer) = self.overlaps[index];
+                for (moving, other, side) in [(inner, outer, 1.0), (outer, inner, -1.0)] {
+                    let contacts = self.contacts_between(moving, other, side);
+                    pushed_in_pass += push_back(
+                        &mut self.organs[moving].positions,
+                        &contacts,
+                        &mut moved[moving],
+                    );
+                }
+            }
+            if pushed_in_pass == 0 {
+                break;
+            }
+        }
+        moved.iter().flatten().filter(|&&m| m).count()
+    }
+
+    /// Contacts of organ `moving` against organ `other` from the current
+    /// positions, each moving particle to be put all the way on its side
+    /// (`side` as in [`contacts_against`]).
+    fn contacts_between(&self, moving: usize, other: usize, side: f64) -> Vec<Contact> {
+        let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let normals = anthesis_mesh::vertex_normals(&o.positions, &o.mesh.triangles);
+        let other_surface = Surface {
+            positions: &o.positions,
+            normals: &normals,
+            mean_edge: o.mean_edge,
+        };
+        let moving_surface = Surface {
+            positions: &m.positions,
+            normals: &[],
+            mean_edge: m.mean_edge,
+        };
+        let tracker = Tracker::new(&o.positions, 2.0 * o.mean_edge);
+        let mut contacts = Vec::new();
+        contacts_against(
+            &moving_surface,
+            &other_surface,
+            &tracker,
+            side,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut contacts,
+        );
+        contacts.retain(|c| !m.is_base[c.particle as usize]);
         contacts
     }
 

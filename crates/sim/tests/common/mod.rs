@@ -76,6 +76,13 @@ pub fn particles_over(
 /// against 10 over `keyframes` steps). With `overlap`, the flower says the
 /// first lies inside the second.
 pub fn inner_driven_into_outer(keyframes: u32, overlap: bool) -> Project {
+    inner_driven_into_outer_by(keyframes, overlap, 20.0)
+}
+
+/// [`inner_driven_into_outer`] with the inner petal's joint driven by
+/// `inner_drive_deg` (the outer one's still by 10 degrees): the larger the
+/// drive, the deeper the inner organ is pushed into the outer one.
+pub fn inner_driven_into_outer_by(keyframes: u32, overlap: bool, inner_drive_deg: f64) -> Project {
     let ramp = |degrees: f64| {
         vec![JointRamp {
             from_step: 0,
@@ -84,7 +91,7 @@ pub fn inner_driven_into_outer(keyframes: u32, overlap: bool) -> Project {
         }]
     };
     let mut inner = petal_template("inner petal", 8, 14);
-    inner.joint_schedule = ramp(20.0);
+    inner.joint_schedule = ramp(inner_drive_deg);
     let mut outer = petal_template("outer petal", 8, 14);
     outer.joint_schedule = ramp(10.0);
     let organ =
@@ -121,4 +128,70 @@ pub fn run_all(project: &Project, selection: &Selection) -> (Vec<Keyframe>, Opti
     let mut keyframes = Vec::new();
     let result = run(project, selection, &mut |_, k| keyframes.push(k.clone()));
     (keyframes, result.err())
+}
+
+/// How far an organ's shape is from looking sane, measured against a
+/// reference shape of the same mesh (the bud for lengths, the previous
+/// keyframe for bends).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeChange {
+    /// Largest edge length over its length in the reference.
+    pub max_edge_ratio: f64,
+    /// Smallest edge length over its length in the reference.
+    pub min_edge_ratio: f64,
+    /// Smallest triangle area over its area in the reference.
+    pub min_area_ratio: f64,
+    /// Largest change of a dihedral angle, in degrees.
+    pub max_bend_change_deg: f64,
+    /// The edge whose dihedral angle changed most.
+    pub max_bend_at: [u32; 2],
+}
+
+/// Compares `positions` with `reference_positions` (same mesh).
+pub fn shape_change(
+    positions: &[DVec3],
+    reference_positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> ShapeChange {
+    let mesh = anthesis_mesh::Mesh {
+        positions: reference_positions.to_vec(),
+        uvs: vec![glam::DVec2::ZERO; reference_positions.len()],
+        triangles: triangles.to_vec(),
+    };
+    let topology = anthesis_mesh::Topology::build(&mesh).expect("a valid mesh");
+    let mut change = ShapeChange {
+        max_edge_ratio: 0.0,
+        min_edge_ratio: f64::INFINITY,
+        min_area_ratio: f64::INFINITY,
+        max_bend_change_deg: 0.0,
+        max_bend_at: [0, 0],
+    };
+    for edge in &topology.edges {
+        let [a, b] = edge.vertices.map(|v| v as usize);
+        let ratio = (positions[a] - positions[b]).length()
+            / (reference_positions[a] - reference_positions[b]).length();
+        change.max_edge_ratio = change.max_edge_ratio.max(ratio);
+        change.min_edge_ratio = change.min_edge_ratio.min(ratio);
+        if let Some(hinge) = edge.hinge() {
+            let now = anthesis_physics::hinge::dihedral_angle(hinge.map(|v| positions[v as usize]));
+            let before = anthesis_physics::hinge::dihedral_angle(
+                hinge.map(|v| reference_positions[v as usize]),
+            );
+            let d = anthesis_physics::elastic::angle_difference(now, before).abs();
+            if d.to_degrees() > change.max_bend_change_deg {
+                change.max_bend_at = edge.vertices;
+            }
+            change.max_bend_change_deg = change.max_bend_change_deg.max(d.to_degrees());
+        }
+    }
+    let area = |x: &[DVec3], t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| x[v as usize]);
+        0.5 * (b - a).cross(c - a).length()
+    };
+    for t in triangles {
+        change.min_area_ratio = change
+            .min_area_ratio
+            .min(area(positions, t) / area(reference_positions, t));
+    }
+    change
 }
