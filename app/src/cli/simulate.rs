@@ -5,8 +5,7 @@ use std::io::{IsTerminal, Write};
 use std::path::Path;
 use std::time::Instant;
 
-use anthesis_export::{GlbOptions, Track};
-use anthesis_flower::Project;
+use anthesis_export::{GlbOptions, Track, TrackLook};
 use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
@@ -83,9 +82,19 @@ pub(super) fn simulate(
             .with_context(|| format!("cannot write statistics to {}", stats_path.display()))?;
     }
     if let Some(out) = out {
-        let mut tracks = tracks(&sim, &frames);
+        let names = sim.organs();
+        let looks = names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| TrackLook::new(name, sim.triangles(i), sim.uvs(i), sim.color(i)));
+        let mut tracks = anthesis_export::organ_tracks(looks, frames.iter().map(Vec::as_slice));
         if is_glb(out) {
-            tracks.push(receptacle_track(&project));
+            let receptacle = anthesis_garden::receptacle_for(&project.flower);
+            tracks.push(Track::still(
+                "receptacle",
+                receptacle,
+                anthesis_garden::RECEPTACLE_COLOR,
+            ));
             anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
                 .with_context(|| format!("cannot write {}", out.display()))?;
         } else {
@@ -158,40 +167,6 @@ fn check_output(out: &Path) -> Result<()> {
         );
     }
     Ok(())
-}
-
-fn tracks(sim: &Simulation, frames: &[Vec<Vec<DVec3>>]) -> Vec<Track> {
-    sim.organs()
-        .iter()
-        .enumerate()
-        .map(|(i, name)| Track {
-            name: name.to_string(),
-            triangles: sim.triangles(i).to_vec(),
-            uvs: sim.uvs(i).to_vec(),
-            base_color: sim.color(i),
-            keyframes: frames.iter().map(|f| f[i].clone()).collect(),
-            base_color_png: None,
-        })
-        .collect()
-}
-
-/// The receptacle as a static mesh, sized to the ring the organs sit on.
-fn receptacle_track(project: &Project) -> Track {
-    let ring = project
-        .flower
-        .organs
-        .iter()
-        .map(|o| o.placement.position.x.hypot(o.placement.position.z))
-        .fold(0.5, f64::max);
-    let mesh = anthesis_garden::receptacle_mesh(1.1 * ring, 0.7 * ring);
-    Track {
-        name: "receptacle".into(),
-        triangles: mesh.triangles,
-        uvs: mesh.uvs,
-        base_color: [0.36, 0.55, 0.24, 1.0],
-        keyframes: vec![mesh.positions],
-        base_color_png: None,
-    }
 }
 
 fn rayon_threads() -> usize {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, channel};
 use std::sync::{Arc, Mutex};
 
-use anthesis_export::{Encoding, GlbOptions, Timing, Track};
+use anthesis_export::{Encoding, GlbOptions, Timing, Track, TrackLook};
 use anthesis_flower::Project;
 use anthesis_sim::Keyframe;
 use eframe::egui;
@@ -73,24 +73,18 @@ pub struct ExportRequests {
 
 /// The animation tracks of the computed keyframes: one per simulated organ.
 pub fn tracks(project: &Project, organs: &[usize], keyframes: &[Arc<Keyframe>]) -> Vec<Track> {
-    organs
-        .iter()
-        .enumerate()
-        .map(|(slot, &organ)| {
-            let template = project.flower.template_of(organ);
-            Track {
-                name: project.flower.organs[organ].name.clone(),
-                triangles: template.mesh.triangles.clone(),
-                uvs: template.mesh.uvs.clone(),
-                base_color: template.color,
-                keyframes: keyframes
-                    .iter()
-                    .map(|k| k.positions[slot].clone())
-                    .collect(),
-                base_color_png: None,
-            }
-        })
-        .collect()
+    let flower = &project.flower;
+    let looks = organs.iter().map(|&organ| {
+        let template = flower.template_of(organ);
+        let mesh = &template.mesh;
+        TrackLook::new(
+            &flower.organs[organ].name,
+            &mesh.triangles,
+            &mesh.uvs,
+            template.color,
+        )
+    });
+    anthesis_export::organ_tracks(looks, keyframes.iter().map(|k| k.positions.as_slice()))
 }
 
 impl ExportDialog {

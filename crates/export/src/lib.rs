@@ -2,6 +2,10 @@
 //! target per keyframe, one Wavefront OBJ per keyframe, and atomic file
 //! writes used for every file Anthesis saves.
 //!
+//! [`organ_tracks`] turns a simulation's keyframes into one [`Track`] per
+//! organ and [`Track::still`] makes the track of a mesh that does not move
+//! (the receptacle).
+//!
 //! # The .glb
 //!
 //! Every [`Track`] (an organ, or the static receptacle) becomes one node and
@@ -49,6 +53,7 @@ mod glb;
 mod obj;
 mod prepare;
 mod report;
+mod tracks;
 
 use std::path::Path;
 
@@ -59,6 +64,7 @@ pub use error::{ExportError, TrackProblem};
 pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
 pub use report::{GlbSize, GlbSizeReport, glb_size_report};
+pub use tracks::{TrackLook, organ_tracks};
 
 /// One organ (or the receptacle) over time: a fixed triangulation and UV
 /// layout, and its positions at every keyframe in the world frame.

@@ -11,7 +11,8 @@
 //! - [`shape`]: numeric shape descriptors (opening angles, turning,
 //!   cupping, corolla profile) that tests use to check each flower's
 //!   character;
-//! - [`receptacle_mesh`]: a receptacle for pictures and exports;
+//! - [`receptacle_mesh`]: a receptacle for pictures and exports, and
+//!   [`receptacle_for`] one sized to a flower;
 //! - [`builtin`]: the committed projects of `assets/flowers/`, embedded in
 //!   the binary.
 //!
@@ -32,7 +33,7 @@ use anthesis_flower::Project;
 use anthesis_flower::project::{ProjectError, parse_project};
 
 pub use flowers::{Cultivar, FLOWER_NAMES, GardenError};
-pub use receptacle::receptacle_mesh;
+pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
 
 /// One embedded file: its path inside its flower's folder and its bytes.
 type EmbeddedFile = (&'static str, &'static [u8]);

@@ -3,6 +3,7 @@
 
 use std::f64::consts::{PI, TAU};
 
+use anthesis_flower::Flower;
 use anthesis_mesh::Mesh;
 use glam::{DVec2, DVec3};
 
@@ -10,6 +11,21 @@ use glam::{DVec2, DVec3};
 const SEGMENTS: usize = 32;
 /// Rings from the bottom pole to the top pole.
 const RINGS: usize = 12;
+
+/// The receptacle's colour in exports (linear RGBA): a stem green.
+pub const RECEPTACLE_COLOR: [f32; 4] = [0.36, 0.55, 0.24, 1.0];
+
+/// The receptacle of `flower` ([`receptacle_mesh`]), sized to the ring its
+/// organs sit on: with the organs' bases at most `ring` from the axis
+/// (taken as at least 0.5), `1.1 * ring` wide and `0.7 * ring` deep.
+pub fn receptacle_for(flower: &Flower) -> Mesh {
+    let ring = flower
+        .organs
+        .iter()
+        .map(|o| o.placement.position.x.hypot(o.placement.position.z))
+        .fold(0.5, f64::max);
+    receptacle_mesh(1.1 * ring, 0.7 * ring)
+}
 
 /// A small rounded receptacle in the world frame: a surface of revolution
 /// about +Y, widest (`radius`) at `y = 0` where the organs sit, rounding
@@ -100,5 +116,34 @@ mod tests {
         }
         // A valid mesh: manifold, no degenerate or unused vertices.
         anthesis_mesh::validate(&mesh).expect("valid receptacle mesh");
+    }
+
+    #[test]
+    fn the_receptacle_for_a_flower_reaches_just_past_its_organs() {
+        let organ_at = |x: f64, z: f64| anthesis_flower::Organ {
+            name: format!("at {x} {z}"),
+            template: 0,
+            placement: anthesis_flower::Placement {
+                position: DVec3::new(x, 0.2, z),
+                azimuth_deg: 0.0,
+                joint_angle_deg: 0.0,
+            },
+        };
+        let mut flower = Flower {
+            templates: Vec::new(),
+            organs: vec![organ_at(1.0, 0.0), organ_at(-3.0, 4.0), organ_at(0.0, -4.5)],
+            overlaps: Vec::new(),
+        };
+        // The farthest base is 5 from the axis (its height does not count).
+        assert_eq!(
+            receptacle_for(&flower),
+            receptacle_mesh(1.1 * 5.0, 0.7 * 5.0)
+        );
+        // Organs on the axis still get a small receptacle.
+        flower.organs = vec![organ_at(0.0, 0.0)];
+        assert_eq!(
+            receptacle_for(&flower),
+            receptacle_mesh(1.1 * 0.5, 0.7 * 0.5)
+        );
     }
 }

@@ -75,14 +75,7 @@ pub fn receptacle() -> Track {
         let z = (uv.x - 0.5) * 3.0;
         DVec3::new(x, 0.5 * (1.0 - (x * x + z * z) / 4.5), z)
     });
-    Track {
-        name: "receptacle".to_owned(),
-        triangles: mesh.triangles,
-        uvs: mesh.uvs,
-        base_color: [0.35, 0.55, 0.2, 1.0],
-        keyframes: vec![mesh.positions],
-        base_color_png: None,
-    }
+    Track::still("receptacle", mesh, [0.35, 0.55, 0.2, 1.0])
 }
 
 /// Two organs (a cupped petal and a flat sepal-like sheet whose base row
