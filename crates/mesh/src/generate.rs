@@ -83,6 +83,28 @@ pub fn test_petal(length: f64, width: f64, columns: usize, rows: usize) -> Mesh 
     })
 }
 
+/// The unit square in the XY plane as two triangles, `[0, 1, 2]` and
+/// `[0, 2, 3]`, corners counter-clockwise from the origin, UV = XY: the
+/// smallest mesh with an interior edge, for tests.
+#[cfg(test)]
+pub(crate) fn unit_square() -> Mesh {
+    Mesh {
+        positions: vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ],
+        uvs: vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(0.0, 1.0),
+        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

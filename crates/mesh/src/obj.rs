@@ -271,6 +271,7 @@ fn obj_text(positions: &[DVec3], uvs: &[DVec2], triangles: &[[u32; 3]]) -> Strin
 mod tests {
     use super::*;
     use crate::generate;
+    use crate::generate::unit_square;
 
     const QUAD: &str = "\
 # a unit square as one polygon
@@ -291,28 +292,10 @@ vn 0 0 1
 f 1/1/1 2/2/1 3/3/1 4/4/1
 ";
 
-    fn square() -> Mesh {
-        Mesh {
-            positions: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(1.0, 0.0, 0.0),
-                DVec3::new(1.0, 1.0, 0.0),
-                DVec3::new(0.0, 1.0, 0.0),
-            ],
-            uvs: vec![
-                DVec2::new(0.0, 0.0),
-                DVec2::new(1.0, 0.0),
-                DVec2::new(1.0, 1.0),
-                DVec2::new(0.0, 1.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-        }
-    }
-
     #[test]
     fn polygon_is_fan_triangulated_and_ignored_statements_are_skipped() {
         let mesh = parse_obj(QUAD).expect("valid quad");
-        assert_eq!(mesh, square());
+        assert_eq!(mesh, unit_square());
     }
 
     #[test]
@@ -321,7 +304,7 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
                     f -3/-3 -2/-2 -1/-1\n\
                     v 0 1 0\nvt 0 1\nf 1/1 3/3 -1/-1\n";
         let mesh = parse_obj(text).expect("valid");
-        assert_eq!(mesh, square());
+        assert_eq!(mesh, unit_square());
     }
 
     #[test]
@@ -329,7 +312,7 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
                     vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0 0\nvt 1 1\n\
                     f 1/1 2/2 3/3\nf 1/5 3/6 4/4\n";
-        assert_eq!(parse_obj(text).expect("no seam"), square());
+        assert_eq!(parse_obj(text).expect("no seam"), unit_square());
     }
 
     #[test]
@@ -337,7 +320,7 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         let text = "v 9 9 9\nv 0 0 0\nv 1 0 0\nv 8 8 8\nv 1 1 0\nv 0 1 0\nv 7 7 7\n\
                     vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
                     f 2/1 3/2 5/3 6/4\n";
-        assert_eq!(parse_obj(text).expect("valid"), square());
+        assert_eq!(parse_obj(text).expect("valid"), unit_square());
     }
 
     #[test]
@@ -484,7 +467,7 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         std::fs::create_dir_all(&dir).expect("temp dir");
         let path = dir.join("square.obj");
         std::fs::write(&path, QUAD).expect("write");
-        assert_eq!(load_obj(&path).expect("loads"), square());
+        assert_eq!(load_obj(&path).expect("loads"), unit_square());
         std::fs::remove_dir_all(&dir).expect("clean up");
 
         let missing = dir.join("missing.obj");

@@ -149,29 +149,12 @@ impl Topology {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::generate::unit_square;
     use glam::{DVec2, DVec3};
-
-    fn quad() -> Mesh {
-        Mesh {
-            positions: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(1.0, 0.0, 0.0),
-                DVec3::new(1.0, 1.0, 0.0),
-                DVec3::new(0.0, 1.0, 0.0),
-            ],
-            uvs: vec![
-                DVec2::new(0.0, 0.0),
-                DVec2::new(1.0, 0.0),
-                DVec2::new(1.0, 1.0),
-                DVec2::new(0.0, 1.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-        }
-    }
 
     #[test]
     fn quad_has_one_interior_edge_with_its_hinge() {
-        let topo = Topology::build(&quad()).expect("valid quad");
+        let topo = Topology::build(&unit_square()).expect("valid quad");
         assert_eq!(topo.edges.len(), 5);
         assert_eq!(topo.interior_edge_count(), 1);
         assert_eq!(topo.boundary_edge_count(), 4);
@@ -183,7 +166,7 @@ mod tests {
 
     #[test]
     fn edge_shared_by_three_triangles_is_non_manifold() {
-        let mut m = quad();
+        let mut m = unit_square();
         m.positions.push(DVec3::new(0.5, 0.5, 1.0));
         m.uvs.push(DVec2::new(0.5, 0.5));
         m.triangles.push([2, 0, 4]);
@@ -200,7 +183,7 @@ mod tests {
 
     #[test]
     fn flipped_neighbour_is_inconsistent_orientation() {
-        let mut m = quad();
+        let mut m = unit_square();
         m.triangles[1] = [0, 3, 2];
         let err = Topology::build(&m).expect_err("flipped");
         assert!(matches!(

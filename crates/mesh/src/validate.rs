@@ -230,26 +230,8 @@ fn count_pieces(triangle_count: usize, topology: &Topology) -> usize {
 mod tests {
     use super::*;
     use crate::generate;
+    use crate::generate::unit_square;
     use glam::{DVec2, DVec3};
-
-    /// The unit square as two triangles, UV = XY.
-    fn square() -> Mesh {
-        Mesh {
-            positions: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(1.0, 0.0, 0.0),
-                DVec3::new(1.0, 1.0, 0.0),
-                DVec3::new(0.0, 1.0, 0.0),
-            ],
-            uvs: vec![
-                DVec2::new(0.0, 0.0),
-                DVec2::new(1.0, 0.0),
-                DVec2::new(1.0, 1.0),
-                DVec2::new(0.0, 1.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-        }
-    }
 
     #[test]
     fn generated_petal_is_valid() {
@@ -277,7 +259,7 @@ mod tests {
 
     #[test]
     fn index_out_of_range() {
-        let mut m = square();
+        let mut m = unit_square();
         m.triangles[1] = [0, 2, 7];
         assert_eq!(
             validate(&m),
@@ -291,7 +273,7 @@ mod tests {
 
     #[test]
     fn repeated_vertex() {
-        let mut m = square();
+        let mut m = unit_square();
         m.triangles[1] = [0, 3, 3];
         assert_eq!(
             validate(&m),
@@ -304,7 +286,7 @@ mod tests {
 
     #[test]
     fn uv_count_mismatch() {
-        let mut m = square();
+        let mut m = unit_square();
         m.uvs.pop();
         assert_eq!(
             validate(&m),
@@ -317,13 +299,13 @@ mod tests {
 
     #[test]
     fn non_finite_position() {
-        let mut m = square();
+        let mut m = unit_square();
         m.positions[2].y = f64::NAN;
         assert_eq!(
             validate(&m),
             Err(MeshError::NonFinitePosition { vertex: 2 })
         );
-        let mut m = square();
+        let mut m = unit_square();
         m.positions[3].z = f64::NEG_INFINITY;
         assert_eq!(
             validate(&m),
@@ -333,14 +315,14 @@ mod tests {
 
     #[test]
     fn non_finite_uv() {
-        let mut m = square();
+        let mut m = unit_square();
         m.uvs[1].x = f64::INFINITY;
         assert_eq!(validate(&m), Err(MeshError::NonFiniteUv { vertex: 1 }));
     }
 
     #[test]
     fn unused_vertex() {
-        let mut m = square();
+        let mut m = unit_square();
         m.positions.insert(1, DVec3::new(5.0, 5.0, 5.0));
         m.uvs.insert(1, DVec2::new(0.5, 0.5));
         for tri in &mut m.triangles {
@@ -355,7 +337,7 @@ mod tests {
 
     #[test]
     fn zero_area_triangle_in_3d() {
-        let mut m = square();
+        let mut m = unit_square();
         // Corner 3 on the diagonal 0-2: triangle 1 collapses to a segment in
         // 3D while its UVs stay a proper triangle.
         m.positions[3] = DVec3::new(2.0, 2.0, 0.0);
@@ -374,7 +356,7 @@ mod tests {
         // The square shrunk to 1e-8 is valid; pushing corner 3 out to the
         // diagonal's extension, 1e-22 (1e-14 of the mesh size) off it, makes
         // triangle 1 a sliver.
-        let mut m = square();
+        let mut m = unit_square();
         for p in &mut m.positions {
             *p *= 1e-8;
         }
@@ -392,7 +374,7 @@ mod tests {
 
     #[test]
     fn zero_area_triangle_in_uv() {
-        let mut m = square();
+        let mut m = unit_square();
         m.uvs[3] = DVec2::new(0.5, 0.5);
         match validate(&m) {
             Err(MeshError::DegenerateTriangle {
@@ -406,7 +388,7 @@ mod tests {
 
     #[test]
     fn non_manifold_edge() {
-        let mut m = square();
+        let mut m = unit_square();
         m.positions.push(DVec3::new(0.5, 0.5, 1.0));
         m.uvs.push(DVec2::new(0.2, 0.8));
         m.triangles.push([2, 0, 4]);
@@ -422,7 +404,7 @@ mod tests {
 
     #[test]
     fn inconsistent_orientation() {
-        let mut m = square();
+        let mut m = unit_square();
         m.triangles[1] = [0, 3, 2];
         assert_eq!(
             validate(&m),
@@ -503,8 +485,8 @@ mod tests {
 
     #[test]
     fn two_pieces() {
-        let mut m = square();
-        let second = square();
+        let mut m = unit_square();
+        let second = unit_square();
         m.positions.extend(
             second
                 .positions
