@@ -347,14 +347,7 @@ fn encode_mesh(
                     .collect();
                 gltf.vec3_i16(&deltas, true)
             }
-            _ => {
-                let deltas: Vec<[f32; 3]> = frame
-                    .iter()
-                    .zip(base)
-                    .map(|(p, p0)| (*p - *p0).as_vec3().to_array())
-                    .collect();
-                gltf.vec3_f32_target(&deltas, true, options.encoding)
-            }
+            _ => gltf.vec3_f32_target(&f32_deltas(frame, base), true, options.encoding),
         };
         target.insert("POSITION".to_owned(), accessor.into());
 
@@ -388,11 +381,7 @@ fn encode_mesh(
                     }
                 }
                 None => {
-                    let deltas: Vec<[f32; 3]> = normals
-                        .iter()
-                        .zip(base_normals)
-                        .map(|(n, n0)| (*n - *n0).as_vec3().to_array())
-                        .collect();
+                    let deltas = f32_deltas(&normals, base_normals);
                     gltf.vec3_f32_target(&deltas, false, options.encoding)
                 }
             };
@@ -449,6 +438,80 @@ fn min_max<const N: usize, T: Copy + PartialOrd + Into<f64>>(values: &[[T; N]]) 
     (as_json(min), as_json(max))
 }
 
+/// `values - base`, vertex by vertex, as `f32`: a morph target's deltas.
+fn f32_deltas(values: &[DVec3], base: &[DVec3]) -> Vec<[f32; 3]> {
+    values
+        .iter()
+        .zip(base)
+        .map(|(v, v0)| (*v - *v0).as_vec3().to_array())
+        .collect()
+}
+
+/// Adds the per-component `min` and `max` of `values` to `accessor`.
+fn set_min_max<const N: usize, T: Copy + PartialOrd + Into<f64>>(
+    accessor: &mut Value,
+    values: &[[T; N]],
+) {
+    let (min, max) = min_max(values);
+    accessor["min"] = min;
+    accessor["max"] = max;
+}
+
+/// The little-endian bytes of `values`, as glTF buffers hold numbers.
+fn le_bytes<T, const B: usize>(
+    values: impl IntoIterator<Item = T>,
+    to_le_bytes: fn(T) -> [u8; B],
+) -> Vec<u8> {
+    values.into_iter().flat_map(to_le_bytes).collect()
+}
+
+/// What an accessor's elements are: the component type, whether integer
+/// components are normalized to `[0, 1]` or `[-1, 1]`, and the glTF type
+/// (`SCALAR`, `VEC2`, `VEC3`).
+#[derive(Clone, Copy)]
+struct Element {
+    component_type: u32,
+    normalized: bool,
+    kind: &'static str,
+}
+
+const VEC3_F32: Element = Element::plain(FLOAT, "VEC3");
+const SCALAR_F32: Element = Element::plain(FLOAT, "SCALAR");
+
+impl Element {
+    const fn plain(component_type: u32, kind: &'static str) -> Element {
+        Element {
+            component_type,
+            normalized: false,
+            kind,
+        }
+    }
+
+    const fn normalized(component_type: u32, kind: &'static str) -> Element {
+        Element {
+            component_type,
+            normalized: true,
+            kind,
+        }
+    }
+
+    /// An accessor of `count` such elements, over buffer view `view` (with
+    /// none, all zeros unless made sparse).
+    fn accessor(self, view: Option<usize>, count: usize) -> Value {
+        let mut accessor = Map::new();
+        if let Some(view) = view {
+            accessor.insert("bufferView".into(), view.into());
+        }
+        accessor.insert("componentType".into(), self.component_type.into());
+        if self.normalized {
+            accessor.insert("normalized".into(), true.into());
+        }
+        accessor.insert("count".into(), count.into());
+        accessor.insert("type".into(), self.kind.into());
+        Value::Object(accessor)
+    }
+}
+
 /// The binary chunk and the buffer views and accessors that describe it.
 #[derive(Default)]
 struct GltfBuilder {
@@ -489,23 +552,25 @@ impl GltfBuilder {
         self.accessors.len() - 1
     }
 
+    /// Stores `bytes` as a new buffer view (see [`GltfBuilder::view`]) and
+    /// returns an accessor of `count` `element`s over it.
+    fn stored(
+        &mut self,
+        bytes: &[u8],
+        stride: Option<usize>,
+        target: Option<u32>,
+        element: Element,
+        count: usize,
+    ) -> Value {
+        let view = self.view(bytes, stride, target);
+        element.accessor(Some(view), count)
+    }
+
     fn vec3_f32(&mut self, values: &[[f32; 3]], with_min_max: bool) -> usize {
-        let bytes: Vec<u8> = values
-            .iter()
-            .flatten()
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, None, Some(ARRAY_BUFFER));
-        let mut accessor = json!({
-            "bufferView": view,
-            "componentType": FLOAT,
-            "count": values.len(),
-            "type": "VEC3",
-        });
+        let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
+        let mut accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), VEC3_F32, values.len());
         if with_min_max {
-            let (min, max) = min_max(values);
-            accessor["min"] = min;
-            accessor["max"] = max;
+            set_min_max(&mut accessor, values);
         }
         self.accessor(accessor)
     }
@@ -540,55 +605,43 @@ impl GltfBuilder {
         if sparse_bytes >= dense_bytes {
             return self.vec3_f32(deltas, with_min_max);
         }
-        let mut accessor = json!({
-            "componentType": FLOAT,
-            "count": deltas.len(),
-            "type": "VEC3",
-        });
+        let mut accessor = VEC3_F32.accessor(None, deltas.len());
         if with_min_max {
-            let (min, max) = min_max(deltas);
-            accessor["min"] = min;
-            accessor["max"] = max;
+            set_min_max(&mut accessor, deltas);
         }
-        // No buffer view: the accessor is zeros, overridden by the sparse
-        // values.
-        let indices = index_bytes(&moved, index_type);
-        let indices_view = self.view(&indices, None, None);
-        let values: Vec<u8> = moved
-            .iter()
-            .flat_map(|&i| deltas[i])
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let values_view = self.view(&values, None, None);
+        let values = le_bytes(moved.iter().flat_map(|&i| deltas[i]), f32::to_le_bytes);
+        self.add_sparse(&mut accessor, &moved, index_type, &values);
+        self.accessor(accessor)
+    }
+
+    /// Makes `accessor` (one with no buffer view, so all zeros) sparse:
+    /// the elements at `positions` hold `values`.
+    fn add_sparse(
+        &mut self,
+        accessor: &mut Value,
+        positions: &[usize],
+        index_type: u32,
+        values: &[u8],
+    ) {
+        let indices_view = self.view(&index_bytes(positions, index_type), None, None);
+        let values_view = self.view(values, None, None);
         accessor["sparse"] = json!({
-            "count": moved.len(),
+            "count": positions.len(),
             "indices": { "bufferView": indices_view, "componentType": index_type },
             "values": { "bufferView": values_view },
         });
-        self.accessor(accessor)
     }
 
     /// Normalized `i16` VEC3, padded to an 8-byte stride as vertex
     /// attributes must be 4-byte aligned.
     fn vec3_i16(&mut self, values: &[[i16; 3]], with_min_max: bool) -> usize {
         self.uses_quantization = true;
-        let bytes: Vec<u8> = values
-            .iter()
-            .flat_map(|v| [v[0], v[1], v[2], 0])
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, Some(8), Some(ARRAY_BUFFER));
-        let mut accessor = json!({
-            "bufferView": view,
-            "componentType": SHORT,
-            "normalized": true,
-            "count": values.len(),
-            "type": "VEC3",
-        });
+        let padded = values.iter().flat_map(|v| [v[0], v[1], v[2], 0]);
+        let bytes = le_bytes(padded, i16::to_le_bytes);
+        let element = Element::normalized(SHORT, "VEC3");
+        let mut accessor = self.stored(&bytes, Some(8), Some(ARRAY_BUFFER), element, values.len());
         if with_min_max {
-            let (min, max) = min_max(values);
-            accessor["min"] = min;
-            accessor["max"] = max;
+            set_min_max(&mut accessor, values);
         }
         self.accessor(accessor)
     }
@@ -596,50 +649,25 @@ impl GltfBuilder {
     /// Normalized `i8` VEC3, padded to a 4-byte stride.
     fn vec3_i8_normalized(&mut self, values: &[[i8; 3]]) -> usize {
         self.uses_quantization = true;
-        let bytes: Vec<u8> = values
-            .iter()
-            .flat_map(|v| [v[0], v[1], v[2], 0])
-            .map(|x| x as u8)
-            .collect();
-        let view = self.view(&bytes, Some(4), Some(ARRAY_BUFFER));
-        self.accessor(json!({
-            "bufferView": view,
-            "componentType": BYTE,
-            "normalized": true,
-            "count": values.len(),
-            "type": "VEC3",
-        }))
+        let padded = values.iter().flat_map(|v| [v[0], v[1], v[2], 0]);
+        let bytes = le_bytes(padded, i8::to_le_bytes);
+        let element = Element::normalized(BYTE, "VEC3");
+        let accessor = self.stored(&bytes, Some(4), Some(ARRAY_BUFFER), element, values.len());
+        self.accessor(accessor)
     }
 
     fn vec2_f32(&mut self, values: &[[f32; 2]]) -> usize {
-        let bytes: Vec<u8> = values
-            .iter()
-            .flatten()
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, None, Some(ARRAY_BUFFER));
-        self.accessor(json!({
-            "bufferView": view,
-            "componentType": FLOAT,
-            "count": values.len(),
-            "type": "VEC2",
-        }))
+        let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
+        let element = Element::plain(FLOAT, "VEC2");
+        let accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), element, values.len());
+        self.accessor(accessor)
     }
 
     fn vec2_u16_normalized(&mut self, values: &[[u16; 2]]) -> usize {
-        let bytes: Vec<u8> = values
-            .iter()
-            .flatten()
-            .flat_map(|x| x.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, None, Some(ARRAY_BUFFER));
-        self.accessor(json!({
-            "bufferView": view,
-            "componentType": UNSIGNED_SHORT,
-            "normalized": true,
-            "count": values.len(),
-            "type": "VEC2",
-        }))
+        let bytes = le_bytes(values.iter().flatten().copied(), u16::to_le_bytes);
+        let element = Element::normalized(UNSIGNED_SHORT, "VEC2");
+        let accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), element, values.len());
+        self.accessor(accessor)
     }
 
     fn indices(&mut self, triangles: &[[u32; 3]], vertex_count: usize) -> usize {
@@ -650,28 +678,25 @@ impl GltfBuilder {
             other => other,
         };
         let bytes = index_bytes(&flat, component_type);
-        let view = self.view(&bytes, None, Some(ELEMENT_ARRAY_BUFFER));
-        self.accessor(json!({
-            "bufferView": view,
-            "componentType": component_type,
-            "count": flat.len(),
-            "type": "SCALAR",
-        }))
+        let element = Element::plain(component_type, "SCALAR");
+        let accessor = self.stored(
+            &bytes,
+            None,
+            Some(ELEMENT_ARRAY_BUFFER),
+            element,
+            flat.len(),
+        );
+        self.accessor(accessor)
     }
 
     fn times(&mut self, times: &[f32]) -> usize {
-        let bytes: Vec<u8> = times.iter().flat_map(|x| x.to_le_bytes()).collect();
-        let view = self.view(&bytes, None, None);
+        let bytes = le_bytes(times.iter().copied(), f32::to_le_bytes);
+        let mut accessor = self.stored(&bytes, None, None, SCALAR_F32, times.len());
         let first = times.first().copied().unwrap_or(0.0);
         let last = times.last().copied().unwrap_or(0.0);
-        self.accessor(json!({
-            "bufferView": view,
-            "componentType": FLOAT,
-            "count": times.len(),
-            "type": "SCALAR",
-            "min": [f32_json(first)],
-            "max": [f32_json(last)],
-        }))
+        accessor["min"] = json!([f32_json(first)]);
+        accessor["max"] = json!([f32_json(last)]);
+        self.accessor(accessor)
     }
 
     /// One-hot weights: at exported keyframe `k >= 1` target `k - 1` has
@@ -679,56 +704,33 @@ impl GltfBuilder {
     fn weights(&mut self, keyframes: usize, targets: usize, encoding: Encoding) -> usize {
         let count = keyframes * targets;
         let ones = (1..keyframes).map(|k| k * targets + (k - 1));
-        match encoding {
+        let accessor = match encoding {
             Encoding::Dense => {
                 let mut values = vec![0.0f32; count];
                 for i in ones {
                     values[i] = 1.0;
                 }
-                let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
-                let view = self.view(&bytes, None, None);
-                self.accessor(json!({
-                    "bufferView": view,
-                    "componentType": FLOAT,
-                    "count": count,
-                    "type": "SCALAR",
-                }))
+                let bytes = le_bytes(values, f32::to_le_bytes);
+                self.stored(&bytes, None, None, SCALAR_F32, count)
             }
             Encoding::Sparse => {
                 let positions: Vec<usize> = ones.collect();
                 let index_type = index_component_type(count);
-                let indices_view = self.view(&index_bytes(&positions, index_type), None, None);
-                let values: Vec<u8> = positions
-                    .iter()
-                    .flat_map(|_| 1.0f32.to_le_bytes())
-                    .collect();
-                let values_view = self.view(&values, None, None);
-                self.accessor(json!({
-                    "componentType": FLOAT,
-                    "count": count,
-                    "type": "SCALAR",
-                    "sparse": {
-                        "count": positions.len(),
-                        "indices": { "bufferView": indices_view, "componentType": index_type },
-                        "values": { "bufferView": values_view },
-                    },
-                }))
+                let values = le_bytes(positions.iter().map(|_| 1.0f32), f32::to_le_bytes);
+                let mut accessor = SCALAR_F32.accessor(None, count);
+                self.add_sparse(&mut accessor, &positions, index_type, &values);
+                accessor
             }
             Encoding::Quantized => {
                 let mut values = vec![0u8; count];
                 for i in ones {
                     values[i] = u8::MAX;
                 }
-                let view = self.view(&values, None, None);
-                self.accessor(json!({
-                    "bufferView": view,
-                    "componentType": UNSIGNED_BYTE,
-                    "normalized": true,
-                    "count": count,
-                    "type": "SCALAR",
-                }))
+                let element = Element::normalized(UNSIGNED_BYTE, "SCALAR");
+                self.stored(&values, None, None, element, count)
             }
-        }
+        };
+        self.accessor(accessor)
     }
 
     /// Assembles the GLB container: header, JSON chunk, binary chunk.
