@@ -1,5 +1,8 @@
 //! Map sets keyed in time and the curves that blend between keys.
 
+use std::iter::Sum;
+use std::ops::Mul;
+
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
@@ -196,31 +199,25 @@ impl KeyedMaps {
         step: f64,
         corners_in_uv: [DVec2; 3],
     ) -> f64 {
-        self.weights_at(step)
-            .iter()
-            .filter(|(_, weight)| *weight != 0.0)
-            .map(|&(index, weight)| {
-                weight
-                    * self.keys[index]
-                        .maps
-                        .scalar(kind)
-                        .triangle_value(corners_in_uv)
-            })
-            .sum()
+        self.blend_at(step, |maps| maps.scalar(kind).triangle_value(corners_in_uv))
     }
 
     /// The blended eq. 1 direction (not normalised) for a triangle at `step`.
     pub fn direction_triangle_value_at(&self, step: f64, corners_in_uv: [DVec2; 3]) -> DVec2 {
+        self.blend_at(step, |maps| maps.direction.triangle_value(corners_in_uv))
+    }
+
+    /// `value_of` the keys around `step`, weighted as [`KeyedMaps::weights_at`]
+    /// says (a key of weight zero is not asked).
+    fn blend_at<T>(&self, step: f64, value_of: impl Fn(&GrowthMaps) -> T) -> T
+    where
+        T: Sum,
+        f64: Mul<T, Output = T>,
+    {
         self.weights_at(step)
             .iter()
             .filter(|(_, weight)| *weight != 0.0)
-            .map(|&(index, weight)| {
-                weight
-                    * self.keys[index]
-                        .maps
-                        .direction
-                        .triangle_value(corners_in_uv)
-            })
+            .map(|&(index, weight)| weight * value_of(&self.keys[index].maps))
             .sum()
     }
 }

@@ -43,7 +43,7 @@ pub use error::MapError;
 pub use growth::{DIRECTION_MAP_NAME, GrowthMaps, MapKind};
 pub use keys::{Blend, KeyedMaps, MapKey};
 pub use png_io::BitDepth;
-pub use raster::{DirectionMap, ScalarMap};
+pub use raster::{DirectionMap, Raster, ScalarMap};
 
 #[cfg(test)]
 mod tests;

@@ -9,42 +9,32 @@ use glam::DVec2;
 use crate::MapError;
 use crate::png_io::{self, BitDepth, DecodedPng};
 
-/// A raster of scalar values over the UV square.
+/// Values of type `T` over the UV square, one per pixel: [`ScalarMap`]
+/// holds `f32`s and [`DirectionMap`] `[u, v]` pairs.
 ///
 /// Values are stored row by row in image order: the first row is the top of
 /// the image (`v = 1`), the last row the bottom (`v = 0`); see the crate
 /// documentation for the UV convention.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ScalarMap {
+pub struct Raster<T> {
     width: u32,
     height: u32,
-    values: Vec<f32>,
+    values: Vec<T>,
 }
+
+/// A raster of scalar values over the UV square.
+pub type ScalarMap = Raster<f32>;
 
 /// A raster of 2D growth directions in UV space, each channel in `[-1, 1]`.
 ///
 /// Stored like [`ScalarMap`] (first row = top of the image = `v = 1`). The
 /// vectors need not be unit length; normalising (and deciding what a zero
 /// vector means) is left to the consumer.
-#[derive(Clone, Debug, PartialEq)]
-pub struct DirectionMap {
-    width: u32,
-    height: u32,
-    values: Vec<[f32; 2]>,
-}
+pub type DirectionMap = Raster<[f32; 2]>;
 
-impl ScalarMap {
-    /// A 1x1 raster: the same value everywhere.
-    pub fn constant(value: f32) -> Self {
-        Self {
-            width: 1,
-            height: 1,
-            values: vec![value],
-        }
-    }
-
+impl<T> Raster<T> {
     /// A raster from values in image order (first row = top = `v = 1`).
-    pub fn new(width: u32, height: u32, values: Vec<f32>) -> Result<Self, MapError> {
+    pub fn new(width: u32, height: u32, values: Vec<T>) -> Result<Self, MapError> {
         check_value_count(width, height, values.len())?;
         Ok(Self {
             width,
@@ -53,9 +43,18 @@ impl ScalarMap {
         })
     }
 
+    /// A 1x1 raster: the same value everywhere.
+    fn single(value: T) -> Self {
+        Self {
+            width: 1,
+            height: 1,
+            values: vec![value],
+        }
+    }
+
     /// A raster whose pixel values are `value_at(uv of the pixel centre)`.
     /// A zero width or height is taken as 1.
-    pub fn from_fn(width: u32, height: u32, value_at: impl Fn(DVec2) -> f32) -> Self {
+    fn at_pixel_centres(width: u32, height: u32, value_at: impl Fn(DVec2) -> T) -> Self {
         let (width, height) = (width.max(1), height.max(1));
         let values = pixel_centres_in_uv(width, height).map(value_at).collect();
         Self {
@@ -79,11 +78,11 @@ impl ScalarMap {
     }
 
     /// All values in image order (first row = top = `v = 1`).
-    pub fn values(&self) -> &[f32] {
+    pub fn values(&self) -> &[T] {
         &self.values
     }
 
-    pub fn values_mut(&mut self) -> &mut [f32] {
+    pub fn values_mut(&mut self) -> &mut [T] {
         &mut self.values
     }
 
@@ -91,6 +90,24 @@ impl ScalarMap {
     /// top row.
     pub fn pixel_centre_in_uv(&self, x: u32, y: u32) -> DVec2 {
         pixel_centre_in_uv(self.width, self.height, x, y)
+    }
+
+    /// `Ok` when the raster is `expected` = `(width, height)` pixels.
+    pub fn check_size(&self, expected: (u32, u32)) -> Result<(), MapError> {
+        check_size(self.size(), expected)
+    }
+}
+
+impl ScalarMap {
+    /// A 1x1 raster: the same value everywhere.
+    pub fn constant(value: f32) -> Self {
+        Self::single(value)
+    }
+
+    /// A raster whose pixel values are `value_at(uv of the pixel centre)`.
+    /// A zero width or height is taken as 1.
+    pub fn from_fn(width: u32, height: u32, value_at: impl Fn(DVec2) -> f32) -> Self {
+        Self::at_pixel_centres(width, height, value_at)
     }
 
     /// Bilinear interpolation between pixel centres; points beyond the outer
@@ -104,11 +121,6 @@ impl ScalarMap {
     /// `(m(uv0) + m(uv1) + m(uv2) + 3 m(centroid)) / 6`.
     pub fn triangle_value(&self, corners_in_uv: [DVec2; 3]) -> f64 {
         triangle_rule(corners_in_uv, |point_in_uv| self.sample(point_in_uv))
-    }
-
-    /// `Ok` when the raster is `expected` = `(width, height)` pixels.
-    pub fn check_size(&self, expected: (u32, u32)) -> Result<(), MapError> {
-        check_size(self.size(), expected)
     }
 
     /// Reads a greyscale PNG, 8-bit (value = code / 255) or 16-bit
@@ -159,63 +171,15 @@ impl ScalarMap {
 impl DirectionMap {
     /// A 1x1 raster: the same direction everywhere.
     pub fn constant(direction_in_uv: DVec2) -> Self {
-        Self {
-            width: 1,
-            height: 1,
-            values: vec![to_pair(direction_in_uv)],
-        }
-    }
-
-    /// A raster from `[u, v]` values in image order (first row = top = `v = 1`).
-    pub fn new(width: u32, height: u32, values: Vec<[f32; 2]>) -> Result<Self, MapError> {
-        check_value_count(width, height, values.len())?;
-        Ok(Self {
-            width,
-            height,
-            values,
-        })
+        Self::single(to_pair(direction_in_uv))
     }
 
     /// A raster whose pixel values are `direction_at(uv of the pixel centre)`.
     /// A zero width or height is taken as 1.
     pub fn from_fn(width: u32, height: u32, direction_at: impl Fn(DVec2) -> DVec2) -> Self {
-        let (width, height) = (width.max(1), height.max(1));
-        let values = pixel_centres_in_uv(width, height)
-            .map(|point_in_uv| to_pair(direction_at(point_in_uv)))
-            .collect();
-        Self {
-            width,
-            height,
-            values,
-        }
-    }
-
-    pub fn width(&self) -> u32 {
-        self.width
-    }
-
-    pub fn height(&self) -> u32 {
-        self.height
-    }
-
-    /// `(width, height)` in pixels.
-    pub fn size(&self) -> (u32, u32) {
-        (self.width, self.height)
-    }
-
-    /// All `[u, v]` values in image order (first row = top = `v = 1`).
-    pub fn values(&self) -> &[[f32; 2]] {
-        &self.values
-    }
-
-    pub fn values_mut(&mut self) -> &mut [[f32; 2]] {
-        &mut self.values
-    }
-
-    /// The UV position of the centre of pixel `(x, y)`, `y` counted from the
-    /// top row.
-    pub fn pixel_centre_in_uv(&self, x: u32, y: u32) -> DVec2 {
-        pixel_centre_in_uv(self.width, self.height, x, y)
+        Self::at_pixel_centres(width, height, |point_in_uv| {
+            to_pair(direction_at(point_in_uv))
+        })
     }
 
     /// Bilinear interpolation of the signed components (not normalised), with
@@ -230,11 +194,6 @@ impl DirectionMap {
     /// Paper eq. 1 on each component (not normalised).
     pub fn triangle_value(&self, corners_in_uv: [DVec2; 3]) -> DVec2 {
         triangle_rule(corners_in_uv, |point_in_uv| self.sample(point_in_uv))
-    }
-
-    /// `Ok` when the raster is `expected` = `(width, height)` pixels.
-    pub fn check_size(&self, expected: (u32, u32)) -> Result<(), MapError> {
-        check_size(self.size(), expected)
     }
 
     /// Reads an RGB or RGBA PNG, 8 or 16 bit: red is the `u` component, green
