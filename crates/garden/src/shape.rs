@@ -265,19 +265,27 @@ pub fn flower_shape<'a>(
         .into_iter()
         .map(|(mesh, positions)| organ_shape(mesh, positions))
         .collect::<Result<Vec<_>, _>>()?;
-    let n = organs.len().max(1) as f64;
-    let mean_of = |f: &dyn Fn(&OrganShape) -> f64| organs.iter().map(f).sum::<f64>() / n;
-    let mean = OrganShape {
-        midrib_angles_deg: [0, 1, 2].map(|k| mean_of(&|o| o.midrib_angles_deg[k])),
-        midrib_turning_deg: mean_of(&|o| o.midrib_turning_deg),
-        lamina_turning_deg: mean_of(&|o| o.lamina_turning_deg),
-        cupping: mean_of(&|o| o.cupping),
-        swelling: mean_of(&|o| o.swelling),
-        radius_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.radius_profile[k])),
-        height_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.height_profile[k])),
-        midrib_length: mean_of(&|o| o.midrib_length),
-    };
-    Ok(FlowerShape { organs, mean })
+    Ok(FlowerShape::of_organs(organs))
+}
+
+impl FlowerShape {
+    /// The shape of a group of measured organs: them and their means (all
+    /// zero for no organs).
+    pub fn of_organs(organs: Vec<OrganShape>) -> FlowerShape {
+        let n = organs.len().max(1) as f64;
+        let mean_of = |f: &dyn Fn(&OrganShape) -> f64| organs.iter().map(f).sum::<f64>() / n;
+        let mean = OrganShape {
+            midrib_angles_deg: [0, 1, 2].map(|k| mean_of(&|o| o.midrib_angles_deg[k])),
+            midrib_turning_deg: mean_of(&|o| o.midrib_turning_deg),
+            lamina_turning_deg: mean_of(&|o| o.lamina_turning_deg),
+            cupping: mean_of(&|o| o.cupping),
+            swelling: mean_of(&|o| o.swelling),
+            radius_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.radius_profile[k])),
+            height_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.height_profile[k])),
+            midrib_length: mean_of(&|o| o.midrib_length),
+        };
+        FlowerShape { organs, mean }
+    }
 }
 
 #[cfg(test)]
@@ -285,6 +293,25 @@ mod tests {
     use super::*;
     use anthesis_mesh::generate::parametric_grid;
     use std::f64::consts::PI;
+
+    #[test]
+    fn a_group_of_organs_has_the_mean_of_each_measure() {
+        let shape = |x: f64| OrganShape {
+            midrib_angles_deg: [x, 2.0 * x, 3.0 * x],
+            midrib_turning_deg: x,
+            lamina_turning_deg: -x,
+            cupping: 0.25 * x,
+            swelling: 0.5 * x,
+            radius_profile: [x; 4],
+            height_profile: [x, 0.0, x, 0.0],
+            midrib_length: 10.0 + x,
+        };
+        let group = FlowerShape::of_organs(vec![shape(1.0), shape(3.0)]);
+        assert_eq!(group.organs, vec![shape(1.0), shape(3.0)]);
+        assert_eq!(group.mean, shape(2.0));
+        let none = FlowerShape::of_organs(Vec::new());
+        assert_eq!(none.mean.midrib_length, 0.0);
+    }
 
     #[test]
     fn opening_angles_read_from_the_axis_outwards() {

@@ -125,22 +125,7 @@ fn lily_tepals_open_and_reflex_backwards() {
 
 /// The shape of some organs of a measured flower.
 fn flower_shape_of(shape: &FlowerShape, organs: &[usize]) -> FlowerShape {
-    let picked: Vec<OrganShape> = organs.iter().map(|&i| shape.organs[i]).collect();
-    let n = picked.len() as f64;
-    let mean_of = |f: &dyn Fn(&OrganShape) -> f64| picked.iter().map(f).sum::<f64>() / n;
-    FlowerShape {
-        mean: OrganShape {
-            midrib_angles_deg: [0, 1, 2].map(|k| mean_of(&|o| o.midrib_angles_deg[k])),
-            midrib_turning_deg: mean_of(&|o| o.midrib_turning_deg),
-            lamina_turning_deg: mean_of(&|o| o.lamina_turning_deg),
-            cupping: mean_of(&|o| o.cupping),
-            swelling: mean_of(&|o| o.swelling),
-            radius_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.radius_profile[k])),
-            height_profile: [0, 1, 2, 3].map(|k| mean_of(&|o| o.height_profile[k])),
-            midrib_length: mean_of(&|o| o.midrib_length),
-        },
-        organs: picked,
-    }
+    FlowerShape::of_organs(organs.iter().map(|&i| shape.organs[i]).collect())
 }
 
 #[test]
