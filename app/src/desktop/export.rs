@@ -338,6 +338,18 @@ mod tests {
     use super::*;
     use std::time::{Duration, Instant};
 
+    /// Polls `dialog` until its export ends (failing after a minute).
+    fn wait_for_the_end(dialog: &mut ExportDialog) -> ExportState {
+        let started = Instant::now();
+        loop {
+            if let Some(end) = dialog.poll() {
+                return end;
+            }
+            assert!(started.elapsed() < Duration::from_secs(60), "export hangs");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+
     #[test]
     fn an_export_writes_a_glb_and_reports_done_with_its_size() {
         let project = anthesis_sim::fixtures::whorl(2, 4, 6, 2);
@@ -352,20 +364,29 @@ mod tests {
             ..ExportDialog::default()
         };
         dialog.start(tracks(&project, &[0, 1], &frames), || {});
-        let started = Instant::now();
-        let end = loop {
-            if let Some(end) = dialog.poll() {
-                break end;
-            }
-            assert!(started.elapsed() < Duration::from_secs(60), "export hangs");
-            std::thread::sleep(Duration::from_millis(5));
-        };
+        let end = wait_for_the_end(&mut dialog);
         let ExportState::Done { bytes, .. } = end else {
             panic!("export failed: {end:?}");
         };
         let on_disk = std::fs::read(dir.path().join("out.glb")).expect("file");
         assert_eq!(on_disk.len() as u64, bytes);
         assert_eq!(&on_disk[..4], b"glTF");
+    }
+
+    #[test]
+    fn a_single_organ_run_exports_that_organ() {
+        let project = anthesis_sim::fixtures::whorl(2, 4, 6, 2);
+        let bud = anthesis_sim::Simulation::new(&project, &anthesis_sim::Selection::Only(1))
+            .expect("sim")
+            .bud();
+        let tracks = tracks(&project, &[1], &[Arc::new(bud.clone())]);
+        assert_eq!(tracks.len(), 1);
+        let template = project.flower.template_of(1);
+        assert_eq!(tracks[0].name, project.flower.organs[1].name);
+        assert_eq!(tracks[0].triangles, template.mesh.triangles);
+        assert_eq!(tracks[0].uvs, template.mesh.uvs);
+        assert_eq!(tracks[0].base_color, template.color);
+        assert_eq!(tracks[0].keyframes, bud.positions);
     }
 
     #[test]
@@ -379,14 +400,7 @@ mod tests {
             ..ExportDialog::default()
         };
         dialog.start(tracks(&project, &[0], &[Arc::new(bud)]), || {});
-        let started = Instant::now();
-        let end = loop {
-            if let Some(end) = dialog.poll() {
-                break end;
-            }
-            assert!(started.elapsed() < Duration::from_secs(30), "export hangs");
-            std::thread::sleep(Duration::from_millis(5));
-        };
+        let end = wait_for_the_end(&mut dialog);
         assert!(
             matches!(&end, ExportState::Failed { message } if message.contains("/no/such/folder")),
             "{end:?}"
