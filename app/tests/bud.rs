@@ -3,18 +3,10 @@
 
 use std::collections::HashMap;
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn anthesis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_anthesis"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+mod common;
 
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+use common::{anthesis, one_line_error, text};
 
 fn utf8(path: &Path) -> &str {
     path.to_str().expect("utf-8 path")
@@ -197,15 +189,8 @@ fn bad_surfaces_and_files_give_one_line_and_a_non_zero_exit() {
     ];
     for (args, expected) in cases {
         let args: Vec<&str> = std::iter::once("bud").chain(args).collect();
-        let out = anthesis(&args);
-        assert!(!out.status.success(), "{args:?} should fail");
+        let out = one_line_error(&args);
         let stderr = text(&out.stderr);
-        assert_eq!(
-            stderr.trim_end().lines().count(),
-            1,
-            "{args:?}: one line expected, got:\n{stderr}"
-        );
-        assert!(stderr.starts_with("error: "), "{stderr}");
         assert!(
             stderr.contains(expected),
             "{args:?}: `{expected}` missing from {stderr}"

@@ -2,18 +2,11 @@
 //! answer or files out, and a non-zero exit with one line on bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn anthesis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_anthesis"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+mod common;
 
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+use common::{anthesis, one_line_error, text};
 
 fn saved_whorl(dir: &Path, organs: usize, keyframes: u32) -> PathBuf {
     let project = anthesis_sim::fixtures::whorl(organs, 8, 14, keyframes);
@@ -145,15 +138,7 @@ fn bad_input_gives_one_line_and_a_non_zero_exit() {
     ];
     for args in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        let out = anthesis(&args);
-        assert!(!out.status.success(), "{args:?} should fail");
-        let stderr = text(&out.stderr);
-        assert_eq!(
-            stderr.trim_end().lines().count(),
-            1,
-            "{args:?}: one line expected, got:\n{stderr}"
-        );
-        assert!(stderr.starts_with("error: "), "{stderr}");
+        one_line_error(&args);
     }
     let out = anthesis(&["simulate"]);
     assert_eq!(

@@ -4,20 +4,13 @@
 //! rendering test fails: it is not skipped.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 
 use image::RgbaImage;
 
-fn anthesis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_anthesis"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
+mod common;
 
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+use common::{anthesis, one_line_error, text};
 
 fn utf8(path: &Path) -> &str {
     path.to_str().expect("utf-8 path")
@@ -174,15 +167,8 @@ fn render_refuses_bad_input_with_one_line() {
     }
     for (args, expected) in cases {
         let args: Vec<&str> = std::iter::once("render").chain(args).collect();
-        let out = anthesis(&args);
-        assert!(!out.status.success(), "{args:?} should fail");
+        let out = one_line_error(&args);
         let stderr = text(&out.stderr);
-        assert_eq!(
-            stderr.trim_end().lines().count(),
-            1,
-            "{args:?}: one line expected, got:\n{stderr}"
-        );
-        assert!(stderr.starts_with("error: "), "{stderr}");
         assert!(
             stderr.contains(expected),
             "{args:?}: `{expected}` missing from {stderr}"
