@@ -7,6 +7,7 @@ pub mod project;
 use anthesis_maps::KeyedMaps;
 use anthesis_mesh::Mesh;
 use anthesis_physics::SolverSettings;
+use anthesis_physics::{BendBase, Model};
 use glam::{DQuat, DVec3};
 
 /// Everything an organ type needs: its bud mesh (in the template frame, see
@@ -160,6 +161,10 @@ pub struct SimulationSettings {
     /// Distance a colliding particle is pushed past its neighbour (paper:
     /// 0.01).
     pub collision_offset: f64,
+    /// The discretisation of growth and mechanics.
+    pub model: Model,
+    /// Which angle a hinge's growth starts from.
+    pub bend_base: BendBase,
 }
 
 impl Default for SimulationSettings {
@@ -168,6 +173,8 @@ impl Default for SimulationSettings {
             keyframes: 100,
             solver: SolverSettings::default(),
             collision_offset: 0.01,
+            model: Model::default(),
+            bend_base: BendBase::default(),
         }
     }
 }

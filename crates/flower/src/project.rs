@@ -523,6 +523,7 @@ impl From<&SimulationFile> for SimulationSettings {
                 max_iterations: file.max_iterations,
             },
             collision_offset: file.collision_offset,
+            ..SimulationSettings::default()
         }
     }
 }

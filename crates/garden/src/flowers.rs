@@ -39,11 +39,19 @@ pub const FLOWER_NAMES: [&str; 4] = [
 
 /// Builds the default flower called `name` (one of [`FLOWER_NAMES`]).
 pub fn flower(name: &str) -> Option<Result<Project, GardenError>> {
+    flower_at_resolution(name, 1.0)
+}
+
+/// Builds the default flower called `name` with every bud remeshed at
+/// `edge_scale` times its default mean edge (0.5 gives about four times the
+/// particles): the same bud surfaces and the same maps, so the runs differ
+/// only in resolution (used by the refinement study).
+pub fn flower_at_resolution(name: &str, edge_scale: f64) -> Option<Result<Project, GardenError>> {
     Some(match name {
-        "lily" => lily(),
-        "eustoma-mellow-yellow" => eustoma(Cultivar::MellowYellow),
-        "eustoma-maite-lady" => eustoma(Cultivar::MaiteLady),
-        "eustoma-pinocchio" => eustoma(Cultivar::Pinocchio),
+        "lily" => lily_at(edge_scale),
+        "eustoma-mellow-yellow" => eustoma_at(Cultivar::MellowYellow, edge_scale),
+        "eustoma-maite-lady" => eustoma_at(Cultivar::MaiteLady, edge_scale),
+        "eustoma-pinocchio" => eustoma_at(Cultivar::Pinocchio, edge_scale),
         _ => return None,
     })
 }
@@ -261,10 +269,14 @@ fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, color: [f32; 4]) ->
 /// The lily petal template: [`lily_petal_bud`] meshed at edge 1.3 (about
 /// the paper's 388 particles), [`lily_maps`], Table 1's material.
 pub fn lily_petal_template() -> Result<Template, GardenError> {
+    lily_petal_template_at(1.0)
+}
+
+fn lily_petal_template_at(edge_scale: f64) -> Result<Template, GardenError> {
     let spec = lily_spec(
         "lily petal",
         lily_petal_bud(),
-        LILY_PETAL_EDGE,
+        LILY_PETAL_EDGE * edge_scale,
         [0.98, 0.55, 0.22, 1.0],
     );
     template("petal", &spec, lily_maps(LilyExcess::PETAL))
@@ -273,10 +285,14 @@ pub fn lily_petal_template() -> Result<Template, GardenError> {
 /// The lily sepal template: [`lily_sepal_bud`] meshed at edge 1.4 (about
 /// the paper's 323 particles), the petal's maps.
 pub fn lily_sepal_template() -> Result<Template, GardenError> {
+    lily_sepal_template_at(1.0)
+}
+
+fn lily_sepal_template_at(edge_scale: f64) -> Result<Template, GardenError> {
     let spec = lily_spec(
         "lily sepal",
         lily_sepal_bud(),
-        LILY_SEPAL_EDGE,
+        LILY_SEPAL_EDGE * edge_scale,
         [0.96, 0.5, 0.2, 1.0],
     );
     template("sepal", &spec, lily_maps(LilyExcess::SEPAL))
@@ -306,7 +322,14 @@ fn ring_whorl(
 
 /// The Asiatic lily: three petals inside three sepals.
 pub fn lily() -> Result<Project, GardenError> {
-    let templates = vec![lily_petal_template()?, lily_sepal_template()?];
+    lily_at(1.0)
+}
+
+fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
+    let templates = vec![
+        lily_petal_template_at(edge_scale)?,
+        lily_sepal_template_at(edge_scale)?,
+    ];
     let arrangement = nested_whorls(&[
         ring_whorl("petal", 0, &lily_petal_bud(), 3, 0.0),
         ring_whorl("sepal", 1, &lily_sepal_bud(), 3, 60.0),
@@ -504,10 +527,14 @@ pub fn eustoma_maps(cultivar: Cultivar) -> Result<KeyedMaps, MapError> {
 /// at edge 2.0 (about the paper's 261 particles), the cultivar's maps,
 /// Table 1's material.
 pub fn eustoma_petal_template(cultivar: Cultivar) -> Result<Template, GardenError> {
+    eustoma_petal_template_at(cultivar, 1.0)
+}
+
+fn eustoma_petal_template_at(cultivar: Cultivar, edge_scale: f64) -> Result<Template, GardenError> {
     let spec = TemplateSpec {
         organ: "Eustoma petal",
         bud: eustoma_petal_bud(),
-        edge: EUSTOMA_EDGE,
+        edge: EUSTOMA_EDGE * edge_scale,
         dg: EUSTOMA_DG,
         thickness: EUSTOMA_THICKNESS,
         stiffness: EUSTOMA_STIFFNESS,
@@ -521,6 +548,10 @@ pub fn eustoma_petal_template(cultivar: Cultivar) -> Result<Template, GardenErro
 /// One Eustoma cultivar: five contorted petals, each one's right side
 /// beneath its neighbour.
 pub fn eustoma(cultivar: Cultivar) -> Result<Project, GardenError> {
+    eustoma_at(cultivar, 1.0)
+}
+
+fn eustoma_at(cultivar: Cultivar, edge_scale: f64) -> Result<Project, GardenError> {
     let bud = eustoma_petal_bud();
     let arrangement = contorted_whorl(&ring_whorl("petal", 0, &bud, 5, 0.0)).ok_or_else(|| {
         GardenError::Arrangement(format!(
@@ -532,7 +563,7 @@ pub fn eustoma(cultivar: Cultivar) -> Result<Project, GardenError> {
     Ok(Project {
         name: cultivar.project_name().to_string(),
         flower: Flower {
-            templates: vec![eustoma_petal_template(cultivar)?],
+            templates: vec![eustoma_petal_template_at(cultivar, edge_scale)?],
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
         },

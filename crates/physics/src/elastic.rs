@@ -16,6 +16,7 @@ use glam::{DMat3, DVec3};
 use anthesis_mesh::Topology;
 
 use crate::hinge::{dihedral_angle, dihedral_gradient, hinge_is_degenerate};
+use crate::membrane::EdgeSmoothedMembrane;
 use crate::pattern::BlockPattern;
 
 /// A particle held on one side of a neighbouring organ: the particle should
@@ -56,6 +57,10 @@ pub struct Elastic {
     /// where the receptacle and the joint schedule put them).
     pub anchors: Vec<(u32, DVec3)>,
     pub anchor_stiffness: f64,
+    /// The consistent model's membrane; `None` for the paper's springs
+    /// (`stretch_stiffness` then holds their stiffness; either way it sets
+    /// the force and contact scales).
+    pub membrane: Option<EdgeSmoothedMembrane>,
 }
 
 impl Elastic {
@@ -87,7 +92,19 @@ impl Elastic {
             contact_stiffness: 0.0,
             anchors: Vec::new(),
             anchor_stiffness: 0.0,
+            membrane: None,
         }
+    }
+
+    /// The springs that carry the stretching energy: every edge, or none
+    /// when the edge-smoothed membrane does.
+    fn springs(&self) -> impl Iterator<Item = (usize, &[u32; 2])> + '_ {
+        let count = if self.membrane.is_some() {
+            0
+        } else {
+            self.edges.len()
+        };
+        self.edges.iter().enumerate().take(count)
     }
 
     /// Particle pairs coupled by the Hessian (edges and hinge wings).
@@ -112,7 +129,10 @@ impl Elastic {
 
     pub fn energy(&self, x: &[DVec3], contacts: &[Contact]) -> f64 {
         let mut e = 0.0;
-        for (idx, &[a, b]) in self.edges.iter().enumerate() {
+        if let Some(m) = &self.membrane {
+            e += m.energy(x, &self.rest_lengths, None);
+        }
+        for (idx, &[a, b]) in self.springs() {
             let stretch = (x[a as usize] - x[b as usize]).length() - self.rest_lengths[idx];
             e += 0.5 * self.stretch_stiffness[idx] * stretch * stretch;
         }
@@ -151,7 +171,10 @@ impl Elastic {
     pub fn energy_and_gradient(&self, x: &[DVec3], contacts: &[Contact], g: &mut [DVec3]) -> f64 {
         g.iter_mut().for_each(|v| *v = DVec3::ZERO);
         let mut e = 0.0;
-        for (idx, &[a, b]) in self.edges.iter().enumerate() {
+        if let Some(m) = &self.membrane {
+            e += m.energy(x, &self.rest_lengths, Some(g));
+        }
+        for (idx, &[a, b]) in self.springs() {
             let d = x[a as usize] - x[b as usize];
             let len = d.length();
             let stretch = len - self.rest_lengths[idx];
@@ -198,7 +221,10 @@ impl Elastic {
         values: &mut [f64],
     ) {
         values.iter_mut().for_each(|v| *v = 0.0);
-        for (idx, &[a, b]) in self.edges.iter().enumerate() {
+        if let Some(m) = &self.membrane {
+            m.hessian(x, &self.rest_lengths, pattern, values);
+        }
+        for (idx, &[a, b]) in self.springs() {
             let d = x[a as usize] - x[b as usize];
             let len = d.length();
             let n = d / len;

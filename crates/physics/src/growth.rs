@@ -2,19 +2,47 @@
 //! its own; the grown copies give the new rest lengths and rest angles.
 //!
 //! For a triangle `T` with growth direction `D` (the UV direction pushed
-//! through the triangle's UV→3D map) and the in-plane `W = n x D`:
-//! - `T'` scales `T` about its barycentre by the e-rate along `D` and the
-//!   w-rate along `W`; each edge's new rest length is the mean of its
-//!   triangles' grown lengths (eq. 3);
-//! - the inner triangle `T_in` offsets each edge of `T` outwards in its plane
-//!   by `s = thickness * tan(theta0 / 2)`, where `theta0` is that edge's
-//!   dihedral angle *as it is now* (like the lengths, which grow from the
-//!   current triangle; the paper's "current rest angle" would let targets
-//!   the shape cannot reach pile up step after step until a triangle folds), intersects the offset lines and lifts the corners by
-//!   `thickness` along the inner normal; `T_in'` grows with the inner rates;
-//!   `s'` is the in-plane distance from the grown base edge to the midpoint of
-//!   the grown inner edge, and the new rest angle of an edge is the sum over
-//!   its triangles of `atan(s' / thickness)` (eq. 4).
+//! through the triangle's UV→3D map) and the in-plane `W = n x D`, `T'`
+//! scales `T` about its barycentre by the e-rate along `D` and the w-rate
+//! along `W`; each edge's new rest length is the mean of its triangles'
+//! grown lengths (eq. 3).
+//!
+//! Rest angles come from the difference between the inner and the base
+//! growth, by one of two rules ([`BendRule`]):
+//!
+//! - [`BendRule::Curvature`] (the default). The petal is a bilayer: an
+//!   inner surface `thickness` from the base one. A material line across
+//!   which the inner side grows by `λ_in` and the base by `λ` bends by
+//!   `Δκ = (λ_in − λ) / thickness` (per unit of its current length), and a
+//!   bend it already has is carried along by the inner growth (its angle
+//!   times `λ_in`: a bilayer of constant thickness grown evenly keeps its
+//!   curvature, so the angle over the lengthened line grows). Per triangle
+//!   the target curvature increment is the tensor
+//!   `ΔK = (e_in − e)/t · D⊗D + (w_in − w)/t · W⊗W`; each hinge's increment
+//!   is the dihedral angle of its two triangles, unfolded flat and lifted
+//!   onto the height field `−½ pᵀ ΔK p` (the mean of its triangles' `ΔK`).
+//!   That is exact for the discrete surface: a mesh whose hinges all have
+//!   these angles lies on the surface of curvature `ΔK` (for isotropic
+//!   growth the angle is `Δκ` times the distance between the two
+//!   triangles' circumcentres, the exact angle between inscribed
+//!   triangles of a sphere; for growth along `D` only, a cylinder bent
+//!   along `D` and straight across it). Nothing is offset, so nothing can
+//!   turn inside out at any edge length.
+//! - [`BendRule::InnerTriangle`], the paper's rule (eq. 4), kept for
+//!   comparison: the inner triangle `T_in` offsets each edge of `T`
+//!   outwards in its plane by `s = thickness * tan(theta0 / 2)`, intersects
+//!   the offset lines and lifts the corners by `thickness` along the inner
+//!   normal; `T_in'` grows with the inner rates; `s'` is the in-plane
+//!   distance from the grown base edge to the midpoint of the grown inner
+//!   edge, and the new rest angle of an edge is the sum over its triangles
+//!   of `atan(s' / thickness)`. Measured (see ARCHITECTURE.md): it realises
+//!   3/4 of an anisotropic bend along the growth direction and leaks 1/4
+//!   across it, is off by tens of percent on irregular triangles, and turns
+//!   the inner triangle inside out when edges are shorter than the
+//!   thickness.
+//!
+//! `theta0`, the angle the growth starts from, is the hinge's current
+//! dihedral angle or its current rest angle ([`BendBase`]).
 
 use anthesis_mesh::Topology;
 
@@ -32,9 +60,66 @@ pub struct GrowthRates {
     pub direction_in_uv: DVec2,
 }
 
+/// How the inner/base growth difference becomes rest angles (see the
+/// module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BendRule {
+    /// Target curvature per triangle, turned exactly into hinge angles.
+    #[default]
+    Curvature,
+    /// The paper's imaginary inner triangle (§4.2, eq. 4).
+    InnerTriangle,
+}
+
+/// The angle a hinge's growth starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BendBase {
+    /// The hinge's dihedral angle as it is now: like the rest lengths, which
+    /// grow from the current triangles, bending that the shape could not
+    /// take is forgotten at each step (the tissue yields).
+    #[default]
+    Dihedral,
+    /// The hinge's rest angle: unreached bending accumulates from step to
+    /// step (the tissue remembers its target).
+    RestAngle,
+}
+
+/// The regional-growth parameters of one organ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GrowthModel {
+    /// Distance of the inner surface from the base surface (> 0).
+    pub thickness: f64,
+    pub bend_rule: BendRule,
+    pub bend_base: BendBase,
+}
+
+impl GrowthModel {
+    /// The default rules at `thickness`.
+    pub fn new(thickness: f64) -> GrowthModel {
+        GrowthModel {
+            thickness,
+            bend_rule: BendRule::default(),
+            bend_base: BendBase::default(),
+        }
+    }
+}
+
 /// The largest half-angle used to offset an edge for the inner triangle;
 /// beyond it `tan` explodes (a fold of nearly 180° between two triangles).
 const MAX_HALF_ANGLE: f64 = 1.4;
+
+/// What the curvature rule needs of one triangle: its frame and its
+/// curvature increment along and across the growth direction, and the
+/// inner rates that carry existing bends.
+#[derive(Debug, Clone, Copy, Default)]
+struct TriangleBend {
+    along: DVec3,
+    across: DVec3,
+    kappa_along: f64,
+    kappa_across: f64,
+    e_in: f64,
+    w_in: f64,
+}
 
 /// Reusable buffers for [`RegionalGrowth::grow`].
 #[derive(Debug, Default, Clone)]
@@ -42,7 +127,8 @@ pub struct RegionalGrowth {
     length_sum: Vec<f64>,
     length_count: Vec<u8>,
     angle_sum: Vec<f64>,
-    angle_now: Vec<f64>,
+    angle_from: Vec<f64>,
+    bends: Vec<TriangleBend>,
 }
 
 impl RegionalGrowth {
@@ -58,7 +144,7 @@ impl RegionalGrowth {
         triangles: &[[u32; 3]],
         topology: &Topology,
         rates: &[GrowthRates],
-        thickness: f64,
+        model: &GrowthModel,
         rest_lengths: &mut [f64],
         rest_angles: &mut [f64],
     ) {
@@ -69,34 +155,171 @@ impl RegionalGrowth {
         self.length_count.resize(edges, 0);
         self.angle_sum.clear();
         self.angle_sum.resize(edges, 0.0);
-        self.angle_now.clear();
-        self.angle_now.extend(topology.edges.iter().map(|e| {
-            e.hinge()
-                .map_or(0.0, |h| dihedral_angle(h.map(|p| positions[p as usize])))
-        }));
+        self.angle_from.clear();
+        self.angle_from
+            .extend(topology.edges.iter().enumerate().map(|(e, edge)| {
+                match (edge.hinge(), model.bend_base) {
+                    (None, _) => 0.0,
+                    (Some(h), BendBase::Dihedral) => {
+                        dihedral_angle(h.map(|p| positions[p as usize]))
+                    }
+                    (Some(_), BendBase::RestAngle) => rest_angles[e],
+                }
+            }));
+        self.bends.clear();
 
         for (t, tri) in triangles.iter().enumerate() {
             let x = tri.map(|i| positions[i as usize]);
             let uv = tri.map(|i| uvs[i as usize]);
             let edge_ids = topology.triangle_edges[t];
-            let theta0 = edge_ids.map(|e| self.angle_now[e as usize]);
-            let grown = grow_triangle(x, uv, &rates[t], thickness, theta0);
-            for k in 0..3 {
-                let e = edge_ids[k] as usize;
-                self.length_sum[e] += grown.lengths[k];
-                self.length_count[e] += 1;
-                self.angle_sum[e] += grown.half_angles[k];
+            let rates = &rates[t];
+            match model.bend_rule {
+                BendRule::Curvature => {
+                    let frame = TriangleFrame::new(x, uv, rates.direction_in_uv);
+                    let lengths = frame.grown_lengths(x, rates.e, rates.w);
+                    for k in 0..3 {
+                        let e = edge_ids[k] as usize;
+                        self.length_sum[e] += lengths[k];
+                        self.length_count[e] += 1;
+                    }
+                    self.bends.push(TriangleBend {
+                        along: frame.along,
+                        across: frame.across,
+                        kappa_along: (rates.e_in - rates.e) / model.thickness,
+                        kappa_across: (rates.w_in - rates.w) / model.thickness,
+                        e_in: rates.e_in,
+                        w_in: rates.w_in,
+                    });
+                }
+                BendRule::InnerTriangle => {
+                    let theta0 = edge_ids.map(|e| self.angle_from[e as usize]);
+                    let grown = grow_triangle(x, uv, rates, model.thickness, theta0);
+                    for k in 0..3 {
+                        let e = edge_ids[k] as usize;
+                        self.length_sum[e] += grown.lengths[k];
+                        self.length_count[e] += 1;
+                        self.angle_sum[e] += grown.half_angles[k];
+                    }
+                }
             }
         }
-        for e in 0..edges {
+        for (e, edge) in topology.edges.iter().enumerate() {
             rest_lengths[e] = self.length_sum[e] / f64::from(self.length_count[e].max(1));
-            rest_angles[e] = if topology.edges[e].is_boundary() {
-                0.0
-            } else {
-                self.angle_sum[e]
+            rest_angles[e] = match (edge.hinge(), edge.right) {
+                (Some(stencil), Some(right)) => match model.bend_rule {
+                    BendRule::InnerTriangle => self.angle_sum[e],
+                    BendRule::Curvature => {
+                        let sides = [
+                            &self.bends[edge.left.triangle as usize],
+                            &self.bends[right.triangle as usize],
+                        ];
+                        curvature_hinge_angle(
+                            stencil.map(|p| positions[p as usize]),
+                            sides,
+                            self.angle_from[e],
+                        )
+                    }
+                },
+                _ => 0.0,
             };
         }
     }
+}
+
+/// A triangle's growth frame: unit normal (inner side), growth direction
+/// and the in-plane direction across it.
+struct TriangleFrame {
+    normal: DVec3,
+    along: DVec3,
+    across: DVec3,
+}
+
+impl TriangleFrame {
+    fn new(x: [DVec3; 3], uv: [DVec2; 3], direction_in_uv: DVec2) -> TriangleFrame {
+        let normal = (x[1] - x[0]).cross(x[2] - x[0]).normalize_or_zero();
+        let along = growth_direction(x, uv, direction_in_uv, normal);
+        TriangleFrame {
+            normal,
+            along,
+            across: normal.cross(along),
+        }
+    }
+
+    /// `points` scaled about their barycentre by `e` along the growth
+    /// direction and `w` across it.
+    fn scale(&self, points: [DVec3; 3], e: f64, w: f64) -> [DVec3; 3] {
+        let centre = (points[0] + points[1] + points[2]) / 3.0;
+        points.map(|p| {
+            let d = p - centre;
+            centre
+                + self.along * (e * d.dot(self.along))
+                + self.across * (w * d.dot(self.across))
+                + self.normal * d.dot(self.normal)
+        })
+    }
+
+    /// Lengths of the edges `(x0,x1)`, `(x1,x2)`, `(x2,x0)` of the grown
+    /// triangle.
+    fn grown_lengths(&self, x: [DVec3; 3], e: f64, w: f64) -> [f64; 3] {
+        let grown = self.scale(x, e, w);
+        [0, 1, 2].map(|k| (grown[(k + 1) % 3] - grown[k]).length())
+    }
+}
+
+/// The new rest angle of the hinge `[xi, xj, xk, xl]` under the curvature
+/// rule: `angle_from` carried by the inner growth across the edge, plus the
+/// dihedral angle the hinge takes on the height field of the mean of its
+/// triangles' curvature increments (see the module documentation).
+fn curvature_hinge_angle(x: [DVec3; 4], sides: [&TriangleBend; 2], angle_from: f64) -> f64 {
+    let [xi, xj, xk, xl] = x;
+    let edge = xj - xi;
+    let edge_length = edge.length();
+    if edge_length == 0.0 {
+        return angle_from;
+    }
+    let along_edge = edge / edge_length;
+    let n_left = edge.cross(xk - xi).normalize_or_zero();
+    let n_right = (xi - xj).cross(xl - xj).normalize_or_zero();
+    // Each triangle's in-plane direction away from the edge towards its own
+    // side: the left triangle lies on +y, the right one, unfolded, on −y.
+    let y_left = n_left.cross(along_edge);
+    let y_right = n_right.cross(along_edge);
+    // The hinge unfolded flat, edge midpoint at the origin, edge along +x.
+    let mid = 0.5 * (xi + xj);
+    let flat = |p: DVec3, y: DVec3| DVec2::new((p - mid).dot(along_edge), (p - mid).dot(y));
+    let points = [
+        flat(xi, y_left),
+        flat(xj, y_left),
+        flat(xk, y_left),
+        flat(xl, y_right),
+    ];
+    // Each side's curvature tensor in the unfolded frame, and the mean.
+    let tensor = |b: &TriangleBend, y: DVec3| {
+        let d = DVec2::new(b.along.dot(along_edge), b.along.dot(y));
+        let w = DVec2::new(b.across.dot(along_edge), b.across.dot(y));
+        [
+            b.kappa_along * d.x * d.x + b.kappa_across * w.x * w.x,
+            b.kappa_along * d.x * d.y + b.kappa_across * w.x * w.y,
+            b.kappa_along * d.y * d.y + b.kappa_across * w.y * w.y,
+        ]
+    };
+    let (kl, kr) = (tensor(sides[0], y_left), tensor(sides[1], y_right));
+    let k = [0, 1, 2].map(|c| 0.5 * (kl[c] + kr[c]));
+    // Height along the inner normal: positive curvature makes the inner
+    // side convex, so the surface falls away from it.
+    let lift =
+        |p: DVec2| p.extend(-0.5 * (k[0] * p.x * p.x + 2.0 * k[1] * p.x * p.y + k[2] * p.y * p.y));
+    let increment = dihedral_angle(points.map(|p| {
+        let q = lift(p);
+        DVec3::new(q.x, q.y, q.z)
+    }));
+    // The inner growth across the edge (perpendicular to it, in each
+    // triangle's plane) carries the bend the hinge already has.
+    let carry = |b: &TriangleBend, y: DVec3| {
+        DVec2::new(b.e_in * y.dot(b.along), b.w_in * y.dot(b.across)).length()
+    };
+    let carried = 0.5 * (carry(sides[0], y_left) + carry(sides[1], y_right));
+    angle_from * carried + increment
 }
 
 /// What one grown triangle contributes to its edges `(t0,t1)`, `(t1,t2)`,
@@ -118,21 +341,9 @@ pub fn grow_triangle(
     thickness: f64,
     theta0: [f64; 3],
 ) -> GrownTriangle {
-    let normal = (x[1] - x[0]).cross(x[2] - x[0]).normalize_or_zero();
-    let along = growth_direction(x, uv, rates.direction_in_uv, normal);
-    let across = normal.cross(along);
-    let scale = |points: [DVec3; 3], e: f64, w: f64| {
-        let centre = (points[0] + points[1] + points[2]) / 3.0;
-        points.map(|p| {
-            let d = p - centre;
-            centre
-                + along * (e * d.dot(along))
-                + across * (w * d.dot(across))
-                + normal * d.dot(normal)
-        })
-    };
-
-    let grown = scale(x, rates.e, rates.w);
+    let frame = TriangleFrame::new(x, uv, rates.direction_in_uv);
+    let normal = frame.normal;
+    let grown = frame.scale(x, rates.e, rates.w);
     let lengths = [0, 1, 2].map(|k| (grown[(k + 1) % 3] - grown[k]).length());
 
     // Inner triangle: offset each edge line outwards by s, intersect, lift.
@@ -148,7 +359,7 @@ pub fn grow_triangle(
         let beta = (offsets[b] - c * offsets[a]) / det;
         x[m] + outward[a] * alpha + outward[b] * beta + normal * thickness
     });
-    let inner_grown = scale(inner, rates.e_in, rates.w_in);
+    let inner_grown = frame.scale(inner, rates.e_in, rates.w_in);
 
     let half_angles = [0, 1, 2].map(|k| {
         let (a, b) = (grown[k], grown[(k + 1) % 3]);
@@ -259,6 +470,86 @@ mod tests {
                 0.5 * theta0[k]
             );
         }
+    }
+
+    /// The circumcentre of a triangle in 3D.
+    fn circumcentre(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+        let (ab, ac) = (b - a, c - a);
+        let n = ab.cross(ac);
+        a + (n.cross(ab) * ac.length_squared() + ac.cross(n) * ab.length_squared())
+            / (2.0 * n.length_squared())
+    }
+
+    #[test]
+    fn isotropic_inner_growth_gives_the_exact_angles_of_a_sphere_on_irregular_triangles() {
+        // Triangles inscribed in a sphere of curvature kappa meet at the
+        // angle between their normals, which pass through their
+        // circumcentres: kappa times the circumcentres' distance (to first
+        // order). The paper's rule uses the barycentres instead and is off by
+        // tens of percent on such triangles.
+        let mut mesh = anthesis_mesh::generate::flat_sheet(4.0, 5.0, 6, 7);
+        let mut seed = 3u64;
+        for (p, uv) in mesh.positions.iter_mut().zip(&mut mesh.uvs) {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let a = (seed >> 11) as f64 / (1u64 << 53) as f64;
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let b = (seed >> 11) as f64 / (1u64 << 53) as f64;
+            *p += DVec3::new(a - 0.5, b - 0.5, 0.0) * 0.4;
+            *uv = DVec2::new(p.x / 4.0, p.y / 5.0);
+        }
+        let topology = Topology::build(&mesh).expect("manifold");
+        let (thickness, excess) = (0.2, 1e-4);
+        let kappa = excess / thickness;
+        let per_triangle =
+            vec![rates(1.0, 1.0, 1.0 + excess, 1.0 + excess, DVec2::Y); mesh.triangles.len()];
+        let mut lengths = vec![0.0; topology.edges.len()];
+        let mut angles = vec![0.0; topology.edges.len()];
+        let mut worst_paper: f64 = 0.0;
+        for rule in [BendRule::Curvature, BendRule::InnerTriangle] {
+            let model = GrowthModel {
+                bend_rule: rule,
+                ..GrowthModel::new(thickness)
+            };
+            RegionalGrowth::default().grow(
+                &mesh.positions,
+                &mesh.uvs,
+                &mesh.triangles,
+                &topology,
+                &per_triangle,
+                &model,
+                &mut lengths,
+                &mut angles,
+            );
+            for (e, edge) in topology.edges.iter().enumerate() {
+                let (Some([i, j, k, l]), Some(right)) = (edge.hinge(), edge.right) else {
+                    continue;
+                };
+                let x = |v: u32| mesh.positions[v as usize];
+                let c_left = circumcentre(x(i), x(j), x(k));
+                let c_right = circumcentre(x(j), x(i), x(l));
+                let across = DVec3::Z.cross(x(j) - x(i)).normalize();
+                let exact = kappa * (c_left - c_right).dot(across);
+                let error = (angles[e] - exact).abs() / exact.abs().max(kappa * 0.1);
+                match rule {
+                    BendRule::Curvature => assert!(
+                        error < 1e-3,
+                        "edge {e} (triangles {} {}): {} vs exact {exact}",
+                        edge.left.triangle,
+                        right.triangle,
+                        angles[e]
+                    ),
+                    BendRule::InnerTriangle => worst_paper = worst_paper.max(error),
+                }
+            }
+        }
+        assert!(
+            worst_paper > 0.1,
+            "the paper's rule is off by {worst_paper} at most here"
+        );
     }
 
     #[test]

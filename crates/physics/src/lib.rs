@@ -6,11 +6,14 @@
 pub mod elastic;
 pub mod growth;
 pub mod hinge;
+pub mod membrane;
+pub mod model;
 pub mod pattern;
 pub mod shape_match;
 pub mod solver;
 
 pub use elastic::{Contact, Elastic};
-pub use growth::{GrowthRates, RegionalGrowth};
+pub use growth::{BendBase, BendRule, GrowthModel, GrowthRates, RegionalGrowth};
+pub use model::Model;
 
 pub use solver::{NewtonSolver, SolverError, SolverSettings, StepReport};

@@ -139,7 +139,7 @@ impl Simulation {
         };
         let organs = chosen
             .iter()
-            .map(|&i| OrganSim::new(&flower.organs[i], flower.template_of(i)))
+            .map(|&i| OrganSim::new(&flower.organs[i], flower.template_of(i), &project.settings))
             .collect::<Result<Vec<_>, _>>()?;
         let overlaps = flower
             .overlaps

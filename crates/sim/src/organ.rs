@@ -5,10 +5,11 @@ use anthesis_flower::{Organ, Placement, Template, joint_angle_after};
 use anthesis_maps::{KeyedMaps, ScalarMap};
 use anthesis_mesh::{Mesh, Topology};
 use anthesis_physics::elastic::edge_areas;
+use anthesis_physics::membrane::EdgeSmoothedMembrane;
 use anthesis_physics::shape_match::match_shape;
 use anthesis_physics::{
-    Contact, Elastic, GrowthRates, NewtonSolver, RegionalGrowth, SolverError, SolverSettings,
-    StepReport,
+    Contact, Elastic, GrowthModel, GrowthRates, Model, NewtonSolver, RegionalGrowth, SolverError,
+    SolverSettings, StepReport,
 };
 use std::collections::VecDeque;
 
@@ -87,6 +88,9 @@ pub(crate) struct OrganSim {
     /// Current world positions.
     pub positions: Vec<DVec3>,
     pub mean_edge: f64,
+    /// The mean edge of the bud mesh: the length scale of the consistent
+    /// model's stiffness (see `anthesis_physics::model`).
+    bud_edge: f64,
     /// Whether each particle is a base particle.
     pub is_base: Vec<bool>,
     placement: Placement,
@@ -95,7 +99,10 @@ pub(crate) struct OrganSim {
     maps: KeyedMaps,
     keys: Vec<SampledKey>,
     dg: f64,
-    thickness: f64,
+    model: Model,
+    growth_model: GrowthModel,
+    /// The membrane's Lamé parameter per edge (consistent model).
+    modulus: Vec<f64>,
     stretch_stiffness: f64,
     bend_stiffness: f64,
     elastic: Elastic,
@@ -111,7 +118,11 @@ pub(crate) struct OrganSim {
 }
 
 impl OrganSim {
-    pub fn new(organ: &Organ, template: &Template) -> Result<OrganSim, SimError> {
+    pub fn new(
+        organ: &Organ,
+        template: &Template,
+        settings: &anthesis_flower::SimulationSettings,
+    ) -> Result<OrganSim, SimError> {
         let bad = |message: String| SimError::BadTemplate {
             template: template.name.clone(),
             message,
@@ -150,7 +161,13 @@ impl OrganSim {
             .iter()
             .map(|p| organ.placement.world_from_template(*p, 0.0))
             .collect();
-        let elastic = Elastic::at_rest(&initial, &topology);
+        let mut elastic = Elastic::at_rest(&initial, &topology);
+        if settings.model.smoothed_membrane() {
+            elastic.membrane = Some(EdgeSmoothedMembrane::new(
+                &template.mesh.triangles,
+                &topology,
+            ));
+        }
         let mean_edge =
             elastic.rest_lengths.iter().sum::<f64>() / elastic.rest_lengths.len().max(1) as f64;
         let solver = NewtonSolver::new(initial.len(), &elastic).map_err(|e| bad(e.to_string()))?;
@@ -167,6 +184,7 @@ impl OrganSim {
             positions: initial.clone(),
             initial,
             mean_edge,
+            bud_edge: mean_edge,
             is_base: (0..template.mesh.vertex_count() as u32)
                 .map(|i| base.contains(&i))
                 .collect(),
@@ -178,7 +196,13 @@ impl OrganSim {
             maps: template.maps.clone(),
             keys,
             dg: template.dg,
-            thickness: template.thickness,
+            model: settings.model,
+            growth_model: GrowthModel {
+                thickness: template.thickness,
+                bend_rule: settings.model.bend_rule(),
+                bend_base: settings.bend_base,
+            },
+            modulus: Vec::new(),
             stretch_stiffness: template.stretch_stiffness,
             bend_stiffness: template.bend_stiffness,
             elastic,
@@ -224,7 +248,7 @@ impl OrganSim {
             &self.mesh.triangles,
             &self.topology,
             &self.rates,
-            self.thickness,
+            &self.growth_model,
             &mut self.elastic.rest_lengths,
             &mut self.elastic.rest_angles,
         );
@@ -275,6 +299,7 @@ impl OrganSim {
     fn update_stiffness(&mut self, step: u32) {
         let weights = self.maps.weights_at(f64::from(step.max(1)));
         let areas = edge_areas(&self.positions, &self.mesh.triangles, &self.topology);
+        self.modulus.resize(areas.len(), 0.0);
         for (e, area) in areas.iter().enumerate() {
             let stretch: f64 = weights
                 .iter()
@@ -282,10 +307,20 @@ impl OrganSim {
                 .sum();
             let bend: f64 = weights.iter().map(|&(k, w)| w * self.keys[k].bend[e]).sum();
             self.elastic.stretch_stiffness[e] = area * self.stretch_stiffness * stretch;
-            self.elastic.bend_stiffness[e] = area * self.bend_stiffness * bend;
+            self.elastic.bend_stiffness[e] = self.model.hinge_stiffness(
+                self.bend_stiffness * bend,
+                self.elastic.rest_lengths[e],
+                *area,
+                self.bud_edge,
+            );
+            self.modulus[e] =
+                Model::membrane_modulus(self.stretch_stiffness * stretch, self.bud_edge);
         }
         let mean_ks = self.elastic.stretch_stiffness.iter().sum::<f64>()
             / self.elastic.stretch_stiffness.len().max(1) as f64;
+        if let Some(m) = &mut self.elastic.membrane {
+            m.update(&self.elastic.rest_lengths, &self.modulus);
+        }
         self.elastic.contact_stiffness = CONTACT_STIFFNESS_FACTOR * mean_ks;
         self.elastic.anchor_stiffness = ANCHOR_FACTOR * mean_ks;
     }
