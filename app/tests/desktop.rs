@@ -62,6 +62,7 @@ fn recorded_keyframes(project: &Project, selection: &Selection) -> Vec<Keyframe>
                     gradient_norm: 1e-7,
                     seconds: 0.05,
                     pushed_particles: 0,
+                    contact_particles: 0,
                 },
             }
         })

@@ -284,6 +284,7 @@ mod tests {
                 gradient_norm: 0.0,
                 seconds: 0.5,
                 pushed_particles: 0,
+                contact_particles: 0,
             },
         })
     }

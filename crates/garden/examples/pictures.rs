@@ -116,7 +116,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if let Ok(s) = s {
                 let m = s.mean;
                 println!(
-                    "kf {:3}: angles {:6.1} {:6.1} {:6.1} turn mid {:6.1} lam {:6.1} cup {:6.3} swell {:6.3} radius {:5.1} {:5.1} {:5.1} {:5.1} height {:5.1} {:5.1} {:5.1} {:5.1} len {:5.1} it {} pushed {}",
+                    "kf {:3}: angles {:6.1} {:6.1} {:6.1} turn mid {:6.1} lam {:6.1} cup {:6.3} swell {:6.3} radius {:5.1} {:5.1} {:5.1} {:5.1} height {:5.1} {:5.1} {:5.1} {:5.1} len {:5.1} it {} contact {} pushed {}",
                     keyframe.index,
                     m.midrib_angles_deg[0],
                     m.midrib_angles_deg[1],
@@ -135,6 +135,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     m.height_profile[3],
                     m.midrib_length,
                     keyframe.stats.iterations,
+                    keyframe.stats.contact_particles,
                     keyframe.stats.pushed_particles
                 );
             }

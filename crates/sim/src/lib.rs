@@ -48,6 +48,9 @@ pub struct KeyframeStats {
     pub seconds: f64,
     /// Particles the final push-back moved.
     pub pushed_particles: u32,
+    /// Particles touching a neighbouring organ when the keyframe ends:
+    /// within the collision offset of its surface or pressed into it.
+    pub contact_particles: u32,
 }
 
 /// One keyframe: world positions of every simulated organ.
@@ -202,6 +205,7 @@ impl Simulation {
                 gradient_norm: 0.0,
                 seconds: 0.0,
                 pushed_particles: 0,
+                contact_particles: 0,
             },
         }
     }
@@ -347,8 +351,29 @@ impl Simulation {
                 gradient_norm: gradient,
                 seconds: started.elapsed().as_secs_f64(),
                 pushed_particles: pushed as u32,
+                contact_particles: self.particles_in_contact(),
             },
         })
+    }
+
+    /// How many particles touch a neighbouring organ: their contact is
+    /// violated or short of it by less than the collision offset (a particle
+    /// with several neighbours counts once).
+    fn particles_in_contact(&self) -> u32 {
+        let offset = self.settings.collision_offset;
+        self.contacts(Violated::MoveAll)
+            .iter()
+            .zip(&self.organs)
+            .map(|(contacts, organ)| {
+                let mut touching: Vec<u32> = contacts
+                    .iter()
+                    .filter(|c| c.violation(organ.positions[c.particle as usize]) > -offset)
+                    .map(|c| c.particle)
+                    .collect();
+                touching.dedup();
+                touching.len() as u32
+            })
+            .sum()
     }
 
     /// Contacts of every organ against the organs it overlaps, from the
