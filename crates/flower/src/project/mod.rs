@@ -1,0 +1,175 @@
+//! The project file format: one TOML file a person can read and diff, with
+//! each template's mesh as an OBJ file and its painted maps as PNG files
+//! beside it.
+//!
+//! ```toml
+//! format = "anthesis-project"
+//! version = 1
+//! name = "Asiatic lily"
+//!
+//! [simulation]                 # optional; each field defaults as shown
+//! keyframes = 100
+//! relative_tolerance = 0.000001
+//! max_iterations = 50
+//! collision_offset = 0.01
+//!
+//! [[templates]]
+//! name = "petal"
+//! mesh = "meshes/petal.obj"    # paths are relative to the project file
+//! dg = 0.003
+//! thickness = 0.2
+//! stretch_stiffness = 20.0
+//! bend_stiffness = 20.0
+//! color = [0.98, 0.62, 0.32, 1.0]          # optional, default opaque white
+//! blend = "linear"                          # optional: "linear" (default),
+//!                                           # "smooth" or
+//!                                           # { logistic = { steepness = 10.0 } }
+//! base_region = { v_max = 0.06 }            # optional: v_max 0.05, u_min 0, u_max 1
+//! joint_schedule = [{ from_step = 0, to_step = 60, degrees = 23.0 }]  # optional
+//!
+//! [[templates.keys]]
+//! step = 40
+//! e_growth = "maps/petal-step40-e_growth.png"   # a PNG, or a number
+//! w_growth = 0.2
+//! e_growth_in = "maps/petal-step40-e_growth_in.png"
+//! w_growth_in = 0.2
+//! stretch = 1.0
+//! bend = 1
+//! direction = [0.0, 1.0]                        # a [u, v] vector, or a PNG
+//!
+//! [[organs]]
+//! name = "petal-1"
+//! template = "petal"
+//! position = [0.0, 0.0, 0.8]   # optional, default the origin
+//! azimuth_deg = 0.0            # optional, default 0
+//! joint_angle_deg = 10.0       # optional, default 0
+//!
+//! [[overlaps]]                 # organ names
+//! inner = "petal-1"
+//! outer = "sepal-1"
+//! ```
+//!
+//! # Rules
+//!
+//! - `format` must be `"anthesis-project"` and `version` at most
+//!   [`FORMAT_VERSION`]; both are checked before anything else, so a file
+//!   from a newer Anthesis gets [`ProjectError::NewerVersion`] rather than a
+//!   complaint about fields this build does not know.
+//! - Every table refuses unknown fields, so a misspelt field is an error
+//!   naming it, with its line and column.
+//! - A map entry of a key is a number (a constant map), a path to a PNG, or
+//!   for `direction` a `[u, v]` pair. An omitted entry is the map kind's
+//!   default: growth 0, stretch and bend 1, direction `[0, 1]`. PNG formats
+//!   are those of [`anthesis_maps`] (greyscale for scalar maps, red = u and
+//!   green = v for directions). A 1x1 PNG is a constant.
+//! - All raster maps of one template, over all its keys, must have the same
+//!   size; the first one read sets it ([`ProjectError::MapSize`]).
+//!
+//! # Saving
+//!
+//! [`save_project`] writes the TOML, each template's mesh as
+//! `meshes/<template>.obj` and each map that is not constant as
+//! `maps/<template>-step<step>-<map>.png`, where `<template>` is the template
+//! name in lower case with anything but ASCII letters, digits, `-` and `_`
+//! replaced by `_` (and `-2`, `-3`, … appended if two templates would share
+//! a name). Constant (1x1) maps are written as numbers.
+//!
+//! Raster maps are written as 16-bit PNGs: painted values are floats, and
+//! 8 bits (steps of 1/255) would visibly quantise a growth rate that is
+//! applied a hundred times over, while 16 bits (steps of 1/65535) change a
+//! value by at most 0.0000077. Saving quantises once; saving what was loaded
+//! writes the same codes again, so repeated saves do not drift. Scalar
+//! rasters must hold values in `[0, 1]` and direction rasters components in
+//! `[-1, 1]` (what a PNG can hold); other values are refused, not clamped.
+//!
+//! Saving first checks the project by the same rules as loading and refuses
+//! (writing nothing) a project it could not load again, so a good file is
+//! never replaced by one that cannot be opened. Each file is written
+//! atomically (a temporary file in the same folder, then a rename), the
+//! meshes and maps first and the TOML last. Map and mesh files that the new
+//! TOML no longer names are left in place.
+
+mod check;
+mod error;
+mod load;
+mod save;
+mod schema;
+
+use std::fs;
+use std::io;
+use std::path::Path;
+
+use crate::Project;
+
+pub use error::ProjectError;
+use error::io_error;
+use load::Loader;
+use save::{plan_save, write_atomically};
+
+/// The value of the `format` field of every project file.
+pub const FORMAT_NAME: &str = "anthesis-project";
+
+/// The newest file format version this build reads, and the one it writes.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Where saved meshes go, relative to the project file.
+pub const MESH_FOLDER: &str = "meshes";
+
+/// Where saved PNG maps go, relative to the project file.
+pub const MAP_FOLDER: &str = "maps";
+
+/// What [`parse_project`] calls the project text in its errors.
+pub const UNNAMED_PROJECT: &str = "(project text)";
+
+/// Reads the project file at `path` and the meshes and PNG maps it names
+/// (paths relative to the project file's folder).
+pub fn load_project(path: &Path) -> Result<Project, ProjectError> {
+    let bytes = fs::read(path).map_err(|error| io_error(path, "cannot read", &error))?;
+    let text = String::from_utf8(bytes).map_err(|_| ProjectError::Syntax {
+        path: path.to_path_buf(),
+        message: "the file is not UTF-8 text".to_string(),
+    })?;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let read = |relative: &str| fs::read(folder.join(relative));
+    let loader = Loader {
+        project_path: path,
+        folder,
+        files: &read,
+    };
+    loader.load(&text)
+}
+
+/// Reads a project from its TOML text; `files` returns the bytes of a mesh
+/// or map given its path as written in the file. For projects that are not
+/// on disk, e.g. embedded in the binary with `include_bytes!`. Errors call
+/// the project file [`UNNAMED_PROJECT`] and other files by their path as
+/// written.
+pub fn parse_project(
+    text: &str,
+    files: &dyn Fn(&str) -> Result<Vec<u8>, io::Error>,
+) -> Result<Project, ProjectError> {
+    let loader = Loader {
+        project_path: Path::new(UNNAMED_PROJECT),
+        folder: Path::new(""),
+        files,
+    };
+    loader.load(text)
+}
+
+/// Writes `project` to `path` with its meshes and maps beside it (see the
+/// module documentation); creates the folders it needs.
+pub fn save_project(project: &Project, path: &Path) -> Result<(), ProjectError> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let plan = plan_save(project, path, folder)?;
+    for (relative, bytes) in &plan.files {
+        write_atomically(&folder.join(relative), bytes)?;
+    }
+    write_atomically(path, plan.toml.as_bytes())
+}
+
+/// The TOML text [`save_project`] would write for `project` at `path`
+/// (checked the same way; no file is written).
+pub fn project_to_toml(project: &Project, path: &Path) -> Result<String, ProjectError> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    Ok(plan_save(project, path, folder)?.toml)
+}

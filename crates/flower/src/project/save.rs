@@ -1,0 +1,293 @@
+//! Saving: a [`Project`] into the TOML text and the mesh and map files.
+
+use std::collections::HashSet;
+use std::fs;
+use std::io::Write;
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use anthesis_maps::{BitDepth, MapKind};
+
+use super::check::{SizeCheck, check_project};
+use super::error::{ProjectError, io_error, map_error};
+use super::schema::{
+    BaseRegionFile, BlendFile, DirectionEntry, JointRampFile, KeyFile, OrganFile, OverlapFile,
+    ProjectFile, ScalarEntry, SimulationFile, TemplateFile,
+};
+use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
+use crate::{Project, Template};
+
+/// The files of a saved project: the TOML text and the meshes and maps, by
+/// path relative to the project file.
+pub(super) struct SavePlan {
+    pub(super) toml: String,
+    pub(super) files: Vec<(String, Vec<u8>)>,
+}
+
+/// Checks `project` and encodes every file [`save_project`] writes.
+/// `folder` is where relative paths are shown from in errors.
+pub(super) fn plan_save(
+    project: &Project,
+    path: &Path,
+    folder: &Path,
+) -> Result<SavePlan, ProjectError> {
+    check_project(project, path)?;
+    let flower = &project.flower;
+    let mut files = Vec::new();
+    let stems = file_stems(flower.templates.iter().map(|t| t.name.as_str()));
+    let mut templates = Vec::with_capacity(flower.templates.len());
+    for (template, stem) in flower.templates.iter().zip(&stems) {
+        templates.push(template_file(template, stem, folder, &mut files)?);
+    }
+    let organs = flower
+        .organs
+        .iter()
+        .map(|organ| OrganFile {
+            name: organ.name.clone(),
+            template: flower.templates[organ.template].name.clone(),
+            position: organ.placement.position.to_array(),
+            azimuth_deg: organ.placement.azimuth_deg,
+            joint_angle_deg: organ.placement.joint_angle_deg,
+        })
+        .collect();
+    let overlaps = flower
+        .overlaps
+        .iter()
+        .map(|overlap| OverlapFile {
+            inner: flower.organs[overlap.inner].name.clone(),
+            outer: flower.organs[overlap.outer].name.clone(),
+        })
+        .collect();
+    let file = ProjectFile {
+        format: FORMAT_NAME.to_string(),
+        version: FORMAT_VERSION,
+        name: project.name.clone(),
+        simulation: SimulationFile::from(&project.settings),
+        templates,
+        organs,
+        overlaps,
+    };
+    let body = toml::to_string(&file).map_err(|error| ProjectError::Invalid {
+        path: path.to_path_buf(),
+        message: format!("cannot write the project as TOML: {error}"),
+    })?;
+    let toml = format!(
+        "# Anthesis project. Meshes are OBJ files in {MESH_FOLDER}/, painted maps 16-bit PNG \
+         files in {MAP_FOLDER}/.\n{body}"
+    );
+    Ok(SavePlan { toml, files })
+}
+
+/// The file entry of one template; adds its mesh and raster maps to `files`.
+pub(super) fn template_file(
+    template: &Template,
+    stem: &str,
+    folder: &Path,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> Result<TemplateFile, ProjectError> {
+    let mesh_relative = format!("{MESH_FOLDER}/{stem}.obj");
+    anthesis_mesh::validate(&template.mesh).map_err(|error| ProjectError::Mesh {
+        path: folder.join(&mesh_relative),
+        error,
+    })?;
+    files.push((
+        mesh_relative.clone(),
+        anthesis_mesh::obj_string(&template.mesh).into_bytes(),
+    ));
+
+    let mut size = SizeCheck::default();
+    let mut keys = Vec::with_capacity(template.maps.keys().len());
+    for key in template.maps.keys() {
+        let mut key_file = KeyFile {
+            step: key.step,
+            ..KeyFile::default()
+        };
+        let map_relative =
+            |map_name: &str| format!("{MAP_FOLDER}/{stem}-step{}-{map_name}.png", key.step);
+        for kind in MapKind::ALL {
+            let map = key.maps.scalar(kind);
+            let entry = if map.size() == (1, 1) {
+                ScalarEntry::Constant(map.values()[0])
+            } else {
+                let relative = map_relative(kind.name());
+                let path = folder.join(&relative);
+                size.check(&path, map.size())?;
+                if let Some(value) = map.values().iter().find(|v| !(0.0..=1.0).contains(*v)) {
+                    return Err(out_of_range(&path, kind.name(), *value, "0 to 1"));
+                }
+                let bytes = map
+                    .to_png_bytes(BitDepth::Sixteen)
+                    .map_err(|error| map_error(&path, error))?;
+                files.push((relative.clone(), bytes));
+                ScalarEntry::File(relative)
+            };
+            *key_file.scalar_mut(kind) = Some(entry);
+        }
+        let direction = &key.maps.direction;
+        let entry = if direction.size() == (1, 1) {
+            DirectionEntry::Constant(direction.values()[0])
+        } else {
+            let relative = map_relative(anthesis_maps::DIRECTION_MAP_NAME);
+            let path = folder.join(&relative);
+            size.check(&path, direction.size())?;
+            let components = direction.values().iter().flatten();
+            if let Some(value) = components.into_iter().find(|v| !(-1.0..=1.0).contains(*v)) {
+                return Err(out_of_range(&path, "direction", *value, "-1 to 1"));
+            }
+            let bytes = direction
+                .to_png_bytes(BitDepth::Sixteen)
+                .map_err(|error| map_error(&path, error))?;
+            files.push((relative.clone(), bytes));
+            DirectionEntry::File(relative)
+        };
+        key_file.direction = Some(entry);
+        keys.push(key_file);
+    }
+
+    let region = &template.base_region;
+    Ok(TemplateFile {
+        name: template.name.clone(),
+        mesh: mesh_relative,
+        dg: template.dg,
+        thickness: template.thickness,
+        stretch_stiffness: template.stretch_stiffness,
+        bend_stiffness: template.bend_stiffness,
+        color: template.color,
+        blend: BlendFile::from(template.maps.blend),
+        base_region: BaseRegionFile {
+            v_max: region.v_max,
+            u_min: region.u_min,
+            u_max: region.u_max,
+        },
+        joint_schedule: template
+            .joint_schedule
+            .iter()
+            .map(JointRampFile::from)
+            .collect(),
+        keys,
+    })
+}
+
+pub(super) fn out_of_range(path: &Path, map_name: &str, value: f32, range: &str) -> ProjectError {
+    ProjectError::Invalid {
+        path: path.to_path_buf(),
+        message: format!(
+            "the {map_name} map holds {value}, but a PNG map holds values from {range}; \
+             the project was not saved"
+        ),
+    }
+}
+
+/// One file-name stem per template: the name in lower case with everything
+/// but ASCII letters, digits, `-` and `_` replaced by `_`, made unique by
+/// appending `-2`, `-3`, ….
+pub(super) fn file_stems<'a>(names: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let mut used = HashSet::new();
+    names
+        .map(|name| {
+            let mut base: String = name
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                        c.to_ascii_lowercase()
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            if base.is_empty() {
+                base = "template".to_string();
+            }
+            let mut stem = base.clone();
+            let mut number = 2;
+            while !used.insert(stem.clone()) {
+                stem = format!("{base}-{number}");
+                number += 1;
+            }
+            stem
+        })
+        .collect()
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and
+/// a rename, so `path` holds either its old contents or all of the new ones.
+/// Creates the folder if needed.
+pub(super) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ProjectError> {
+    static NEXT_TEMP: AtomicU64 = AtomicU64::new(0);
+    let folder = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let Some(file_name) = path.file_name() else {
+        return Err(ProjectError::Io {
+            path: path.to_path_buf(),
+            message: "cannot write: the path does not name a file".to_string(),
+        });
+    };
+    fs::create_dir_all(folder).map_err(|error| io_error(folder, "cannot create folder", &error))?;
+    let temp_path = folder.join(format!(
+        ".{}.{}-{}.tmp",
+        file_name.to_string_lossy(),
+        std::process::id(),
+        NEXT_TEMP.fetch_add(1, Ordering::Relaxed)
+    ));
+    let written = fs::File::create(&temp_path).and_then(|mut file| {
+        file.write_all(bytes)?;
+        file.sync_all()
+    });
+    let result = written.and_then(|()| fs::rename(&temp_path, path));
+    if let Err(error) = result {
+        // The temporary file is of no use now; failing to remove it changes
+        // nothing for the caller.
+        let _ = fs::remove_file(&temp_path);
+        return Err(io_error(path, "cannot write", &error));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stems_are_file_safe_lower_case_and_unique() {
+        let names = ["Petal", "petal", "Outer sepal/2", "", "ünï", "petal-2"];
+        let stems = file_stems(names.into_iter());
+        assert_eq!(
+            stems,
+            [
+                "petal",
+                "petal-2",
+                "outer_sepal_2",
+                "template",
+                "_n_",
+                "petal-2-2"
+            ]
+        );
+    }
+
+    #[test]
+    fn atomic_write_replaces_the_file_and_leaves_no_temporary() {
+        let folder = tempfile::tempdir().expect("temp dir");
+        let path = folder.path().join("sub").join("a.txt");
+        write_atomically(&path, b"old").expect("first write");
+        write_atomically(&path, b"new contents").expect("second write");
+        assert_eq!(fs::read(&path).expect("read"), b"new contents");
+        let entries: Vec<_> = fs::read_dir(folder.path().join("sub"))
+            .expect("list")
+            .map(|entry| entry.expect("entry").file_name())
+            .collect();
+        assert_eq!(entries, ["a.txt"]);
+    }
+
+    #[test]
+    fn atomic_write_into_a_file_reports_the_path() {
+        let folder = tempfile::tempdir().expect("temp dir");
+        let blocker = folder.path().join("blocker");
+        fs::write(&blocker, b"a file, not a folder").expect("write");
+        let path = blocker.join("a.txt");
+        let error = write_atomically(&path, b"x").expect_err("parent is a file");
+        assert!(matches!(error, ProjectError::Io { .. }), "{error:?}");
+        assert!(error.to_string().contains("blocker"), "{error}");
+    }
+}

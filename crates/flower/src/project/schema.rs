@@ -1,0 +1,327 @@
+//! The file structures, as serde reads and writes them, and their
+//! conversions from and to the plain parts of a [`Project`](crate::Project).
+
+use std::fmt;
+
+use anthesis_maps::{Blend, MapKind};
+use anthesis_physics::SolverSettings;
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::{Deserialize, Serialize, Serializer};
+
+use crate::{BaseRegion, JointRamp, SimulationSettings};
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ProjectFile {
+    pub(super) format: String,
+    pub(super) version: u32,
+    pub(super) name: String,
+    #[serde(default)]
+    pub(super) simulation: SimulationFile,
+    #[serde(default)]
+    pub(super) templates: Vec<TemplateFile>,
+    #[serde(default)]
+    pub(super) organs: Vec<OrganFile>,
+    #[serde(default)]
+    pub(super) overlaps: Vec<OverlapFile>,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(super) struct SimulationFile {
+    pub(super) keyframes: u32,
+    pub(super) relative_tolerance: f64,
+    pub(super) max_iterations: u32,
+    pub(super) collision_offset: f64,
+}
+
+impl Default for SimulationFile {
+    fn default() -> Self {
+        SimulationFile::from(&SimulationSettings::default())
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TemplateFile {
+    pub(super) name: String,
+    pub(super) mesh: String,
+    pub(super) dg: f64,
+    pub(super) thickness: f64,
+    pub(super) stretch_stiffness: f64,
+    pub(super) bend_stiffness: f64,
+    #[serde(default = "opaque_white")]
+    pub(super) color: [f32; 4],
+    #[serde(default)]
+    pub(super) blend: BlendFile,
+    #[serde(default)]
+    pub(super) base_region: BaseRegionFile,
+    #[serde(default)]
+    pub(super) joint_schedule: Vec<JointRampFile>,
+    pub(super) keys: Vec<KeyFile>,
+}
+
+fn opaque_white() -> [f32; 4] {
+    [1.0; 4]
+}
+
+/// Like [`Blend`], but refusing unknown fields.
+#[derive(Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub(super) enum BlendFile {
+    #[default]
+    Linear,
+    Smooth,
+    Logistic {
+        #[serde(default = "default_steepness")]
+        steepness: f64,
+    },
+}
+
+fn default_steepness() -> f64 {
+    Blend::DEFAULT_STEEPNESS
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(super) struct BaseRegionFile {
+    pub(super) v_max: f64,
+    pub(super) u_min: f64,
+    pub(super) u_max: f64,
+}
+
+impl Default for BaseRegionFile {
+    fn default() -> Self {
+        let region = BaseRegion::default();
+        BaseRegionFile {
+            v_max: region.v_max,
+            u_min: region.u_min,
+            u_max: region.u_max,
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct JointRampFile {
+    pub(super) from_step: u32,
+    pub(super) to_step: u32,
+    pub(super) degrees: f64,
+}
+
+#[derive(Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct KeyFile {
+    pub(super) step: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) e_growth: Option<ScalarEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) w_growth: Option<ScalarEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) e_growth_in: Option<ScalarEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) w_growth_in: Option<ScalarEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) stretch: Option<ScalarEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) bend: Option<ScalarEntry>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) direction: Option<DirectionEntry>,
+}
+
+impl KeyFile {
+    /// The entry of one scalar map: the one place that pairs field and kind.
+    pub(super) fn scalar_mut(&mut self, kind: MapKind) -> &mut Option<ScalarEntry> {
+        match kind {
+            MapKind::EGrowth => &mut self.e_growth,
+            MapKind::WGrowth => &mut self.w_growth,
+            MapKind::EGrowthIn => &mut self.e_growth_in,
+            MapKind::WGrowthIn => &mut self.w_growth_in,
+            MapKind::Stretch => &mut self.stretch,
+            MapKind::Bend => &mut self.bend,
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct OrganFile {
+    pub(super) name: String,
+    pub(super) template: String,
+    #[serde(default)]
+    pub(super) position: [f64; 3],
+    #[serde(default)]
+    pub(super) azimuth_deg: f64,
+    #[serde(default)]
+    pub(super) joint_angle_deg: f64,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct OverlapFile {
+    pub(super) inner: String,
+    pub(super) outer: String,
+}
+
+/// A scalar map entry: a number or a PNG path.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum ScalarEntry {
+    Constant(f32),
+    File(String),
+}
+
+/// A direction map entry: a `[u, v]` pair or a PNG path.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum DirectionEntry {
+    Constant([f32; 2]),
+    File(String),
+}
+
+impl Serialize for ScalarEntry {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            ScalarEntry::Constant(value) => serializer.serialize_f32(*value),
+            ScalarEntry::File(path) => serializer.serialize_str(path),
+        }
+    }
+}
+
+impl Serialize for DirectionEntry {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            DirectionEntry::Constant(pair) => pair.serialize(serializer),
+            DirectionEntry::File(path) => serializer.serialize_str(path),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for ScalarEntry {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(ScalarEntryVisitor)
+    }
+}
+
+impl<'de> Deserialize<'de> for DirectionEntry {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        deserializer.deserialize_any(DirectionEntryVisitor)
+    }
+}
+
+pub(super) struct ScalarEntryVisitor;
+
+impl Visitor<'_> for ScalarEntryVisitor {
+    type Value = ScalarEntry;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number (a constant map) or the path of a PNG file")
+    }
+
+    fn visit_f64<E: de::Error>(self, value: f64) -> Result<ScalarEntry, E> {
+        Ok(ScalarEntry::Constant(value as f32))
+    }
+
+    fn visit_i64<E: de::Error>(self, value: i64) -> Result<ScalarEntry, E> {
+        Ok(ScalarEntry::Constant(value as f32))
+    }
+
+    fn visit_u64<E: de::Error>(self, value: u64) -> Result<ScalarEntry, E> {
+        Ok(ScalarEntry::Constant(value as f32))
+    }
+
+    fn visit_str<E: de::Error>(self, path: &str) -> Result<ScalarEntry, E> {
+        Ok(ScalarEntry::File(path.to_string()))
+    }
+}
+
+pub(super) struct DirectionEntryVisitor;
+
+impl<'de> Visitor<'de> for DirectionEntryVisitor {
+    type Value = DirectionEntry;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a [u, v] pair of numbers (a constant direction) or the path of a PNG file")
+    }
+
+    fn visit_str<E: de::Error>(self, path: &str) -> Result<DirectionEntry, E> {
+        Ok(DirectionEntry::File(path.to_string()))
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<DirectionEntry, A::Error> {
+        let mut pair = [0.0f32; 2];
+        for (index, component) in pair.iter_mut().enumerate() {
+            let value: f64 = seq
+                .next_element()?
+                .ok_or_else(|| de::Error::invalid_length(index, &self))?;
+            *component = value as f32;
+        }
+        if seq.next_element::<de::IgnoredAny>()?.is_some() {
+            return Err(de::Error::invalid_length(3, &self));
+        }
+        Ok(DirectionEntry::Constant(pair))
+    }
+}
+
+impl From<&SimulationSettings> for SimulationFile {
+    fn from(settings: &SimulationSettings) -> Self {
+        SimulationFile {
+            keyframes: settings.keyframes,
+            relative_tolerance: settings.solver.relative_tolerance,
+            max_iterations: settings.solver.max_iterations,
+            collision_offset: settings.collision_offset,
+        }
+    }
+}
+
+impl From<&SimulationFile> for SimulationSettings {
+    fn from(file: &SimulationFile) -> Self {
+        SimulationSettings {
+            keyframes: file.keyframes,
+            solver: SolverSettings {
+                relative_tolerance: file.relative_tolerance,
+                max_iterations: file.max_iterations,
+            },
+            collision_offset: file.collision_offset,
+            ..SimulationSettings::default()
+        }
+    }
+}
+
+impl From<Blend> for BlendFile {
+    fn from(blend: Blend) -> Self {
+        match blend {
+            Blend::Linear => BlendFile::Linear,
+            Blend::Smooth => BlendFile::Smooth,
+            Blend::Logistic { steepness } => BlendFile::Logistic { steepness },
+        }
+    }
+}
+
+impl From<&BlendFile> for Blend {
+    fn from(file: &BlendFile) -> Self {
+        match *file {
+            BlendFile::Linear => Blend::Linear,
+            BlendFile::Smooth => Blend::Smooth,
+            BlendFile::Logistic { steepness } => Blend::Logistic { steepness },
+        }
+    }
+}
+
+impl From<&JointRamp> for JointRampFile {
+    fn from(ramp: &JointRamp) -> Self {
+        JointRampFile {
+            from_step: ramp.from_step,
+            to_step: ramp.to_step,
+            degrees: ramp.degrees,
+        }
+    }
+}
+
+impl From<&JointRampFile> for JointRamp {
+    fn from(file: &JointRampFile) -> Self {
+        JointRamp {
+            from_step: file.from_step,
+            to_step: file.to_step,
+            degrees: file.degrees,
+        }
+    }
+}
