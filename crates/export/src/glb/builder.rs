@@ -1,0 +1,424 @@
+//! The binary chunk of a .glb and the buffer views and accessors that
+//! describe it, and the GLB container around the JSON.
+
+use serde_json::{Map, Value, json};
+
+use crate::{Encoding, ExportError};
+
+const BYTE: u32 = 5120;
+const UNSIGNED_BYTE: u32 = 5121;
+const SHORT: u32 = 5122;
+const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_INT: u32 = 5125;
+const FLOAT: u32 = 5126;
+
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+
+pub(super) const LINEAR: u32 = 9729;
+pub(super) const LINEAR_MIPMAP_LINEAR: u32 = 9987;
+pub(super) const CLAMP_TO_EDGE: u32 = 33071;
+
+pub(super) const TRIANGLES: u32 = 4;
+
+pub(super) const KHR_MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
+
+/// An `f32` as the shortest JSON number that reads back as the same `f32`
+/// (`0.1` rather than `0.10000000149011612`).
+pub(super) fn f32_json(x: f32) -> Value {
+    x.to_string()
+        .parse::<f64>()
+        .ok()
+        .and_then(serde_json::Number::from_f64)
+        .map_or(Value::Null, Value::Number)
+}
+
+/// Per-component minimum and maximum, as JSON arrays.
+fn min_max<const N: usize, T: Copy + PartialOrd + Into<f64>>(values: &[[T; N]]) -> (Value, Value) {
+    let mut min = values[0];
+    let mut max = values[0];
+    for v in values {
+        for i in 0..N {
+            if v[i] < min[i] {
+                min[i] = v[i];
+            }
+            if v[i] > max[i] {
+                max[i] = v[i];
+            }
+        }
+    }
+    // Every T used here (f32, i16) is exactly an f32.
+    let as_json = |a: [T; N]| {
+        Value::from(
+            a.iter()
+                .map(|&x| f32_json(x.into() as f32))
+                .collect::<Vec<_>>(),
+        )
+    };
+    (as_json(min), as_json(max))
+}
+
+/// Adds the per-component `min` and `max` of `values` to `accessor`.
+fn set_min_max<const N: usize, T: Copy + PartialOrd + Into<f64>>(
+    accessor: &mut Value,
+    values: &[[T; N]],
+) {
+    let (min, max) = min_max(values);
+    accessor["min"] = min;
+    accessor["max"] = max;
+}
+
+/// The little-endian bytes of `values`, as glTF buffers hold numbers.
+fn le_bytes<T, const B: usize>(
+    values: impl IntoIterator<Item = T>,
+    to_le_bytes: fn(T) -> [u8; B],
+) -> Vec<u8> {
+    values.into_iter().flat_map(to_le_bytes).collect()
+}
+
+/// What an accessor's elements are: the component type, whether integer
+/// components are normalized to `[0, 1]` or `[-1, 1]`, and the glTF type
+/// (`SCALAR`, `VEC2`, `VEC3`).
+#[derive(Clone, Copy)]
+struct Element {
+    component_type: u32,
+    normalized: bool,
+    kind: &'static str,
+}
+
+const VEC3_F32: Element = Element::plain(FLOAT, "VEC3");
+const SCALAR_F32: Element = Element::plain(FLOAT, "SCALAR");
+
+impl Element {
+    const fn plain(component_type: u32, kind: &'static str) -> Element {
+        Element {
+            component_type,
+            normalized: false,
+            kind,
+        }
+    }
+
+    const fn normalized(component_type: u32, kind: &'static str) -> Element {
+        Element {
+            component_type,
+            normalized: true,
+            kind,
+        }
+    }
+
+    /// An accessor of `count` such elements, over buffer view `view` (with
+    /// none, all zeros unless made sparse).
+    fn accessor(self, view: Option<usize>, count: usize) -> Value {
+        let mut accessor = Map::new();
+        if let Some(view) = view {
+            accessor.insert("bufferView".into(), view.into());
+        }
+        accessor.insert("componentType".into(), self.component_type.into());
+        if self.normalized {
+            accessor.insert("normalized".into(), true.into());
+        }
+        accessor.insert("count".into(), count.into());
+        accessor.insert("type".into(), self.kind.into());
+        Value::Object(accessor)
+    }
+}
+
+/// The binary chunk and the buffer views and accessors that describe it.
+#[derive(Default)]
+pub(super) struct GltfBuilder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+    pub(super) uses_quantization: bool,
+}
+
+impl GltfBuilder {
+    /// Appends `bytes` 4-byte aligned as a new buffer view.
+    pub(super) fn view(
+        &mut self,
+        bytes: &[u8],
+        stride: Option<usize>,
+        target: Option<u32>,
+    ) -> usize {
+        self.pad();
+        let mut view = json!({
+            "buffer": 0,
+            "byteOffset": self.bin.len(),
+            "byteLength": bytes.len(),
+        });
+        if let Some(stride) = stride {
+            view["byteStride"] = stride.into();
+        }
+        if let Some(target) = target {
+            view["target"] = target.into();
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(view);
+        self.views.len() - 1
+    }
+
+    fn pad(&mut self) {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+    }
+
+    fn accessor(&mut self, accessor: Value) -> usize {
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    /// Stores `bytes` as a new buffer view (see [`GltfBuilder::view`]) and
+    /// returns an accessor of `count` `element`s over it.
+    fn stored(
+        &mut self,
+        bytes: &[u8],
+        stride: Option<usize>,
+        target: Option<u32>,
+        element: Element,
+        count: usize,
+    ) -> Value {
+        let view = self.view(bytes, stride, target);
+        element.accessor(Some(view), count)
+    }
+
+    pub(super) fn vec3_f32(&mut self, values: &[[f32; 3]], with_min_max: bool) -> usize {
+        let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
+        let mut accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), VEC3_F32, values.len());
+        if with_min_max {
+            set_min_max(&mut accessor, values);
+        }
+        self.accessor(accessor)
+    }
+
+    /// A morph-target delta accessor; with [`Encoding::Sparse`] only the
+    /// vertices with a non-zero delta are stored, when that is smaller.
+    pub(super) fn vec3_f32_target(
+        &mut self,
+        deltas: &[[f32; 3]],
+        with_min_max: bool,
+        encoding: Encoding,
+    ) -> usize {
+        if encoding != Encoding::Sparse {
+            return self.vec3_f32(deltas, with_min_max);
+        }
+        let mut moved: Vec<usize> = deltas
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.iter().any(|&x| x != 0.0))
+            .map(|(i, _)| i)
+            .collect();
+        if moved.is_empty() {
+            // Nothing moved. glTF allows an accessor with neither buffer view
+            // nor sparse data (all zeros), but some readers (the `gltf`
+            // crate) reject it, so store one explicit zero instead.
+            moved.push(0);
+        }
+        let index_type = index_component_type(deltas.len());
+        let index_size = component_size(index_type);
+        let dense_bytes = 12 * deltas.len();
+        let sparse_bytes = moved.len() * (index_size + 12);
+        if sparse_bytes >= dense_bytes {
+            return self.vec3_f32(deltas, with_min_max);
+        }
+        let mut accessor = VEC3_F32.accessor(None, deltas.len());
+        if with_min_max {
+            set_min_max(&mut accessor, deltas);
+        }
+        let values = le_bytes(moved.iter().flat_map(|&i| deltas[i]), f32::to_le_bytes);
+        self.add_sparse(&mut accessor, &moved, index_type, &values);
+        self.accessor(accessor)
+    }
+
+    /// Makes `accessor` (one with no buffer view, so all zeros) sparse:
+    /// the elements at `positions` hold `values`.
+    fn add_sparse(
+        &mut self,
+        accessor: &mut Value,
+        positions: &[usize],
+        index_type: u32,
+        values: &[u8],
+    ) {
+        let indices_view = self.view(&index_bytes(positions, index_type), None, None);
+        let values_view = self.view(values, None, None);
+        accessor["sparse"] = json!({
+            "count": positions.len(),
+            "indices": { "bufferView": indices_view, "componentType": index_type },
+            "values": { "bufferView": values_view },
+        });
+    }
+
+    /// Normalized `i16` VEC3, padded to an 8-byte stride as vertex
+    /// attributes must be 4-byte aligned.
+    pub(super) fn vec3_i16(&mut self, values: &[[i16; 3]], with_min_max: bool) -> usize {
+        self.uses_quantization = true;
+        let padded = values.iter().flat_map(|v| [v[0], v[1], v[2], 0]);
+        let bytes = le_bytes(padded, i16::to_le_bytes);
+        let element = Element::normalized(SHORT, "VEC3");
+        let mut accessor = self.stored(&bytes, Some(8), Some(ARRAY_BUFFER), element, values.len());
+        if with_min_max {
+            set_min_max(&mut accessor, values);
+        }
+        self.accessor(accessor)
+    }
+
+    /// Normalized `i8` VEC3, padded to a 4-byte stride.
+    pub(super) fn vec3_i8_normalized(&mut self, values: &[[i8; 3]]) -> usize {
+        self.uses_quantization = true;
+        let padded = values.iter().flat_map(|v| [v[0], v[1], v[2], 0]);
+        let bytes = le_bytes(padded, i8::to_le_bytes);
+        let element = Element::normalized(BYTE, "VEC3");
+        let accessor = self.stored(&bytes, Some(4), Some(ARRAY_BUFFER), element, values.len());
+        self.accessor(accessor)
+    }
+
+    pub(super) fn vec2_f32(&mut self, values: &[[f32; 2]]) -> usize {
+        let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
+        let element = Element::plain(FLOAT, "VEC2");
+        let accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), element, values.len());
+        self.accessor(accessor)
+    }
+
+    pub(super) fn vec2_u16_normalized(&mut self, values: &[[u16; 2]]) -> usize {
+        let bytes = le_bytes(values.iter().flatten().copied(), u16::to_le_bytes);
+        let element = Element::normalized(UNSIGNED_SHORT, "VEC2");
+        let accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), element, values.len());
+        self.accessor(accessor)
+    }
+
+    pub(super) fn indices(&mut self, triangles: &[[u32; 3]], vertex_count: usize) -> usize {
+        let flat: Vec<usize> = triangles.iter().flatten().map(|&i| i as usize).collect();
+        // At least u16: some graphics APIs have no 8-bit index buffers.
+        let component_type = match index_component_type(vertex_count) {
+            UNSIGNED_BYTE => UNSIGNED_SHORT,
+            other => other,
+        };
+        let bytes = index_bytes(&flat, component_type);
+        let element = Element::plain(component_type, "SCALAR");
+        let accessor = self.stored(
+            &bytes,
+            None,
+            Some(ELEMENT_ARRAY_BUFFER),
+            element,
+            flat.len(),
+        );
+        self.accessor(accessor)
+    }
+
+    pub(super) fn times(&mut self, times: &[f32]) -> usize {
+        let bytes = le_bytes(times.iter().copied(), f32::to_le_bytes);
+        let mut accessor = self.stored(&bytes, None, None, SCALAR_F32, times.len());
+        let first = times.first().copied().unwrap_or(0.0);
+        let last = times.last().copied().unwrap_or(0.0);
+        accessor["min"] = json!([f32_json(first)]);
+        accessor["max"] = json!([f32_json(last)]);
+        self.accessor(accessor)
+    }
+
+    /// One-hot weights: at exported keyframe `k >= 1` target `k - 1` has
+    /// weight 1, all else 0.
+    pub(super) fn weights(
+        &mut self,
+        keyframes: usize,
+        targets: usize,
+        encoding: Encoding,
+    ) -> usize {
+        let count = keyframes * targets;
+        let ones = (1..keyframes).map(|k| k * targets + (k - 1));
+        let accessor = match encoding {
+            Encoding::Dense => {
+                let mut values = vec![0.0f32; count];
+                for i in ones {
+                    values[i] = 1.0;
+                }
+                let bytes = le_bytes(values, f32::to_le_bytes);
+                self.stored(&bytes, None, None, SCALAR_F32, count)
+            }
+            Encoding::Sparse => {
+                let positions: Vec<usize> = ones.collect();
+                let index_type = index_component_type(count);
+                let values = le_bytes(positions.iter().map(|_| 1.0f32), f32::to_le_bytes);
+                let mut accessor = SCALAR_F32.accessor(None, count);
+                self.add_sparse(&mut accessor, &positions, index_type, &values);
+                accessor
+            }
+            Encoding::Quantized => {
+                let mut values = vec![0u8; count];
+                for i in ones {
+                    values[i] = u8::MAX;
+                }
+                let element = Element::normalized(UNSIGNED_BYTE, "SCALAR");
+                self.stored(&values, None, None, element, count)
+            }
+        };
+        self.accessor(accessor)
+    }
+
+    /// Assembles the GLB container: header, JSON chunk, binary chunk.
+    pub(super) fn finish(mut self, mut root: Value) -> Result<Vec<u8>, ExportError> {
+        self.pad();
+        root["buffers"] = json!([{ "byteLength": self.bin.len() }]);
+        root["bufferViews"] = Value::Array(self.views);
+        root["accessors"] = Value::Array(self.accessors);
+        let mut json_chunk = serde_json::to_vec(&root).map_err(|e| ExportError::Io {
+            path: "<glTF JSON>".into(),
+            source: std::io::Error::other(e),
+        })?;
+        while !json_chunk.len().is_multiple_of(4) {
+            json_chunk.push(b' ');
+        }
+        let total = 12 + 8 + json_chunk.len() + 8 + self.bin.len();
+        let too_large = || ExportError::TooLarge {
+            bytes: total as u64,
+        };
+        let total_u32 = u32::try_from(total).map_err(|_| too_large())?;
+        let json_len = u32::try_from(json_chunk.len()).map_err(|_| too_large())?;
+        let bin_len = u32::try_from(self.bin.len()).map_err(|_| too_large())?;
+
+        let mut glb = Vec::with_capacity(total);
+        glb.extend_from_slice(b"glTF");
+        glb.extend_from_slice(&2u32.to_le_bytes());
+        glb.extend_from_slice(&total_u32.to_le_bytes());
+        glb.extend_from_slice(&json_len.to_le_bytes());
+        glb.extend_from_slice(b"JSON");
+        glb.extend_from_slice(&json_chunk);
+        glb.extend_from_slice(&bin_len.to_le_bytes());
+        glb.extend_from_slice(b"BIN\0");
+        glb.extend_from_slice(&self.bin);
+        Ok(glb)
+    }
+}
+
+/// The smallest index type for indices below `count`. The maximum value of
+/// each type is avoided: glTF reserves it for primitive restart.
+fn index_component_type(count: usize) -> u32 {
+    if count <= u8::MAX as usize {
+        UNSIGNED_BYTE
+    } else if count <= u16::MAX as usize {
+        UNSIGNED_SHORT
+    } else {
+        UNSIGNED_INT
+    }
+}
+
+fn component_size(component_type: u32) -> usize {
+    match component_type {
+        BYTE | UNSIGNED_BYTE => 1,
+        SHORT | UNSIGNED_SHORT => 2,
+        _ => 4,
+    }
+}
+
+fn index_bytes(indices: &[usize], component_type: u32) -> Vec<u8> {
+    match component_type {
+        UNSIGNED_BYTE => indices.iter().map(|&i| i as u8).collect(),
+        UNSIGNED_SHORT => indices
+            .iter()
+            .flat_map(|&i| (i as u16).to_le_bytes())
+            .collect(),
+        _ => indices
+            .iter()
+            .flat_map(|&i| (i as u32).to_le_bytes())
+            .collect(),
+    }
+}

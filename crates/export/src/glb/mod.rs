@@ -1,0 +1,189 @@
+//! The animated .glb writer. The glTF JSON is built with `serde_json`
+//! values rather than the `gltf-json` types: the writer needs exact control
+//! over optional fields (sparse accessors without a buffer view, normalized
+//! quantized accessors, `mesh.extras.targetNames`, extensions), and
+//! `serde_json` keeps the `gltf` crate a test-only dependency.
+
+mod builder;
+mod encode;
+
+use glam::DVec3;
+use serde_json::{Value, json};
+
+use crate::prepare::{
+    animation_times, sample_keyframes, sample_positions, target_name, validate_options,
+    validate_tracks,
+};
+use crate::{ExportError, GlbOptions, Track};
+use builder::{
+    CLAMP_TO_EDGE, GltfBuilder, KHR_MESH_QUANTIZATION, LINEAR, LINEAR_MIPMAP_LINEAR, TRIANGLES,
+    f32_json,
+};
+use encode::encode_mesh;
+
+/// Builds the animated .glb of `tracks` in memory (see the crate
+/// documentation for its layout). `progress` is called with values rising
+/// from 0 to 1, about once per exported keyframe of each track.
+///
+/// Fails with a typed error, before any work, on invalid tracks (no
+/// keyframes, vertex counts that differ between keyframes or from the UVs,
+/// indices out of range, NaN or infinite coordinates, base colours outside
+/// `[0, 1]`, a texture that is not a PNG, animated tracks with different
+/// keyframe counts) and on invalid options.
+pub fn glb_bytes(
+    tracks: &[Track],
+    options: &GlbOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Vec<u8>, ExportError> {
+    let keyframe_count = validate_tracks(tracks)?;
+    validate_options(options, keyframe_count)?;
+    progress(0.0);
+
+    let sample_at = sample_positions(keyframe_count, options.max_morph_targets);
+    let target_count = sample_at.len() - 1;
+    let target_names: Vec<Value> = sample_at[1..]
+        .iter()
+        .map(|&x| Value::from(target_name(x)))
+        .collect();
+
+    let total_work = tracks
+        .iter()
+        .map(|t| {
+            if t.keyframes.len() > 1 {
+                sample_at.len()
+            } else {
+                1
+            }
+        })
+        .sum::<usize>() as f32
+        + 1.0;
+    let mut work_done = 0usize;
+    let mut tick = |progress: &mut dyn FnMut(f32)| {
+        work_done += 1;
+        progress(work_done as f32 / total_work);
+    };
+
+    let mut gltf = GltfBuilder::default();
+    let mut nodes = Vec::with_capacity(tracks.len());
+    let mut meshes = Vec::with_capacity(tracks.len());
+    let mut materials = Vec::with_capacity(tracks.len());
+    let mut images = Vec::new();
+    let mut textures = Vec::new();
+    let mut animated_nodes = Vec::new();
+
+    for (index, track) in tracks.iter().enumerate() {
+        let frames: Vec<Vec<DVec3>> = if track.keyframes.len() > 1 {
+            sample_at
+                .iter()
+                .map(|&x| sample_keyframes(&track.keyframes, x))
+                .collect()
+        } else {
+            vec![track.keyframes[0].clone()]
+        };
+
+        let mut material = json!({
+            "name": track.name,
+            "pbrMetallicRoughness": {
+                "baseColorFactor": track.base_color.map(f32_json),
+                "metallicFactor": 0.0,
+                "roughnessFactor": 0.7,
+            },
+            "doubleSided": true,
+        });
+        if track.base_color[3] < 1.0 {
+            material["alphaMode"] = json!("BLEND");
+        }
+        if let Some(png) = &track.base_color_png {
+            let view = gltf.view(png, None, None);
+            images.push(json!({
+                "name": track.name,
+                "bufferView": view,
+                "mimeType": "image/png",
+            }));
+            textures.push(json!({ "sampler": 0, "source": images.len() - 1 }));
+            material["pbrMetallicRoughness"]["baseColorTexture"] =
+                json!({ "index": textures.len() - 1 });
+        }
+        materials.push(material);
+
+        let encoded = encode_mesh(&mut gltf, track, &frames, options, &mut || tick(progress));
+
+        let mut primitive = json!({
+            "attributes": encoded.attributes,
+            "indices": encoded.indices,
+            "material": index,
+            "mode": TRIANGLES,
+        });
+        let mut mesh = json!({ "name": track.name });
+        if !encoded.targets.is_empty() {
+            primitive["targets"] = Value::Array(encoded.targets);
+            mesh["weights"] = Value::Array(vec![json!(0.0); target_count]);
+            mesh["extras"] = json!({ "targetNames": target_names });
+            animated_nodes.push(index);
+        }
+        mesh["primitives"] = json!([primitive]);
+        meshes.push(mesh);
+
+        let mut node = json!({ "name": track.name, "mesh": index });
+        if let Some(qbox) = encoded.dequantization {
+            node["translation"] = json!(qbox.center.map(f32_json));
+            node["scale"] = json!([
+                f32_json(qbox.scale),
+                f32_json(qbox.scale),
+                f32_json(qbox.scale)
+            ]);
+        }
+        nodes.push(node);
+    }
+
+    let mut root = json!({
+        "asset": {
+            "version": "2.0",
+            "generator": concat!("Anthesis (anthesis-export ", env!("CARGO_PKG_VERSION"), ")"),
+        },
+        "scene": 0,
+        "scenes": [{ "name": "flower", "nodes": (0..tracks.len()).collect::<Vec<_>>() }],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+    });
+
+    if !animated_nodes.is_empty() {
+        let sample_times = animation_times(options.timing, keyframe_count, &sample_at)?;
+        let input = gltf.times(&sample_times);
+        let output = gltf.weights(sample_at.len(), target_count, options.encoding);
+        // All animated meshes share the keyframe times and the one-hot
+        // weights, so they share one sampler's accessors.
+        let samplers: Vec<Value> = animated_nodes
+            .iter()
+            .map(|_| json!({ "input": input, "output": output, "interpolation": "LINEAR" }))
+            .collect();
+        let channels: Vec<Value> = animated_nodes
+            .iter()
+            .enumerate()
+            .map(|(sampler, &node)| {
+                json!({ "sampler": sampler, "target": { "node": node, "path": "weights" } })
+            })
+            .collect();
+        root["animations"] =
+            json!([{ "name": "opening", "samplers": samplers, "channels": channels }]);
+    }
+    if !images.is_empty() {
+        root["images"] = Value::Array(images);
+        root["textures"] = Value::Array(textures);
+        root["samplers"] = json!([{
+            "magFilter": LINEAR,
+            "minFilter": LINEAR_MIPMAP_LINEAR,
+            "wrapS": CLAMP_TO_EDGE,
+            "wrapT": CLAMP_TO_EDGE,
+        }]);
+    }
+    if gltf.uses_quantization {
+        root["extensionsUsed"] = json!([KHR_MESH_QUANTIZATION]);
+        root["extensionsRequired"] = json!([KHR_MESH_QUANTIZATION]);
+    }
+
+    let bytes = gltf.finish(root)?;
+    progress(1.0);
+    Ok(bytes)
+}
