@@ -160,6 +160,7 @@ fn lily() -> Project {
                 max_iterations: 40,
             },
             collision_offset: 0.02,
+            ..SimulationSettings::default()
         },
     }
 }
