@@ -15,7 +15,10 @@ mod topology;
 pub mod validate;
 
 pub use error::{MeshError, Space};
-pub use obj::{load_obj, obj_string, parse_obj, parse_obj_unvalidated, write_obj};
+pub use obj::{
+    ObjFile, ObjWarning, load_obj, load_obj_file, obj_string, parse_obj, parse_obj_file,
+    parse_obj_unvalidated, write_obj,
+};
 pub use topology::{Edge, EdgeSide, Topology};
 pub use validate::validate;
 

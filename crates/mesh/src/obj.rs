@@ -5,12 +5,21 @@
 //! `v/vt/vn`, indices may be negative (relative to the end of the list so
 //! far), and polygons with more than three corners are fan-triangulated.
 //! `o`, `g`, `s`, `usemtl` and `mtllib` statements and `#` comments are
-//! ignored; any other statement is a syntax error.
+//! ignored; `l` (loose edges, which Blender writes) and `p` (points) are
+//! ignored with an [`ObjWarning`]; any other statement is a syntax error.
+//! A UTF-8 byte-order mark at the start is skipped.
 //!
 //! An organ needs exactly one UV per vertex, so every OBJ position takes the
 //! UV of the face corners that use it; a position used with two different
 //! UVs is a UV seam and is rejected. Positions used by no face are dropped.
+//!
+//! Files from elsewhere are read with limits: only regular files of at most
+//! [`MAX_OBJ_BYTES`], at most [`MAX_VERTICES`] vertices,
+//! [`MAX_TEXCOORDS`] texture coordinates and [`MAX_TRIANGLES`] triangles,
+//! coordinates within [`validate::MAX_COORDINATE`]. Errors name the OBJ
+//! line and count vertices and faces as the OBJ does, from 1.
 
+use std::fmt;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -18,20 +27,92 @@ use glam::{DVec2, DVec3};
 
 use crate::{Mesh, MeshError, validate, vertex_normals};
 
-/// Reads and validates the OBJ file at `path`.
+/// The largest OBJ file read, in bytes. A 2-million-triangle mesh with
+/// normals is about 150 MB.
+pub const MAX_OBJ_BYTES: u64 = 256 << 20;
+/// The most vertices (`v` statements) an OBJ may have.
+pub const MAX_VERTICES: usize = 1_000_000;
+/// The most texture coordinates (`vt` statements) an OBJ may have.
+pub const MAX_TEXCOORDS: usize = 4 * MAX_VERTICES;
+/// The most triangles an OBJ may have (polygons count as their triangles).
+pub const MAX_TRIANGLES: usize = 2 * MAX_VERTICES;
+
+/// How much of a word from the file an error message quotes.
+const QUOTED_CHARS: usize = 32;
+
+/// Statements that were read past, one warning per kind.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ObjWarning {
+    /// The statement, e.g. `l`.
+    pub keyword: &'static str,
+    /// How many there were.
+    pub count: usize,
+    /// The line of the first one.
+    pub first_line: usize,
+}
+
+impl fmt::Display for ObjWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let what = match self.keyword {
+            "l" => "line (`l`)",
+            _ => "point (`p`)",
+        };
+        let plural = if self.count == 1 { "" } else { "s" };
+        write!(
+            f,
+            "OBJ line {}: {} {what} statement{plural} ignored; an organ is made of faces only",
+            self.first_line, self.count
+        )
+    }
+}
+
+/// A mesh read from an OBJ file, and what was read past.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjFile {
+    pub mesh: Mesh,
+    pub warnings: Vec<ObjWarning>,
+}
+
+/// Reads and validates the OBJ file at `path` (warnings dropped; see
+/// [`load_obj_file`]).
 pub fn load_obj(path: &Path) -> Result<Mesh, MeshError> {
-    let text = std::fs::read_to_string(path)
+    load_obj_file(path).map(|file| file.mesh)
+}
+
+/// Reads and validates the OBJ file at `path`: a regular file of at most
+/// [`MAX_OBJ_BYTES`] bytes of UTF-8 text.
+pub fn load_obj_file(path: &Path) -> Result<ObjFile, MeshError> {
+    let text = anthesis_files::read_regular_text(path, MAX_OBJ_BYTES, "an OBJ mesh")
         .map_err(|e| MeshError::Io(format!("{}: {e}", path.display())))?;
-    parse_obj(&text)
+    parse_obj_file(&text)
+}
+
+/// Parses OBJ text into a mesh and validates it (warnings dropped; see
+/// [`parse_obj_file`]).
+pub fn parse_obj(text: &str) -> Result<Mesh, MeshError> {
+    parse_obj_file(text).map(|file| file.mesh)
 }
 
 /// Parses OBJ text into a mesh and validates it (see
-/// [`validate::validate`]). Errors found by validation name vertices of the
-/// returned mesh, i.e. after unused OBJ positions have been dropped.
-pub fn parse_obj(text: &str) -> Result<Mesh, MeshError> {
-    let mesh = parse_obj_unvalidated(text)?;
-    validate::validate(&mesh)?;
-    Ok(mesh)
+/// [`validate::validate`]). Errors come wrapped in [`MeshError::InObj`]
+/// with the OBJ line and the OBJ's own numbers (from 1) where one element
+/// is at fault.
+pub fn parse_obj_file(text: &str) -> Result<ObjFile, MeshError> {
+    let parsed = parse(text)?;
+    if let Err(error) = validate::validate(&parsed.mesh) {
+        return Err(parsed.locate(error));
+    }
+    Ok(ObjFile {
+        mesh: parsed.mesh,
+        warnings: parsed.warnings,
+    })
+}
+
+/// Parses OBJ text into a mesh without geometric validation. It still fails
+/// on syntax errors, an empty file, missing UVs and UV seams, because those
+/// make a mesh with one UV per vertex impossible to build.
+pub fn parse_obj_unvalidated(text: &str) -> Result<Mesh, MeshError> {
+    parse(text).map(|parsed| parsed.mesh)
 }
 
 /// One corner of an OBJ face: 0-based position and texture coordinate
@@ -42,15 +123,130 @@ struct Corner {
     texcoord: Option<usize>,
 }
 
-/// Parses OBJ text into a mesh without geometric validation. It still fails
-/// on syntax errors, missing UVs and UV seams, because those make a mesh
-/// with one UV per vertex impossible to build. [`MeshError::UvSeam`] names
-/// the 0-based index of the position among the file's `v` statements.
-pub fn parse_obj_unvalidated(text: &str) -> Result<Mesh, MeshError> {
+/// A parsed OBJ and where each element of its mesh came from.
+struct Parsed {
+    mesh: Mesh,
+    warnings: Vec<ObjWarning>,
+    /// Per mesh vertex: its number among the `v` statements (from 1), the
+    /// line of that statement and the line of its `vt`.
+    vertex_number: Vec<usize>,
+    vertex_line: Vec<usize>,
+    texcoord_line: Vec<usize>,
+    /// Per triangle: the number of its `f` statement (from 1) and its line.
+    face_number: Vec<usize>,
+    face_line: Vec<usize>,
+}
+
+impl Parsed {
+    /// `error`, found by validating the mesh, in the OBJ's numbers and with
+    /// the line of the statement at fault.
+    fn locate(&self, error: MeshError) -> MeshError {
+        use MeshError::*;
+        let vertex = |v: usize| self.vertex_number[v];
+        let vertex_u32 = |v: u32| u32::try_from(self.vertex_number[v as usize]).unwrap_or(u32::MAX);
+        let face = |t: usize| self.face_number[t];
+        let (line, error) = match error {
+            RepeatedVertex {
+                triangle,
+                vertex: v,
+            } => (
+                Some(self.face_line[triangle]),
+                RepeatedVertex {
+                    triangle: face(triangle),
+                    vertex: vertex_u32(v),
+                },
+            ),
+            NonFinitePosition { vertex: v } => (
+                Some(self.vertex_line[v]),
+                NonFinitePosition { vertex: vertex(v) },
+            ),
+            CoordinateOutOfRange { vertex: v, value } => (
+                Some(self.vertex_line[v]),
+                CoordinateOutOfRange {
+                    vertex: vertex(v),
+                    value,
+                },
+            ),
+            NonFiniteUv { vertex: v } => (
+                Some(self.texcoord_line[v]),
+                NonFiniteUv { vertex: vertex(v) },
+            ),
+            UvOutOfRange { vertex: v, value } => (
+                Some(self.texcoord_line[v]),
+                UvOutOfRange {
+                    vertex: vertex(v),
+                    value,
+                },
+            ),
+            DegenerateTriangle {
+                triangle,
+                space,
+                area,
+            } => (
+                Some(self.face_line[triangle]),
+                DegenerateTriangle {
+                    triangle: face(triangle),
+                    space,
+                    area,
+                },
+            ),
+            NonManifoldEdge { a, b, faces } => (
+                None,
+                NonManifoldEdge {
+                    a: vertex_u32(a),
+                    b: vertex_u32(b),
+                    faces,
+                },
+            ),
+            NonManifoldVertex { vertex: v, fans } => (
+                Some(self.vertex_line[v as usize]),
+                NonManifoldVertex {
+                    vertex: vertex_u32(v),
+                    fans,
+                },
+            ),
+            InconsistentOrientation {
+                a,
+                b,
+                first,
+                second,
+            } => (
+                Some(self.face_line[second]),
+                InconsistentOrientation {
+                    a: vertex_u32(a),
+                    b: vertex_u32(b),
+                    first: face(first),
+                    second: face(second),
+                },
+            ),
+            FlippedUv { triangle } => (
+                Some(self.face_line[triangle]),
+                FlippedUv {
+                    triangle: face(triangle),
+                },
+            ),
+            // Nothing to renumber: the whole mesh is at fault.
+            other => return other,
+        };
+        InObj {
+            line,
+            error: Box::new(error),
+        }
+    }
+}
+
+fn parse(text: &str) -> Result<Parsed, MeshError> {
+    // Notepad and some exporters start UTF-8 files with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut positions: Vec<DVec3> = Vec::new();
+    let mut position_lines: Vec<usize> = Vec::new();
     let mut texcoords: Vec<DVec2> = Vec::new();
+    let mut texcoord_lines: Vec<usize> = Vec::new();
     let mut triangles: Vec<[Corner; 3]> = Vec::new();
+    let mut face_of_triangle: Vec<(usize, usize)> = Vec::new();
+    let mut face_count = 0;
     let mut first_face_without_uv: Option<usize> = None;
+    let mut warnings: Vec<ObjWarning> = Vec::new();
 
     for (line_index, raw_line) in text.lines().enumerate() {
         let line = line_index + 1;
@@ -60,14 +256,24 @@ pub fn parse_obj_unvalidated(text: &str) -> Result<Mesh, MeshError> {
             continue;
         };
         let syntax = |message: String| MeshError::ObjSyntax { line, message };
+        let too_many =
+            |what: &'static str, limit: usize| MeshError::TooManyElements { line, what, limit };
         match keyword {
             "v" => {
+                if positions.len() == MAX_VERTICES {
+                    return Err(too_many("vertices", MAX_VERTICES));
+                }
                 let [x, y, z] = parse_numbers::<3>(&mut words, "v", "x y z").map_err(syntax)?;
                 positions.push(DVec3::new(x, y, z));
+                position_lines.push(line);
             }
             "vt" => {
+                if texcoords.len() == MAX_TEXCOORDS {
+                    return Err(too_many("texture coordinates", MAX_TEXCOORDS));
+                }
                 let [u, v] = parse_numbers::<2>(&mut words, "vt", "u v").map_err(syntax)?;
                 texcoords.push(DVec2::new(u, v));
+                texcoord_lines.push(line);
             }
             "f" => {
                 let mut corners = Vec::new();
@@ -85,15 +291,41 @@ pub fn parse_obj_unvalidated(text: &str) -> Result<Mesh, MeshError> {
                         corners.len()
                     )));
                 }
+                if triangles.len() + corners.len() - 2 > MAX_TRIANGLES {
+                    return Err(too_many("triangles", MAX_TRIANGLES));
+                }
+                face_count += 1;
                 for k in 1..corners.len() - 1 {
                     triangles.push([corners[0], corners[k], corners[k + 1]]);
+                    face_of_triangle.push((face_count, line));
                 }
             }
+            // Blender writes loose edges as `l`; points are as loose. Neither
+            // is part of a surface.
+            "l" | "p" => match warnings.iter_mut().find(|w| w.keyword == keyword) {
+                Some(warning) => warning.count += 1,
+                None => warnings.push(ObjWarning {
+                    keyword: if keyword == "l" { "l" } else { "p" },
+                    count: 1,
+                    first_line: line,
+                }),
+            },
             "vn" | "o" | "g" | "s" | "usemtl" | "mtllib" => {}
-            other => return Err(syntax(format!("unsupported statement `{other}`"))),
+            other => {
+                return Err(syntax(format!(
+                    "unsupported statement `{}`",
+                    anthesis_files::excerpt(other, QUOTED_CHARS)
+                )));
+            }
         }
     }
 
+    if positions.is_empty() && triangles.is_empty() {
+        return Err(MeshError::EmptyObj);
+    }
+    if triangles.is_empty() {
+        return Err(MeshError::NoFaces);
+    }
     if texcoords.is_empty() {
         return Err(MeshError::MissingUvs);
     }
@@ -103,36 +335,53 @@ pub fn parse_obj_unvalidated(text: &str) -> Result<Mesh, MeshError> {
 
     // One texture coordinate per position; a second, different one is a seam.
     let mut texcoord_of_position: Vec<Option<usize>> = vec![None; positions.len()];
-    for corner in triangles.iter().flatten() {
-        let Some(texcoord) = corner.texcoord else {
-            continue;
-        };
-        match texcoord_of_position[corner.position] {
-            None => texcoord_of_position[corner.position] = Some(texcoord),
-            Some(previous) if texcoords[previous] != texcoords[texcoord] => {
-                return Err(MeshError::UvSeam {
-                    vertex: corner.position,
-                });
+    for (triangle, corners) in triangles.iter().enumerate() {
+        for corner in corners {
+            let Some(texcoord) = corner.texcoord else {
+                continue;
+            };
+            match texcoord_of_position[corner.position] {
+                None => texcoord_of_position[corner.position] = Some(texcoord),
+                Some(previous) if texcoords[previous] != texcoords[texcoord] => {
+                    return Err(MeshError::InObj {
+                        line: Some(face_of_triangle[triangle].1),
+                        error: Box::new(MeshError::UvSeam {
+                            vertex: corner.position + 1,
+                        }),
+                    });
+                }
+                Some(_) => {}
             }
-            Some(_) => {}
         }
     }
 
     // Keep the used positions in file order.
-    let mut mesh = Mesh::default();
+    let mut parsed = Parsed {
+        mesh: Mesh::default(),
+        warnings,
+        vertex_number: Vec::new(),
+        vertex_line: Vec::new(),
+        texcoord_line: Vec::new(),
+        face_number: face_of_triangle.iter().map(|&(face, _)| face).collect(),
+        face_line: face_of_triangle.iter().map(|&(_, line)| line).collect(),
+    };
+    let mesh = &mut parsed.mesh;
     let mut new_index: Vec<u32> = vec![u32::MAX; positions.len()];
     for (position_index, texcoord) in texcoord_of_position.iter().enumerate() {
-        if let Some(texcoord) = texcoord {
+        if let Some(texcoord) = *texcoord {
             new_index[position_index] = mesh.positions.len() as u32;
             mesh.positions.push(positions[position_index]);
-            mesh.uvs.push(texcoords[*texcoord]);
+            mesh.uvs.push(texcoords[texcoord]);
+            parsed.vertex_number.push(position_index + 1);
+            parsed.vertex_line.push(position_lines[position_index]);
+            parsed.texcoord_line.push(texcoord_lines[texcoord]);
         }
     }
     mesh.triangles = triangles
         .iter()
         .map(|corners| corners.map(|c| new_index[c.position]))
         .collect();
-    Ok(mesh)
+    Ok(parsed)
 }
 
 /// Parses the first `N` numbers after a keyword; further numbers (such as
@@ -147,9 +396,12 @@ fn parse_numbers<'a, const N: usize>(
         let word = words
             .next()
             .ok_or_else(|| format!("`{keyword}` needs {expected}"))?;
-        *number = word
-            .parse()
-            .map_err(|_| format!("`{word}` is not a number"))?;
+        *number = word.parse().map_err(|_| {
+            format!(
+                "`{}` is not a number",
+                anthesis_files::excerpt(word, QUOTED_CHARS)
+            )
+        })?;
     }
     Ok(numbers)
 }
@@ -164,7 +416,10 @@ fn parse_corner(
 ) -> Result<Corner, String> {
     let parts: Vec<&str> = word.split('/').collect();
     if parts.len() > 3 {
-        return Err(format!("face corner `{word}` has too many `/`"));
+        return Err(format!(
+            "face corner `{}` has too many `/`",
+            anthesis_files::excerpt(word, QUOTED_CHARS)
+        ));
     }
     let position = resolve_index(parts[0], position_count, "vertex")?;
     let texcoord = match parts.get(1) {
@@ -178,9 +433,12 @@ fn parse_corner(
 
 /// Turns a 1-based or negative (relative) OBJ index into a 0-based one.
 fn resolve_index(word: &str, count: usize, what: &str) -> Result<usize, String> {
-    let index: i64 = word
-        .parse()
-        .map_err(|_| format!("`{word}` is not a {what} index"))?;
+    let index: i64 = word.parse().map_err(|_| {
+        format!(
+            "`{}` is not a {what} index",
+            anthesis_files::excerpt(word, QUOTED_CHARS)
+        )
+    })?;
     let resolved = if index > 0 {
         index - 1
     } else if index < 0 {
@@ -328,7 +586,20 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
                     vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\n\
                     f 1/1 2/2 3/3\nf 1/1 3/5 4/4\n";
-        assert_eq!(parse_obj(text), Err(MeshError::UvSeam { vertex: 2 }));
+        // Position 3 (the OBJ's third `v`) meets a second UV on line 11.
+        let error = parse_obj(text).expect_err("a seam");
+        assert_eq!(
+            error,
+            MeshError::InObj {
+                line: Some(11),
+                error: Box::new(MeshError::UvSeam { vertex: 3 })
+            }
+        );
+        assert!(
+            error
+                .to_string()
+                .starts_with("OBJ line 11: vertex 3 has two")
+        );
     }
 
     #[test]
@@ -372,7 +643,13 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
                 3,
                 "`a` is not a vertex index",
             ),
-            ("# fine\nl 1 2\n", 2, "unsupported statement `l`"),
+            ("# fine\nvp 1 2\n", 2, "unsupported statement `vp`"),
+            (
+                "v 0 0 0\nv 1 x2345678901234567890123456789012345678901 0\n",
+                2,
+                "`x2345678901234567890123456789012…` is not a number",
+            ),
+            ("v 0 0 \u{1b}[2J\n", 1, "`\\u{1b}[2J` is not a number"),
         ];
         for (text, expected_line, expected_message) in cases {
             match parse_obj(text) {
@@ -388,17 +665,31 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         }
     }
 
+    /// `error` wrapped with an OBJ line.
+    fn at_line(line: usize, error: MeshError) -> MeshError {
+        MeshError::InObj {
+            line: Some(line),
+            error: Box::new(error),
+        }
+    }
+
     #[test]
     fn import_validates_non_finite_coordinates() {
+        // QUAD's `v` statements are on lines 7 to 10.
         let text = QUAD.replace("v 1 1 0", "v 1 nan 0");
         assert_eq!(
             parse_obj(&text),
-            Err(MeshError::NonFinitePosition { vertex: 2 })
+            Err(at_line(9, MeshError::NonFinitePosition { vertex: 3 }))
         );
         let text = QUAD.replace("v 1 0 0", "v inf 0 0");
+        let error = parse_obj(&text).expect_err("infinite");
         assert_eq!(
-            parse_obj(&text),
-            Err(MeshError::NonFinitePosition { vertex: 1 })
+            error,
+            at_line(8, MeshError::NonFinitePosition { vertex: 2 })
+        );
+        assert_eq!(
+            error.to_string(),
+            "OBJ line 8: vertex 2 has a non-finite coordinate (NaN or infinite)"
         );
         // The unvalidated parser hands the mesh over as it is.
         let mesh = parse_obj_unvalidated(&text).expect("parses");
@@ -411,11 +702,191 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         let text = QUAD.replace("f 1/1/1 2/2/1 3/3/1 4/4/1", "f 1/1 2/2 3/3\nf 1/1 4/4 3/3");
         assert_eq!(
             parse_obj(&text),
-            Err(MeshError::InconsistentOrientation {
-                a: 2,
-                b: 0,
-                first: 0,
-                second: 1
+            Err(at_line(
+                17,
+                MeshError::InconsistentOrientation {
+                    a: 3,
+                    b: 1,
+                    first: 1,
+                    second: 2
+                }
+            ))
+        );
+    }
+
+    #[test]
+    fn validation_errors_count_as_the_obj_does() {
+        // Position 1 is unused (dropped from the mesh) and the quad is the
+        // second face: the errors still name OBJ vertex 4 and face 2.
+        // The square v2..v5 as a quad, and a fin v4-v2-v6 on its diagonal.
+        let text = "v 9 9 9\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\n\
+                    vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.2 0.8\n\
+                    f 2/1 3/2 4/3 5/4\n\
+                    f 4/3 2/1 6/5\n";
+        let error = parse_obj(text).expect_err("non-manifold");
+        assert_eq!(
+            error.to_string(),
+            "edge 2-4 is shared by 3 triangles (non-manifold; at most 2 allowed)"
+        );
+        let text = "v 9 9 9\nv 0 0 0\nv 1 0 0\nv 2 2 0\nv 0 1 0\n\
+                    vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+                    f 2/1 3/2 4/3\n\
+                    f 2/1 4/3 4/3\n";
+        assert_eq!(
+            parse_obj(text),
+            Err(at_line(
+                11,
+                MeshError::RepeatedVertex {
+                    triangle: 2,
+                    vertex: 4
+                }
+            ))
+        );
+        let text = "v 0 0 0\nv 1 0 0\nv 2 0 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+        match parse_obj(text) {
+            Err(MeshError::InObj {
+                line: Some(7),
+                error,
+            }) => assert!(
+                matches!(
+                    *error,
+                    MeshError::DegenerateTriangle {
+                        triangle: 1,
+                        space: crate::Space::World,
+                        ..
+                    }
+                ),
+                "{error:?}"
+            ),
+            other => panic!("expected a degenerate face 1 on line 7, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_huge_coordinate_is_out_of_range_at_its_line() {
+        let text = QUAD.replace("v 1 1 0", "v 1 1e30 0");
+        let error = parse_obj(&text).expect_err("out of range");
+        assert_eq!(
+            error,
+            at_line(
+                9,
+                MeshError::CoordinateOutOfRange {
+                    vertex: 3,
+                    value: 1e30
+                }
+            )
+        );
+        assert_eq!(
+            error.to_string(),
+            "OBJ line 9: vertex 3 has a coordinate of 1e30, out of range: coordinates must \
+             lie within ±1e6"
+        );
+        let text = QUAD.replace("vt 1 0", "vt 1e9 0");
+        assert_eq!(
+            parse_obj(&text),
+            Err(at_line(
+                12,
+                MeshError::UvOutOfRange {
+                    vertex: 2,
+                    value: 1e9
+                }
+            ))
+        );
+    }
+
+    #[test]
+    fn empty_files_say_they_are_empty() {
+        for text in [
+            "",
+            "\n\n",
+            "# only a comment\n",
+            "\u{feff}",
+            "o petal\ng front\n",
+        ] {
+            assert_eq!(parse_obj(text), Err(MeshError::EmptyObj), "{text:?}");
+        }
+        assert_eq!(
+            MeshError::EmptyObj.to_string(),
+            "the OBJ file is empty: it has no vertices (v) and no faces (f)"
+        );
+        let points_only = "v 0 0 0\nv 1 0 0\nvt 0 0\n";
+        assert_eq!(parse_obj(points_only), Err(MeshError::NoFaces));
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let with_bom = format!("\u{feff}{QUAD}");
+        assert_eq!(parse_obj(&with_bom).expect("valid"), unit_square());
+        let bom_before_v = "\u{feff}v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+                            vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\r\n";
+        assert_eq!(parse_obj(bom_before_v).expect("valid"), unit_square());
+    }
+
+    #[test]
+    fn loose_edges_and_points_are_ignored_with_a_warning() {
+        let text = format!("{QUAD}l 1 2\nl 2 3 4\np 1\n");
+        let file = parse_obj_file(&text).expect("valid");
+        assert_eq!(file.mesh, unit_square());
+        assert_eq!(
+            file.warnings,
+            [
+                ObjWarning {
+                    keyword: "l",
+                    count: 2,
+                    first_line: 17
+                },
+                ObjWarning {
+                    keyword: "p",
+                    count: 1,
+                    first_line: 19
+                }
+            ]
+        );
+        assert_eq!(
+            file.warnings[0].to_string(),
+            "OBJ line 17: 2 line (`l`) statements ignored; an organ is made of faces only"
+        );
+        assert!(parse_obj_file(QUAD).expect("valid").warnings.is_empty());
+    }
+
+    #[test]
+    fn too_many_triangles_stop_reading_at_the_line() {
+        // One polygon with MAX_TRIANGLES + 1 triangles: the limit is met
+        // while reading, before a mesh is built.
+        let corners = MAX_TRIANGLES + 3;
+        let mut text = String::from("v 0 0 0\nvt 0 0\nf");
+        for _ in 0..corners {
+            text.push_str(" 1/1");
+        }
+        text.push('\n');
+        assert_eq!(
+            parse_obj(&text),
+            Err(MeshError::TooManyElements {
+                line: 3,
+                what: "triangles",
+                limit: MAX_TRIANGLES
+            })
+        );
+        let error = MeshError::TooManyElements {
+            line: 3,
+            what: "vertices",
+            limit: MAX_VERTICES,
+        };
+        assert_eq!(
+            error.to_string(),
+            "OBJ line 3: more than 1000000 vertices, the most an organ mesh may have"
+        );
+    }
+
+    #[test]
+    fn too_many_vertices_stop_reading_at_the_line() {
+        let text = "v 0 0 0\n".repeat(MAX_VERTICES + 1);
+        assert_eq!(
+            parse_obj(&text),
+            Err(MeshError::TooManyElements {
+                line: MAX_VERTICES + 1,
+                what: "vertices",
+                limit: MAX_VERTICES
             })
         );
     }
@@ -474,7 +945,20 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         match load_obj(&missing) {
             Err(MeshError::Io(message)) => {
                 assert!(message.contains("missing.obj"), "{message}");
+                assert!(message.contains("does not exist"), "{message}");
             }
+            other => panic!("expected an Io error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn load_obj_reads_only_regular_files() {
+        match load_obj(Path::new("/dev/zero")) {
+            Err(MeshError::Io(message)) => assert_eq!(
+                message,
+                "/dev/zero: it is a character device (like /dev/zero), not a regular file; \
+                 only regular files are read"
+            ),
             other => panic!("expected an Io error, got {other:?}"),
         }
     }

@@ -10,13 +10,20 @@ use crate::{Mesh, MeshError, Topology};
 /// independent of the mesh's scale.
 pub const DEGENERATE_AREA_RATIO: f64 = 1e-12;
 
+/// The largest size of a position coordinate or a UV component. Far beyond
+/// any organ in any unit (a 5 cm petal is 50,000 in micrometres); values
+/// past it come from a broken exporter or a hand edit, and squared (areas,
+/// energies) they would lose all precision.
+pub const MAX_COORDINATE: f64 = 1e6;
+
 /// Checks that `mesh` is a single, manifold, consistently oriented triangle
 /// surface with one finite UV per vertex and no degenerate triangle, in 3D
 /// or in UV, and no flipped UV triangle. Returns its edge topology.
 ///
 /// The checks run in this order and the first failure is returned: empty
 /// mesh, index out of range, repeated vertex in a triangle, UV count,
-/// non-finite position, non-finite UV, unused vertex, zero area in 3D, zero
+/// non-finite position, non-finite UV, position or UV beyond
+/// [`MAX_COORDINATE`], unused vertex, zero area in 3D, zero
 /// area in UV, non-manifold edge and inconsistent orientation (from
 /// [`Topology::build`]), non-manifold vertex, flipped UV triangle, more than
 /// one connected piece.
@@ -59,6 +66,17 @@ pub fn validate(mesh: &Mesh) -> Result<Topology, MeshError> {
     }
     if let Some(vertex) = mesh.uvs.iter().position(|uv| !uv.is_finite()) {
         return Err(MeshError::NonFiniteUv { vertex });
+    }
+    let too_large = |values: &[f64]| values.iter().copied().find(|v| v.abs() > MAX_COORDINATE);
+    for (vertex, p) in mesh.positions.iter().enumerate() {
+        if let Some(value) = too_large(&p.to_array()) {
+            return Err(MeshError::CoordinateOutOfRange { vertex, value });
+        }
+    }
+    for (vertex, uv) in mesh.uvs.iter().enumerate() {
+        if let Some(value) = too_large(&uv.to_array()) {
+            return Err(MeshError::UvOutOfRange { vertex, value });
+        }
     }
     let mut used = vec![false; vertex_count];
     for &i in mesh.triangles.iter().flatten() {
@@ -310,6 +328,35 @@ mod tests {
         assert_eq!(
             validate(&m),
             Err(MeshError::NonFinitePosition { vertex: 3 })
+        );
+    }
+
+    #[test]
+    fn coordinates_beyond_the_limit_are_out_of_range() {
+        let mut m = unit_square();
+        m.positions[2].x = 1e30;
+        assert_eq!(
+            validate(&m),
+            Err(MeshError::CoordinateOutOfRange {
+                vertex: 2,
+                value: 1e30
+            })
+        );
+        let mut m = unit_square();
+        m.positions[1].z = -MAX_COORDINATE;
+        assert!(validate(&m).is_ok(), "the limit itself is allowed");
+        let mut m = unit_square();
+        m.uvs[3].y = -2e6;
+        assert_eq!(
+            validate(&m),
+            Err(MeshError::UvOutOfRange {
+                vertex: 3,
+                value: -2e6
+            })
+        );
+        assert_eq!(
+            validate(&m).expect_err("out of range").to_string(),
+            "vertex 3 has a UV component of -2e6, out of range: UVs must lie within ±1e6"
         );
     }
 
