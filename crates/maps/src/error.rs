@@ -44,6 +44,13 @@ pub enum MapError {
         y: u32,
         rgb: [u16; 3],
     },
+    #[error(
+        "the map is {width}x{height} pixels, more than the limit of {limit}x{limit}; scale it \
+         down in a paint program (a map is sampled once per triangle, so detail beyond that \
+         is lost anyway)",
+        limit = crate::png_io::MAX_MAP_SIDE
+    )]
+    TooManyPixels { width: u32, height: u32 },
     #[error("map file {}: {message}", path.display())]
     Io { path: PathBuf, message: String },
     #[error("{}: {error}", path.display())]

@@ -174,20 +174,16 @@ impl KeyedMaps {
     /// so exactly at a key's step that key has weight 1. The weights sum to 1;
     /// when one key contributes the second weight is 0.
     pub fn weights_at(&self, step: f64) -> [(usize, f64); 2] {
-        let last = self.keys.len() - 1;
-        // The number of keys at or before `step` (0 for a NaN step).
-        let reached = self.keys.partition_point(|key| f64::from(key.step) <= step);
-        if reached == 0 {
-            return [(0, 1.0), (0, 0.0)];
+        blend_weights(&self.keys, |key| key.step, self.blend, step)
+    }
+
+    /// The key steps and the blend without the maps: all a simulation needs
+    /// once it has sampled each key's maps, so it need not copy them.
+    pub fn schedule(&self) -> KeySchedule {
+        KeySchedule {
+            steps: self.keys.iter().map(|key| key.step).collect(),
+            blend: self.blend,
         }
-        if reached > last {
-            return [(last, 1.0), (last, 0.0)];
-        }
-        let (earlier, later) = (reached - 1, reached);
-        let start = f64::from(self.keys[earlier].step);
-        let end = f64::from(self.keys[later].step);
-        let weight = self.blend.apply((step - start) / (end - start));
-        [(earlier, 1.0 - weight), (later, weight)]
     }
 
     /// The blended eq. 1 value of one scalar map for a triangle at `step`.
@@ -220,4 +216,42 @@ impl KeyedMaps {
             .map(|&(index, weight)| weight * value_of(&self.keys[index].maps))
             .sum()
     }
+}
+
+/// The steps of a [`KeyedMaps`] and its blend, without the maps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KeySchedule {
+    steps: Vec<u32>,
+    pub blend: Blend,
+}
+
+impl KeySchedule {
+    /// The same weights as [`KeyedMaps::weights_at`] of the map set this
+    /// schedule came from.
+    pub fn weights_at(&self, step: f64) -> [(usize, f64); 2] {
+        blend_weights(&self.steps, |&step| step, self.blend, step)
+    }
+}
+
+/// [`KeyedMaps::weights_at`] over `keys` sorted by `step_of`, at least one.
+fn blend_weights<K>(
+    keys: &[K],
+    step_of: impl Fn(&K) -> u32,
+    blend: Blend,
+    step: f64,
+) -> [(usize, f64); 2] {
+    let last = keys.len() - 1;
+    // The number of keys at or before `step` (0 for a NaN step).
+    let reached = keys.partition_point(|key| f64::from(step_of(key)) <= step);
+    if reached == 0 {
+        return [(0, 1.0), (0, 0.0)];
+    }
+    if reached > last {
+        return [(last, 1.0), (last, 0.0)];
+    }
+    let (earlier, later) = (reached - 1, reached);
+    let start = f64::from(step_of(&keys[earlier]));
+    let end = f64::from(step_of(&keys[later]));
+    let weight = blend.apply((step - start) / (end - start));
+    [(earlier, 1.0 - weight), (later, weight)]
 }

@@ -41,8 +41,8 @@ mod raster;
 
 pub use error::MapError;
 pub use growth::{DIRECTION_MAP_NAME, GrowthMaps, MapKind};
-pub use keys::{Blend, KeyedMaps, MapKey};
-pub use png_io::BitDepth;
+pub use keys::{Blend, KeySchedule, KeyedMaps, MapKey};
+pub use png_io::{BitDepth, MAX_MAP_SIDE, MAX_PNG_BYTES};
 pub use raster::{DirectionMap, Raster, ScalarMap};
 
 #[cfg(test)]

@@ -11,9 +11,18 @@ use crate::MapError;
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
 
-/// Decoded images larger than this are refused (the `image` crate's default
-/// allocation limit); a growth map is a few megabytes at most.
-const MAX_DECODED_BYTES: u64 = 512 * 1024 * 1024;
+/// The largest PNG file read, in bytes (a 4096x4096 16-bit RGBA map that
+/// does not compress at all is 128 MiB).
+pub const MAX_PNG_BYTES: u64 = 256 << 20;
+
+/// The widest and tallest map read, in pixels. A map is sampled at the
+/// organ's triangles (a lily petal has 685), so 4096 is far past what
+/// sampling can tell apart; a 16k x 16k map took 8 GB to load.
+pub const MAX_MAP_SIDE: u32 = 4096;
+
+/// The most the PNG decoder may allocate: the pixels of the largest map,
+/// 16-bit RGBA, and room for its chunks.
+const MAX_DECODE_ALLOCATION: u64 = 2 * (MAX_MAP_SIDE as u64).pow(2) * 8;
 
 /// Bits per channel of a written PNG.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -80,9 +89,16 @@ pub(crate) fn decode(bytes: &[u8]) -> Result<DecodedPng, MapError> {
     let decode_error = |error: image::ImageError| MapError::Decode {
         message: error.to_string(),
     };
-    let decoder =
-        PngDecoder::with_limits(Cursor::new(bytes), Limits::default()).map_err(decode_error)?;
+    // The allocation limit also bounds what the decoder unpacks from
+    // compressed text chunks before the pixels. The size is checked here,
+    // with a message of our own, before any pixel is decoded.
+    let mut limits = Limits::no_limits();
+    limits.max_alloc = Some(MAX_DECODE_ALLOCATION);
+    let decoder = PngDecoder::with_limits(Cursor::new(bytes), limits).map_err(decode_error)?;
     let (width, height) = decoder.dimensions();
+    if width > MAX_MAP_SIDE || height > MAX_MAP_SIDE {
+        return Err(MapError::TooManyPixels { width, height });
+    }
     let color = decoder.color_type();
     let (channels, depth) = match color {
         ColorType::L8 => (1, BitDepth::Eight),
@@ -101,14 +117,6 @@ pub(crate) fn decode(bytes: &[u8]) -> Result<DecodedPng, MapError> {
         }
     };
     let total_bytes = decoder.total_bytes();
-    if total_bytes > MAX_DECODED_BYTES {
-        return Err(MapError::Decode {
-            message: format!(
-                "a {width}x{height} image is too large to load as a map \
-                 ({total_bytes} bytes decoded, at most {MAX_DECODED_BYTES})"
-            ),
-        });
-    }
     if width == 0 || height == 0 {
         return Err(MapError::EmptyRaster { width, height });
     }

@@ -378,10 +378,14 @@ fn not_grey(png: &DecodedPng, pixel_index: usize, pixel: &[u16]) -> MapError {
     }
 }
 
+/// The bytes of the map file at `path`: a regular file of at most
+/// [`png_io::MAX_PNG_BYTES`].
 fn read_file(path: &Path) -> Result<Vec<u8>, MapError> {
-    std::fs::read(path).map_err(|error| MapError::Io {
-        path: path.to_path_buf(),
-        message: format!("cannot read: {error}"),
+    anthesis_files::read_regular(path, png_io::MAX_PNG_BYTES, "a PNG map").map_err(|error| {
+        MapError::Io {
+            path: path.to_path_buf(),
+            message: error.to_string(),
+        }
     })
 }
 

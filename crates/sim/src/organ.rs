@@ -2,7 +2,7 @@
 //! key, its elastic state, solver and attachment.
 
 use anthesis_flower::{Organ, Placement, Template, joint_angle_after};
-use anthesis_maps::{KeyedMaps, ScalarMap};
+use anthesis_maps::{KeySchedule, ScalarMap};
 use anthesis_mesh::{Mesh, Topology};
 use anthesis_physics::elastic::edge_areas;
 use anthesis_physics::membrane::EdgeSmoothedMembrane;
@@ -107,7 +107,9 @@ pub(crate) struct OrganSim {
     placement: Placement,
     schedule: Vec<anthesis_flower::JointRamp>,
     base: Vec<u32>,
-    maps: KeyedMaps,
+    /// When each sampled key holds; the maps themselves stay with the
+    /// template (a copy per organ cost 4 GB for 16k maps).
+    key_schedule: KeySchedule,
     keys: Vec<SampledKey>,
     dg: f64,
     model: Model,
@@ -204,7 +206,7 @@ impl OrganSim {
             base_current: Vec::with_capacity(base.len()),
             base_target: Vec::with_capacity(base.len()),
             base,
-            maps: template.maps.clone(),
+            key_schedule: template.maps.schedule(),
             keys,
             dg: template.dg,
             model: settings.model,
@@ -233,7 +235,7 @@ impl OrganSim {
     pub fn grow(&mut self, step: u32) {
         self.mean_edge = self.elastic.rest_lengths.iter().sum::<f64>()
             / self.elastic.rest_lengths.len().max(1) as f64;
-        let weights = self.maps.weights_at(f64::from(step));
+        let weights = self.key_schedule.weights_at(f64::from(step));
         let blend = |values: fn(&SampledKey) -> &Vec<f64>, t: usize| -> f64 {
             weights
                 .iter()
@@ -308,7 +310,7 @@ impl OrganSim {
     }
 
     fn update_stiffness(&mut self, step: u32) {
-        let weights = self.maps.weights_at(f64::from(step.max(1)));
+        let weights = self.key_schedule.weights_at(f64::from(step.max(1)));
         let areas = edge_areas(&self.positions, &self.mesh.triangles, &self.topology);
         self.modulus.resize(areas.len(), 0.0);
         for (e, area) in areas.iter().enumerate() {

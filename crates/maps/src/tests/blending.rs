@@ -124,6 +124,18 @@ fn weights_before_after_and_at_keys() {
 }
 
 #[test]
+fn the_schedule_weighs_like_the_maps_it_came_from() {
+    for blend in BLENDS {
+        let maps = keyed(&[10, 50, 100], blend);
+        let schedule = maps.schedule();
+        for tenth_step in -10..=1200 {
+            let step = f64::from(tenth_step) / 10.0;
+            assert_eq!(schedule.weights_at(step), maps.weights_at(step), "{step}");
+        }
+    }
+}
+
+#[test]
 fn weights_follow_the_blend_and_sum_to_one() {
     for blend in BLENDS {
         let maps = keyed(&[10, 50], blend);

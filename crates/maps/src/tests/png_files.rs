@@ -300,3 +300,76 @@ fn writing_into_a_missing_folder_is_an_io_error() {
         "{result:?}"
     );
 }
+
+#[test]
+fn maps_wider_or_taller_than_the_limit_are_refused_before_decoding() {
+    let side = crate::MAX_MAP_SIDE;
+    let at_limit = png_with(side, 1, ExtendedColorType::L8, &vec![128; side as usize]);
+    assert_eq!(
+        ScalarMap::from_png_bytes(&at_limit)
+            .expect("at the limit")
+            .size(),
+        (side, 1)
+    );
+    for (width, height) in [(side + 1, 1), (1, side + 1)] {
+        let count = (width * height) as usize;
+        let png = png_with(width, height, ExtendedColorType::L8, &vec![128; count]);
+        let error = ScalarMap::from_png_bytes(&png).expect_err("too large");
+        assert_eq!(error, MapError::TooManyPixels { width, height });
+        let error = DirectionMap::from_png_bytes(&png).expect_err("too large");
+        assert_eq!(error, MapError::TooManyPixels { width, height });
+    }
+    assert!(
+        MapError::TooManyPixels {
+            width: 16384,
+            height: 16384
+        }
+        .to_string()
+        .starts_with("the map is 16384x16384 pixels, more than the limit of 4096x4096;")
+    );
+}
+
+#[test]
+fn only_regular_files_within_the_size_limit_are_read() {
+    let folder = tempfile::tempdir().expect("temporary folder");
+    let fifo = folder.path().join("pipe.png");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo runs");
+    assert!(status.success());
+    // A sparse file: larger than the limit without using the disk.
+    let huge = folder.path().join("huge.png");
+    std::fs::File::create(&huge)
+        .and_then(|file| file.set_len(crate::MAX_PNG_BYTES + 1))
+        .expect("sparse file");
+    let cases: [(&std::path::Path, &str); 4] = [
+        (
+            std::path::Path::new("/dev/zero"),
+            "it is a character device (like /dev/zero), not a regular file",
+        ),
+        (
+            std::path::Path::new("/dev/urandom"),
+            "it is a character device (like /dev/zero), not a regular file",
+        ),
+        (&fifo, "it is a named pipe (FIFO), not a regular file"),
+        (
+            &huge,
+            "it is 256 MiB (268435457 bytes), more than the limit of 256 MiB for a PNG map",
+        ),
+    ];
+    for (path, expected) in cases {
+        for error in [
+            ScalarMap::load_png(path).expect_err("refused"),
+            DirectionMap::load_png(path).expect_err("refused"),
+        ] {
+            match &error {
+                MapError::Io { path: p, message } => {
+                    assert_eq!(p, path);
+                    assert!(message.starts_with(expected), "{path:?}: {message}");
+                }
+                other => panic!("{path:?}: expected an Io error, got {other:?}"),
+            }
+        }
+    }
+}
