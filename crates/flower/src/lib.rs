@@ -3,6 +3,7 @@
 //! The project file format that stores all this is in [`project`].
 
 pub mod project;
+pub mod scale;
 
 use anthesis_maps::KeyedMaps;
 use anthesis_mesh::Mesh;

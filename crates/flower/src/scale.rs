@@ -1,0 +1,209 @@
+//! Whether a template's mesh is in the project's unit of length.
+//!
+//! Lengths in a project have no unit: a lily made in centimetres and the
+//! same lily made in millimetres (meshes, positions, thickness and
+//! collision offset all ×10) simulate alike. What breaks is a mesh in one
+//! unit dropped into a project in another, as from a tool that works in
+//! millimetres: growth bends an organ by a curvature set by its thickness,
+//! so a petal ten times too long for its thickness rolls up ten times as
+//! far, and the solver gives up at the first keyframe without a word about
+//! why. This module catches that before a run.
+//!
+//! The test: an organ's length (the longest side of its mesh's bounding
+//! box) against its thickness. Real petals and sepals are 10 to 2,000
+//! thicknesses long (a fleshy magnolia tepal about 50, a lily petal about
+//! 200 to 400, the thinnest poppy petals about 1,500); the paper's flowers
+//! are 220 (lily) and 442 (*Eustoma*). A mesh outside that range is taken
+//! to be in another unit, off by the power of ten that brings it nearest
+//! to 300 thicknesses.
+
+use std::fmt;
+use std::ops::RangeInclusive;
+
+use anthesis_mesh::Mesh;
+use glam::DVec3;
+
+use crate::{Flower, Template};
+
+/// How many thicknesses long an organ may be.
+pub const LENGTH_IN_THICKNESSES: RangeInclusive<f64> = 10.0..=2000.0;
+
+/// The organ length, in thicknesses, that a mesh in the right unit is
+/// assumed to be near: about the paper's flowers (220 and 442).
+const TYPICAL_LENGTH_IN_THICKNESSES: f64 = 300.0;
+
+/// A template whose mesh does not fit its thickness: most likely a mesh in
+/// another unit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScaleMismatch {
+    pub template: String,
+    /// The longest side of the mesh's bounding box, in project units.
+    pub length: f64,
+    pub thickness: f64,
+    /// The power of ten the mesh looks too large by: 10 for a mesh made in
+    /// millimetres in a project in centimetres, 0.001 for one made in
+    /// metres in a project in millimetres.
+    pub factor: f64,
+}
+
+impl ScaleMismatch {
+    /// The mesh scaled by `1 / factor` about the template origin (the
+    /// organ's base): the conversion an import can offer.
+    pub fn rescaled(&self, mesh: &Mesh) -> Mesh {
+        let mut mesh = mesh.clone();
+        for p in &mut mesh.positions {
+            *p /= self.factor;
+        }
+        mesh
+    }
+}
+
+impl fmt::Display for ScaleMismatch {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (low, high) = (
+            LENGTH_IN_THICKNESSES.start(),
+            LENGTH_IN_THICKNESSES.end(),
+        );
+        let size = if self.factor > 1.0 { "large" } else { "small" };
+        let times = if self.factor > 1.0 {
+            self.factor
+        } else {
+            1.0 / self.factor
+        };
+        write!(
+            f,
+            "template \"{}\": its mesh is {:.3} long, {:.0} times its thickness {}, but organs are \
+             {low} to {high} thicknesses long. The mesh looks {times:.0} times too {size}: {}. \
+             Scale the mesh by {} (or the thickness by {})",
+            self.template,
+            self.length,
+            self.length / self.thickness,
+            self.thickness,
+            unit_guess(self.factor),
+            1.0 / self.factor,
+            self.factor
+        )
+    }
+}
+
+/// The units a mesh too large (or small) by `factor` was probably made in.
+fn unit_guess(factor: f64) -> String {
+    let exponent = factor.log10().round() as i32;
+    match exponent {
+        1 => "was it made in millimetres for a project in centimetres?".to_string(),
+        2 => "was it made in centimetres for a project in metres?".to_string(),
+        3 => "was it made in millimetres for a project in metres?".to_string(),
+        -1 => "was it made in centimetres for a project in millimetres?".to_string(),
+        -2 => "was it made in metres for a project in centimetres?".to_string(),
+        -3 => "was it made in metres for a project in millimetres?".to_string(),
+        e if e > 0 => format!("it was probably made in a unit 1e{e} times smaller"),
+        e => format!("it was probably made in a unit 1e{} times larger", -e),
+    }
+}
+
+/// The longest side of the bounding box of `mesh` (0 for an empty mesh).
+pub fn organ_length(mesh: &Mesh) -> f64 {
+    let Some(first) = mesh.positions.first() else {
+        return 0.0;
+    };
+    let (low, high) = mesh
+        .positions
+        .iter()
+        .fold((*first, *first), |(low, high), &p| (low.min(p), high.max(p)));
+    let extent: DVec3 = high - low;
+    extent.max_element()
+}
+
+/// The mismatch of one template, if its mesh does not fit its thickness.
+pub fn check_template(template: &Template) -> Option<ScaleMismatch> {
+    let length = organ_length(&template.mesh);
+    let thickness = template.thickness;
+    let in_thicknesses = length / thickness;
+    if !in_thicknesses.is_finite()
+        || in_thicknesses <= 0.0
+        || LENGTH_IN_THICKNESSES.contains(&in_thicknesses)
+    {
+        // Not a question of units: an empty mesh or a thickness of 0 get
+        // their own errors elsewhere.
+        return None;
+    }
+    let exponent = (in_thicknesses / TYPICAL_LENGTH_IN_THICKNESSES)
+        .log10()
+        .round();
+    Some(ScaleMismatch {
+        template: template.name.clone(),
+        length,
+        thickness,
+        factor: 10f64.powf(exponent),
+    })
+}
+
+/// Every template of `flower` whose mesh does not fit its thickness.
+pub fn check_flower(flower: &Flower) -> Vec<ScaleMismatch> {
+    flower.templates.iter().filter_map(check_template).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use anthesis_maps::{GrowthMaps, KeyedMaps};
+
+    /// A template like the lily petal: a 13 x 44 sheet, thickness 0.2.
+    fn petal(scale: f64, thickness: f64) -> Template {
+        let mut mesh = anthesis_mesh::generate::test_petal(44.0, 13.0, 9, 17);
+        for p in &mut mesh.positions {
+            *p *= scale;
+        }
+        Template {
+            name: "petal".to_string(),
+            mesh,
+            maps: KeyedMaps::single(GrowthMaps::uniform()),
+            dg: 0.003,
+            thickness,
+            stretch_stiffness: 20.0,
+            bend_stiffness: 20.0,
+            base_region: Default::default(),
+            joint_schedule: Vec::new(),
+            color: [1.0; 4],
+        }
+    }
+
+    #[test]
+    fn a_mesh_in_the_project_unit_fits_at_any_consistent_scale() {
+        for scale in [0.001, 0.1, 1.0, 10.0, 1000.0] {
+            let template = petal(scale, 0.2 * scale);
+            assert_eq!(check_template(&template), None, "scale {scale}");
+        }
+    }
+
+    #[test]
+    fn a_mesh_in_another_unit_names_the_factor() {
+        for (scale, factor) in [(10.0, 10.0), (100.0, 100.0), (1000.0, 1000.0), (0.001, 0.001)] {
+            let mismatch = check_template(&petal(scale, 0.2)).expect("mismatch");
+            assert_eq!(mismatch.factor, factor, "scale {scale}");
+            assert!((mismatch.length - 44.0 * scale).abs() < 1e-9 * scale);
+            // Converting back fits.
+            let mut fixed = petal(scale, 0.2);
+            fixed.mesh = mismatch.rescaled(&fixed.mesh);
+            assert_eq!(check_template(&fixed), None, "scale {scale}");
+        }
+    }
+
+    #[test]
+    fn the_message_says_what_and_how_to_fix_it() {
+        let mismatch = check_template(&petal(10.0, 0.2)).expect("mismatch");
+        assert_eq!(
+            mismatch.to_string(),
+            "template \"petal\": its mesh is 440.000 long, 2200 times its thickness 0.2, but \
+             organs are 10 to 2000 thicknesses long. The mesh looks 10 times too large: was it \
+             made in millimetres for a project in centimetres? Scale the mesh by 0.1 (or the \
+             thickness by 10)"
+        );
+        let mismatch = check_template(&petal(0.001, 0.2)).expect("mismatch");
+        let message = mismatch.to_string();
+        assert!(
+            message.contains("looks 1000 times too small: was it made in metres for a project in millimetres?"),
+            "{message}"
+        );
+    }
+}
