@@ -60,10 +60,7 @@ impl ScaleMismatch {
 
 impl fmt::Display for ScaleMismatch {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let (low, high) = (
-            LENGTH_IN_THICKNESSES.start(),
-            LENGTH_IN_THICKNESSES.end(),
-        );
+        let (low, high) = (LENGTH_IN_THICKNESSES.start(), LENGTH_IN_THICKNESSES.end());
         let size = if self.factor > 1.0 { "large" } else { "small" };
         let times = if self.factor > 1.0 {
             self.factor
@@ -72,12 +69,12 @@ impl fmt::Display for ScaleMismatch {
         };
         write!(
             f,
-            "template \"{}\": its mesh is {:.3} long, {:.0} times its thickness {}, but organs are \
-             {low} to {high} thicknesses long. The mesh looks {times:.0} times too {size}: {}. \
-             Scale the mesh by {} (or the thickness by {})",
+            "template \"{}\": its mesh is {} long, {} times its thickness {}, but organs are \
+             {low} to {high} thicknesses long. The mesh looks {times:.0} times too {size}, \
+             perhaps {}. Scale the mesh by {} (or the thickness by {})",
             self.template,
-            self.length,
-            self.length / self.thickness,
+            significant(self.length),
+            significant(self.length / self.thickness),
             self.thickness,
             unit_guess(self.factor),
             1.0 / self.factor,
@@ -89,15 +86,28 @@ impl fmt::Display for ScaleMismatch {
 /// The units a mesh too large (or small) by `factor` was probably made in.
 fn unit_guess(factor: f64) -> String {
     let exponent = factor.log10().round() as i32;
-    match exponent {
-        1 => "was it made in millimetres for a project in centimetres?".to_string(),
-        2 => "was it made in centimetres for a project in metres?".to_string(),
-        3 => "was it made in millimetres for a project in metres?".to_string(),
-        -1 => "was it made in centimetres for a project in millimetres?".to_string(),
-        -2 => "was it made in metres for a project in centimetres?".to_string(),
-        -3 => "was it made in metres for a project in millimetres?".to_string(),
-        e if e > 0 => format!("it was probably made in a unit 1e{e} times smaller"),
-        e => format!("it was probably made in a unit 1e{} times larger", -e),
+    let units = match exponent {
+        1 => "millimetres for a project in centimetres",
+        2 => "centimetres for a project in metres",
+        3 => "millimetres for a project in metres",
+        -1 => "centimetres for a project in millimetres",
+        -2 => "metres for a project in centimetres",
+        -3 => "metres for a project in millimetres",
+        e if e > 0 => return format!("made in a unit 1e{e} times smaller than the project's"),
+        e => return format!("made in a unit 1e{} times larger than the project's", -e),
+    };
+    format!("made in {units}")
+}
+
+/// `value` with four significant digits and no trailing zeros.
+fn significant(value: f64) -> String {
+    let digits_before_point = value.abs().log10().floor() as i32 + 1;
+    let decimals = (4 - digits_before_point).clamp(0, 12) as usize;
+    let text = format!("{value:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
     }
 }
 
@@ -109,7 +119,9 @@ pub fn organ_length(mesh: &Mesh) -> f64 {
     let (low, high) = mesh
         .positions
         .iter()
-        .fold((*first, *first), |(low, high), &p| (low.min(p), high.max(p)));
+        .fold((*first, *first), |(low, high), &p| {
+            (low.min(p), high.max(p))
+        });
     let extent: DVec3 = high - low;
     extent.max_element()
 }
@@ -178,7 +190,12 @@ mod tests {
 
     #[test]
     fn a_mesh_in_another_unit_names_the_factor() {
-        for (scale, factor) in [(10.0, 10.0), (100.0, 100.0), (1000.0, 1000.0), (0.001, 0.001)] {
+        for (scale, factor) in [
+            (10.0, 10.0),
+            (100.0, 100.0),
+            (1000.0, 1000.0),
+            (0.001, 0.001),
+        ] {
             let mismatch = check_template(&petal(scale, 0.2)).expect("mismatch");
             assert_eq!(mismatch.factor, factor, "scale {scale}");
             assert!((mismatch.length - 44.0 * scale).abs() < 1e-9 * scale);
@@ -194,15 +211,19 @@ mod tests {
         let mismatch = check_template(&petal(10.0, 0.2)).expect("mismatch");
         assert_eq!(
             mismatch.to_string(),
-            "template \"petal\": its mesh is 440.000 long, 2200 times its thickness 0.2, but \
-             organs are 10 to 2000 thicknesses long. The mesh looks 10 times too large: was it \
-             made in millimetres for a project in centimetres? Scale the mesh by 0.1 (or the \
-             thickness by 10)"
+            "template \"petal\": its mesh is 440 long, 2200 times its thickness 0.2, but organs \
+             are 10 to 2000 thicknesses long. The mesh looks 10 times too large, perhaps made in \
+             millimetres for a project in centimetres. Scale the mesh by 0.1 (or the thickness \
+             by 10)"
         );
         let mismatch = check_template(&petal(0.001, 0.2)).expect("mismatch");
         let message = mismatch.to_string();
         assert!(
-            message.contains("looks 1000 times too small: was it made in metres for a project in millimetres?"),
+            message.contains(
+                "is 0.044 long, 0.22 times its thickness 0.2, but organs are 10 to 2000 thicknesses \
+                 long. The mesh looks 1000 times too small, perhaps made in metres for a project \
+                 in millimetres. Scale the mesh by 1000"
+            ),
             "{message}"
         );
     }
