@@ -159,12 +159,12 @@ pub fn bud(args: &BudArgs) -> Result<()> {
     };
     if let Some(path) = &args.save_surface {
         // Export errors name the file.
-        anthesis_export::write_atomic(path, shape.to_json()?.as_bytes())?;
+        anthesis_files::write_atomic(path, shape.to_json()?.as_bytes())?;
     }
     let Bud { mesh, quality } =
         build_organ(shape.surface(), &options).context("cannot mesh the surface")?;
     if let Some(out) = &args.out {
-        anthesis_export::write_atomic(out, anthesis_mesh::obj_string(&mesh).as_bytes())?;
+        anthesis_files::write_atomic(out, anthesis_mesh::obj_string(&mesh).as_bytes())?;
     }
     println!("{}", quality_line(&quality));
     if let Some(out) = &args.out {

@@ -211,7 +211,7 @@ fn write_png(path: &Path, picture: &RgbaImage) -> Result<()> {
         .write_to(&mut Cursor::new(&mut bytes), image::ImageFormat::Png)
         .with_context(|| format!("cannot encode {}", path.display()))?;
     // Export errors name the file.
-    Ok(anthesis_export::write_atomic(path, &bytes)?)
+    Ok(anthesis_files::write_atomic(path, &bytes)?)
 }
 
 /// The pictures (all of one size) in a row, left to right.

@@ -78,7 +78,7 @@ pub(super) fn simulate(
             threads: rayon_threads(),
         };
         let json = serde_json::to_string_pretty(&file)?;
-        anthesis_export::write_atomic(stats_path, json.as_bytes())
+        anthesis_files::write_atomic(stats_path, json.as_bytes())
             .with_context(|| format!("cannot write statistics to {}", stats_path.display()))?;
     }
     if let Some(out) = out {

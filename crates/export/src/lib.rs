@@ -1,6 +1,6 @@
 //! Exports a simulated flower: an animated glTF binary (.glb) with one morph
-//! target per keyframe, one Wavefront OBJ per keyframe, and atomic file
-//! writes used for every file Anthesis saves.
+//! target per keyframe, and one Wavefront OBJ per keyframe, each file
+//! written with [`anthesis_files::write_atomic`].
 //!
 //! [`organ_tracks`] turns a simulation's keyframes into one [`Track`] per
 //! organ and [`Track::still`] makes the track of a mesh that does not move
@@ -47,7 +47,6 @@
 //! See [`Encoding`] for the three storage modes and [`glb_size_report`] for
 //! the file size in each.
 
-mod atomic;
 mod error;
 mod glb;
 mod obj;
@@ -59,7 +58,6 @@ use std::path::Path;
 
 use glam::{DVec2, DVec3};
 
-pub use atomic::write_atomic;
 pub use error::{ExportError, TrackProblem};
 pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
@@ -168,7 +166,7 @@ impl Default for GlbOptions {
 }
 
 /// Builds the .glb (see [`glb_bytes`]) and writes it to `path` atomically
-/// (see [`write_atomic`]): an existing file at `path` is replaced only by a
+/// (see [`anthesis_files::write_atomic`]): an existing file at `path` is replaced only by a
 /// completely written new one. `progress` goes from 0 to 1.
 pub fn write_glb(
     path: &Path,
@@ -178,9 +176,9 @@ pub fn write_glb(
 ) -> Result<(), ExportError> {
     // Check the destination before the (possibly long) encoding, so a typo
     // in the folder is reported at once.
-    atomic::check_destination(path)?;
+    anthesis_files::check_destination(path)?;
     let bytes = glb_bytes(tracks, options, &mut |p| progress(0.95 * p))?;
-    write_atomic(path, &bytes)?;
+    anthesis_files::write_atomic(path, &bytes)?;
     progress(1.0);
     Ok(())
 }

@@ -3,9 +3,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::atomic::{check_destination, write_atomic};
 use crate::prepare::{unit_normals, validate_tracks};
 use crate::{ExportError, Track};
+use anthesis_files::{check_destination, write_atomic};
 
 /// File name of keyframe `keyframe` in a sequence of `keyframe_count`:
 /// `keyframe_0007.obj`, zero-padded to at least four digits so the files sort

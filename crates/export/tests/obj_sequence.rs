@@ -2,6 +2,7 @@
 
 mod common;
 
+use anthesis_files::WriteError;
 use std::collections::BTreeMap;
 
 use anthesis_export::{ExportError, write_obj_sequence};
@@ -134,7 +135,9 @@ fn obj_sequence_into_a_missing_folder_is_a_clear_error() {
     let missing = dir.path().join("frames");
     let error = write_obj_sequence(&missing, &fixture(3)).expect_err("missing folder");
     match &error {
-        ExportError::MissingFolder { folder, .. } => assert_eq!(folder, &missing),
+        ExportError::Write(WriteError::MissingFolder { folder, .. }) => {
+            assert_eq!(folder, &missing)
+        }
         other => panic!("expected MissingFolder, got {other:?}"),
     }
     assert!(error.to_string().contains("does not exist"), "{error}");

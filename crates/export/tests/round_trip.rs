@@ -5,6 +5,7 @@
 mod common;
 
 use anthesis_export::{Encoding, ExportError, GlbOptions, Timing, Track, glb_bytes, write_glb};
+use anthesis_files::WriteError;
 use anthesis_mesh::vertex_normals;
 use common::*;
 use glam::DVec3;
@@ -600,7 +601,7 @@ fn write_glb_reports_a_missing_folder_before_exporting() {
     })
     .expect_err("missing folder");
     assert!(
-        matches!(error, ExportError::MissingFolder { .. }),
+        matches!(error, ExportError::Write(WriteError::MissingFolder { .. })),
         "{error:?}"
     );
     assert!(error.to_string().contains("renders"), "{error}");

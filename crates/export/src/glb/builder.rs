@@ -360,10 +360,7 @@ impl GltfBuilder {
         root["buffers"] = json!([{ "byteLength": self.bin.len() }]);
         root["bufferViews"] = Value::Array(self.views);
         root["accessors"] = Value::Array(self.accessors);
-        let mut json_chunk = serde_json::to_vec(&root).map_err(|e| ExportError::Io {
-            path: "<glTF JSON>".into(),
-            source: std::io::Error::other(e),
-        })?;
+        let mut json_chunk = serde_json::to_vec(&root)?;
         while !json_chunk.len().is_multiple_of(4) {
             json_chunk.push(b' ');
         }

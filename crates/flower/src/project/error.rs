@@ -10,8 +10,9 @@ use super::FORMAT_NAME;
 
 /// Everything that can go wrong reading or writing a project. Every message
 /// names the file it is about.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, PartialEq, thiserror::Error)]
 pub enum ProjectError {
+    /// A file named in the project could not be read.
     #[error("{}: {message}", path.display())]
     Io { path: PathBuf, message: String },
     /// Invalid or truncated TOML, a missing or unknown field, a value of the
@@ -72,6 +73,9 @@ pub enum ProjectError {
         what: &'static str,
         name: String,
     },
+    /// A file of the project could not be written (saving).
+    #[error(transparent)]
+    Write(#[from] anthesis_files::WriteError),
     /// A value out of its range, e.g. a thickness of 0 or no map keys.
     #[error("{}: {message}", path.display())]
     Invalid { path: PathBuf, message: String },

@@ -84,10 +84,11 @@
 //!
 //! Saving first checks the project by the same rules as loading and refuses
 //! (writing nothing) a project it could not load again, so a good file is
-//! never replaced by one that cannot be opened. Each file is written
-//! atomically (a temporary file in the same folder, then a rename), the
-//! meshes and maps first and the TOML last. Map and mesh files that the new
-//! TOML no longer names are left in place.
+//! never replaced by one that cannot be opened. Each file is written with
+//! [`anthesis_files::write_atomic`] (a temporary file in the same folder,
+//! then a rename; a symbolic link is followed and a replaced file keeps its
+//! permissions), the meshes and maps first and the TOML last. Map and mesh
+//! files that the new TOML no longer names are left in place.
 
 mod check;
 mod error;
@@ -104,7 +105,7 @@ use crate::Project;
 pub use error::ProjectError;
 use error::io_error;
 use load::Loader;
-use save::{plan_save, write_atomically};
+use save::{plan_save, write_file};
 
 /// The value of the `format` field of every project file.
 pub const FORMAT_NAME: &str = "anthesis-project";
@@ -162,9 +163,9 @@ pub fn save_project(project: &Project, path: &Path) -> Result<(), ProjectError> 
     let folder = path.parent().unwrap_or(Path::new(""));
     let plan = plan_save(project, path, folder)?;
     for (relative, bytes) in &plan.files {
-        write_atomically(&folder.join(relative), bytes)?;
+        write_file(&folder.join(relative), bytes)?;
     }
-    write_atomically(path, plan.toml.as_bytes())
+    write_file(path, plan.toml.as_bytes())
 }
 
 /// The TOML text [`save_project`] would write for `project` at `path`

@@ -1,15 +1,12 @@
 //! Saving: a [`Project`] into the TOML text and the mesh and map files.
 
 use std::collections::HashSet;
-use std::fs;
-use std::io::Write;
 use std::path::Path;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use anthesis_maps::{BitDepth, MapKind};
 
 use super::check::{SizeCheck, check_project};
-use super::error::{ProjectError, io_error, map_error};
+use super::error::{ProjectError, map_error};
 use super::schema::{
     BaseRegionFile, BlendFile, DirectionEntry, JointRampFile, KeyFile, OrganFile, OverlapFile,
     ProjectFile, ScalarEntry, SimulationFile, TemplateFile,
@@ -209,44 +206,19 @@ pub(super) fn file_stems<'a>(names: impl Iterator<Item = &'a str>) -> Vec<String
         .collect()
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and
-/// a rename, so `path` holds either its old contents or all of the new ones.
-/// Creates the folder if needed.
-pub(super) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), ProjectError> {
-    static NEXT_TEMP: AtomicU64 = AtomicU64::new(0);
-    let folder = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let Some(file_name) = path.file_name() else {
-        return Err(ProjectError::Io {
-            path: path.to_path_buf(),
-            message: "cannot write: the path does not name a file".to_string(),
-        });
-    };
-    fs::create_dir_all(folder).map_err(|error| io_error(folder, "cannot create folder", &error))?;
-    let temp_path = folder.join(format!(
-        ".{}.{}-{}.tmp",
-        file_name.to_string_lossy(),
-        std::process::id(),
-        NEXT_TEMP.fetch_add(1, Ordering::Relaxed)
-    ));
-    let written = fs::File::create(&temp_path).and_then(|mut file| {
-        file.write_all(bytes)?;
-        file.sync_all()
-    });
-    let result = written.and_then(|()| fs::rename(&temp_path, path));
-    if let Err(error) = result {
-        // The temporary file is of no use now; failing to remove it changes
-        // nothing for the caller.
-        let _ = fs::remove_file(&temp_path);
-        return Err(io_error(path, "cannot write", &error));
-    }
-    Ok(())
+/// Writes one file of a saved project with [`anthesis_files::write_atomic`],
+/// creating its folder (the project's folder, `meshes/` or `maps/`) first.
+pub(super) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ProjectError> {
+    anthesis_files::create_folder(&anthesis_files::folder_of(path), path)?;
+    Ok(anthesis_files::write_atomic(path, bytes)?)
 }
 
 #[cfg(test)]
 mod tests {
+    use std::fs;
+
+    use anthesis_files::WriteError;
+
     use super::*;
 
     #[test]
@@ -267,11 +239,11 @@ mod tests {
     }
 
     #[test]
-    fn atomic_write_replaces_the_file_and_leaves_no_temporary() {
+    fn a_file_is_written_into_a_new_folder_and_leaves_no_temporary() {
         let folder = tempfile::tempdir().expect("temp dir");
         let path = folder.path().join("sub").join("a.txt");
-        write_atomically(&path, b"old").expect("first write");
-        write_atomically(&path, b"new contents").expect("second write");
+        write_file(&path, b"old").expect("first write");
+        write_file(&path, b"new contents").expect("second write");
         assert_eq!(fs::read(&path).expect("read"), b"new contents");
         let entries: Vec<_> = fs::read_dir(folder.path().join("sub"))
             .expect("list")
@@ -281,13 +253,16 @@ mod tests {
     }
 
     #[test]
-    fn atomic_write_into_a_file_reports_the_path() {
+    fn a_file_in_place_of_the_folder_is_named() {
         let folder = tempfile::tempdir().expect("temp dir");
         let blocker = folder.path().join("blocker");
         fs::write(&blocker, b"a file, not a folder").expect("write");
         let path = blocker.join("a.txt");
-        let error = write_atomically(&path, b"x").expect_err("parent is a file");
-        assert!(matches!(error, ProjectError::Io { .. }), "{error:?}");
+        let error = write_file(&path, b"x").expect_err("parent is a file");
+        assert!(
+            matches!(&error, ProjectError::Write(WriteError::NotAFolder { folder, .. }) if *folder == blocker),
+            "{error:?}"
+        );
         assert!(error.to_string().contains("blocker"), "{error}");
     }
 }
