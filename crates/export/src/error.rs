@@ -32,6 +32,8 @@ pub enum ExportError {
     InvalidOptions(String),
     #[error("the .glb would be {bytes} bytes, more than the 4 GiB the format allows")]
     TooLarge { bytes: u64 },
+    #[error("cannot build the USD layer: {0}")]
+    Usd(String),
 }
 
 /// What is wrong with one track's data.

@@ -1,5 +1,6 @@
 //! Exports a simulated flower: an animated glTF binary (.glb) with one morph
-//! target per keyframe, and one Wavefront OBJ per keyframe, each file
+//! target per keyframe, a USD layer (.usda) with one time-sampled mesh per
+//! organ (see [`write_usd`]), and one Wavefront OBJ per keyframe, each file
 //! written with [`anthesis_files::write_atomic`].
 //!
 //! [`organ_tracks`] turns a simulation's keyframes into one [`Track`] per
@@ -53,6 +54,7 @@ mod obj;
 mod prepare;
 mod report;
 mod tracks;
+mod usd;
 
 use std::path::Path;
 
@@ -63,6 +65,7 @@ pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
 pub use report::{GlbSize, GlbSizeReport, glb_size_report};
 pub use tracks::{TrackLook, organ_tracks};
+pub use usd::{USD_ROOT_PRIM, UsdOptions, is_usd_path, usd_bytes, write_usd};
 
 /// One organ (or the receptacle) over time: a fixed triangulation and UV
 /// layout, and its positions at every keyframe in the world frame.

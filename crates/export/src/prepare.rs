@@ -113,25 +113,30 @@ pub(crate) fn validate_options(
     options: &GlbOptions,
     keyframe_count: usize,
 ) -> Result<(), ExportError> {
-    match options.timing {
-        Timing::FramesPerSecond(fps) if !(fps.is_finite() && fps > 0.0) => {
-            return Err(ExportError::InvalidOptions(format!(
-                "the frame rate must be a positive number of keyframes per second, not {fps}"
-            )));
-        }
-        Timing::Duration(seconds) if !(seconds.is_finite() && seconds > 0.0) => {
-            return Err(ExportError::InvalidOptions(format!(
-                "the duration must be a positive number of seconds, not {seconds}"
-            )));
-        }
-        _ => {}
-    }
+    validate_timing(options.timing)?;
     if keyframe_count > 1 && options.max_morph_targets == 0 {
         return Err(ExportError::InvalidOptions(
             "an animation needs at least one morph target per mesh".to_owned(),
         ));
     }
     Ok(())
+}
+
+/// A frame rate or duration must be a positive, finite number.
+pub(crate) fn validate_timing(timing: Timing) -> Result<(), ExportError> {
+    match timing {
+        Timing::FramesPerSecond(fps) if !(fps.is_finite() && fps > 0.0) => {
+            Err(ExportError::InvalidOptions(format!(
+                "the frame rate must be a positive number of keyframes per second, not {fps}"
+            )))
+        }
+        Timing::Duration(seconds) if !(seconds.is_finite() && seconds > 0.0) => {
+            Err(ExportError::InvalidOptions(format!(
+                "the duration must be a positive number of seconds, not {seconds}"
+            )))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Where the exported keyframes sit in the original sequence, in keyframe

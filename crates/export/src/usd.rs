@@ -1,0 +1,579 @@
+//! The USD writer (`.usda` text layers), for film pipelines: Blender,
+//! Houdini, Maya, usdview.
+//!
+//! The layer is built and written with the `openusd` crate (a Rust
+//! implementation of USD's scene description and file formats) rather than
+//! by hand, so quoting, value syntax and metadata follow the format. Its
+//! version 0.6 (the last that builds with this project's Rust) has two
+//! flaws Pixar's USD trips over, both fixed upstream in 0.8: a one-item
+//! `apiSchemas` list loses its brackets (repaired here after writing), and
+//! binary `.usdc` files store prim child lists with the wrong type (so
+//! `.usdc` is not offered; see [`write_usd`]).
+//!
+//! # The stage
+//!
+//! - Layer metadata: `defaultPrim = "flower"`, `upAxis = "Y"` (the flower
+//!   axis), `metersPerUnit = 1` (one project unit is one metre, as in the
+//!   .glb, so both import at the same size), `startTimeCode = 0`,
+//!   `endTimeCode = K - 1` and `timeCodesPerSecond = framesPerSecond =` the
+//!   keyframes per second: keyframe `k` is time code (frame) `k`.
+//! - `/flower` is an `Xform` (kind `component`) holding one `Mesh` per
+//!   [`Track`], named after the track made into a valid USD identifier
+//!   (`petal-1` becomes `petal_1`), and a `Scope` `/flower/materials`.
+//! - Each `Mesh`: `points` (and `normals`, vertex interpolation, unless
+//!   [`UsdOptions::normals`] is off) as one time sample per keyframe, or as
+//!   a default value for a track that does not move; `extent` likewise;
+//!   `faceVertexCounts` (all 3) and `faceVertexIndices`; `primvars:st`
+//!   (vertex interpolation, `v = 0` at the organ's base, which is also the
+//!   bottom row of a map image as USD expects); `primvars:displayColor` and
+//!   `primvars:displayOpacity` (constant, the track's linear base colour);
+//!   `doubleSided = true`, `orientation = "rightHanded"` (triangles wind
+//!   counter-clockwise around the inner side's normal) and
+//!   `subdivisionScheme = "none"` (the triangles are the surface, not a
+//!   subdivision cage).
+//! - Each mesh is bound (`MaterialBindingAPI`, `material:binding`) to a
+//!   `Material` whose `UsdPreviewSurface` has the base colour as
+//!   `diffuseColor`, its alpha as `opacity`, roughness 0.7 and metallic 0,
+//!   like the .glb's material. Base-colour textures are not written (a USD
+//!   texture is a separate file next to the layer).
+
+use std::path::Path;
+
+use glam::DVec3;
+use openusd::gf;
+use openusd::sdf::{self, ChildrenKey, FieldKey, ListOp, SpecType, Specifier, Value, Variability};
+
+use crate::prepare::{unit_normals, validate_timing, validate_tracks};
+use crate::{ExportError, Timing, Track};
+
+/// Whether `path` names a USD file this writer produces: `.usda` or `.usd`
+/// (USD tells text from binary by the contents, so a text `.usd` opens
+/// everywhere USD does).
+pub fn is_usd_path(path: &Path) -> bool {
+    usd_extension(path).is_some_and(|e| e == "usda" || e == "usd")
+}
+
+fn usd_extension(path: &Path) -> Option<String> {
+    Some(path.extension()?.to_str()?.to_ascii_lowercase())
+}
+
+/// Options of the USD export.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct UsdOptions {
+    /// Sets `timeCodesPerSecond` and `framesPerSecond`: keyframes per
+    /// second, or the whole animation's length (then the rate is
+    /// `(K - 1) / seconds`).
+    pub timing: Timing,
+    /// Write `normals` (default `true`); without them clients compute
+    /// smooth normals themselves.
+    pub normals: bool,
+}
+
+impl Default for UsdOptions {
+    fn default() -> Self {
+        Self {
+            timing: Timing::FramesPerSecond(crate::DEFAULT_FRAMES_PER_SECOND),
+            normals: true,
+        }
+    }
+}
+
+/// Name of the root `Xform` (also the layer's `defaultPrim`).
+pub const USD_ROOT_PRIM: &str = "flower";
+
+/// Builds the USD layer of `tracks` in memory, as `.usda` text. `progress` rises
+/// from 0 to 1, about once per keyframe of each track. Fails with a typed
+/// error, before any work, on the same invalid input as
+/// [`glb_bytes`](crate::glb_bytes).
+pub fn usd_bytes(
+    tracks: &[Track],
+    options: &UsdOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Vec<u8>, ExportError> {
+    let keyframe_count = validate_tracks(tracks)?;
+    validate_timing(options.timing)?;
+    let frames_per_second = match options.timing {
+        Timing::FramesPerSecond(fps) => fps,
+        Timing::Duration(seconds) => (keyframe_count.max(2) - 1) as f64 / seconds,
+    };
+    if !(frames_per_second.is_finite() && frames_per_second > 0.0) {
+        return Err(ExportError::InvalidOptions(format!(
+            "{:?} gives no usable frame rate for {keyframe_count} keyframes",
+            options.timing
+        )));
+    }
+    progress(0.0);
+
+    let mut layer = LayerBuilder::new();
+    let root = layer.pseudo_root()?;
+    root.add(FieldKey::DefaultPrim, Value::Token(USD_ROOT_PRIM.into()));
+    root.add("upAxis", Value::Token("Y".into()));
+    root.add("metersPerUnit", Value::Double(1.0));
+    root.add(FieldKey::StartTimeCode, Value::Double(0.0));
+    root.add(
+        FieldKey::EndTimeCode,
+        Value::Double((keyframe_count - 1) as f64),
+    );
+    root.add(
+        FieldKey::TimeCodesPerSecond,
+        Value::Double(frames_per_second),
+    );
+    root.add(FieldKey::FramesPerSecond, Value::Double(frames_per_second));
+    root.add(
+        FieldKey::Documentation,
+        Value::String(concat!("Anthesis (anthesis-export ", env!("CARGO_PKG_VERSION"), ")").into()),
+    );
+
+    let names = prim_names(tracks);
+    let flower = layer.prim(&sdf::Path::abs_root(), USD_ROOT_PRIM, "Xform")?;
+    layer.set_field(&flower, FieldKey::Kind, Value::Token("component".into()))?;
+    let materials = layer.prim(&flower, "materials", "Scope")?;
+
+    let total_work = tracks
+        .iter()
+        .map(|t| t.keyframes.len())
+        .sum::<usize>()
+        .max(1) as f32;
+    let mut work_done = 0usize;
+    for (track, name) in tracks.iter().zip(&names) {
+        let material = write_material(&mut layer, &materials, name, track.base_color)?;
+        let mesh = layer.prim(&flower, name, "Mesh")?;
+        write_mesh(
+            &mut layer,
+            &mesh,
+            &material,
+            track,
+            options.normals,
+            &mut || {
+                work_done += 1;
+                progress(0.95 * work_done as f32 / total_work);
+            },
+        )?;
+    }
+
+    let bytes = layer.into_text()?.into_bytes();
+    progress(1.0);
+    Ok(bytes)
+}
+
+/// Builds the USD layer (see [`usd_bytes`]) and writes it to `path` (a
+/// `.usda` or `.usd` file) atomically (see [`anthesis_files::write_atomic`]):
+/// an existing file at `path` is replaced only by a completely written one.
+///
+/// `.usdc` (the binary crate format) is refused with an error that says
+/// why: the USD library this project can build (openusd 0.6; later versions
+/// need a newer Rust) writes crate files whose child lists Pixar's USD does
+/// not read, so the prims would be missing. `usdcat FILE.usda -o FILE.usdc`
+/// converts a written layer.
+pub fn write_usd(
+    path: &Path,
+    tracks: &[Track],
+    options: &UsdOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<(), ExportError> {
+    match usd_extension(path).as_deref() {
+        Some("usda" | "usd") => {}
+        Some("usdc") => {
+            return Err(ExportError::InvalidOptions(format!(
+                "{}: binary .usdc is not written yet (the USD library Anthesis builds with \
+                 writes crate files Pixar's USD cannot read); export .usda and convert it \
+                 with `usdcat FILE.usda -o FILE.usdc` if you need the binary form",
+                path.display()
+            )));
+        }
+        _ => {
+            return Err(ExportError::InvalidOptions(format!(
+                "{} does not end in .usda or .usd",
+                path.display()
+            )));
+        }
+    }
+    anthesis_files::check_destination(path)?;
+    let bytes = usd_bytes(tracks, options, progress)?;
+    Ok(anthesis_files::write_atomic(path, &bytes)?)
+}
+
+/// Valid, distinct USD prim names for the tracks: every character that is
+/// not an ASCII letter, digit or `_` becomes `_`, a leading digit gets a
+/// `_` in front, and repeats get `_2`, `_3`, … (`materials` is taken by the
+/// materials scope).
+fn prim_names(tracks: &[Track]) -> Vec<String> {
+    let mut taken = vec!["materials".to_owned()];
+    tracks
+        .iter()
+        .map(|track| {
+            let mut base: String = track
+                .name
+                .chars()
+                .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                .collect();
+            if base.is_empty() || base.starts_with(|c: char| c.is_ascii_digit()) {
+                base.insert(0, '_');
+            }
+            let mut name = base.clone();
+            let mut n = 2;
+            while taken.contains(&name) {
+                name = format!("{base}_{n}");
+                n += 1;
+            }
+            taken.push(name.clone());
+            name
+        })
+        .collect()
+}
+
+fn vec3f(v: DVec3) -> gf::Vec3f {
+    let v = v.as_vec3();
+    gf::vec3f(v.x, v.y, v.z)
+}
+
+fn vec3fs(values: &[DVec3]) -> Value {
+    Value::Vec3fVec(values.iter().map(|&v| vec3f(v)).collect())
+}
+
+/// `[min, max]` of the points, as USD's `extent` wants it.
+fn extent(points: &[DVec3]) -> Value {
+    let (mut min, mut max) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in points {
+        min = min.min(*p);
+        max = max.max(*p);
+    }
+    Value::Vec3fVec(vec![vec3f(min), vec3f(max)])
+}
+
+/// A value that is either constant or sampled once per keyframe (at time
+/// code `k` for keyframe `k`).
+enum Sampled {
+    Constant(Value),
+    PerKeyframe(Vec<Value>),
+}
+
+impl Sampled {
+    fn of(frames: &[Vec<DVec3>], mut value: impl FnMut(&[DVec3]) -> Value) -> Sampled {
+        match frames {
+            [only] => Sampled::Constant(value(only)),
+            _ => Sampled::PerKeyframe(frames.iter().map(|f| value(f)).collect()),
+        }
+    }
+}
+
+fn write_mesh(
+    layer: &mut LayerBuilder,
+    mesh: &sdf::Path,
+    material: &sdf::Path,
+    track: &Track,
+    normals: bool,
+    tick: &mut dyn FnMut(),
+) -> Result<(), ExportError> {
+    layer.set_field(
+        mesh,
+        FieldKey::ApiSchemas,
+        Value::TokenListOp(ListOp::prepended(["MaterialBindingAPI".into()])),
+    )?;
+    let uniform = Some(Variability::Uniform);
+    layer.attribute(mesh, "doubleSided", "bool", uniform, Value::Bool(true))?;
+    layer.attribute(
+        mesh,
+        "orientation",
+        "token",
+        uniform,
+        Value::Token("rightHanded".into()),
+    )?;
+    layer.attribute(
+        mesh,
+        "subdivisionScheme",
+        "token",
+        uniform,
+        Value::Token("none".into()),
+    )?;
+    layer.attribute(
+        mesh,
+        "faceVertexCounts",
+        "int[]",
+        None,
+        Value::IntVec(vec![3; track.triangles.len()]),
+    )?;
+    let indices: Vec<i32> = track
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&i| i32::try_from(i).unwrap_or(i32::MAX))
+        .collect();
+    layer.attribute(
+        mesh,
+        "faceVertexIndices",
+        "int[]",
+        None,
+        Value::IntVec(indices),
+    )?;
+
+    let frames = &track.keyframes;
+    let points = Sampled::of(frames, |f| {
+        tick();
+        vec3fs(f)
+    });
+    layer.sampled_attribute(mesh, "points", "point3f[]", points)?;
+    layer.sampled_attribute(mesh, "extent", "float3[]", Sampled::of(frames, extent))?;
+    if normals {
+        let values = Sampled::of(frames, |f| vec3fs(&unit_normals(f, &track.triangles)));
+        let normals = layer.sampled_attribute(mesh, "normals", "normal3f[]", values)?;
+        layer.set_field(&normals, "interpolation", Value::Token("vertex".into()))?;
+    }
+
+    let st: Vec<gf::Vec2f> = track
+        .uvs
+        .iter()
+        .map(|uv| {
+            let uv = uv.as_vec2();
+            gf::vec2f(uv.x, uv.y)
+        })
+        .collect();
+    let st = layer.attribute(
+        mesh,
+        "primvars:st",
+        "texCoord2f[]",
+        None,
+        Value::Vec2fVec(st),
+    )?;
+    layer.set_field(&st, "interpolation", Value::Token("vertex".into()))?;
+
+    let [r, g, b, a] = track.base_color;
+    let color = layer.attribute(
+        mesh,
+        "primvars:displayColor",
+        "color3f[]",
+        None,
+        Value::Vec3fVec(vec![gf::vec3f(r, g, b)]),
+    )?;
+    layer.set_field(&color, "interpolation", Value::Token("constant".into()))?;
+    let opacity = layer.attribute(
+        mesh,
+        "primvars:displayOpacity",
+        "float[]",
+        None,
+        Value::FloatVec(vec![a]),
+    )?;
+    layer.set_field(&opacity, "interpolation", Value::Token("constant".into()))?;
+
+    layer.relationship(mesh, "material:binding", material)?;
+    Ok(())
+}
+
+/// A `Material` with a `UsdPreviewSurface` of `color` under `scope`;
+/// returns the material's path.
+fn write_material(
+    layer: &mut LayerBuilder,
+    scope: &sdf::Path,
+    name: &str,
+    color: [f32; 4],
+) -> Result<sdf::Path, ExportError> {
+    let material = layer.prim(scope, name, "Material")?;
+    let shader = layer.prim(&material, "surface", "Shader")?;
+    layer.attribute(
+        &shader,
+        "info:id",
+        "token",
+        Some(Variability::Uniform),
+        Value::Token("UsdPreviewSurface".into()),
+    )?;
+    let [r, g, b, a] = color;
+    layer.attribute(
+        &shader,
+        "inputs:diffuseColor",
+        "color3f",
+        None,
+        Value::Vec3f(gf::vec3f(r, g, b)),
+    )?;
+    layer.attribute(&shader, "inputs:opacity", "float", None, Value::Float(a))?;
+    layer.attribute(
+        &shader,
+        "inputs:roughness",
+        "float",
+        None,
+        Value::Float(0.7),
+    )?;
+    layer.attribute(&shader, "inputs:metallic", "float", None, Value::Float(0.0))?;
+    let shader_output = layer.declared_attribute(&shader, "outputs:surface", "token")?;
+    let material_output = layer.declared_attribute(&material, "outputs:surface", "token")?;
+    layer.set_field(
+        &material_output,
+        FieldKey::ConnectionPaths,
+        Value::PathListOp(ListOp::explicit([shader_output])),
+    )?;
+    Ok(material)
+}
+
+/// An `sdf::Data` layer built top-down, keeping each spec's lists of prim
+/// and property children as USD requires.
+struct LayerBuilder {
+    data: sdf::Data,
+}
+
+fn usd_error(error: impl std::fmt::Display) -> ExportError {
+    ExportError::Usd(error.to_string())
+}
+
+impl LayerBuilder {
+    /// A layer holding only its pseudo-root.
+    fn new() -> LayerBuilder {
+        let mut data = sdf::Data::new();
+        data.create_spec(sdf::Path::abs_root(), SpecType::PseudoRoot);
+        LayerBuilder { data }
+    }
+
+    /// The spec of the layer's metadata and root prims.
+    fn pseudo_root(&mut self) -> Result<&mut sdf::SpecData, ExportError> {
+        self.spec(&sdf::Path::abs_root())
+    }
+
+    /// The spec at `path`, which this builder created before.
+    fn spec(&mut self, path: &sdf::Path) -> Result<&mut sdf::SpecData, ExportError> {
+        self.data
+            .spec_mut(path)
+            .ok_or_else(|| ExportError::Usd(format!("no spec at {path} to edit")))
+    }
+
+    fn set_field(
+        &mut self,
+        path: &sdf::Path,
+        key: impl AsRef<str>,
+        value: Value,
+    ) -> Result<(), ExportError> {
+        self.spec(path)?.add(key, value);
+        Ok(())
+    }
+
+    /// Appends `name` to the `children` list of `parent`.
+    fn add_child(
+        &mut self,
+        parent: &sdf::Path,
+        children: ChildrenKey,
+        name: &str,
+    ) -> Result<(), ExportError> {
+        let spec = self.spec(parent)?;
+        match spec.get_mut(children.as_str()) {
+            Some(Value::TokenVec(names)) => names.push(name.into()),
+            _ => spec.add(children, Value::TokenVec(vec![name.into()])),
+        }
+        Ok(())
+    }
+
+    /// Defines a prim `name` of `type_name` under `parent`.
+    fn prim(
+        &mut self,
+        parent: &sdf::Path,
+        name: &str,
+        type_name: &str,
+    ) -> Result<sdf::Path, ExportError> {
+        let path = parent.append_path(name).map_err(usd_error)?;
+        let spec = self.data.create_spec(path.clone(), SpecType::Prim);
+        spec.add(FieldKey::Specifier, Value::Specifier(Specifier::Def));
+        spec.add(FieldKey::TypeName, Value::Token(type_name.into()));
+        self.add_child(parent, ChildrenKey::PrimChildren, name)?;
+        Ok(path)
+    }
+
+    /// A non-custom attribute of `type_name` without a value (an output).
+    fn declared_attribute(
+        &mut self,
+        prim: &sdf::Path,
+        name: &str,
+        type_name: &str,
+    ) -> Result<sdf::Path, ExportError> {
+        let path = prim.append_property(name).map_err(usd_error)?;
+        let spec = self.data.create_spec(path.clone(), SpecType::Attribute);
+        spec.add(FieldKey::TypeName, Value::Token(type_name.into()));
+        spec.add(FieldKey::Custom, Value::Bool(false));
+        self.add_child(prim, ChildrenKey::PropertyChildren, name)?;
+        Ok(path)
+    }
+
+    /// A non-custom attribute with a default value.
+    fn attribute(
+        &mut self,
+        prim: &sdf::Path,
+        name: &str,
+        type_name: &str,
+        variability: Option<Variability>,
+        value: Value,
+    ) -> Result<sdf::Path, ExportError> {
+        let path = self.declared_attribute(prim, name, type_name)?;
+        if let Some(variability) = variability {
+            self.set_field(
+                &path,
+                FieldKey::Variability,
+                Value::Variability(variability),
+            )?;
+        }
+        self.set_field(&path, FieldKey::Default, value)?;
+        Ok(path)
+    }
+
+    /// An attribute with a default value or one time sample per keyframe.
+    fn sampled_attribute(
+        &mut self,
+        prim: &sdf::Path,
+        name: &str,
+        type_name: &str,
+        value: Sampled,
+    ) -> Result<sdf::Path, ExportError> {
+        match value {
+            Sampled::Constant(value) => self.attribute(prim, name, type_name, None, value),
+            Sampled::PerKeyframe(values) => {
+                let path = self.declared_attribute(prim, name, type_name)?;
+                let samples = values
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, v)| (k as f64, v))
+                    .collect();
+                self.set_field(&path, FieldKey::TimeSamples, Value::TimeSamples(samples))?;
+                Ok(path)
+            }
+        }
+    }
+
+    /// A relationship `name` on `prim` targeting `target`.
+    fn relationship(
+        &mut self,
+        prim: &sdf::Path,
+        name: &str,
+        target: &sdf::Path,
+    ) -> Result<(), ExportError> {
+        let path = prim.append_property(name).map_err(usd_error)?;
+        let spec = self.data.create_spec(path, SpecType::Relationship);
+        spec.add(FieldKey::Custom, Value::Bool(false));
+        spec.add(
+            FieldKey::TargetPaths,
+            Value::PathListOp(ListOp::explicit([target.clone()])),
+        );
+        self.add_child(prim, ChildrenKey::PropertyChildren, name)?;
+        Ok(())
+    }
+
+    fn into_text(self) -> Result<String, ExportError> {
+        let text = openusd::usda::TextWriter::write_to_string(&self.data).map_err(usd_error)?;
+        Ok(bracket_single_api_schemas(&text))
+    }
+}
+
+/// openusd 0.6 writes a one-item token list op without brackets
+/// (`prepend apiSchemas = "MaterialBindingAPI"`), which USD's text parser
+/// rejects (it wants `["MaterialBindingAPI"]`; fixed in openusd 0.8, which
+/// needs a newer Rust than this project's). Adds the brackets on the
+/// `apiSchemas` lines, the only token list op this writer authors.
+fn bracket_single_api_schemas(text: &str) -> String {
+    let mut fixed = String::with_capacity(text.len() + 64);
+    for line in text.lines() {
+        let unbracketed = line
+            .split_once("prepend apiSchemas = \"")
+            .filter(|(indent, rest)| indent.trim().is_empty() && !rest.contains(','));
+        match unbracketed {
+            Some((indent, rest)) => {
+                fixed.push_str(&format!("{indent}prepend apiSchemas = [\"{rest}]"));
+            }
+            None => fixed.push_str(line),
+        }
+        fixed.push('\n');
+    }
+    fixed
+}
