@@ -52,7 +52,7 @@ fn simulate_writes_stats_json_and_a_glb() {
     assert_eq!(keyframes.len(), 5);
     for (i, k) in keyframes.iter().enumerate() {
         assert_eq!(k["index"], i + 1);
-        for field in ["energy", "iterations", "gradient_norm", "seconds"] {
+        for field in ["energy", "iterations", "relative_gradient", "seconds"] {
             assert!(k[field].is_number(), "keyframe {i} lacks {field}");
         }
     }

@@ -33,7 +33,7 @@ fn recorded_keyframes(project: &Project, selection: &Selection) -> Vec<Keyframe>
     };
     (0..=project.settings.keyframes)
         .map(|k| {
-            let positions = organs
+            let positions_in_world = organs
                 .iter()
                 .map(|&i| {
                     let organ = &project.flower.organs[i];
@@ -54,12 +54,12 @@ fn recorded_keyframes(project: &Project, selection: &Selection) -> Vec<Keyframe>
                 .collect();
             Keyframe {
                 index: k,
-                positions,
+                positions_in_world,
                 stats: KeyframeStats {
                     index: k,
                     energy: f64::from(k * k) * 0.01,
                     iterations: 2 + k % 3,
-                    gradient_norm: 1e-7,
+                    relative_gradient: 1e-7,
                     seconds: 0.05,
                     pushed_particles: 0,
                     contact_particles: 0,
@@ -135,7 +135,7 @@ fn first_frame_shows_the_flower_opening_and_the_timeline() {
     feed(&mut harness, Some(8));
     harness.run();
     assert_eq!(
-        harness.state().playback().time,
+        harness.state().playback().time_in_keyframes,
         8.0,
         "follows new keyframes"
     );
@@ -145,7 +145,7 @@ fn first_frame_shows_the_flower_opening_and_the_timeline() {
     feed(&mut harness, None);
     harness.run();
     harness.get_by_label("20 keyframes in 1 s");
-    assert_eq!(harness.state().playback().time, 20.0);
+    assert_eq!(harness.state().playback().time_in_keyframes, 20.0);
     harness.snapshot("app_open_flower");
 }
 
@@ -158,24 +158,24 @@ fn timeline_buttons_and_shortcuts_scrub_step_and_play() {
 
     harness.get_by_label("Start").click();
     harness.run();
-    assert_eq!(harness.state().playback().time, 0.0);
+    assert_eq!(harness.state().playback().time_in_keyframes, 0.0);
     harness.get_by_label("Next").click();
     harness.run();
-    assert_eq!(harness.state().playback().time, 1.0);
+    assert_eq!(harness.state().playback().time_in_keyframes, 1.0);
 
     harness.key_press(egui::Key::ArrowRight);
     harness.key_press(egui::Key::ArrowRight);
     harness.run();
-    assert_eq!(harness.state().playback().time, 3.0);
+    assert_eq!(harness.state().playback().time_in_keyframes, 3.0);
     harness.key_press(egui::Key::ArrowLeft);
     harness.run();
-    assert_eq!(harness.state().playback().time, 2.0);
+    assert_eq!(harness.state().playback().time_in_keyframes, 2.0);
     harness.key_press(egui::Key::End);
     harness.run();
-    assert_eq!(harness.state().playback().time, 20.0);
+    assert_eq!(harness.state().playback().time_in_keyframes, 20.0);
     harness.key_press(egui::Key::Home);
     harness.run();
-    assert_eq!(harness.state().playback().time, 0.0);
+    assert_eq!(harness.state().playback().time_in_keyframes, 0.0);
 
     // Space plays: a few frames later the time has moved on.
     harness.key_press(egui::Key::Space);
@@ -183,7 +183,7 @@ fn timeline_buttons_and_shortcuts_scrub_step_and_play() {
     harness.step();
     harness.step();
     assert!(harness.state().playback().playing);
-    assert!(harness.state().playback().time > 0.0);
+    assert!(harness.state().playback().time_in_keyframes > 0.0);
     harness.key_press(egui::Key::Space);
     harness.step();
     assert!(!harness.state().playback().playing);
@@ -193,7 +193,7 @@ fn timeline_buttons_and_shortcuts_scrub_step_and_play() {
     let timeline = harness.get_by_label("Timeline").rect();
     harness.state_mut().playback_mut().scrub_to(9.5, Some(20));
     harness.run();
-    assert_eq!(harness.state().playback().time, 9.5);
+    assert_eq!(harness.state().playback().time_in_keyframes, 9.5);
     harness.snapshot("app_scrubbed_between_keyframes");
     assert!(timeline.width() > 500.0);
 }
@@ -663,7 +663,7 @@ fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
         .keyframes()
         .last()
         .expect("keyframes")
-        .positions[0][middle];
+        .positions_in_world[0][middle];
     app.camera_mut().target = shown;
     app.camera_mut().distance = 40.0;
     app.paint_mut().on_3d = true;

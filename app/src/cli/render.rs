@@ -110,12 +110,12 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     };
     let mut scenes: Vec<(u32, Vec<OrganMesh>)> = Vec::with_capacity(frames.len());
     if frames.first() == Some(&0) {
-        scenes.push((0, organs_at(&sim.bud().positions)));
+        scenes.push((0, organs_at(&sim.bud().positions_in_world)));
     }
     let last_wanted = frames.last().copied().unwrap_or(0);
     run_keyframes(&mut sim, last_wanted, &mut |keyframe| {
         if frames.binary_search(&keyframe.index).is_ok() {
-            scenes.push((keyframe.index, organs_at(&keyframe.positions)));
+            scenes.push((keyframe.index, organs_at(&keyframe.positions_in_world)));
         }
     })?;
 

@@ -62,11 +62,11 @@ pub(super) fn simulate(
 
     let mut sim = Simulation::new(&project, &selection)?;
     let total = sim.keyframe_count();
-    let mut frames: Vec<Vec<Vec<DVec3>>> = vec![sim.bud().positions];
+    let mut frames: Vec<Vec<Vec<DVec3>>> = vec![sim.bud().positions_in_world];
     let mut stats = Vec::with_capacity(total as usize);
     let seconds = run_keyframes(&mut sim, total, &mut |keyframe| {
         stats.push(keyframe.stats);
-        frames.push(keyframe.positions);
+        frames.push(keyframe.positions_in_world);
     })?;
 
     if let Some(stats_path) = stats_path {

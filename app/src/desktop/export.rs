@@ -84,7 +84,10 @@ pub fn tracks(project: &Project, organs: &[usize], keyframes: &[Arc<Keyframe>]) 
             template.color,
         )
     });
-    anthesis_export::organ_tracks(looks, keyframes.iter().map(|k| k.positions.as_slice()))
+    anthesis_export::organ_tracks(
+        looks,
+        keyframes.iter().map(|k| k.positions_in_world.as_slice()),
+    )
 }
 
 impl ExportDialog {
@@ -386,7 +389,7 @@ mod tests {
         assert_eq!(tracks[0].triangles, template.mesh.triangles);
         assert_eq!(tracks[0].uvs, template.mesh.uvs);
         assert_eq!(tracks[0].base_color, template.color);
-        assert_eq!(tracks[0].keyframes, bud.positions);
+        assert_eq!(tracks[0].keyframes, bud.positions_in_world);
     }
 
     #[test]

@@ -488,7 +488,7 @@ impl AnthesisApp {
         self.selected_organ = 0;
         self.framed = false;
         self.needs_run = true;
-        self.playback.time = 0.0;
+        self.playback.time_in_keyframes = 0.0;
         self.playback.follow = true;
     }
 
@@ -679,7 +679,7 @@ impl AnthesisApp {
         let scene = viewport::build_scene(
             self.doc.project(),
             &self.session,
-            self.playback.time,
+            self.playback.time_in_keyframes,
             self.view.show_others || !self.single_organ_preview,
         );
         if let Some(bounds) = viewport::scene_bounds(&scene) {
@@ -873,7 +873,7 @@ impl AnthesisApp {
         let scene = viewport::build_scene(
             self.doc.project(),
             &self.session,
-            self.playback.time,
+            self.playback.time_in_keyframes,
             show_others,
         );
         if !self.framed

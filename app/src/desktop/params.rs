@@ -192,7 +192,7 @@ pub fn parameters_ui(ui: &mut egui::Ui, doc: &mut Document, template: usize) -> 
                 );
                 mark(
                     ui.add(
-                        DragValue::new(&mut ramp.degrees)
+                        DragValue::new(&mut ramp.angle_deg)
                             .speed(0.1)
                             .range(-180.0..=180.0)
                             .suffix("°"),
@@ -225,7 +225,7 @@ pub fn parameters_ui(ui: &mut egui::Ui, doc: &mut Document, template: usize) -> 
         draft.joint_schedule.push(JointRamp {
             from_step: from,
             to_step: from + 20,
-            degrees: 5.0,
+            angle_deg: 5.0,
         });
         mark(true, "add joint ramp");
     }

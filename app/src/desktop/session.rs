@@ -241,20 +241,20 @@ impl SimSession {
         Some(elapsed / f64::from(done) * f64::from(self.total.saturating_sub(done)))
     }
 
-    /// Positions of every simulated organ at `time` (in keyframes),
+    /// Positions of every simulated organ at `time_in_keyframes`,
     /// interpolated linearly between the two keyframes around it; times
     /// past the newest keyframe show the newest. `None` before the bud.
-    pub fn positions_at(&self, time: f64) -> Option<Vec<Vec<glam::DVec3>>> {
+    pub fn positions_at(&self, time_in_keyframes: f64) -> Option<Vec<Vec<glam::DVec3>>> {
         let last = self.keyframes.len().checked_sub(1)?;
-        let time = time.clamp(0.0, last as f64);
+        let time = time_in_keyframes.clamp(0.0, last as f64);
         let below = (time.floor() as usize).min(last);
         let above = (below + 1).min(last);
         let t = time - below as f64;
         let (a, b) = (&self.keyframes[below], &self.keyframes[above]);
         Some(
-            a.positions
+            a.positions_in_world
                 .iter()
-                .zip(&b.positions)
+                .zip(&b.positions_in_world)
                 .map(|(pa, pb)| pa.iter().zip(pb).map(|(p, q)| p.lerp(*q, t)).collect())
                 .collect(),
         )
@@ -276,12 +276,12 @@ mod tests {
     fn keyframe(index: u32, x: f64) -> Arc<Keyframe> {
         Arc::new(Keyframe {
             index,
-            positions: vec![vec![DVec3::new(x, 0.0, 0.0)]],
+            positions_in_world: vec![vec![DVec3::new(x, 0.0, 0.0)]],
             stats: KeyframeStats {
                 index,
                 energy: 1.0,
                 iterations: 2,
-                gradient_norm: 0.0,
+                relative_gradient: 0.0,
                 seconds: 0.5,
                 pushed_particles: 0,
                 contact_particles: 0,

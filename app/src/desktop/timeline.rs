@@ -13,11 +13,12 @@ pub const BASE_KEYFRAMES_PER_SECOND: f64 = 24.0;
 /// Speeds offered in the speed menu.
 pub const SPEEDS: [f64; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
 
-/// Playback state. `time` is in keyframes (0 = the bud, fractional times
-/// are interpolated).
+/// Playback state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Playback {
-    pub time: f64,
+    /// Where playback is, counted in keyframes: 0 is the bud, 2.5 halfway
+    /// between keyframes 2 and 3 (shown interpolated).
+    pub time_in_keyframes: f64,
     pub playing: bool,
     pub looping: bool,
     pub speed: f64,
@@ -29,7 +30,7 @@ pub struct Playback {
 impl Default for Playback {
     fn default() -> Self {
         Playback {
-            time: 0.0,
+            time_in_keyframes: 0.0,
             playing: false,
             looping: true,
             speed: 1.0,
@@ -45,36 +46,36 @@ impl Playback {
     /// with loop on, a finished run starts again from the bud.
     pub fn advance(&mut self, seconds: f64, computed: Option<u32>, total: u32) {
         let Some(computed) = computed else {
-            self.time = 0.0;
+            self.time_in_keyframes = 0.0;
             return;
         };
         let end = f64::from(computed);
         if self.follow {
-            self.time = end;
+            self.time_in_keyframes = end;
             return;
         }
         if self.playing {
-            self.time += seconds * self.speed * BASE_KEYFRAMES_PER_SECOND;
-            if self.time >= end {
+            self.time_in_keyframes += seconds * self.speed * BASE_KEYFRAMES_PER_SECOND;
+            if self.time_in_keyframes >= end {
                 if self.looping && computed >= total && total > 0 {
-                    self.time %= end.max(1.0);
+                    self.time_in_keyframes %= end.max(1.0);
                 } else {
-                    self.time = end;
+                    self.time_in_keyframes = end;
                     if computed >= total {
                         self.playing = false;
                     }
                 }
             }
         }
-        self.time = self.time.clamp(0.0, end);
+        self.time_in_keyframes = self.time_in_keyframes.clamp(0.0, end);
     }
 
     pub fn toggle_play(&mut self, computed: Option<u32>) {
         self.follow = false;
         self.playing = !self.playing;
         // Play from the start when at the end.
-        if self.playing && computed.is_some_and(|c| self.time >= f64::from(c)) {
-            self.time = 0.0;
+        if self.playing && computed.is_some_and(|c| self.time_in_keyframes >= f64::from(c)) {
+            self.time_in_keyframes = 0.0;
         }
     }
 
@@ -84,30 +85,30 @@ impl Playback {
         self.playing = false;
         let end = f64::from(computed.unwrap_or(0));
         let next = if direction < 0 {
-            (self.time - 1e-9).ceil() - 1.0
+            (self.time_in_keyframes - 1e-9).ceil() - 1.0
         } else {
-            (self.time + 1e-9).floor() + 1.0
+            (self.time_in_keyframes + 1e-9).floor() + 1.0
         };
-        self.time = next.clamp(0.0, end);
+        self.time_in_keyframes = next.clamp(0.0, end);
     }
 
     pub fn go_to_start(&mut self) {
         self.follow = false;
-        self.time = 0.0;
+        self.time_in_keyframes = 0.0;
     }
 
     /// To the newest keyframe, and follow new ones.
     pub fn go_to_end(&mut self, computed: Option<u32>) {
         self.playing = false;
         self.follow = true;
-        self.time = f64::from(computed.unwrap_or(0));
+        self.time_in_keyframes = f64::from(computed.unwrap_or(0));
     }
 
     /// Jumps to `time` (clamped to the computed keyframes).
     pub fn scrub_to(&mut self, time: f64, computed: Option<u32>) {
         self.follow = false;
         self.playing = false;
-        self.time = time.clamp(0.0, f64::from(computed.unwrap_or(0)));
+        self.time_in_keyframes = time.clamp(0.0, f64::from(computed.unwrap_or(0)));
     }
 }
 
@@ -214,7 +215,7 @@ pub fn timeline_ui(
         ui.separator();
         ui.label(format!(
             "keyframe {:.1} / {}",
-            playback.time,
+            playback.time_in_keyframes,
             session.total()
         ));
         ui.separator();
@@ -238,7 +239,7 @@ pub fn timeline_ui(
         });
     });
     scrubber(ui, playback, computed, total);
-    stats_plot(ui, session, playback.time);
+    stats_plot(ui, session, playback.time_in_keyframes);
     requests
 }
 
@@ -286,7 +287,7 @@ fn scrubber(ui: &mut egui::Ui, playback: &mut Playback, computed: Option<u32>, t
         Stroke::new(1.0, visuals.widgets.noninteractive.bg_stroke.color),
         StrokeKind::Inside,
     );
-    let x = x_of(playback.time);
+    let x = x_of(playback.time_in_keyframes);
     painter.line_segment(
         [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
         Stroke::new(2.5, Color32::from_rgb(230, 120, 40)),
@@ -380,15 +381,19 @@ mod tests {
         };
         // One second at 1x is 24 keyframes; only 10 are computed of 100.
         p.advance(1.0, Some(10), 100);
-        assert_eq!(p.time, 10.0);
+        assert_eq!(p.time_in_keyframes, 10.0);
         assert!(p.playing, "waits for more keyframes");
-        p.time = 95.0;
+        p.time_in_keyframes = 95.0;
         p.advance(0.5, Some(100), 100);
-        assert!((p.time - 7.0).abs() < 1e-9, "looped to {}", p.time);
+        assert!(
+            (p.time_in_keyframes - 7.0).abs() < 1e-9,
+            "looped to {}",
+            p.time_in_keyframes
+        );
         p.looping = false;
-        p.time = 95.0;
+        p.time_in_keyframes = 95.0;
         p.advance(0.5, Some(100), 100);
-        assert_eq!(p.time, 100.0);
+        assert_eq!(p.time_in_keyframes, 100.0);
         assert!(!p.playing);
     }
 
@@ -396,18 +401,18 @@ mod tests {
     fn stepping_lands_on_whole_keyframes_and_follow_tracks_the_newest() {
         let mut p = Playback::default();
         p.advance(0.1, Some(7), 100);
-        assert_eq!(p.time, 7.0, "follows new keyframes");
+        assert_eq!(p.time_in_keyframes, 7.0, "follows new keyframes");
         p.scrub_to(3.4, Some(7));
         p.step(1, Some(7));
-        assert_eq!(p.time, 4.0);
+        assert_eq!(p.time_in_keyframes, 4.0);
         p.step(-1, Some(7));
-        assert_eq!(p.time, 3.0);
+        assert_eq!(p.time_in_keyframes, 3.0);
         p.step(-1, Some(7));
-        assert_eq!(p.time, 2.0);
+        assert_eq!(p.time_in_keyframes, 2.0);
         p.advance(0.1, Some(8), 100);
-        assert_eq!(p.time, 2.0, "scrubbing stops following");
+        assert_eq!(p.time_in_keyframes, 2.0, "scrubbing stops following");
         p.go_to_end(Some(8));
         p.advance(0.1, Some(9), 100);
-        assert_eq!(p.time, 9.0);
+        assert_eq!(p.time_in_keyframes, 9.0);
     }
 }

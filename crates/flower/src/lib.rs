@@ -68,14 +68,16 @@ impl BaseRegion {
     }
 }
 
-/// The joint angle grows by `degrees` spread evenly over steps
+/// The joint angle grows by `angle_deg` spread evenly over steps
 /// `from_step + 1 ..= to_step` (the paper's lily: 23° over steps 1–60, i.e.
 /// `from_step = 0, to_step = 60`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointRamp {
     pub from_step: u32,
     pub to_step: u32,
-    pub degrees: f64,
+    /// What the ramp adds to the joint angle, in degrees (`degrees` in the
+    /// project file).
+    pub angle_deg: f64,
 }
 
 /// The joint angle added by the schedule after `step` steps, in radians.
@@ -86,7 +88,7 @@ pub fn joint_angle_after(schedule: &[JointRamp], step: u32) -> f64 {
             let span = ramp.to_step.saturating_sub(ramp.from_step).max(1);
             let done =
                 step.clamp(ramp.from_step, ramp.to_step.max(ramp.from_step)) - ramp.from_step;
-            ramp.degrees * f64::from(done) / f64::from(span)
+            ramp.angle_deg * f64::from(done) / f64::from(span)
         })
         .sum::<f64>()
         .to_radians()
@@ -197,7 +199,7 @@ mod tests {
         let lily = [JointRamp {
             from_step: 0,
             to_step: 60,
-            degrees: 23.0,
+            angle_deg: 23.0,
         }];
         assert_eq!(joint_angle_after(&lily, 0), 0.0);
         assert!((joint_angle_after(&lily, 30) - 11.5f64.to_radians()).abs() < 1e-12);

@@ -94,12 +94,12 @@ fn petal_template() -> Template {
             JointRamp {
                 from_step: 0,
                 to_step: 60,
-                degrees: 23.0,
+                angle_deg: 23.0,
             },
             JointRamp {
                 from_step: 70,
                 to_step: 90,
-                degrees: -4.5,
+                angle_deg: -4.5,
             },
         ],
         color: [0.98, 0.62, 0.32, 1.0],
@@ -775,7 +775,7 @@ template = "petal"
         }
     );
     assert_eq!(template.maps.blend, Blend::logistic());
-    assert_eq!(template.joint_schedule[0].degrees, 23.0);
+    assert_eq!(template.joint_schedule[0].angle_deg, 23.0);
     let keys = template.maps.keys();
     assert_eq!(keys.len(), 2);
     assert_eq!(keys[0].maps.e_growth, e_growth);

@@ -9,7 +9,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let project = anthesis_garden::builtin_lily()?;
     let mut frames: Vec<Vec<Vec<glam::DVec3>>> = Vec::new();
     let sim = run(&project, &Selection::All, &mut |_, k| {
-        frames.push(k.positions.clone())
+        frames.push(k.positions_in_world.clone())
     })?;
     let names = sim.organs();
     let looks = names

@@ -107,7 +107,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let s = shape::flower_shape(
                 meshes
                     .iter()
-                    .zip(&keyframe.positions)
+                    .zip(&keyframe.positions_in_world)
                     .map(|(m, p)| (m, p.as_slice())),
             );
             if let Err(e) = &s {
@@ -139,7 +139,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     keyframe.stats.pushed_particles
                 );
             }
-            kept.push((keyframe.index, keyframe.positions.clone()));
+            kept.push((keyframe.index, keyframe.positions_in_world.clone()));
         }
     });
     println!(

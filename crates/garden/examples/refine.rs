@@ -44,7 +44,7 @@ fn main() {
         let started = Instant::now();
         let mut last = Vec::new();
         let outcome = run(&project, &selection, &mut |_, k| {
-            last = k.positions[0].clone();
+            last = k.positions_in_world[0].clone();
         });
         let seconds = started.elapsed().as_secs_f64();
         if let Err(e) = outcome {

@@ -249,7 +249,7 @@ fn template(
 pub const LILY_JOINT: JointRamp = JointRamp {
     from_step: 0,
     to_step: 60,
-    degrees: 23.0,
+    angle_deg: 23.0,
 };
 
 fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, color: [f32; 4]) -> TemplateSpec {
@@ -423,7 +423,7 @@ const EUSTOMA_BASE_V: f64 = 0.05;
 pub const EUSTOMA_JOINT: JointRamp = JointRamp {
     from_step: 0,
     to_step: 50,
-    degrees: 15.0,
+    angle_deg: 15.0,
 };
 
 /// Lower, middle and upper regions of an Eustoma petal (weights that sum

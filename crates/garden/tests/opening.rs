@@ -32,7 +32,7 @@ fn shapes(project: &Project, selection: &Selection, organs: &[usize]) -> Vec<Flo
                     .expect("organ simulated");
                 (
                     &project.flower.template_of(organ).mesh,
-                    keyframe.positions[slot].as_slice(),
+                    keyframe.positions_in_world[slot].as_slice(),
                 )
             }))
             .expect("measurable");

@@ -21,7 +21,7 @@ fn main() {
                 k.index,
                 k.stats.energy,
                 k.stats.iterations,
-                k.stats.gradient_norm,
+                k.stats.relative_gradient,
                 k.stats.pushed_particles
             );
         }

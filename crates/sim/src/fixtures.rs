@@ -104,7 +104,7 @@ fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
         joint_schedule: vec![JointRamp {
             from_step: 0,
             to_step: 60,
-            degrees: 23.0,
+            angle_deg: 23.0,
         }],
         color: [0.95, 0.55, 0.35, 1.0],
     }

@@ -41,9 +41,10 @@ pub struct KeyframeStats {
     pub energy: f64,
     /// Newton iterations taken (the largest over organs).
     pub iterations: u32,
-    /// Largest relative gradient over organs at convergence (see
+    /// Largest relative gradient over organs at convergence: the largest
+    /// force on a particle over a typical edge's force at 100 % strain (see
     /// `SolverSettings::relative_tolerance`).
-    pub gradient_norm: f64,
+    pub relative_gradient: f64,
     /// Wall time for this keyframe.
     pub seconds: f64,
     /// Particles the final push-back moved.
@@ -58,8 +59,8 @@ pub struct KeyframeStats {
 pub struct Keyframe {
     pub index: u32,
     /// One position list per simulated organ, in the order of
-    /// [`Simulation::organs`].
-    pub positions: Vec<Vec<DVec3>>,
+    /// [`Simulation::organs`], in the world frame.
+    pub positions_in_world: Vec<Vec<DVec3>>,
     pub stats: KeyframeStats,
 }
 
@@ -197,12 +198,12 @@ impl Simulation {
     pub fn bud(&self) -> Keyframe {
         Keyframe {
             index: 0,
-            positions: self.organs.iter().map(|o| o.initial.clone()).collect(),
+            positions_in_world: self.organs.iter().map(|o| o.initial.clone()).collect(),
             stats: KeyframeStats {
                 index: 0,
                 energy: 0.0,
                 iterations: 0,
-                gradient_norm: 0.0,
+                relative_gradient: 0.0,
                 seconds: 0.0,
                 pushed_particles: 0,
                 contact_particles: 0,
@@ -343,12 +344,12 @@ impl Simulation {
         self.next_step += 1;
         Ok(Keyframe {
             index: step,
-            positions: self.organs.iter().map(|o| o.positions.clone()).collect(),
+            positions_in_world: self.organs.iter().map(|o| o.positions.clone()).collect(),
             stats: KeyframeStats {
                 index: step,
                 energy,
                 iterations,
-                gradient_norm: gradient,
+                relative_gradient: gradient,
                 seconds: started.elapsed().as_secs_f64(),
                 pushed_particles: pushed as u32,
                 contact_particles: self.particles_in_contact(),

@@ -98,7 +98,7 @@ fn the_base_stays_where_the_receptacle_and_the_scheduled_angle_put_it() {
                 })
                 .collect();
             let mean_edge = common::mean_edge(&bud_in_world, sim.triangles(organ));
-            let positions = &keyframe.positions[organ];
+            let positions = &keyframe.positions_in_world[organ];
             let scheduled = joint_angle_after(&template.joint_schedule, keyframe.index);
             assert!(scheduled > 0.1, "the schedule must have turned the joint");
             if let Err(why) = check_base_placed(&project, organ, positions, scheduled, mean_edge) {
@@ -112,7 +112,7 @@ fn the_base_stays_where_the_receptacle_and_the_scheduled_angle_put_it() {
             let other_schedule = [JointRamp {
                 from_step: 0,
                 to_step: 60,
-                degrees: 20.0,
+                angle_deg: 20.0,
             }];
             let other = joint_angle_after(&other_schedule, keyframe.index);
             assert!(
@@ -137,16 +137,16 @@ fn a_larger_schedule_turns_the_base_further() {
     template.joint_schedule = vec![JointRamp {
         from_step: 0,
         to_step: 20,
-        degrees: 40.0,
+        angle_deg: 40.0,
     }];
     let (keyframes, error) = common::run_all(&project, &Selection::All);
     assert_eq!(error, None);
     let last = keyframes.last().expect("the bud at least");
     assert_eq!(last.index, 20);
     let template = project.flower.template_of(0);
-    let bud: Vec<DVec3> = keyframes[0].positions[0].clone();
+    let bud: Vec<DVec3> = keyframes[0].positions_in_world[0].clone();
     let mean_edge = common::mean_edge(&bud, &template.mesh.triangles);
-    let positions = &last.positions[0];
+    let positions = &last.positions_in_world[0];
     check_base_placed(&project, 0, positions, 40f64.to_radians(), mean_edge)
         .unwrap_or_else(|why| panic!("{why}"));
     let old = joint_angle_after(&old_schedule, 20);

@@ -28,7 +28,10 @@ fn assert_on_their_sides(project: &Project, keyframes: &[Keyframe], exempt_base:
     let [inner_checked, outer_checked] = [checked(inner_template), checked(outer_template)];
     let mut closest = f64::INFINITY;
     for keyframe in keyframes {
-        let [inner, outer] = [&keyframe.positions[0], &keyframe.positions[1]];
+        let [inner, outer] = [
+            &keyframe.positions_in_world[0],
+            &keyframe.positions_in_world[1],
+        ];
         // Inner particles over the outer organ lie on its inner side,
         // at least `offset` from it.
         let over_outer = particles_over(inner, outer, &outer_template.mesh.triangles);
@@ -64,7 +67,7 @@ fn assert_on_their_sides(project: &Project, keyframes: &[Keyframe], exempt_base:
         }
     }
     for k in keyframes {
-        assert!(k.positions.iter().flatten().all(|p| p.is_finite()));
+        assert!(k.positions_in_world.iter().flatten().all(|p| p.is_finite()));
     }
     closest
 }
@@ -80,10 +83,16 @@ fn shape_problem(project: &Project, keyframes: &[Keyframe]) -> Option<String> {
         let [before, now] = [&pair[0], &pair[1]];
         for organ in 0..2 {
             let triangles = &project.flower.templates[organ].mesh.triangles;
-            let since_bud =
-                common::shape_change(&now.positions[organ], &bud.positions[organ], triangles);
-            let since_last =
-                common::shape_change(&now.positions[organ], &before.positions[organ], triangles);
+            let since_bud = common::shape_change(
+                &now.positions_in_world[organ],
+                &bud.positions_in_world[organ],
+                triangles,
+            );
+            let since_last = common::shape_change(
+                &now.positions_in_world[organ],
+                &before.positions_in_world[organ],
+                triangles,
+            );
             let context = format!("keyframe {}, organ {organ}", now.index);
             if since_bud.max_edge_ratio >= 1.2 {
                 return Some(format!(
@@ -147,8 +156,8 @@ fn an_inner_organ_driven_twice_as_hard_presses_on_the_outer_one_without_cutting_
         .iter()
         .filter(|k| {
             particles_over(
-                &k.positions[0],
-                &k.positions[1],
+                &k.positions_in_world[0],
+                &k.positions_in_world[1],
                 &project.flower.templates[1].mesh.triangles,
             )
             .iter()
@@ -187,11 +196,15 @@ fn without_the_overlap_rule_the_same_organs_cut_through_each_other() {
     assert_eq!(error, None);
     let last = keyframes.last().expect("keyframes");
     let outer_triangles = &project.flower.templates[1].mesh.triangles;
-    let wrong: Vec<f64> = particles_over(&last.positions[0], &last.positions[1], outer_triangles)
-        .iter()
-        .map(|s| s.along_normal)
-        .filter(|&d| d < offset - 1e-6)
-        .collect();
+    let wrong: Vec<f64> = particles_over(
+        &last.positions_in_world[0],
+        &last.positions_in_world[1],
+        outer_triangles,
+    )
+    .iter()
+    .map(|s| s.along_normal)
+    .filter(|&d| d < offset - 1e-6)
+    .collect();
     assert!(
         wrong.len() >= 10,
         "only {} inner particles ended on the wrong side",
@@ -213,11 +226,11 @@ fn the_sanity_check_sees_a_particle_pushed_out_of_its_sheet() {
     assert_eq!(error, None);
     let triangles = &project.flower.templates[0].mesh.triangles;
     let k = keyframes.len() - 1;
-    let normals = anthesis_mesh::vertex_normals(&keyframes[k].positions[0], triangles);
-    let edge = common::mean_edge(&keyframes[k].positions[0], triangles);
+    let normals = anthesis_mesh::vertex_normals(&keyframes[k].positions_in_world[0], triangles);
+    let edge = common::mean_edge(&keyframes[k].positions_in_world[0], triangles);
     let particle = 60;
     assert_eq!(shape_problem(&project, &keyframes), None);
-    keyframes[k].positions[0][particle] += normals[particle] * (edge / 3.0);
+    keyframes[k].positions_in_world[0][particle] += normals[particle] * (edge / 3.0);
     let problem = shape_problem(&project, &keyframes);
     assert!(
         problem.as_deref().is_some_and(|p| p.contains("turned")),

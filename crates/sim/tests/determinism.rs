@@ -12,7 +12,7 @@ fn fingerprint(keyframes: &[Keyframe]) -> Vec<u64> {
     let mut bits = Vec::new();
     for k in keyframes {
         bits.push(u64::from(k.index));
-        for organ in &k.positions {
+        for organ in &k.positions_in_world {
             bits.push(organ.len() as u64);
             for p in organ {
                 bits.extend([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]);
@@ -22,7 +22,7 @@ fn fingerprint(keyframes: &[Keyframe]) -> Vec<u64> {
             u64::from(k.stats.index),
             k.stats.energy.to_bits(),
             u64::from(k.stats.iterations),
-            k.stats.gradient_norm.to_bits(),
+            k.stats.relative_gradient.to_bits(),
             u64::from(k.stats.pushed_particles),
         ]);
     }
@@ -81,7 +81,7 @@ fn the_fingerprint_sees_a_one_bit_change() {
     let (mut keyframes, error) = common::run_all(&project, &Selection::All);
     assert_eq!(error, None);
     let before = fingerprint(&keyframes);
-    let p = &mut keyframes[2].positions[0][7];
+    let p = &mut keyframes[2].positions_in_world[0][7];
     p.y = f64::from_bits(p.y.to_bits() ^ 1);
     assert_ne!(fingerprint(&keyframes), before);
 }

@@ -173,11 +173,11 @@ pub(super) fn template_problem(template: &Template) -> Option<String> {
         ));
     }
     for ramp in &template.joint_schedule {
-        if ramp.from_step > ramp.to_step || !ramp.degrees.is_finite() {
+        if ramp.from_step > ramp.to_step || !ramp.angle_deg.is_finite() {
             return Some(format!(
                 "joint_schedule ramp from step {} to step {} by {} degrees: from_step must not \
                  exceed to_step and degrees must be finite",
-                ramp.from_step, ramp.to_step, ramp.degrees
+                ramp.from_step, ramp.to_step, ramp.angle_deg
             ));
         }
     }

@@ -311,7 +311,7 @@ impl From<&JointRamp> for JointRampFile {
         JointRampFile {
             from_step: ramp.from_step,
             to_step: ramp.to_step,
-            degrees: ramp.degrees,
+            degrees: ramp.angle_deg,
         }
     }
 }
@@ -321,7 +321,7 @@ impl From<&JointRampFile> for JointRamp {
         JointRamp {
             from_step: file.from_step,
             to_step: file.to_step,
-            degrees: file.degrees,
+            angle_deg: file.degrees,
         }
     }
 }

@@ -83,11 +83,11 @@ pub fn inner_driven_into_outer(keyframes: u32, overlap: bool) -> Project {
 /// `inner_drive_deg` (the outer one's still by 10 degrees): the larger the
 /// drive, the deeper the inner organ is pushed into the outer one.
 pub fn inner_driven_into_outer_by(keyframes: u32, overlap: bool, inner_drive_deg: f64) -> Project {
-    let ramp = |degrees: f64| {
+    let ramp = |angle_deg: f64| {
         vec![JointRamp {
             from_step: 0,
             to_step: keyframes,
-            degrees,
+            angle_deg,
         }]
     };
     let mut inner = petal_template("inner petal", 8, 14);
