@@ -50,20 +50,22 @@ pub enum Command {
         /// Write per-keyframe statistics as JSON.
         #[arg(long, value_name = "FILE.json")]
         stats: Option<PathBuf>,
-        /// Write the animation: FILE.glb for an animated glTF, otherwise a
+        /// Write the animation: FILE.glb for an animated glTF, FILE.usda
+        /// for a USD layer (one time sample per keyframe), otherwise a
         /// folder that receives one OBJ per keyframe.
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
-        /// Keyframes per second in the .glb (default 24).
+        /// Keyframes per second in the .glb or .usda (default 24).
         #[arg(long, conflicts_with = "duration")]
         fps: Option<f64>,
-        /// Length of the whole .glb animation in seconds.
+        /// Length of the whole .glb or .usda animation in seconds.
         #[arg(long)]
         duration: Option<f64>,
         /// Most morph targets per mesh in the .glb; longer runs are resampled.
         #[arg(long, default_value_t = anthesis_export::DEFAULT_MAX_MORPH_TARGETS)]
         max_targets: usize,
-        /// Leave normals out of the .glb (smaller; clients compute them).
+        /// Leave normals out of the .glb or .usda (smaller; clients compute
+        /// them: three.js shades a .glb without normals flat).
         #[arg(long)]
         no_normals: bool,
         /// How the .glb stores its data.

@@ -77,6 +77,40 @@ fn simulate_writes_stats_json_and_a_glb() {
 }
 
 #[test]
+fn simulate_writes_a_usd_layer_with_every_organ_and_the_receptacle() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 4);
+    let usda = dir.path().join("flower.usda");
+    let out = anthesis(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--fps",
+        "12",
+        "--out",
+        usda.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // Pixar's USD reads such layers back in anthesis-export's tests; here
+    // the command line's choices show in the text.
+    let layer = std::fs::read_to_string(&usda).expect("usda written");
+    assert!(layer.starts_with("#usda 1.0"), "{}", &layer[..80]);
+    for line in [
+        "endTimeCode = 4",
+        "timeCodesPerSecond = 12",
+        "def Mesh \"petal_1\"",
+        "def Mesh \"sepal_1\"",
+        "def Mesh \"receptacle\"",
+        "normal3f[] normals.timeSamples",
+    ] {
+        assert!(layer.contains(line), "no `{line}` in the layer");
+    }
+    // The last keyframe (4) is sampled in each of the two organs' points,
+    // normals and extent.
+    assert_eq!(layer.matches("\n            4.0: [(").count(), 2 * 3);
+    assert_eq!(layer.matches("\n            5.0: [(").count(), 0);
+}
+
+#[test]
 fn simulate_one_organ_and_obj_output() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = saved_whorl(dir.path(), 2, 2);
@@ -135,11 +169,27 @@ fn bad_input_gives_one_line_and_a_non_zero_exit() {
             "--out".into(),
             "/no/such/folder/x.glb".into(),
         ],
+        vec![
+            "simulate".into(),
+            p.into(),
+            "--out".into(),
+            "/no/such/folder/x.usda".into(),
+        ],
     ];
     for args in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
         one_line_error(&args);
     }
+    // Binary USD is refused before the simulation, saying how to get it.
+    let usdc = dir.path().join("flower.usdc");
+    let out = one_line_error(&["simulate", p, "--out", usdc.to_str().expect("utf-8")]);
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("usdcat") && !stderr.contains("simulated"),
+        "{stderr}"
+    );
+    assert!(!usdc.exists());
+
     let out = anthesis(&["simulate"]);
     assert_eq!(
         out.status.code(),

@@ -5,7 +5,7 @@ use std::io::{IsTerminal, Write};
 use std::path::Path;
 use std::time::Instant;
 
-use anthesis_export::{GlbOptions, Track, TrackLook};
+use anthesis_export::{GlbOptions, Track, TrackLook, UsdOptions};
 use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
@@ -88,18 +88,30 @@ pub(super) fn simulate(
             .enumerate()
             .map(|(i, name)| TrackLook::new(name, sim.triangles(i), sim.uvs(i), sim.color(i)));
         let mut tracks = anthesis_export::organ_tracks(looks, frames.iter().map(Vec::as_slice));
-        if is_glb(out) {
+        let kind = OutputKind::of(out);
+        if kind != OutputKind::ObjFolder {
             let receptacle = anthesis_garden::receptacle_for(&project.flower);
             tracks.push(Track::still(
                 "receptacle",
                 receptacle,
                 anthesis_garden::RECEPTACLE_COLOR,
             ));
-            anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
-                .with_context(|| format!("cannot write {}", out.display()))?;
-        } else {
-            anthesis_export::write_obj_sequence(out, &tracks)
-                .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
+        }
+        match kind {
+            OutputKind::Glb => anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
+                .with_context(|| format!("cannot write {}", out.display()))?,
+            OutputKind::Usd => {
+                let usd = UsdOptions {
+                    timing: glb.timing,
+                    normals: glb.normals,
+                };
+                anthesis_export::write_usd(out, &tracks, &usd, &mut |_| {})
+                    .with_context(|| format!("cannot write {}", out.display()))?
+            }
+            OutputKind::ObjFolder => {
+                anthesis_export::write_obj_sequence(out, &tracks)
+                    .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
+            }
         }
         eprintln!("wrote {}", out.display());
     }
@@ -141,30 +153,51 @@ pub(super) fn run_keyframes(
     Ok(seconds)
 }
 
-fn is_glb(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+/// What `--out` asks for, by its extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum OutputKind {
+    Glb,
+    Usd,
+    ObjFolder,
+}
+
+impl OutputKind {
+    fn of(path: &Path) -> OutputKind {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+        {
+            OutputKind::Glb
+        } else if anthesis_export::is_usd_path(path) {
+            OutputKind::Usd
+        } else {
+            OutputKind::ObjFolder
+        }
+    }
 }
 
 /// Fails early, before a long simulation, when the output cannot be written.
 fn check_output(out: &Path) -> Result<()> {
-    if is_glb(out) {
-        let parent = out
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        if !parent.is_dir() {
-            bail!(
-                "cannot write {}: folder {} does not exist",
-                out.display(),
-                parent.display()
-            );
+    match OutputKind::of(out) {
+        OutputKind::Glb => {
+            let parent = out
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            if !parent.is_dir() {
+                bail!(
+                    "cannot write {}: folder {} does not exist",
+                    out.display(),
+                    parent.display()
+                );
+            }
         }
-    } else if out.exists() && !out.is_dir() {
-        bail!(
-            "--out {} must be a .glb file or a folder for OBJ files",
+        OutputKind::Usd => anthesis_export::check_usd_destination(out)?,
+        OutputKind::ObjFolder if out.exists() && !out.is_dir() => bail!(
+            "--out {} must be a .glb or .usda file or a folder for OBJ files",
             out.display()
-        );
+        ),
+        OutputKind::ObjFolder => {}
     }
     Ok(())
 }

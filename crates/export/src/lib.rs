@@ -65,7 +65,9 @@ pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
 pub use report::{GlbSize, GlbSizeReport, glb_size_report};
 pub use tracks::{TrackLook, organ_tracks};
-pub use usd::{USD_ROOT_PRIM, UsdOptions, is_usd_path, usd_bytes, write_usd};
+pub use usd::{
+    USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, write_usd,
+};
 
 /// One organ (or the receptacle) over time: a fixed triangulation and UV
 /// layout, and its positions at every keyframe in the world frame.

@@ -46,11 +46,12 @@ use openusd::sdf::{self, ChildrenKey, FieldKey, ListOp, SpecType, Specifier, Val
 use crate::prepare::{unit_normals, validate_timing, validate_tracks};
 use crate::{ExportError, Timing, Track};
 
-/// Whether `path` names a USD file this writer produces: `.usda` or `.usd`
-/// (USD tells text from binary by the contents, so a text `.usd` opens
-/// everywhere USD does).
+/// Whether `path` names a USD file (`.usda`, `.usd` or `.usdc`), so that a
+/// caller sends it to [`write_usd`] (which writes text to `.usda` and
+/// `.usd`, USD telling text from binary by the contents, and explains why
+/// it refuses `.usdc`).
 pub fn is_usd_path(path: &Path) -> bool {
-    usd_extension(path).is_some_and(|e| e == "usda" || e == "usd")
+    usd_extension(path).is_some_and(|e| matches!(e.as_str(), "usda" | "usd" | "usdc"))
 }
 
 fn usd_extension(path: &Path) -> Option<String> {
@@ -171,26 +172,29 @@ pub fn write_usd(
     options: &UsdOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<(), ExportError> {
-    match usd_extension(path).as_deref() {
-        Some("usda" | "usd") => {}
-        Some("usdc") => {
-            return Err(ExportError::InvalidOptions(format!(
-                "{}: binary .usdc is not written yet (the USD library Anthesis builds with \
-                 writes crate files Pixar's USD cannot read); export .usda and convert it \
-                 with `usdcat FILE.usda -o FILE.usdc` if you need the binary form",
-                path.display()
-            )));
-        }
-        _ => {
-            return Err(ExportError::InvalidOptions(format!(
-                "{} does not end in .usda or .usd",
-                path.display()
-            )));
-        }
-    }
-    anthesis_files::check_destination(path)?;
+    check_usd_destination(path)?;
     let bytes = usd_bytes(tracks, options, progress)?;
     Ok(anthesis_files::write_atomic(path, &bytes)?)
+}
+
+/// The checks [`write_usd`] makes before any work, for callers that want
+/// to fail before a long simulation: the file name ends in `.usda` or
+/// `.usd` (a `.usdc` gets an error that says why and how to convert), and
+/// its folder exists and is a folder.
+pub fn check_usd_destination(path: &Path) -> Result<(), ExportError> {
+    match usd_extension(path).as_deref() {
+        Some("usda" | "usd") => Ok(anthesis_files::check_destination(path)?),
+        Some("usdc") => Err(ExportError::InvalidOptions(format!(
+            "{}: binary .usdc is not written yet (the USD library Anthesis builds with \
+             writes crate files Pixar's USD cannot read); export .usda and convert it \
+             with `usdcat FILE.usda -o FILE.usdc` if you need the binary form",
+            path.display()
+        ))),
+        _ => Err(ExportError::InvalidOptions(format!(
+            "{} does not end in .usda or .usd",
+            path.display()
+        ))),
+    }
 }
 
 /// Valid, distinct USD prim names for the tracks: every character that is

@@ -351,10 +351,10 @@ fn bad_requests_fail_clearly_and_leave_an_existing_file_alone() {
 
 #[test]
 fn usd_paths_are_told_by_their_extension() {
-    for usd in ["a/b.usda", "b.USDA", "b.usd"] {
+    for usd in ["a/b.usda", "b.USDA", "b.usd", "b.usdc"] {
         assert!(is_usd_path(Path::new(usd)), "{usd}");
     }
-    for other in ["b.usdc", "b.glb", "usda", "folder/"] {
+    for other in ["b.usdz", "b.glb", "usda", "folder/"] {
         assert!(!is_usd_path(Path::new(other)), "{other}");
     }
 }
