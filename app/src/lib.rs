@@ -1,5 +1,6 @@
 //! The Anthesis application: the desktop window ([`desktop`]) and the
 //! command line ([`cli`]) over the engine crates.
 
+pub mod animation;
 pub mod cli;
 pub mod desktop;

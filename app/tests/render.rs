@@ -71,12 +71,13 @@ fn render_writes_the_requested_frames_and_a_tile() {
     assert_eq!(
         names,
         [
+            "camera.json",
             "frame-000.png",
             "frame-002.png",
             "frame-004.png",
             "tiled.png"
         ],
-        "only the pictures, no temporary files"
+        "only the pictures and their camera, no temporary files"
     );
     let frames: Vec<RgbaImage> = ["frame-000.png", "frame-002.png", "frame-004.png"]
         .iter()
@@ -125,6 +126,113 @@ fn render_writes_the_requested_frames_and_a_tile() {
         let tile = image::imageops::crop_imm(&tiled, x0, 0, 160, 120).to_image();
         assert!(tile == *frame, "tile {i} is frame {i}");
     }
+}
+
+#[test]
+fn render_animation_writes_a_looping_gif_and_numbered_png_frames() {
+    use image::AnimationDecoder;
+    use image::codecs::gif::GifDecoder;
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let project = saved_whorl(dir.path());
+    let gif = dir.path().join("opening.gif");
+    let out = anthesis(&[
+        "render",
+        utf8(&project),
+        "--animation",
+        utf8(&gif),
+        "--step",
+        "3",
+        "--size",
+        "96x64",
+        "--fps",
+        "10",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let file = std::io::BufReader::new(std::fs::File::open(&gif).expect("gif written"));
+    let frames = GifDecoder::new(file)
+        .expect("a GIF")
+        .into_frames()
+        .collect_frames()
+        .expect("frames decode");
+    // Keyframes 0, 3 and the last (4).
+    assert_eq!(frames.len(), 3);
+    let delays: Vec<(u32, u32)> = frames.iter().map(|f| f.delay().numer_denom_ms()).collect();
+    let ms = |(n, d): (u32, u32)| f64::from(n) / f64::from(d);
+    assert!((ms(delays[0]) - 100.0).abs() < 1e-9, "{delays:?}");
+    // The open flower is held for a second before the loop starts again.
+    assert!((ms(delays[2]) - 1100.0).abs() < 1e-9, "{delays:?}");
+    let pictures: Vec<RgbaImage> = frames.into_iter().map(|f| f.into_buffer()).collect();
+    for picture in &pictures {
+        assert_eq!(picture.dimensions(), (96, 64));
+        assert!(organ_pixels(picture).len() > 100, "the flower shows");
+    }
+    let changed = pictures[0]
+        .pixels()
+        .zip(pictures[2].pixels())
+        .filter(|(p, q)| differs(p, q))
+        .count();
+    assert!(
+        changed > 50,
+        "bud and open flower differ in {changed} pixels"
+    );
+
+    // A folder (created) of PNG frames, the camera turning once around.
+    let folder = dir.path().join("frames");
+    let out = anthesis(&[
+        "render",
+        utf8(&project),
+        "--animation",
+        utf8(&folder),
+        "--turn",
+        "360",
+        "--size",
+        "64x48",
+        "--background",
+        "ffffff",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let mut names: Vec<String> = std::fs::read_dir(&folder)
+        .expect("list")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let expected: Vec<String> = (0..5).map(|i| format!("frame-{i:04}.png")).collect();
+    assert_eq!(names, expected);
+    let first = load_png(&folder.join("frame-0000.png"));
+    assert_eq!(first.dimensions(), (64, 48));
+    assert_eq!(
+        first.get_pixel(0, 0).0,
+        [255, 255, 255, 255],
+        "white background"
+    );
+
+    // Impossible requests fail before simulating and write nothing.
+    let too_wide = dir.path().join("wide.gif");
+    for (args, expected) in [
+        (
+            vec!["--animation", utf8(&too_wide), "--size", "70000x10"],
+            "65535",
+        ),
+        (
+            vec!["--animation", utf8(&too_wide), "--fps", "60"],
+            "frames per second",
+        ),
+        (
+            vec!["--animation", utf8(&too_wide), "--step", "0"],
+            "--step",
+        ),
+        (
+            vec!["--animation", utf8(&too_wide), "--background", "white"],
+            "RRGGBB",
+        ),
+    ] {
+        let args: Vec<&str> = ["render", utf8(&project)].into_iter().chain(args).collect();
+        let out = one_line_error(&args);
+        let stderr = text(&out.stderr);
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+    assert!(!too_wide.exists());
 }
 
 #[test]

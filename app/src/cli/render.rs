@@ -1,17 +1,20 @@
 //! `anthesis render`: pictures of chosen keyframes, rendered offscreen with
-//! one camera for the whole run.
+//! one camera for the whole run, or the opening as an animation (GIF or PNG
+//! frames, see [`crate::animation`]).
 
-use std::io::Cursor;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use anthesis_render::{Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
-use anthesis_sim::Simulation;
+use anthesis_flower::Project;
+use anthesis_render::{Background, Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
+use anthesis_sim::{Selection, Simulation};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbaImage;
 
 use super::simulate::run_keyframes;
 use super::{load, selection};
+use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
@@ -23,8 +26,29 @@ pub struct RenderArgs {
     pub frames: Option<String>,
     /// An existing folder; receives frame-NNN.png per keyframe (NNN the
     /// keyframe number).
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
+    #[arg(long, value_name = "DIR", required_unless_present = "animation")]
+    pub out: Option<PathBuf>,
+    /// Render the opening as an animation instead: OUT.gif (loops, holds the
+    /// open flower for a second) or a folder (created if missing) of
+    /// frame-0000.png, frame-0001.png, … in playback order.
+    #[arg(long, value_name = "OUT.gif|FOLDER", conflicts_with_all = ["out", "frames", "tile"])]
+    pub animation: Option<PathBuf>,
+    /// With --animation: show every N-th keyframe (the last is always shown).
+    #[arg(long, value_name = "N", default_value_t = 1, requires = "animation")]
+    pub step: u32,
+    /// With --animation: turn the camera this many degrees around the flower
+    /// axis over the animation (360 = once around).
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true,
+        requires = "animation"
+    )]
+    pub turn: f64,
+    /// With --animation to a GIF: frames per second (at most 50).
+    #[arg(long, value_name = "F", default_value_t = crate::animation::DEFAULT_GIF_FRAMES_PER_SECOND, requires = "animation")]
+    pub fps: f64,
     /// Simulate and show only this organ (no collisions).
     #[arg(long, value_name = "NAME")]
     pub organ: Option<String>,
@@ -55,6 +79,10 @@ pub struct RenderArgs {
     /// Also write DIR/tiled.png: the frames side by side, in keyframe order.
     #[arg(long)]
     pub tile: bool,
+    /// A plain background colour as hexadecimal sRGB, such as ffffff for
+    /// white (default: a soft blue-grey gradient).
+    #[arg(long, value_name = "RRGGBB")]
+    pub background: Option<String>,
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
@@ -67,10 +95,6 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     }
     let selection = selection(&project, args.organ.as_deref())?;
     let last_keyframe = project.settings.keyframes;
-    let frames = match &args.frames {
-        Some(list) => parse_frames(list, last_keyframe)?,
-        None => default_frames(last_keyframe),
-    };
     let (width, height) = parse_size(&args.size)?;
     if !args.azimuth.is_finite() {
         bail!(
@@ -84,10 +108,44 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             args.elevation
         );
     }
-    check_folder(&args.out)?;
+    let animation = match &args.animation {
+        Some(path) => {
+            if args.step == 0 {
+                bail!("--step must be at least 1");
+            }
+            let target = AnimationTarget::of(path);
+            let options = AnimationOptions {
+                width,
+                height,
+                azimuth_deg: args.azimuth,
+                elevation_deg: args.elevation,
+                turn_deg: args.turn,
+                frames_per_second: args.fps,
+            };
+            animation::check_request(&target, &options)?;
+            Some((target, options))
+        }
+        None => None,
+    };
+    let frames = match (&animation, &args.frames) {
+        (Some(_), _) => animation::keyframes_every(args.step, last_keyframe),
+        (None, Some(list)) => parse_frames(list, last_keyframe)?,
+        (None, None) => default_frames(last_keyframe),
+    };
+    let out = match (&animation, &args.out) {
+        (None, Some(out)) => {
+            check_folder(out)?;
+            Some(out)
+        }
+        _ => None,
+    };
+    let background = args.background.as_deref().map(parse_color).transpose()?;
     // Before the simulation, so that a machine without a GPU driver fails
     // at once.
     let mut renderer = OffscreenRenderer::new().context("cannot render")?;
+    if let Some(srgb) = background {
+        renderer.set_background(Background::plain(srgb));
+    }
     let max_side = renderer.device().limits().max_texture_dimension_2d;
     if width > max_side || height > max_side {
         bail!(
@@ -95,7 +153,115 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         );
     }
 
-    let mut sim = Simulation::new(&project, &selection)?;
+    let scenes = simulate_scenes(&project, &selection, &frames)?;
+    if let Some((target, options)) = &animation {
+        let count = scenes.len();
+        let organs: Vec<Vec<OrganMesh>> = scenes.into_iter().map(|(_, organs)| organs).collect();
+        let show_progress = std::io::stderr().is_terminal();
+        animation::write_animation(&mut renderer, &organs, options, target, &mut |done| {
+            if show_progress {
+                eprint!("\rrendered frame {done}/{count}   ");
+            }
+        })?;
+        if show_progress {
+            eprintln!();
+        }
+        eprintln!(
+            "wrote {count} frame(s) of {width}x{height} to {}",
+            target.path().display()
+        );
+        return Ok(());
+    }
+    let Some(out) = out else {
+        bail!("--out DIR or --animation OUT.gif|FOLDER says where the pictures go");
+    };
+
+    // One camera for all pictures, so the flower does not jump between them.
+    let bounds = scenes
+        .iter()
+        .filter_map(|(_, organs)| organs_bounds_in_world(organs))
+        .reduce(|(lo_a, hi_a), (lo_b, hi_b)| (lo_a.min(lo_b), hi_a.max(hi_b)));
+    let Some((lo, hi)) = bounds else {
+        bail!("there is nothing to render: the organs have no vertices");
+    };
+    let camera = Camera::framing(lo, hi, args.azimuth, args.elevation);
+    let mut pictures = Vec::with_capacity(scenes.len());
+    for (index, organs) in &scenes {
+        let picture = renderer
+            .render(organs, &camera, width, height)
+            .with_context(|| format!("cannot render keyframe {index}"))?;
+        let path = out.join(format!("frame-{index:03}.png"));
+        write_png(&path, &picture)?;
+        pictures.push(picture);
+    }
+    write_camera(&out.join("camera.json"), &camera, width, height)?;
+    let mut written = scenes.len();
+    if args.tile {
+        write_png(&out.join("tiled.png"), &side_by_side(&pictures))?;
+        written += 1;
+    }
+    eprintln!(
+        "wrote {written} picture(s) of {width}x{height} and camera.json to {}",
+        out.display()
+    );
+    Ok(())
+}
+
+/// The camera of the pictures, for matching them in another renderer: eye,
+/// target and up in the world frame, the vertical field of view of these
+/// pictures in degrees (what three.js and Blender call the field of view
+/// for a landscape picture), the near clipping distance, and the size.
+#[derive(serde::Serialize)]
+struct CameraFile {
+    eye: [f64; 3],
+    target: [f64; 3],
+    up: [f64; 3],
+    vertical_fov_deg: f64,
+    near: f64,
+    width: u32,
+    height: u32,
+}
+
+fn write_camera(path: &Path, camera: &Camera, width: u32, height: u32) -> Result<()> {
+    let aspect = width as f32 / height as f32;
+    let file = CameraFile {
+        eye: camera.eye.to_array(),
+        target: camera.target.to_array(),
+        up: camera.up.to_array(),
+        vertical_fov_deg: camera.vertical_fov(aspect).to_degrees(),
+        near: camera.near_clip(),
+        width,
+        height,
+    };
+    let json = serde_json::to_string_pretty(&file)?;
+    Ok(anthesis_files::write_atomic(path, json.as_bytes())?)
+}
+
+/// `RRGGBB` hexadecimal sRGB (a leading `#` allowed) as components in
+/// `[0, 1]`.
+fn parse_color(hex: &str) -> Result<[f32; 3]> {
+    let digits = hex.trim().trim_start_matches('#');
+    let channel = |i: usize| {
+        digits
+            .get(2 * i..2 * i + 2)
+            .and_then(|d| u8::from_str_radix(d, 16).ok())
+    };
+    match (digits.len(), channel(0), channel(1), channel(2)) {
+        (6, Some(r), Some(g), Some(b)) => Ok([r, g, b].map(|c| f32::from(c) / 255.0)),
+        _ => bail!(
+            "--background takes a colour as RRGGBB hexadecimal, such as ffffff for white, not `{hex}`"
+        ),
+    }
+}
+
+/// Simulates through the last of `frames` (sorted keyframe numbers, 0 the
+/// bud) and returns each of those keyframes' organs, ready to draw.
+fn simulate_scenes(
+    project: &Project,
+    selection: &Selection,
+    frames: &[u32],
+) -> Result<Vec<(u32, Vec<OrganMesh>)>> {
+    let mut sim = Simulation::new(project, selection)?;
     let colors: Vec<[f32; 4]> = (0..sim.organs().len()).map(|i| sim.color(i)).collect();
     let triangles: Vec<Vec<[u32; 3]>> = (0..colors.len())
         .map(|i| sim.triangles(i).to_vec())
@@ -118,35 +284,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             scenes.push((keyframe.index, organs_at(&keyframe.positions_in_world)));
         }
     })?;
-
-    // One camera for all pictures, so the flower does not jump between them.
-    let bounds = scenes
-        .iter()
-        .filter_map(|(_, organs)| organs_bounds_in_world(organs))
-        .reduce(|(lo_a, hi_a), (lo_b, hi_b)| (lo_a.min(lo_b), hi_a.max(hi_b)));
-    let Some((lo, hi)) = bounds else {
-        bail!("there is nothing to render: the organs have no vertices");
-    };
-    let camera = Camera::framing(lo, hi, args.azimuth, args.elevation);
-    let mut pictures = Vec::with_capacity(scenes.len());
-    for (index, organs) in &scenes {
-        let picture = renderer
-            .render(organs, &camera, width, height)
-            .with_context(|| format!("cannot render keyframe {index}"))?;
-        let path = args.out.join(format!("frame-{index:03}.png"));
-        write_png(&path, &picture)?;
-        pictures.push(picture);
-    }
-    let mut written = scenes.len();
-    if args.tile {
-        write_png(&args.out.join("tiled.png"), &side_by_side(&pictures))?;
-        written += 1;
-    }
-    eprintln!(
-        "wrote {written} picture(s) of {width}x{height} to {}",
-        args.out.display()
-    );
-    Ok(())
+    Ok(scenes)
 }
 
 /// The bud, the last keyframe and the quarters in between (without
@@ -205,15 +343,6 @@ fn check_folder(folder: &Path) -> Result<()> {
     Ok(())
 }
 
-fn write_png(path: &Path, picture: &RgbaImage) -> Result<()> {
-    let mut bytes = Vec::new();
-    picture
-        .write_to(&mut Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .with_context(|| format!("cannot encode {}", path.display()))?;
-    // Export errors name the file.
-    Ok(anthesis_files::write_atomic(path, &bytes)?)
-}
-
 /// The pictures (all of one size) in a row, left to right.
 fn side_by_side(pictures: &[RgbaImage]) -> RgbaImage {
     let (width, height) = pictures.first().map_or((0, 0), RgbaImage::dimensions);
@@ -241,6 +370,18 @@ mod tests {
         assert_eq!(default_frames(100), [0, 25, 50, 75, 100]);
         assert_eq!(default_frames(2), [0, 1, 2]);
         assert_eq!(default_frames(1), [0, 1]);
+    }
+
+    #[test]
+    fn background_colours_parse_as_hexadecimal_srgb() {
+        assert_eq!(
+            parse_color("ff0080").expect("valid"),
+            [1.0, 0.0, 128.0 / 255.0]
+        );
+        assert_eq!(parse_color("#FFFFFF").expect("valid"), [1.0; 3]);
+        for bad in ["fff", "white", "ff00zz", "ff00ff00", "é00000"] {
+            assert!(parse_color(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]
