@@ -1,0 +1,223 @@
+//! The built-in lily's .glb in every encoding, played by three.js (pinned
+//! in `tests/browser/package.json`, with its meshopt decoder) inside
+//! Debian's headless Chromium with software WebGL: no console error, every
+//! organ drawn, and silhouettes that match `anthesis render` of the same
+//! keyframes seen by the same camera. Fails, never skips, when Node.js,
+//! the npm packages or Chromium are missing: `.ci/run` installs them.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use common::{anthesis, text};
+use image::RgbaImage;
+use serde_json::{Value, json};
+
+const INSTALL_HINT: &str = "install Debian's `chromium` and Node.js, then run `npm ci --prefix tests/browser` in the repository root (.ci/run does both)";
+
+/// Keyframes compared: the bud, two stages of the opening, the open flower.
+const KEYFRAMES: [u32; 4] = [0, 25, 50, 100];
+/// The default frame rate of the export (keyframes per second).
+const FRAMES_PER_SECOND: f64 = 24.0;
+const ORGANS: [&str; 6] = [
+    "petal-1", "petal-2", "petal-3", "sepal-1", "sepal-2", "sepal-3",
+];
+const WIDTH: u32 = 320;
+const HEIGHT: u32 = 240;
+
+fn browser_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/browser")
+}
+
+fn run_ok(args: &[&str]) {
+    let out = anthesis(args);
+    assert!(
+        out.status.success(),
+        "anthesis {args:?} failed: {}",
+        text(&out.stderr)
+    );
+}
+
+fn image_at(path: &str) -> RgbaImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("cannot read {path}: {e}"))
+        .to_rgba8()
+}
+
+/// Pixels `anthesis render` drew an organ on: anything clearly away from
+/// the magenta background (antialiased edges half-way count).
+fn anthesis_mask(picture: &RgbaImage) -> Vec<bool> {
+    picture
+        .pixels()
+        .map(|p| {
+            let [r, g, b, _] = p.0.map(i32::from);
+            (255 - r).abs() + g + (255 - b).abs() > 3 * 64
+        })
+        .collect()
+}
+
+/// Pixels three.js drew an organ on in the ids picture (black background).
+fn three_mask(ids: &RgbaImage) -> Vec<bool> {
+    ids.pixels().map(|p| p.0[1] == 255).collect()
+}
+
+/// Intersection over union of two masks.
+fn overlap(a: &[bool], b: &[bool]) -> f64 {
+    let both = a.iter().zip(b).filter(|(x, y)| **x && **y).count();
+    let either = a.iter().zip(b).filter(|(x, y)| **x || **y).count();
+    both as f64 / either.max(1) as f64
+}
+
+/// Mean absolute difference of two pictures' colour channels, in 0..255.
+fn mean_difference(a: &RgbaImage, b: &RgbaImage) -> f64 {
+    let sum: u64 = a
+        .pixels()
+        .zip(b.pixels())
+        .map(|(p, q)| {
+            (0..3)
+                .map(|c| u64::from(p.0[c].abs_diff(q.0[c])))
+                .sum::<u64>()
+        })
+        .sum();
+    sum as f64 / (3 * a.width() * a.height()) as f64
+}
+
+#[test]
+fn every_encoding_of_the_lily_plays_in_three_js_like_anthesis_renders_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = |name: &str| dir.path().join(name).display().to_string();
+
+    let encodings = ["dense", "sparse", "quantized"];
+    let mut files = Vec::new();
+    for encoding in encodings {
+        let path = d(&format!("lily-{encoding}.glb"));
+        run_ok(&[
+            "simulate",
+            "builtin:lily",
+            "--encoding",
+            encoding,
+            "--out",
+            &path,
+        ]);
+        files.push(json!({ "name": encoding, "path": path }));
+    }
+    let renders = d("anthesis");
+    std::fs::create_dir(&renders).expect("mkdir");
+    let frames: Vec<String> = KEYFRAMES.iter().map(u32::to_string).collect();
+    run_ok(&[
+        "render",
+        "builtin:lily",
+        "--frames",
+        &frames.join(","),
+        "--size",
+        &format!("{WIDTH}x{HEIGHT}"),
+        "--background",
+        "ff00ff",
+        "--out",
+        &renders,
+    ]);
+    let camera: Value = serde_json::from_str(
+        &std::fs::read_to_string(Path::new(&renders).join("camera.json")).expect("camera.json"),
+    )
+    .expect("camera JSON");
+
+    let three_out = d("three");
+    std::fs::create_dir(&three_out).expect("mkdir");
+    let job = json!({
+        "width": WIDTH,
+        "height": HEIGHT,
+        "times": KEYFRAMES.map(|k| f64::from(k) / FRAMES_PER_SECOND),
+        "camera": camera,
+        // anthesis render draws the organs only.
+        "hide": ["receptacle"],
+        "files": files,
+        "out": three_out,
+    });
+    let job_path = d("job.json");
+    std::fs::write(&job_path, job.to_string()).expect("write job");
+
+    let script = browser_dir().join("render.mjs");
+    assert!(
+        browser_dir()
+            .join("node_modules/three/package.json")
+            .is_file(),
+        "three.js is not installed: {INSTALL_HINT}"
+    );
+    let output = Command::new("node")
+        .arg(&script)
+        .arg(&job_path)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run node ({e}): {INSTALL_HINT}"));
+    assert!(
+        output.status.success(),
+        "the browser check failed ({}): {}\n{INSTALL_HINT}",
+        output.status,
+        text(&output.stderr)
+    );
+    let report: Value = serde_json::from_slice(&output.stdout).expect("report JSON");
+
+    // No console error, page error or failed request, and no three.js
+    // warning (Chromium's own GL performance notes are allowed).
+    for message in report["messages"].as_array().expect("messages") {
+        let body = message["text"].as_str().unwrap_or_default();
+        assert!(
+            message["kind"] != "error" && !body.contains("THREE."),
+            "the browser reported: {message}"
+        );
+    }
+
+    let reports = report["files"].as_array().expect("files");
+    assert_eq!(reports.len(), encodings.len());
+    let mut dense_shaded: Vec<RgbaImage> = Vec::new();
+    for (file, encoding) in reports.iter().zip(encodings) {
+        assert_eq!(file["three"], "187", "{encoding}");
+        let mut meshes: Vec<&str> = ORGANS.to_vec();
+        meshes.push("receptacle");
+        assert_eq!(file["meshes"], json!(meshes), "{encoding}");
+        for organ in ORGANS {
+            assert_eq!(file["morph_targets"][organ], 100, "{encoding} {organ}");
+            assert_eq!(file["morph_normals"][organ], 100, "{encoding} {organ}");
+            assert_eq!(file["flat_shading"][organ], false, "{encoding} {organ}");
+        }
+        let animation = &file["animations"][0];
+        assert_eq!(animation["name"], "opening");
+        let duration = animation["duration"].as_f64().expect("duration");
+        assert!(
+            (duration - 100.0 / FRAMES_PER_SECOND).abs() < 1e-5,
+            "{duration}"
+        );
+
+        let frames = file["frames"].as_array().expect("frames");
+        assert_eq!(frames.len(), KEYFRAMES.len());
+        for (i, (frame, keyframe)) in frames.iter().zip(KEYFRAMES).enumerate() {
+            let what = format!("{encoding} at keyframe {keyframe}");
+            let ours = image_at(&format!("{renders}/frame-{keyframe:03}.png"));
+            let ids = image_at(frame["ids"].as_str().expect("ids"));
+            let iou = overlap(&anthesis_mask(&ours), &three_mask(&ids));
+            assert!(iou >= 0.95, "{what}: silhouettes overlap only {iou:.3}");
+            eprintln!("{what}: silhouette overlap {iou:.4}");
+
+            let shaded = image_at(frame["shaded"].as_str().expect("shaded"));
+            if encoding == "dense" {
+                dense_shaded.push(shaded);
+            } else {
+                // The same shapes and normals shade the same: storage
+                // must not change what a viewer sees.
+                let difference = mean_difference(&dense_shaded[i], &shaded);
+                eprintln!("{what}: mean shading difference from dense {difference:.3}");
+                assert!(
+                    difference < 1.0,
+                    "{what}: shading differs by {difference:.2}"
+                );
+            }
+        }
+        // Every organ shows in the open flower (in the bud the sepals hide
+        // the petals).
+        let open = &frames[KEYFRAMES.len() - 1]["pixels"];
+        for organ in ORGANS {
+            let pixels = open[organ].as_u64().unwrap_or(0);
+            assert!(pixels > 100, "{encoding}: {organ} covers {pixels} pixels");
+        }
+    }
+}
