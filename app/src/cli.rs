@@ -82,9 +82,15 @@ pub enum Command {
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum EncodingArg {
+    /// Plain 32-bit floats: read by every glTF tool.
     Dense,
+    /// Morph targets store only the vertices that move.
     Sparse,
+    /// KHR_mesh_quantization: 16- and 8-bit integers.
     Quantized,
+    /// Quantized and compressed with EXT_meshopt_compression: the smallest;
+    /// readers need a meshopt decoder (three.js: setMeshoptDecoder).
+    Meshopt,
 }
 
 impl From<EncodingArg> for Encoding {
@@ -93,6 +99,7 @@ impl From<EncodingArg> for Encoding {
             EncodingArg::Dense => Encoding::Dense,
             EncodingArg::Sparse => Encoding::Sparse,
             EncodingArg::Quantized => Encoding::Quantized,
+            EncodingArg::Meshopt => Encoding::Meshopt,
         }
     }
 }

@@ -88,7 +88,7 @@ fn every_encoding_of_the_lily_plays_in_three_js_like_anthesis_renders_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = |name: &str| dir.path().join(name).display().to_string();
 
-    let encodings = ["dense", "sparse", "quantized"];
+    let encodings = ["dense", "sparse", "quantized", "meshopt"];
     let mut files = Vec::new();
     for encoding in encodings {
         let path = d(&format!("lily-{encoding}.glb"));

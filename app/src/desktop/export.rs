@@ -288,7 +288,9 @@ impl ExportDialog {
                         .response
                         .on_hover_text(
                             "dense: plain floats, read everywhere; sparse: only moving vertices; \
-                             quantized: KHR_mesh_quantization, about half the size",
+                             quantized: KHR_mesh_quantization, about half the size; \
+                             meshopt: quantized and compressed (EXT_meshopt_compression), \
+                             the smallest, for three.js with its meshopt decoder",
                         );
                         ui.end_row();
                     });

@@ -307,7 +307,7 @@ fn every_encoding_rebuilds_every_keyframe() {
             let to_world = |p: DVec3| translation + p * scale;
             // Quantized positions are within half a step of the normalized
             // i16 grid, i.e. scale / 65534, plus f32 rounding.
-            let tolerance = if encoding == Encoding::Quantized {
+            let tolerance = if is_quantized(encoding) {
                 assert!(scale > 1.0, "quantized meshes are scaled from [-1, 1]");
                 scale / 32767.0
             } else {
@@ -359,11 +359,7 @@ fn every_encoding_rebuilds_every_keyframe() {
                     .zip(&normal_deltas)
                     .map(|(b, d)| (*b + *d).normalize())
                     .collect();
-                let normal_tolerance = if encoding == Encoding::Quantized {
-                    0.01
-                } else {
-                    1e-6
-                };
+                let normal_tolerance = if is_quantized(encoding) { 0.01 } else { 1e-6 };
                 assert_close(
                     &rebuilt,
                     &normals(&track.keyframes[k + 1], track),

@@ -18,7 +18,7 @@ fn lily_sized_export_sizes_in_every_mode() {
     assert_eq!(report.vertices, 6 * 390 + 36);
     assert_eq!(report.keyframes, 100);
     assert_eq!(report.morph_targets, 99);
-    assert_eq!(report.sizes.len(), 6);
+    assert_eq!(report.sizes.len(), 2 * Encoding::ALL.len());
 
     let bytes = |e, n| report.bytes(e, n).expect("size");
     // Dense with normals: 6 x 390 x 99 targets x (12 + 12) bytes dominate;
@@ -34,6 +34,8 @@ fn lily_sized_export_sizes_in_every_mode() {
     }
     // Quantized targets take 8 + 4 bytes per vertex instead of 24.
     assert!(bytes(Encoding::Quantized, true) * 10 < dense * 6);
+    // meshopt compresses the quantized streams further.
+    assert!(bytes(Encoding::Meshopt, true) < bytes(Encoding::Quantized, true));
     // Every tepal vertex moves, so sparse storage cannot win here; it must
     // never be larger than dense by more than the weights it saves.
     assert!(bytes(Encoding::Sparse, true) <= dense);

@@ -35,6 +35,14 @@ fn every_encoding_passes_the_validator_with_and_without_normals() {
                 .unwrap_or_default();
             if encoding == Encoding::Quantized {
                 assert_eq!(required, vec![serde_json::json!("KHR_mesh_quantization")]);
+            } else if encoding == Encoding::Meshopt {
+                assert_eq!(
+                    required,
+                    vec![
+                        serde_json::json!("KHR_mesh_quantization"),
+                        serde_json::json!("EXT_meshopt_compression")
+                    ]
+                );
             } else {
                 assert!(required.is_empty(), "{encoding}: {required:?}");
             }

@@ -22,6 +22,7 @@ pub(super) const CLAMP_TO_EDGE: u32 = 33071;
 pub(super) const TRIANGLES: u32 = 4;
 
 pub(super) const KHR_MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
+const EXT_MESHOPT_COMPRESSION: &str = "EXT_meshopt_compression";
 
 /// An `f32` as the shortest JSON number that reads back as the same `f32`
 /// (`0.1` rather than `0.10000000149011612`).
@@ -123,16 +124,53 @@ impl Element {
     }
 }
 
+/// How a buffer view's bytes may be compressed with `EXT_meshopt_compression`.
+#[derive(Clone, Copy)]
+enum Layout {
+    /// Stored as they are (images, animation data, sparse parts).
+    Raw,
+    /// Vertex attributes of `element_size` bytes each (a multiple of 4):
+    /// meshopt's `ATTRIBUTES` mode.
+    Vertices { element_size: usize },
+    /// Triangle indices of `index_size` bytes each (2 or 4): meshopt's
+    /// `TRIANGLES` mode.
+    Triangles { index_size: usize },
+    /// `f32` 3-vectors that may be stored lossily through meshopt's
+    /// `EXPONENTIAL` filter (see [`EXP_FILTER_MANTISSA_BITS`]).
+    ExponentialVec3,
+}
+
+/// Mantissa bits (sign included) of the `EXPONENTIAL` filter for `f32`
+/// normal deltas, whose exponent is shared per component over the view:
+/// deltas up to 2 in size keep steps of 2 / 2^9 < 0.004, the rounding of
+/// the `i8` deltas (steps of 1/127) used where a delta fits in [-1, 1].
+const EXP_FILTER_MANTISSA_BITS: i32 = 10;
+
 /// The binary chunk and the buffer views and accessors that describe it.
-#[derive(Default)]
 pub(super) struct GltfBuilder {
     bin: Vec<u8>,
     views: Vec<Value>,
     accessors: Vec<Value>,
     pub(super) uses_quantization: bool,
+    /// Compress vertex and index views with `EXT_meshopt_compression`.
+    meshopt: bool,
+    /// Size of the uncompressed data the compressed views decode into (the
+    /// fallback buffer, which holds no bytes in the file).
+    fallback_len: usize,
 }
 
 impl GltfBuilder {
+    pub(super) fn new(encoding: Encoding) -> GltfBuilder {
+        GltfBuilder {
+            bin: Vec::new(),
+            views: Vec::new(),
+            accessors: Vec::new(),
+            uses_quantization: false,
+            meshopt: encoding == Encoding::Meshopt,
+            fallback_len: 0,
+        }
+    }
+
     /// Appends `bytes` 4-byte aligned as a new buffer view.
     pub(super) fn view(
         &mut self,
@@ -140,19 +178,69 @@ impl GltfBuilder {
         stride: Option<usize>,
         target: Option<u32>,
     ) -> usize {
+        self.view_of(bytes, stride, target, Layout::Raw)
+    }
+
+    /// Appends `bytes` as a new buffer view, compressed with meshopt when
+    /// the builder compresses and `layout` allows it.
+    fn view_of(
+        &mut self,
+        bytes: &[u8],
+        stride: Option<usize>,
+        target: Option<u32>,
+        layout: Layout,
+    ) -> usize {
+        let compressed = if self.meshopt {
+            compress(bytes, layout)
+        } else {
+            None
+        };
         self.pad();
-        let mut view = json!({
-            "buffer": 0,
-            "byteOffset": self.bin.len(),
-            "byteLength": bytes.len(),
-        });
+        let mut view = match compressed {
+            Some(Compressed {
+                bytes: compressed,
+                stride: extension_stride,
+                count,
+                mode,
+                filter,
+            }) => {
+                let fallback_offset = self.fallback_len;
+                self.fallback_len += bytes.len().next_multiple_of(4);
+                let mut extension = json!({
+                    "buffer": 0,
+                    "byteOffset": self.bin.len(),
+                    "byteLength": compressed.len(),
+                    "byteStride": extension_stride,
+                    "count": count,
+                    "mode": mode,
+                });
+                if let Some(filter) = filter {
+                    extension["filter"] = filter.into();
+                }
+                self.bin.extend_from_slice(&compressed);
+                json!({
+                    "buffer": 1,
+                    "byteOffset": fallback_offset,
+                    "byteLength": bytes.len(),
+                    "extensions": { EXT_MESHOPT_COMPRESSION: extension },
+                })
+            }
+            None => {
+                let view = json!({
+                    "buffer": 0,
+                    "byteOffset": self.bin.len(),
+                    "byteLength": bytes.len(),
+                });
+                self.bin.extend_from_slice(bytes);
+                view
+            }
+        };
         if let Some(stride) = stride {
             view["byteStride"] = stride.into();
         }
         if let Some(target) = target {
             view["target"] = target.into();
         }
-        self.bin.extend_from_slice(bytes);
         self.views.push(view);
         self.views.len() - 1
     }
@@ -182,9 +270,39 @@ impl GltfBuilder {
         element.accessor(Some(view), count)
     }
 
+    /// Like [`GltfBuilder::stored`] for vertex attributes whose elements
+    /// are `element_size` bytes apart (compressible with meshopt).
+    fn stored_vertices(
+        &mut self,
+        bytes: &[u8],
+        element_size: usize,
+        padded: bool,
+        element: Element,
+        count: usize,
+    ) -> Value {
+        // A padded element needs its stride spelt out; a compressed view
+        // always names it (the decoder's element size).
+        let stride = (padded || self.meshopt).then_some(element_size);
+        let layout = Layout::Vertices { element_size };
+        let view = self.view_of(bytes, stride, Some(ARRAY_BUFFER), layout);
+        element.accessor(Some(view), count)
+    }
+
     pub(super) fn vec3_f32(&mut self, values: &[[f32; 3]], with_min_max: bool) -> usize {
         let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
-        let mut accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), VEC3_F32, values.len());
+        let mut accessor = if self.meshopt && !with_min_max {
+            // Without min/max (which must match the stored values
+            // exactly) the values may go through the lossy filter.
+            let view = self.view_of(
+                &bytes,
+                Some(12),
+                Some(ARRAY_BUFFER),
+                Layout::ExponentialVec3,
+            );
+            VEC3_F32.accessor(Some(view), values.len())
+        } else {
+            self.stored_vertices(&bytes, 12, false, VEC3_F32, values.len())
+        };
         if with_min_max {
             set_min_max(&mut accessor, values);
         }
@@ -255,7 +373,7 @@ impl GltfBuilder {
         let padded = values.iter().flat_map(|v| [v[0], v[1], v[2], 0]);
         let bytes = le_bytes(padded, i16::to_le_bytes);
         let element = Element::normalized(SHORT, "VEC3");
-        let mut accessor = self.stored(&bytes, Some(8), Some(ARRAY_BUFFER), element, values.len());
+        let mut accessor = self.stored_vertices(&bytes, 8, true, element, values.len());
         if with_min_max {
             set_min_max(&mut accessor, values);
         }
@@ -268,21 +386,21 @@ impl GltfBuilder {
         let padded = values.iter().flat_map(|v| [v[0], v[1], v[2], 0]);
         let bytes = le_bytes(padded, i8::to_le_bytes);
         let element = Element::normalized(BYTE, "VEC3");
-        let accessor = self.stored(&bytes, Some(4), Some(ARRAY_BUFFER), element, values.len());
+        let accessor = self.stored_vertices(&bytes, 4, true, element, values.len());
         self.accessor(accessor)
     }
 
     pub(super) fn vec2_f32(&mut self, values: &[[f32; 2]]) -> usize {
         let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
         let element = Element::plain(FLOAT, "VEC2");
-        let accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), element, values.len());
+        let accessor = self.stored_vertices(&bytes, 8, false, element, values.len());
         self.accessor(accessor)
     }
 
     pub(super) fn vec2_u16_normalized(&mut self, values: &[[u16; 2]]) -> usize {
         let bytes = le_bytes(values.iter().flatten().copied(), u16::to_le_bytes);
         let element = Element::normalized(UNSIGNED_SHORT, "VEC2");
-        let accessor = self.stored(&bytes, None, Some(ARRAY_BUFFER), element, values.len());
+        let accessor = self.stored_vertices(&bytes, 4, false, element, values.len());
         self.accessor(accessor)
     }
 
@@ -295,14 +413,11 @@ impl GltfBuilder {
         };
         let bytes = index_bytes(&flat, component_type);
         let element = Element::plain(component_type, "SCALAR");
-        let accessor = self.stored(
-            &bytes,
-            None,
-            Some(ELEMENT_ARRAY_BUFFER),
-            element,
-            flat.len(),
-        );
-        self.accessor(accessor)
+        let layout = Layout::Triangles {
+            index_size: component_size(component_type),
+        };
+        let view = self.view_of(&bytes, None, Some(ELEMENT_ARRAY_BUFFER), layout);
+        self.accessor(element.accessor(Some(view), flat.len()))
     }
 
     pub(super) fn times(&mut self, times: &[f32]) -> usize {
@@ -342,7 +457,7 @@ impl GltfBuilder {
                 self.add_sparse(&mut accessor, &positions, index_type, &values);
                 accessor
             }
-            Encoding::Quantized => {
+            Encoding::Quantized | Encoding::Meshopt => {
                 let mut values = vec![0u8; count];
                 for i in ones {
                     values[i] = u8::MAX;
@@ -357,7 +472,21 @@ impl GltfBuilder {
     /// Assembles the GLB container: header, JSON chunk, binary chunk.
     pub(super) fn finish(mut self, mut root: Value) -> Result<Vec<u8>, ExportError> {
         self.pad();
-        root["buffers"] = json!([{ "byteLength": self.bin.len() }]);
+        let mut buffers = vec![json!({ "byteLength": self.bin.len() })];
+        if self.fallback_len > 0 {
+            // The compressed views decode into this buffer; it has no data
+            // in the file, so every reader needs the extension.
+            buffers.push(json!({
+                "byteLength": self.fallback_len,
+                "extensions": { EXT_MESHOPT_COMPRESSION: { "fallback": true } },
+            }));
+            for key in ["extensionsUsed", "extensionsRequired"] {
+                let mut names = root[key].as_array().cloned().unwrap_or_default();
+                names.push(EXT_MESHOPT_COMPRESSION.into());
+                root[key] = Value::Array(names);
+            }
+        }
+        root["buffers"] = Value::Array(buffers);
         root["bufferViews"] = Value::Array(self.views);
         root["accessors"] = Value::Array(self.accessors);
         let mut json_chunk = serde_json::to_vec(&root)?;
@@ -417,5 +546,130 @@ fn index_bytes(indices: &[usize], component_type: u32) -> Vec<u8> {
             .iter()
             .flat_map(|&i| (i as u32).to_le_bytes())
             .collect(),
+    }
+}
+
+/// A buffer view's bytes as `EXT_meshopt_compression` stores them, with the
+/// extension's `byteStride`, `count`, `mode` and `filter`.
+struct Compressed {
+    bytes: Vec<u8>,
+    stride: usize,
+    count: usize,
+    mode: &'static str,
+    filter: Option<&'static str>,
+}
+
+/// `bytes` compressed with meshoptimizer for `EXT_meshopt_compression`;
+/// `None` when `layout` is not compressible or compression would not make
+/// the view smaller.
+///
+/// Vertex streams use the version 0 vertex codec, the one the extension
+/// specifies (meshoptimizer 1.x writes version 1 unless asked);
+/// the index codec's version 1 is the extension's.
+fn compress(bytes: &[u8], layout: Layout) -> Option<Compressed> {
+    let (compressed, stride, mode, filter) = match layout {
+        Layout::Raw => return None,
+        Layout::Vertices { element_size } => {
+            if !bytes.len().is_multiple_of(element_size) {
+                return None;
+            }
+            let compressed = match element_size {
+                4 => encode_vertices::<4>(bytes),
+                8 => encode_vertices::<8>(bytes),
+                12 => encode_vertices::<12>(bytes),
+                _ => return None,
+            }?;
+            (compressed, element_size, "ATTRIBUTES", None)
+        }
+        Layout::ExponentialVec3 => {
+            if !bytes.len().is_multiple_of(12) {
+                return None;
+            }
+            let vectors: Vec<[f32; 3]> = bytes
+                .chunks_exact(12)
+                .map(|c| {
+                    [0, 4, 8].map(|i| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]))
+                })
+                .collect();
+            let filtered = meshopt::encode_filter_exp(
+                &vectors,
+                EXP_FILTER_MANTISSA_BITS,
+                meshopt::EncodeExpMode::SharedComponent,
+            );
+            let compressed = meshopt::encode_vertex_buffer_level(&filtered, 2, Some(0)).ok()?;
+            (compressed, 12, "ATTRIBUTES", Some("EXPONENTIAL"))
+        }
+        Layout::Triangles { index_size } => {
+            let indices: Vec<u32> = match index_size {
+                2 => bytes
+                    .chunks_exact(2)
+                    .map(|c| u32::from(u16::from_le_bytes([c[0], c[1]])))
+                    .collect(),
+                4 => bytes
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect(),
+                _ => return None,
+            };
+            if !indices.len().is_multiple_of(3) {
+                return None;
+            }
+            let vertex_count = indices.iter().max().map_or(0, |&i| i as usize + 1);
+            let compressed = meshopt::encode_index_buffer(&indices, vertex_count).ok()?;
+            (compressed, index_size, "TRIANGLES", None)
+        }
+    };
+    (compressed.len() < bytes.len()).then(|| Compressed {
+        count: bytes.len() / stride,
+        bytes: compressed,
+        stride,
+        mode,
+        filter,
+    })
+}
+
+/// Vertex codec version 0 over elements of `N` bytes.
+fn encode_vertices<const N: usize>(bytes: &[u8]) -> Option<Vec<u8>> {
+    let elements: Vec<[u8; N]> = bytes
+        .chunks_exact(N)
+        .map(|c| c.try_into().unwrap_or([0; N]))
+        .collect();
+    meshopt::encode_vertex_buffer_level(&elements, 2, Some(0)).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exponential_filter_keeps_large_normal_deltas_within_its_step() {
+        // Normal deltas as a curled tip makes them: up to 1.84 per component.
+        let deltas: Vec<[f32; 3]> = (0..500)
+            .map(|i| {
+                let t = i as f32 / 499.0;
+                [1.84 * t - 0.9, (7.0 * t).sin(), -0.3 * t]
+            })
+            .collect();
+        let bytes = le_bytes(deltas.iter().flatten().copied(), f32::to_le_bytes);
+        let compressed = compress(&bytes, Layout::ExponentialVec3).expect("compresses");
+        assert!(compressed.bytes.len() * 2 < bytes.len());
+        assert_eq!(
+            (
+                compressed.stride,
+                compressed.count,
+                compressed.mode,
+                compressed.filter
+            ),
+            (12, 500, "ATTRIBUTES", Some("EXPONENTIAL"))
+        );
+        let mut decoded =
+            meshopt::decode_vertex_buffer::<[u32; 3]>(&compressed.bytes, 500).expect("decodes");
+        meshopt::decode_filter_exp(&mut decoded);
+        for (d, e) in deltas.iter().zip(&decoded) {
+            for c in 0..3 {
+                let back = f32::from_bits(e[c]);
+                assert!((back - d[c]).abs() < 0.004, "{} -> {back}", d[c]);
+            }
+        }
     }
 }

@@ -1,5 +1,6 @@
 //! One track's mesh as glTF accessors: base attributes and morph-target
-//! deltas, dense, sparse or quantized (`KHR_mesh_quantization`).
+//! deltas, dense, sparse or quantized (`KHR_mesh_quantization`, also the
+//! accessors that `EXT_meshopt_compression` compresses).
 
 use glam::{DVec2, DVec3};
 use serde_json::{Map, Value};
@@ -83,7 +84,7 @@ pub(super) fn encode_mesh(
     tick: &mut dyn FnMut(),
 ) -> EncodedMesh {
     let base = &frames[0];
-    let quantized = options.encoding == Encoding::Quantized;
+    let quantized = matches!(options.encoding, Encoding::Quantized | Encoding::Meshopt);
     let mut attributes = Map::new();
     let normal_of = |frame: &[DVec3]| unit_normals(frame, &track.triangles);
     let base_normals = options.normals.then(|| normal_of(base));

@@ -63,7 +63,7 @@ pub fn glb_bytes(
         progress(work_done as f32 / total_work);
     };
 
-    let mut gltf = GltfBuilder::default();
+    let mut gltf = GltfBuilder::new(options.encoding);
     let mut nodes = Vec::with_capacity(tracks.len());
     let mut meshes = Vec::with_capacity(tracks.len());
     let mut materials = Vec::with_capacity(tracks.len());

@@ -251,7 +251,116 @@ pub fn parse_glb(bytes: &[u8]) -> Glb {
     let bin_len = u32_at(bytes, bin_at);
     assert_eq!(&bytes[bin_at + 4..bin_at + 8], b"BIN\0");
     let bin = bytes[bin_at + 8..bin_at + 8 + bin_len].to_vec();
-    Glb { json, bin }
+    decompress_meshopt(Glb { json, bin })
+}
+
+/// Replaces every `EXT_meshopt_compression` buffer view by its data as
+/// meshoptimizer's own decoder restores it (appended to the binary chunk),
+/// so the reader below sees plain views. Checks the fallback buffer is
+/// declared as the extension asks.
+fn decompress_meshopt(mut glb: Glb) -> Glb {
+    let views = glb.json["bufferViews"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    for (index, view) in views.iter().enumerate() {
+        let Some(extension) = view["extensions"].get("EXT_meshopt_compression") else {
+            continue;
+        };
+        let fallback = &glb.json["buffers"][view["buffer"].as_u64().expect("buffer") as usize];
+        assert_eq!(
+            fallback["extensions"]["EXT_meshopt_compression"]["fallback"], true,
+            "view {index} decodes into a buffer that is not a fallback"
+        );
+        assert!(fallback.get("uri").is_none());
+        assert_eq!(
+            extension["buffer"], 0,
+            "compressed data lives in the GLB chunk"
+        );
+        let at = extension["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let length = extension["byteLength"].as_u64().expect("byteLength") as usize;
+        let stride = extension["byteStride"].as_u64().expect("byteStride") as usize;
+        let count = extension["count"].as_u64().expect("count") as usize;
+        let filter = extension["filter"].as_str().unwrap_or("NONE");
+        let encoded = &glb.bin[at..at + length];
+        let decoded: Vec<u8> = match extension["mode"].as_str().expect("mode") {
+            "ATTRIBUTES" => {
+                assert_eq!(
+                    meshopt::decode_vertex_version(encoded),
+                    Some(0),
+                    "EXT_meshopt_compression wants the version 0 vertex codec"
+                );
+                match filter {
+                    "NONE" => decode_vertices(encoded, stride, count),
+                    "EXPONENTIAL" => {
+                        assert_eq!(stride, 12, "the filter is used on f32 3-vectors");
+                        let mut values = meshopt::decode_vertex_buffer::<[u32; 3]>(encoded, count)
+                            .expect("vertices decode");
+                        meshopt::decode_filter_exp(&mut values);
+                        values
+                            .iter()
+                            .flatten()
+                            .flat_map(|v| v.to_le_bytes())
+                            .collect()
+                    }
+                    other => panic!("unexpected filter {other}"),
+                }
+            }
+            "TRIANGLES" => match stride {
+                2 => meshopt::decode_index_buffer::<u16>(encoded, count)
+                    .expect("indices decode")
+                    .iter()
+                    .flat_map(|i| i.to_le_bytes())
+                    .collect(),
+                4 => meshopt::decode_index_buffer::<u32>(encoded, count)
+                    .expect("indices decode")
+                    .iter()
+                    .flat_map(|i| i.to_le_bytes())
+                    .collect(),
+                other => panic!("index stride {other}"),
+            },
+            other => panic!("unexpected meshopt mode {other}"),
+        };
+        assert_eq!(
+            decoded.len(),
+            view["byteLength"].as_u64().expect("byteLength") as usize,
+            "view {index}: decoded size"
+        );
+        while !glb.bin.len().is_multiple_of(4) {
+            glb.bin.push(0);
+        }
+        let plain = &mut glb.json["bufferViews"][index];
+        plain["buffer"] = 0.into();
+        plain["byteOffset"] = glb.bin.len().into();
+        plain.as_object_mut().expect("view").remove("extensions");
+        glb.bin.extend_from_slice(&decoded);
+    }
+    glb
+}
+
+fn decode_vertices(encoded: &[u8], stride: usize, count: usize) -> Vec<u8> {
+    fn decode<const N: usize>(encoded: &[u8], count: usize) -> Vec<u8>
+    where
+        [u8; N]: Default,
+    {
+        meshopt::decode_vertex_buffer::<[u8; N]>(encoded, count)
+            .expect("vertices decode")
+            .concat()
+    }
+    match stride {
+        4 => decode::<4>(encoded, count),
+        8 => decode::<8>(encoded, count),
+        12 => decode::<12>(encoded, count),
+        other => panic!("vertex stride {other}"),
+    }
+}
+
+/// Whether the encoding stores quantized accessors (`KHR_mesh_quantization`).
+pub fn is_quantized(encoding: anthesis_export::Encoding) -> bool {
+    matches!(
+        encoding,
+        anthesis_export::Encoding::Quantized | anthesis_export::Encoding::Meshopt
+    )
 }
 
 pub fn pack_glb(json: &Value, bin: &[u8]) -> Vec<u8> {
