@@ -1,12 +1,12 @@
-//! The export dialog: a .glb path (typed or picked with the native dialog)
-//! and the glTF options; the export runs on a thread named
+//! The export dialog: a .glb or .usda path (typed or picked with the native
+//! dialog) and the options; the export runs on a thread named
 //! `anthesis-export` and reports progress, then the result or the error.
 
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, channel};
 use std::sync::{Arc, Mutex};
 
-use anthesis_export::{Encoding, GlbOptions, Timing, Track, TrackLook};
+use anthesis_export::{Encoding, GlbOptions, Timing, Track, TrackLook, UsdOptions};
 use anthesis_flower::Project;
 use anthesis_sim::Keyframe;
 use eframe::egui;
@@ -133,7 +133,7 @@ impl ExportDialog {
             .name("anthesis-export".into())
             .spawn(move || {
                 let mut last = -1.0_f32;
-                let result = anthesis_export::write_glb(&target, &tracks, &options, &mut |p| {
+                let mut progress = |p: f32| {
                     // Report in steps of 1 %.
                     if p - last >= 0.01 {
                         last = p;
@@ -142,9 +142,20 @@ impl ExportDialog {
                         }
                         (*progress_wake)();
                     }
-                })
-                .map_err(|e| e.to_string())
-                .and_then(|()| {
+                };
+                // The file name picks the format: a USD layer for .usda
+                // or .usd (.usdc gets an error saying how to convert),
+                // else the animated glTF.
+                let written = if anthesis_export::is_usd_path(&target) {
+                    let usd = UsdOptions {
+                        timing: options.timing,
+                        normals: options.normals,
+                    };
+                    anthesis_export::write_usd(&target, &tracks, &usd, &mut progress)
+                } else {
+                    anthesis_export::write_glb(&target, &tracks, &options, &mut progress)
+                };
+                let result = written.map_err(|e| e.to_string()).and_then(|()| {
                     std::fs::metadata(&target)
                         .map(|m| m.len())
                         .map_err(|e| format!("{}: {e}", target.display()))
@@ -221,7 +232,10 @@ impl ExportDialog {
                             .desired_width(300.0),
                     )
                     .labelled_by(label)
-                    .on_hover_text("Where the animated .glb goes (replaced atomically)");
+                    .on_hover_text(
+                        "Where the animation goes (replaced atomically): FILE.glb for an \
+                         animated glTF, FILE.usda for a USD layer (Blender, Houdini)",
+                    );
                     if ui.button("Browse…").clicked() {
                         requests.browse = true;
                     }
@@ -410,5 +424,42 @@ mod tests {
             matches!(&end, ExportState::Failed { message } if message.contains("/no/such/folder")),
             "{end:?}"
         );
+    }
+
+    #[test]
+    fn a_usda_path_writes_a_usd_layer_and_usdc_says_how_to_convert() {
+        let project = anthesis_sim::fixtures::whorl(2, 4, 6, 2);
+        let mut frames = Vec::new();
+        anthesis_sim::run(&project, &anthesis_sim::Selection::All, &mut |_, k| {
+            frames.push(Arc::new(k.clone()))
+        })
+        .expect("simulates");
+        let dir = tempfile::tempdir().expect("temp dir");
+        let usda = dir.path().join("out.usda");
+        let mut dialog = ExportDialog {
+            path: usda.display().to_string(),
+            ..ExportDialog::default()
+        };
+        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        let end = wait_for_the_end(&mut dialog);
+        let ExportState::Done { bytes, .. } = end else {
+            panic!("export failed: {end:?}");
+        };
+        // Pixar's USD reads such layers in anthesis-export's tests.
+        let layer = std::fs::read_to_string(&usda).expect("layer written");
+        assert_eq!(layer.len() as u64, bytes);
+        assert!(layer.starts_with("#usda 1.0"));
+        assert_eq!(layer.matches("def Mesh ").count(), 2, "one mesh per organ");
+        assert!(layer.contains("endTimeCode = 2"));
+
+        let usdc = dir.path().join("out.usdc");
+        dialog.path = usdc.display().to_string();
+        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        let end = wait_for_the_end(&mut dialog);
+        assert!(
+            matches!(&end, ExportState::Failed { message } if message.contains("usdcat")),
+            "{end:?}"
+        );
+        assert!(!usdc.exists());
     }
 }

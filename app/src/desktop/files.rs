@@ -65,8 +65,9 @@ impl Dialogs {
                         .set_file_name("flower.anthesis.toml")
                         .save_file(),
                     DialogPurpose::ExportGlb => dialog
-                        .set_title("Export an animated glTF")
+                        .set_title("Export the animation (.glb or .usda)")
                         .add_filter("glTF binary", &["glb"])
+                        .add_filter("USD layer", &["usda", "usd"])
                         .set_file_name("flower.glb")
                         .save_file(),
                 };
