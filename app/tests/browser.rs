@@ -102,6 +102,14 @@ fn every_encoding_of_the_lily_plays_in_three_js_like_anthesis_renders_it() {
         ]);
         files.push(json!({ "name": encoding, "path": path }));
     }
+    // The compressed lily with normals stays within 2 MB (dense: 5.5 MB).
+    let meshopt_bytes = std::fs::metadata(d("lily-meshopt.glb"))
+        .expect("meshopt file")
+        .len();
+    assert!(
+        meshopt_bytes <= 2_000_000,
+        "meshopt lily: {meshopt_bytes} bytes"
+    );
     let renders = d("anthesis");
     std::fs::create_dir(&renders).expect("mkdir");
     let frames: Vec<String> = KEYFRAMES.iter().map(u32::to_string).collect();

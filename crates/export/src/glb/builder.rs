@@ -157,6 +157,20 @@ pub(super) struct GltfBuilder {
     /// Size of the uncompressed data the compressed views decode into (the
     /// fallback buffer, which holds no bytes in the file).
     fallback_len: usize,
+    /// With meshopt, vertex attributes of one element size (and filter)
+    /// share one buffer view, written by [`GltfBuilder::finish`]: one
+    /// compressed stream instead of one per accessor keeps the JSON and
+    /// the per-stream overhead small (hundreds of morph targets).
+    groups: Vec<Group>,
+}
+
+/// Vertex data waiting to become one shared buffer view.
+struct Group {
+    element_size: usize,
+    exponential: bool,
+    bytes: Vec<u8>,
+    /// The accessors over this data, each at its byte offset.
+    accessors: Vec<usize>,
 }
 
 impl GltfBuilder {
@@ -168,6 +182,7 @@ impl GltfBuilder {
             uses_quantization: false,
             meshopt: encoding == Encoding::Meshopt,
             fallback_len: 0,
+            groups: Vec::new(),
         }
     }
 
@@ -256,6 +271,65 @@ impl GltfBuilder {
         self.accessors.len() - 1
     }
 
+    /// Adds an accessor of `count` `element`s over `bytes`, appended to the
+    /// shared view of its element size (see [`GltfBuilder::groups`]).
+    fn grouped(
+        &mut self,
+        bytes: &[u8],
+        element_size: usize,
+        exponential: bool,
+        element: Element,
+        count: usize,
+    ) -> Value {
+        let at = match self
+            .groups
+            .iter()
+            .position(|g| g.element_size == element_size && g.exponential == exponential)
+        {
+            Some(at) => at,
+            None => {
+                self.groups.push(Group {
+                    element_size,
+                    exponential,
+                    bytes: Vec::new(),
+                    accessors: Vec::new(),
+                });
+                self.groups.len() - 1
+            }
+        };
+        let group = &mut self.groups[at];
+        let mut accessor = element.accessor(None, count);
+        if !group.bytes.is_empty() {
+            accessor["byteOffset"] = group.bytes.len().into();
+        }
+        group.bytes.extend_from_slice(bytes);
+        // The accessor's index is the next one pushed.
+        group.accessors.push(self.accessors.len());
+        accessor
+    }
+
+    /// Writes each group as one buffer view and points its accessors at it.
+    fn write_groups(&mut self) {
+        for group in std::mem::take(&mut self.groups) {
+            let layout = if group.exponential {
+                Layout::ExponentialVec3
+            } else {
+                Layout::Vertices {
+                    element_size: group.element_size,
+                }
+            };
+            let view = self.view_of(
+                &group.bytes,
+                Some(group.element_size),
+                Some(ARRAY_BUFFER),
+                layout,
+            );
+            for accessor in group.accessors {
+                self.accessors[accessor]["bufferView"] = view.into();
+            }
+        }
+    }
+
     /// Stores `bytes` as a new buffer view (see [`GltfBuilder::view`]) and
     /// returns an accessor of `count` `element`s over it.
     fn stored(
@@ -280,9 +354,11 @@ impl GltfBuilder {
         element: Element,
         count: usize,
     ) -> Value {
-        // A padded element needs its stride spelt out; a compressed view
-        // always names it (the decoder's element size).
-        let stride = (padded || self.meshopt).then_some(element_size);
+        if self.meshopt {
+            return self.grouped(bytes, element_size, false, element, count);
+        }
+        // A padded element needs its stride spelt out.
+        let stride = padded.then_some(element_size);
         let layout = Layout::Vertices { element_size };
         let view = self.view_of(bytes, stride, Some(ARRAY_BUFFER), layout);
         element.accessor(Some(view), count)
@@ -293,13 +369,7 @@ impl GltfBuilder {
         let mut accessor = if self.meshopt && !with_min_max {
             // Without min/max (which must match the stored values
             // exactly) the values may go through the lossy filter.
-            let view = self.view_of(
-                &bytes,
-                Some(12),
-                Some(ARRAY_BUFFER),
-                Layout::ExponentialVec3,
-            );
-            VEC3_F32.accessor(Some(view), values.len())
+            self.grouped(&bytes, 12, true, VEC3_F32, values.len())
         } else {
             self.stored_vertices(&bytes, 12, false, VEC3_F32, values.len())
         };
@@ -471,6 +541,7 @@ impl GltfBuilder {
 
     /// Assembles the GLB container: header, JSON chunk, binary chunk.
     pub(super) fn finish(mut self, mut root: Value) -> Result<Vec<u8>, ExportError> {
+        self.write_groups();
         self.pad();
         let mut buffers = vec![json!({ "byteLength": self.bin.len() })];
         if self.fallback_len > 0 {
