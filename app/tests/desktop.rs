@@ -377,7 +377,7 @@ fn the_export_dialog_writes_a_glb_and_reports_it() {
     harness.run();
     harness.get_by_label("File").click();
     harness.run();
-    harness.get_by_label("Export glTF…  (Ctrl+E)").click();
+    harness.get_by_label("Export animation…  (Ctrl+E)").click();
     harness.run();
     assert_eq!(
         harness.state().export_dialog().path,

@@ -1,15 +1,19 @@
-//! The export dialog: a .glb or .usda path (typed or picked with the native
-//! dialog) and the options; the export runs on a thread named
+//! The export dialog: a .glb, .usda or .gif path (typed or picked with the
+//! native dialog) and the options; the export runs on a thread named
 //! `anthesis-export` and reports progress, then the result or the error.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, channel};
 use std::sync::{Arc, Mutex};
 
 use anthesis_export::{Encoding, GlbOptions, Timing, Track, TrackLook, UsdOptions};
 use anthesis_flower::Project;
+use anthesis_render::{OffscreenRenderer, OrganMesh};
 use anthesis_sim::Keyframe;
+use anyhow::Context;
 use eframe::egui;
+
+use crate::animation::{self, AnimationOptions, AnimationTarget};
 
 /// How the dialog asks for the animation's timing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,6 +46,10 @@ pub struct ExportDialog {
     pub max_morph_targets: usize,
     pub normals: bool,
     pub encoding: Encoding,
+    /// How a .gif export looks (size, camera, turn, speed).
+    pub animation: AnimationOptions,
+    /// A .gif shows every `animation_step`-th keyframe (and the last).
+    pub animation_step: u32,
     state: ExportState,
     job: Option<(PathBuf, Receiver<Message>)>,
 }
@@ -58,10 +66,59 @@ impl Default for ExportDialog {
             max_morph_targets: defaults.max_morph_targets,
             normals: defaults.normals,
             encoding: defaults.encoding,
+            animation: AnimationOptions::default(),
+            animation_step: 1,
             state: ExportState::Idle,
             job: None,
         }
     }
+}
+
+/// Whether `path` asks for a rendered animation (`.gif`).
+pub fn is_gif_path(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
+}
+
+/// Renders every `step`-th keyframe of `tracks` (and the last) offscreen
+/// and writes them as a looping GIF (see [`animation::write_animation`]).
+fn write_gif(
+    path: &Path,
+    tracks: &[Track],
+    options: &AnimationOptions,
+    step: u32,
+    progress: &mut dyn FnMut(f32),
+) -> anyhow::Result<()> {
+    let target = AnimationTarget::Gif(path.to_path_buf());
+    animation::check_request(&target, options)?;
+    let count = tracks.iter().map(|t| t.keyframes.len()).max().unwrap_or(0);
+    let Some(last) = count.checked_sub(1) else {
+        anyhow::bail!("there are no keyframes to render yet");
+    };
+    let keyframes = animation::keyframes_every(step, last as u32);
+    let scenes: Vec<Vec<OrganMesh>> = keyframes
+        .iter()
+        .map(|&k| {
+            tracks
+                .iter()
+                .filter_map(|t| {
+                    // A still track (one keyframe) shows it throughout.
+                    let positions = t.keyframes.get(k as usize).or(t.keyframes.last())?;
+                    Some(OrganMesh::from_positions(
+                        positions,
+                        &t.triangles,
+                        t.base_color,
+                    ))
+                })
+                .collect()
+        })
+        .collect();
+    let mut renderer = OffscreenRenderer::new().context("cannot render")?;
+    let frames = scenes.len();
+    animation::write_animation(&mut renderer, &scenes, options, &target, &mut |done| {
+        progress(done as f32 / frames as f32)
+    })?;
+    Ok(())
 }
 
 /// What the user asked the dialog for.
@@ -91,6 +148,65 @@ pub fn tracks(project: &Project, organs: &[usize], keyframes: &[Arc<Keyframe>]) 
 }
 
 impl ExportDialog {
+    /// The .gif rows of the options grid: size, keyframe step, camera and
+    /// turn, speed.
+    fn gif_options_ui(&mut self, ui: &mut egui::Ui) {
+        let a = &mut self.animation;
+        let label = ui.label("GIF size").id;
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::DragValue::new(&mut a.width)
+                    .range(16..=4096)
+                    .suffix(" px"),
+            )
+            .labelled_by(label);
+            ui.label("×");
+            ui.add(
+                egui::DragValue::new(&mut a.height)
+                    .range(16..=4096)
+                    .suffix(" px"),
+            )
+            .labelled_by(label);
+        });
+        ui.end_row();
+        let label = ui.label("Every Nth keyframe").id;
+        ui.add(egui::DragValue::new(&mut self.animation_step).range(1..=1000))
+            .labelled_by(label);
+        ui.end_row();
+        let label = ui.label("Camera azimuth").id;
+        ui.add(
+            egui::DragValue::new(&mut a.azimuth_deg)
+                .range(-360.0..=360.0)
+                .suffix("°"),
+        )
+        .labelled_by(label);
+        ui.end_row();
+        let label = ui.label("Camera elevation").id;
+        ui.add(
+            egui::DragValue::new(&mut a.elevation_deg)
+                .range(-90.0..=90.0)
+                .suffix("°"),
+        )
+        .labelled_by(label);
+        ui.end_row();
+        let label = ui.label("Camera turn").id;
+        ui.add(
+            egui::DragValue::new(&mut a.turn_deg)
+                .range(-720.0..=720.0)
+                .suffix("°"),
+        )
+        .labelled_by(label)
+        .on_hover_text("How far the camera circles the flower over the animation");
+        ui.end_row();
+        let label = ui.label("GIF frames per second").id;
+        ui.add(
+            egui::DragValue::new(&mut a.frames_per_second)
+                .range(1.0..=animation::MAX_GIF_FRAMES_PER_SECOND),
+        )
+        .labelled_by(label);
+        ui.end_row();
+    }
+
     pub fn state(&self) -> &ExportState {
         &self.state
     }
@@ -124,6 +240,8 @@ impl ExportDialog {
             return;
         }
         let options = self.options();
+        let animation = self.animation;
+        let animation_step = self.animation_step;
         let (send, receive) = channel();
         let target = path.clone();
         let wake = Arc::new(wake);
@@ -144,18 +262,23 @@ impl ExportDialog {
                     }
                 };
                 // The file name picks the format: a USD layer for .usda
-                // or .usd (.usdc gets an error saying how to convert),
-                // else the animated glTF.
+                // or .usd (.usdc gets an error saying how to convert), a
+                // rendered animation for .gif, else the animated glTF.
                 let written = if anthesis_export::is_usd_path(&target) {
                     let usd = UsdOptions {
                         timing: options.timing,
                         normals: options.normals,
                     };
                     anthesis_export::write_usd(&target, &tracks, &usd, &mut progress)
+                        .map_err(|e| e.to_string())
+                } else if is_gif_path(&target) {
+                    write_gif(&target, &tracks, &animation, animation_step, &mut progress)
+                        .map_err(|e| format!("{e:#}"))
                 } else {
                     anthesis_export::write_glb(&target, &tracks, &options, &mut progress)
+                        .map_err(|e| e.to_string())
                 };
-                let result = written.map_err(|e| e.to_string()).and_then(|()| {
+                let result = written.and_then(|()| {
                     std::fs::metadata(&target)
                         .map(|m| m.len())
                         .map_err(|e| format!("{}: {e}", target.display()))
@@ -219,7 +342,7 @@ impl ExportDialog {
     ) -> ExportRequests {
         let mut requests = ExportRequests::default();
         let mut open = self.open;
-        egui::Window::new("Export glTF")
+        egui::Window::new("Export the animation")
             .open(&mut open)
             .resizable(false)
             .collapsible(false)
@@ -234,7 +357,8 @@ impl ExportDialog {
                     .labelled_by(label)
                     .on_hover_text(
                         "Where the animation goes (replaced atomically): FILE.glb for an \
-                         animated glTF, FILE.usda for a USD layer (Blender, Houdini)",
+                         animated glTF, FILE.usda for a USD layer (Blender, Houdini), \
+                         FILE.gif for a rendered animation (slides)",
                     );
                     if ui.button("Browse…").clicked() {
                         requests.browse = true;
@@ -307,6 +431,9 @@ impl ExportDialog {
                              the smallest, for three.js with its meshopt decoder",
                         );
                         ui.end_row();
+                        if is_gif_path(Path::new(self.path.trim())) {
+                            self.gif_options_ui(ui);
+                        }
                     });
                 let after_bud = keyframes_ready.saturating_sub(1);
                 ui.label(format!(
@@ -461,5 +588,60 @@ mod tests {
             "{end:?}"
         );
         assert!(!usdc.exists());
+    }
+
+    #[test]
+    fn a_gif_path_renders_the_opening_with_the_dialogs_options() {
+        use image::AnimationDecoder;
+
+        let project = anthesis_sim::fixtures::whorl(2, 4, 6, 4);
+        let mut frames = vec![Arc::new(
+            anthesis_sim::Simulation::new(&project, &anthesis_sim::Selection::All)
+                .expect("sim")
+                .bud(),
+        )];
+        anthesis_sim::run(&project, &anthesis_sim::Selection::All, &mut |_, k| {
+            frames.push(Arc::new(k.clone()))
+        })
+        .expect("simulates");
+        let dir = tempfile::tempdir().expect("temp dir");
+        let gif = dir.path().join("opening.gif");
+        let mut dialog = ExportDialog {
+            path: gif.display().to_string(),
+            animation_step: 2,
+            ..ExportDialog::default()
+        };
+        dialog.animation.width = 80;
+        dialog.animation.height = 60;
+        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        let end = wait_for_the_end(&mut dialog);
+        let ExportState::Done { bytes, .. } = end else {
+            panic!("export failed: {end:?}");
+        };
+        assert_eq!(std::fs::metadata(&gif).expect("gif").len(), bytes);
+        let file = std::io::BufReader::new(std::fs::File::open(&gif).expect("open"));
+        let decoded = image::codecs::gif::GifDecoder::new(file)
+            .expect("a GIF")
+            .into_frames()
+            .collect_frames()
+            .expect("frames");
+        let keyframes = frames.len() as u32 - 1;
+        assert_eq!(
+            decoded.len(),
+            animation::keyframes_every(2, keyframes).len()
+        );
+        assert_eq!(decoded[0].buffer().dimensions(), (80, 60));
+
+        // Too large for a GIF: refused, nothing written.
+        let wide = dir.path().join("wide.gif");
+        dialog.path = wide.display().to_string();
+        dialog.animation.width = 70_000;
+        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        let end = wait_for_the_end(&mut dialog);
+        assert!(
+            matches!(&end, ExportState::Failed { message } if message.contains("65535")),
+            "{end:?}"
+        );
+        assert!(!wide.exists());
     }
 }

@@ -65,9 +65,10 @@ impl Dialogs {
                         .set_file_name("flower.anthesis.toml")
                         .save_file(),
                     DialogPurpose::ExportGlb => dialog
-                        .set_title("Export the animation (.glb or .usda)")
+                        .set_title("Export the animation (.glb, .usda or .gif)")
                         .add_filter("glTF binary", &["glb"])
                         .add_filter("USD layer", &["usda", "usd"])
+                        .add_filter("GIF animation", &["gif"])
                         .set_file_name("flower.glb")
                         .save_file(),
                 };

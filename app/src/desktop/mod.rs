@@ -714,7 +714,7 @@ impl AnthesisApp {
                     self.save_as();
                 }
                 ui.separator();
-                if ui.button("Export glTF…  (Ctrl+E)").clicked() {
+                if ui.button("Export animation…  (Ctrl+E)").clicked() {
                     self.open_export();
                 }
                 ui.separator();
