@@ -364,9 +364,18 @@ impl ExportDialog {
                         requests.browse = true;
                     }
                 });
+                // Only the options of the chosen format: a GIF has its own,
+                // a USD layer has timing and normals.
+                let target = PathBuf::from(self.path.trim());
+                let gif = is_gif_path(&target);
+                let usd = anthesis_export::is_usd_path(&target);
                 egui::Grid::new("export options")
                     .num_columns(2)
                     .show(ui, |ui| {
+                        if gif {
+                            self.gif_options_ui(ui);
+                            return;
+                        }
                         ui.label("Timing");
                         ui.horizontal(|ui| {
                             ui.radio_value(
@@ -403,20 +412,27 @@ impl ExportDialog {
                             }
                         }
                         ui.end_row();
-                        let label = ui
-                            .label("Most morph targets")
-                            .on_hover_text(
-                                "Per mesh; longer runs are resampled to this many keyframes \
-                                 (clients slow down with very many targets)",
+                        if !usd {
+                            let label = ui
+                                .label("Most morph targets")
+                                .on_hover_text(
+                                    "Per mesh; longer runs are resampled to this many keyframes \
+                                     (clients slow down with very many targets)",
+                                )
+                                .id;
+                            ui.add(
+                                egui::DragValue::new(&mut self.max_morph_targets).range(2..=2000),
                             )
-                            .id;
-                        ui.add(egui::DragValue::new(&mut self.max_morph_targets).range(2..=2000))
                             .labelled_by(label);
-                        ui.end_row();
+                            ui.end_row();
+                        }
                         ui.label("Normals");
                         ui.checkbox(&mut self.normals, "store normals")
                             .on_hover_text("Without them the file is about half as large");
                         ui.end_row();
+                        if usd {
+                            return;
+                        }
                         ui.label("Encoding");
                         ui.horizontal(|ui| {
                             for encoding in Encoding::ALL {
@@ -431,9 +447,6 @@ impl ExportDialog {
                              the smallest, for three.js with its meshopt decoder",
                         );
                         ui.end_row();
-                        if is_gif_path(Path::new(self.path.trim())) {
-                            self.gif_options_ui(ui);
-                        }
                     });
                 let after_bud = keyframes_ready.saturating_sub(1);
                 ui.label(format!(
