@@ -222,10 +222,10 @@ pub fn check_relative(path: &Path) -> Result<(), FileError> {
     Ok(())
 }
 
-/// At most `max_chars` characters of `text` for an error message, escaped
-/// (control characters, quotes and backslashes as Rust writes them in a
-/// string) and marked with `…` when cut: what a message may show of a
-/// file's content.
+/// At most `max_chars` characters of `text` for an error message, with
+/// control characters escaped (`\n`, `\u{1b}`: a file cannot move the
+/// terminal's cursor or colour its text) and `…` where it was cut: what a
+/// message may show of a file's content.
 pub fn excerpt(text: &str, max_chars: usize) -> String {
     let mut shown = String::new();
     for (count, c) in text.chars().enumerate() {
@@ -233,7 +233,11 @@ pub fn excerpt(text: &str, max_chars: usize) -> String {
             shown.push('…');
             break;
         }
-        shown.extend(c.escape_debug());
+        if c.is_control() {
+            shown.extend(c.escape_default());
+        } else {
+            shown.push(c);
+        }
     }
     shown
 }

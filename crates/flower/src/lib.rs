@@ -155,10 +155,16 @@ impl Flower {
     }
 }
 
+/// The most keyframes a run may have. The paper uses 100; every keyframe
+/// is kept in memory (positions of every particle) and exported, so a run
+/// of a billion keyframes asked for 40 GB before it started.
+pub const MAX_KEYFRAMES: u32 = 10_000;
+
 /// How a project is simulated.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimulationSettings {
-    /// Number of keyframes after the bud (paper: N = 100).
+    /// Number of keyframes after the bud (paper: N = 100), 1 to
+    /// [`MAX_KEYFRAMES`].
     pub keyframes: u32,
     pub solver: SolverSettings,
     /// Distance a colliding particle is pushed past its neighbour (paper:

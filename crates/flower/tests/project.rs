@@ -837,3 +837,323 @@ fn a_missing_project_file_is_an_io_error() {
         "{error:?}"
     );
 }
+
+/// The project's message when loading `path` fails.
+fn load_message(path: &Path) -> String {
+    match load_project(path) {
+        Ok(_) => panic!("{} loaded but must fail", path.display()),
+        Err(error) => error.to_string(),
+    }
+}
+
+#[test]
+fn paths_outside_the_project_folder_are_refused_without_reading_them() {
+    let (folder, path) = saved_lily();
+    let project_folder = path.parent().expect("folder").to_path_buf();
+    // A secret beside the project folder and links that lead to it.
+    fs::write(folder.path().join("secret.txt"), "root:x:0:0:secret\n").expect("write");
+    std::os::unix::fs::symlink("../../secret.txt", project_folder.join("meshes/link.obj"))
+        .expect("symlink");
+    std::os::unix::fs::symlink(folder.path(), project_folder.join("outside")).expect("symlink");
+    let cases = [
+        (
+            "../../../../etc/passwd",
+            "template \"Petal\": mesh = \"../../../../etc/passwd\" is refused: the path leaves \
+             the project's folder through `..`",
+        ),
+        (
+            "/etc/hostname",
+            "template \"Petal\": mesh = \"/etc/hostname\" is refused: the path is absolute; \
+             files named in a project must be given relative to the project's folder",
+        ),
+        (
+            "meshes/link.obj",
+            "template \"Petal\": mesh = \"meshes/link.obj\" is refused: the path leads outside \
+             the project's folder through a symbolic link; files named in a project must lie \
+             inside its folder",
+        ),
+        (
+            "outside/secret.txt",
+            "template \"Petal\": mesh = \"outside/secret.txt\" is refused: the path leads \
+             outside the project's folder through a symbolic link",
+        ),
+        (
+            "",
+            "template \"Petal\": mesh = \"\" is refused: the path is empty",
+        ),
+    ];
+    for (mesh, expected) in cases {
+        let text = fs::read_to_string(&path).expect("read");
+        let edited = replace_once(
+            text.clone(),
+            "mesh = \"meshes/petal.obj\"",
+            &format!("mesh = \"{mesh}\""),
+        );
+        fs::write(&path, edited).expect("write");
+        let message = load_message(&path);
+        assert!(message.contains(expected), "{mesh}: {message}");
+        assert!(!message.contains("root:x"), "{message}");
+        fs::write(&path, text).expect("restore");
+    }
+    // A map path climbing out is refused the same way, naming its key.
+    edit(&path, |text| {
+        replace_once(
+            text,
+            "e_growth = \"maps/petal-step0-e_growth.png\"",
+            "e_growth = \"maps/../../secret.txt\"",
+        )
+    });
+    assert!(
+        load_message(&path).contains(
+            "template \"Petal\", key 0: e_growth = \"maps/../../secret.txt\" is refused: the path \
+             leaves the project's folder through `..`"
+        ),
+        "{}",
+        load_message(&path)
+    );
+}
+
+#[test]
+fn paths_that_stay_inside_are_fine_through_dot_dot_and_links() {
+    let (_folder, path) = saved_lily();
+    let project_folder = path.parent().expect("folder");
+    std::os::unix::fs::symlink("petal.obj", project_folder.join("meshes/alias.obj"))
+        .expect("symlink");
+    edit(&path, |text| {
+        replace_once(
+            text,
+            "mesh = \"meshes/petal.obj\"",
+            "mesh = \"maps/../meshes/alias.obj\"",
+        )
+    });
+    assert_eq!(load_project(&path).expect("inside"), lily());
+}
+
+#[test]
+fn parse_project_refuses_paths_that_climb_out_too() {
+    let (_folder, path) = saved_lily();
+    let folder = path.parent().expect("folder").to_path_buf();
+    let text =
+        fs::read_to_string(&path)
+            .expect("read")
+            .replacen("meshes/petal.obj", "../petal.obj", 1);
+    let files = |relative: &str| fs::read(folder.join(relative));
+    let error = parse_project(&text, &files).expect_err("climbs out");
+    assert!(
+        error
+            .to_string()
+            .contains("mesh = \"../petal.obj\" is refused: the path leaves the project's folder"),
+        "{error}"
+    );
+}
+
+#[test]
+fn special_files_named_by_a_project_are_not_read() {
+    let (_folder, path) = saved_lily();
+    let folder = path.parent().expect("folder").to_path_buf();
+    let fifo = folder.join("meshes/pipe.obj");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo");
+    assert!(status.success());
+    std::os::unix::fs::symlink("/dev/zero", folder.join("maps/zero.png")).expect("symlink");
+    edit(&path, |text| {
+        replace_once(
+            text,
+            "mesh = \"meshes/petal.obj\"",
+            "mesh = \"meshes/pipe.obj\"",
+        )
+    });
+    let message = load_message(&path);
+    assert!(
+        message.ends_with("meshes/pipe.obj: it is a named pipe (FIFO), not a regular file; only regular files are read"),
+        "{message}"
+    );
+    // A link to /dev/zero leads outside the folder: refused as such, unread.
+    edit(&path, |text| {
+        replace_once(
+            text,
+            "mesh = \"meshes/pipe.obj\"",
+            "mesh = \"meshes/petal.obj\"",
+        )
+    });
+    edit(&path, |text| {
+        replace_once(
+            text,
+            "bend = \"maps/petal-step0-bend.png\"",
+            "bend = \"maps/zero.png\"",
+        )
+    });
+    assert!(
+        load_message(&path).contains("bend = \"maps/zero.png\" is refused: the path leads outside"),
+        "{}",
+        load_message(&path)
+    );
+}
+
+#[test]
+fn a_project_file_that_is_not_a_regular_file_is_not_read() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let fifo = folder.path().join("pipe.anthesis.toml");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo")
+            .success()
+    );
+    assert_eq!(
+        load_message(&fifo),
+        format!(
+            "{}: it is a named pipe (FIFO), not a regular file; only regular files are read",
+            fifo.display()
+        )
+    );
+    assert!(load_message(Path::new("/dev/zero")).contains("character device"));
+}
+
+#[test]
+fn a_project_cut_after_its_header_or_without_organs_is_an_error() {
+    let (_folder, path) = saved_lily();
+    let full = fs::read_to_string(&path).expect("read");
+    let header_end = full.find("[simulation]").expect("a simulation table");
+    fs::write(&path, &full[..header_end]).expect("write");
+    assert_eq!(
+        load_message(&path),
+        format!(
+            "{}: the project defines no templates ([[templates]]); is the file cut short?",
+            path.display()
+        )
+    );
+    let organs_start = full.find("[[organs]]").expect("organs");
+    fs::write(&path, &full[..organs_start]).expect("write");
+    assert_eq!(
+        load_message(&path),
+        format!(
+            "{}: the project has no organs ([[organs]]); is the file cut short?",
+            path.display()
+        )
+    );
+}
+
+#[test]
+fn negative_map_values_and_dg_of_minus_one_are_refused() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "w_growth = 0.2", "w_growth = -5")
+    });
+    assert!(
+        load_message(&path).contains(
+            "template \"Petal\": map key at step 0: the w_growth map holds -5; map values must be \
+             0 or more (for shrinkage, give the template a negative dg)"
+        ),
+        "{}",
+        load_message(&path)
+    );
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| replace_once(text, "dg = 0.003", "dg = -1"));
+    assert!(
+        load_message(&path).contains(
+            "dg must be a number greater than -1 (a growth rate 1 + dg × map value must stay \
+             positive), found -1"
+        ),
+        "{}",
+        load_message(&path)
+    );
+    // Shrinkage itself is allowed.
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        replace_once(text, "dg = 0.003", "dg = -0.002")
+    });
+    assert!(load_project(&path).is_ok());
+}
+
+#[test]
+fn a_base_region_without_three_particles_is_refused_at_save_and_load() {
+    // The lily petal's base row has particles at u = 0, 0.2, ..., 1.
+    let mut project = lily();
+    project.flower.templates[0].base_region.u_min = 0.45;
+    project.flower.templates[0].base_region.u_max = 0.55;
+    let folder = tempfile::tempdir().expect("temp dir");
+    let error = save_project(&project, &folder.path().join("lily.anthesis.toml"))
+        .expect_err("no base particle");
+    assert!(
+        error.to_string().contains(
+            "template \"Petal\": the base region (v <= 0.06, u from 0.45 to 0.55) holds 0 \
+             particle(s) of the mesh; at least 3 are needed to attach the organ"
+        ),
+        "{error}"
+    );
+}
+
+#[test]
+fn the_map_of_the_wrong_size_is_the_one_named() {
+    // The first map read (e_growth) is the odd one out: the others are 8x6.
+    let (_folder, path) = saved_lily();
+    let png = path
+        .parent()
+        .expect("folder")
+        .join("maps/petal-step0-e_growth.png");
+    let bytes = ScalarMap::from_fn(5, 5, |uv| uv.x as f32)
+        .to_png_bytes(BitDepth::Eight)
+        .expect("encode");
+    fs::write(&png, bytes).expect("write");
+    assert_eq!(
+        load_project(&path).expect_err("wrong size"),
+        ProjectError::MapSize {
+            path: png,
+            expected: (8, 6),
+            found: (5, 5),
+        }
+    );
+}
+
+#[test]
+fn long_names_and_control_characters_are_not_echoed() {
+    let (_folder, path) = saved_lily();
+    let long = "x".repeat(5000);
+    edit(&path, |text| {
+        text.replace("\"petal-1\"", &format!("\"{long}\""))
+    });
+    let message = load_message(&path);
+    assert!(message.len() < 300, "{message}");
+    assert!(
+        message.contains("is longer than 100 characters"),
+        "{message}"
+    );
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        text.replace("\"petal-1\"", "\"petal\\u001b[2J\"")
+    });
+    let message = load_message(&path);
+    assert!(message.contains("holds a control character"), "{message}");
+    assert!(!message.contains('\u{1b}'), "{message:?}");
+}
+
+#[test]
+fn a_huge_line_is_not_echoed_whole() {
+    let (_folder, path) = saved_lily();
+    let junk = "y".repeat(100_000);
+    edit(&path, |text| format!("{text}\n{junk} = 1 2\n"));
+    let message = load_message(&path);
+    assert!(message.len() < 1000, "{} characters", message.len());
+}
+
+#[test]
+fn obj_warnings_reach_the_caller_naming_the_file() {
+    let (_folder, path) = saved_lily();
+    let obj = path.parent().expect("folder").join("meshes/petal.obj");
+    let mut text = fs::read_to_string(&obj).expect("read");
+    text.push_str("l 1 2\nl 2 3\n");
+    fs::write(&obj, text).expect("write");
+    let loaded = anthesis_flower::project::load_project_with_warnings(&path).expect("loads");
+    assert_eq!(loaded.project, lily());
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    assert!(
+        loaded.warnings[0].contains("meshes/petal.obj: OBJ line")
+            && loaded.warnings[0].contains("2 line (`l`) statements ignored"),
+        "{:?}",
+        loaded.warnings
+    );
+}

@@ -145,29 +145,11 @@ impl OrganSim {
                 template: template.name.clone(),
                 error,
             })?;
-        if !(template.thickness > 0.0 && template.thickness.is_finite()) {
-            return Err(bad(format!(
-                "thickness must be positive, got {}",
-                template.thickness
-            )));
-        }
-        if !(template.stretch_stiffness > 0.0 && template.bend_stiffness > 0.0) {
-            return Err(bad("stretch and bend stiffness must be positive".into()));
-        }
-        if !template.dg.is_finite() || template.dg <= -1.0 {
-            return Err(bad(format!(
-                "dg must be finite and above -1, got {}",
-                template.dg
-            )));
+        // The same rules as loading and `anthesis info`.
+        if let Some(problem) = template.problem() {
+            return Err(bad(problem));
         }
         let base = template.base_region.particles(&template.mesh);
-        if base.len() < 3 {
-            return Err(bad(format!(
-                "the base region (v <= {}) holds {} particles; at least 3 are needed to attach the organ",
-                template.base_region.v_max,
-                base.len()
-            )));
-        }
         let initial: Vec<DVec3> = template
             .mesh
             .positions

@@ -193,7 +193,7 @@ fn excerpts_are_short_and_escaped() {
         "root:x:0:0…"
     );
     assert_eq!(excerpt("a\u{1b}[31mred\n", 20), "a\\u{1b}[31mred\\n");
-    assert_eq!(excerpt("\"quoted\"", 20), "\\\"quoted\\\"");
+    assert_eq!(excerpt("\"quoted\" \\ ü", 20), "\"quoted\" \\ ü");
 }
 
 #[test]

@@ -1,38 +1,87 @@
 //! The rules every loaded or saved project obeys.
 
 use std::collections::HashSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anthesis_maps::{Blend, MapKind};
 
 use super::error::ProjectError;
-use crate::{Project, Template};
+use crate::{MAX_KEYFRAMES, Project, Template};
 
-/// All raster maps of a template must share one size; the first sets it.
-/// 1x1 maps are constants and fit any size.
+/// All raster maps of a template must share one size. 1x1 maps are
+/// constants and fit any size. The size most maps have is the right one
+/// (the first read wins a tie), so the error names the map that differs.
 #[derive(Default)]
 pub(super) struct SizeCheck {
-    pub(super) expected: Option<(u32, u32)>,
+    maps: Vec<(PathBuf, (u32, u32))>,
 }
 
 impl SizeCheck {
-    pub(super) fn check(&mut self, path: &Path, found: (u32, u32)) -> Result<(), ProjectError> {
-        if found == (1, 1) {
-            return Ok(());
+    /// Notes the size of the raster map at `path`.
+    pub(super) fn add(&mut self, path: &Path, size: (u32, u32)) {
+        if size != (1, 1) {
+            self.maps.push((path.to_path_buf(), size));
         }
-        match self.expected {
-            None => {
-                self.expected = Some(found);
-                Ok(())
-            }
-            Some(expected) if expected == found => Ok(()),
-            Some(expected) => Err(ProjectError::MapSize {
-                path: path.to_path_buf(),
+    }
+
+    /// Fails on the first map whose size is not the one most maps have.
+    pub(super) fn finish(&self) -> Result<(), ProjectError> {
+        let count = |size: (u32, u32)| self.maps.iter().filter(|(_, s)| *s == size).count();
+        let Some(expected) = self
+            .maps
+            .iter()
+            .map(|(_, size)| *size)
+            .reduce(|best, size| {
+                if count(size) > count(best) {
+                    size
+                } else {
+                    best
+                }
+            })
+        else {
+            return Ok(());
+        };
+        match self.maps.iter().find(|(_, size)| *size != expected) {
+            None => Ok(()),
+            Some((path, found)) => Err(ProjectError::MapSize {
+                path: path.clone(),
                 expected,
-                found,
+                found: *found,
             }),
         }
     }
+}
+
+/// The longest template or organ name, in characters.
+pub const MAX_NAME_CHARS: usize = 100;
+
+/// Template and organ names are quoted in messages: they must be short and
+/// hold no control characters.
+pub(super) fn check_names<'a>(
+    templates: impl Iterator<Item = &'a str>,
+    organs: impl Iterator<Item = &'a str>,
+    path: &Path,
+) -> Result<(), ProjectError> {
+    let named = templates
+        .map(|name| ("template", name))
+        .chain(organs.map(|name| ("organ", name)));
+    for (what, name) in named {
+        let problem = if name.chars().count() > MAX_NAME_CHARS {
+            format!("is longer than {MAX_NAME_CHARS} characters")
+        } else if name.chars().any(char::is_control) {
+            "holds a control character".to_string()
+        } else {
+            continue;
+        };
+        return Err(ProjectError::Invalid {
+            path: path.to_path_buf(),
+            message: format!(
+                "the {what} name \"{}\" {problem}",
+                anthesis_files::excerpt(name, 40)
+            ),
+        });
+    }
+    Ok(())
 }
 
 pub(super) fn check_unique<'a>(
@@ -63,6 +112,21 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
         })
     };
     let flower = &project.flower;
+    check_names(
+        flower.templates.iter().map(|t| t.name.as_str()),
+        flower.organs.iter().map(|o| o.name.as_str()),
+        path,
+    )?;
+    if flower.templates.is_empty() {
+        return invalid(
+            "the project defines no templates ([[templates]]); is the file cut short?".to_string(),
+        );
+    }
+    if flower.organs.is_empty() {
+        return invalid(
+            "the project has no organs ([[organs]]); is the file cut short?".to_string(),
+        );
+    }
     check_unique(
         flower.templates.iter().map(|t| t.name.as_str()),
         "template",
@@ -73,6 +137,12 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
     let settings = &project.settings;
     if settings.keyframes == 0 {
         return invalid("simulation: keyframes must be at least 1".to_string());
+    }
+    if settings.keyframes > MAX_KEYFRAMES {
+        return invalid(format!(
+            "simulation: keyframes is {}, more than the limit of {MAX_KEYFRAMES}",
+            settings.keyframes
+        ));
     }
     if !(settings.solver.relative_tolerance > 0.0 && settings.solver.relative_tolerance.is_finite())
     {
@@ -92,7 +162,7 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
     }
 
     for template in &flower.templates {
-        if let Some(message) = template_problem(template) {
+        if let Some(message) = template.problem() {
             return invalid(format!("template \"{}\": {message}", template.name));
         }
     }
@@ -136,11 +206,24 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
     Ok(())
 }
 
-/// What is wrong with a template's numbers, if anything.
-pub(super) fn template_problem(template: &Template) -> Option<String> {
+impl Template {
+    /// What is wrong with this template's numbers, if anything: the one
+    /// set of rules that loading, saving, `anthesis info` and the
+    /// simulation apply. The mesh itself is checked by
+    /// [`anthesis_mesh::validate`].
+    pub fn problem(&self) -> Option<String> {
+        template_problem(self)
+    }
+}
+
+fn template_problem(template: &Template) -> Option<String> {
     let positive = |value: f64| value > 0.0 && value.is_finite();
-    if !template.dg.is_finite() {
-        return Some(format!("dg must be a finite number, found {}", template.dg));
+    if !template.dg.is_finite() || template.dg <= -1.0 {
+        return Some(format!(
+            "dg must be a number greater than -1 (a growth rate 1 + dg × map value must stay \
+             positive), found {}",
+            template.dg
+        ));
     }
     let scales = [
         ("thickness", template.thickness),
@@ -164,6 +247,14 @@ pub(super) fn template_problem(template: &Template) -> Option<String> {
         return Some(format!(
             "base_region u_min ({}) is greater than u_max ({})",
             region.u_min, region.u_max
+        ));
+    }
+    let base = region.particles(&template.mesh).len();
+    if base < 3 {
+        return Some(format!(
+            "the base region (v <= {}, u from {} to {}) holds {base} particle(s) of the mesh; at \
+             least 3 are needed to attach the organ",
+            region.v_max, region.u_min, region.u_max
         ));
     }
     if template.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
@@ -194,6 +285,18 @@ pub(super) fn template_problem(template: &Template) -> Option<String> {
             if let Some(value) = values.iter().find(|value| !value.is_finite()) {
                 return Some(format!(
                     "map key at step {}: the {} map holds {value}; map values must be finite",
+                    key.step,
+                    kind.name()
+                ));
+            }
+            // A negative growth value shrinks an organ the user meant to
+            // grow (e_growth = -5 halved a petal in 5 keyframes); shrinkage
+            // is a negative dg. Values above 1 (constants only: a PNG holds
+            // 0 to 1) scale a rate or stiffness up.
+            if let Some(value) = values.iter().find(|value| **value < 0.0) {
+                return Some(format!(
+                    "map key at step {}: the {} map holds {value}; map values must be 0 or \
+                     more (for shrinkage, give the template a negative dg)",
                     key.step,
                     kind.name()
                 ));

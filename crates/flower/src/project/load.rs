@@ -1,27 +1,68 @@
 //! Loading: the TOML text and the files it names into a [`Project`].
 
+use std::cell::RefCell;
 use std::collections::HashSet;
-use std::io;
 use std::path::{Path, PathBuf};
+
+use anthesis_files::FileError;
 
 use anthesis_maps::{Blend, DirectionMap, GrowthMaps, KeyedMaps, MapKey, MapKind, ScalarMap};
 use anthesis_mesh::{Mesh, MeshError};
 use glam::{DVec2, DVec3};
 
-use super::check::{SizeCheck, check_project, check_unique};
-use super::error::{ProjectError, io_error, map_error};
+use super::check::{SizeCheck, check_names, check_project, check_unique};
+use super::error::{ProjectError, map_error};
 use super::schema::{DirectionEntry, ProjectFile, ScalarEntry, TemplateFile};
 use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::{
     BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings, Template,
 };
 
+/// The largest project file read, in bytes; a project file names its
+/// meshes and maps, so even a garden of templates is a few kilobytes.
+pub const MAX_PROJECT_BYTES: u64 = 16 << 20;
+
+/// The longest path a project may name, in characters.
+const MAX_PATH_CHARS: usize = 1024;
+
+/// How much of a file's content a message quotes.
+const QUOTED_CHARS: usize = 60;
+
+/// What kind of file a project names, for its size limit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum FileKind {
+    Mesh,
+    Map,
+}
+
+impl FileKind {
+    pub(super) fn limit(self) -> u64 {
+        match self {
+            FileKind::Mesh => anthesis_mesh::obj::MAX_OBJ_BYTES,
+            FileKind::Map => anthesis_maps::MAX_PNG_BYTES,
+        }
+    }
+
+    pub(super) fn what(self) -> &'static str {
+        match self {
+            FileKind::Mesh => "an OBJ mesh",
+            FileKind::Map => "a PNG map",
+        }
+    }
+}
+
+/// Reads a file named in a project, given the path as written there.
+pub(super) type ReadFile<'a> = &'a dyn Fn(&str, FileKind) -> Result<Vec<u8>, FileError>;
+
 pub(super) struct Loader<'a> {
     /// The project file, for messages.
     pub(super) project_path: &'a Path,
     /// What relative paths are shown relative to in messages.
     pub(super) folder: &'a Path,
-    pub(super) files: &'a dyn Fn(&str) -> Result<Vec<u8>, io::Error>,
+    pub(super) files: ReadFile<'a>,
+    /// Warnings met on the way (e.g. OBJ statements read past), each
+    /// naming its file.
+    pub(super) warnings: RefCell<Vec<String>>,
 }
 
 impl Loader<'_> {
@@ -39,7 +80,7 @@ impl Loader<'_> {
     fn syntax(&self, error: &toml::de::Error) -> ProjectError {
         ProjectError::Syntax {
             path: self.project_path.to_path_buf(),
-            message: error.to_string().trim_end().to_string(),
+            message: shorten_lines(error.to_string().trim_end()),
         }
     }
 
@@ -52,6 +93,12 @@ impl Loader<'_> {
 
     fn project(&self, file: ProjectFile) -> Result<Project, ProjectError> {
         let path = self.project_path;
+        // Names are quoted in the messages below: check them first.
+        check_names(
+            file.templates.iter().map(|t| t.name.as_str()),
+            file.organs.iter().map(|o| o.name.as_str()),
+            path,
+        )?;
         check_unique(
             file.templates.iter().map(|t| t.name.as_str()),
             "template",
@@ -130,24 +177,32 @@ impl Loader<'_> {
                 key.step
             )));
         }
-        let mesh = self.mesh(&file.mesh)?;
+        let mesh = self.mesh(&file.mesh, name)?;
         let mut size = SizeCheck::default();
         let mut keys = Vec::with_capacity(file.keys.len());
         for mut key in file.keys {
             let mut maps = GrowthMaps::uniform();
+            let step = key.step;
+            let entry_name = |map: &str| format!("template \"{name}\", key {step}: {map}");
             for kind in MapKind::ALL {
                 if let Some(entry) = key.scalar_mut(kind).take() {
-                    *maps.scalar_mut(kind) = self.scalar_map(entry, &mut size)?;
+                    *maps.scalar_mut(kind) =
+                        self.scalar_map(entry, &entry_name(kind.name()), &mut size)?;
                 }
             }
             if let Some(entry) = key.direction.take() {
-                maps.direction = self.direction_map(entry, &mut size)?;
+                maps.direction = self.direction_map(
+                    entry,
+                    &entry_name(anthesis_maps::DIRECTION_MAP_NAME),
+                    &mut size,
+                )?;
             }
             keys.push(MapKey {
                 step: key.step,
                 maps,
             });
         }
+        size.finish()?;
         let maps = KeyedMaps::new(keys, Blend::from(&file.blend))
             .map_err(|error| self.invalid(format!("template \"{name}\": {error}")))?;
         Ok(Template {
@@ -168,36 +223,76 @@ impl Loader<'_> {
         })
     }
 
-    /// The bytes of a file named in the project, and the path to show for it.
-    fn read(&self, relative: &str) -> Result<(Vec<u8>, PathBuf), ProjectError> {
+    /// The bytes of a file named in the project, and the path to show for
+    /// it. `entry` says where the project names it, e.g. `template
+    /// "petal": mesh`, for a path that is refused.
+    fn read(
+        &self,
+        relative: &str,
+        kind: FileKind,
+        entry: &str,
+    ) -> Result<(Vec<u8>, PathBuf), ProjectError> {
+        let refused = |reason: String| {
+            self.invalid(format!(
+                "{entry} = \"{}\" is refused: {reason}",
+                anthesis_files::excerpt(relative, QUOTED_CHARS)
+            ))
+        };
+        if relative.chars().count() > MAX_PATH_CHARS {
+            return Err(refused(format!(
+                "the path is longer than {MAX_PATH_CHARS} characters"
+            )));
+        }
         let path = self.folder.join(relative);
-        match (self.files)(relative) {
+        match (self.files)(relative, kind) {
             Ok(bytes) => Ok((bytes, path)),
-            Err(error) => Err(io_error(&path, "cannot read", &error)),
+            Err(
+                error @ (FileError::EmptyPath
+                | FileError::Absolute
+                | FileError::ClimbsOut
+                | FileError::LinksOut),
+            ) => Err(refused(error.to_string())),
+            Err(error) => Err(ProjectError::Io {
+                path,
+                message: error.to_string(),
+            }),
         }
     }
 
-    fn mesh(&self, relative: &str) -> Result<Mesh, ProjectError> {
-        let (bytes, path) = self.read(relative)?;
+    fn mesh(&self, relative: &str, template: &str) -> Result<Mesh, ProjectError> {
+        let (bytes, path) = self.read(
+            relative,
+            FileKind::Mesh,
+            &format!("template \"{template}\": mesh"),
+        )?;
         let parsed = match String::from_utf8(bytes) {
-            Ok(text) => anthesis_mesh::parse_obj(&text),
+            Ok(text) => anthesis_mesh::parse_obj_file(&text),
             Err(_) => Err(MeshError::Io("the file is not UTF-8 text".to_string())),
         };
-        parsed.map_err(|error| ProjectError::Mesh { path, error })
+        let file = parsed.map_err(|error| ProjectError::Mesh {
+            path: path.clone(),
+            error,
+        })?;
+        let mut warnings = self.warnings.borrow_mut();
+        for warning in file.warnings {
+            warnings.push(format!("{}: {warning}", path.display()));
+        }
+        Ok(file.mesh)
     }
 
     fn scalar_map(
         &self,
         entry: ScalarEntry,
+        entry_name: &str,
         size: &mut SizeCheck,
     ) -> Result<ScalarMap, ProjectError> {
         match entry {
             ScalarEntry::Constant(value) => Ok(ScalarMap::constant(value)),
             ScalarEntry::File(relative) => {
-                let (bytes, path) = self.read(&relative)?;
+                let (bytes, path) = self.read(&relative, FileKind::Map, entry_name)?;
                 let map =
                     ScalarMap::from_png_bytes(&bytes).map_err(|error| map_error(&path, error))?;
-                size.check(&path, map.size())?;
+                size.add(&path, map.size());
                 Ok(map)
             }
         }
@@ -206,6 +301,7 @@ impl Loader<'_> {
     fn direction_map(
         &self,
         entry: DirectionEntry,
+        entry_name: &str,
         size: &mut SizeCheck,
     ) -> Result<DirectionMap, ProjectError> {
         match entry {
@@ -214,14 +310,31 @@ impl Loader<'_> {
                 f64::from(v),
             ))),
             DirectionEntry::File(relative) => {
-                let (bytes, path) = self.read(&relative)?;
+                let (bytes, path) = self.read(&relative, FileKind::Map, entry_name)?;
                 let map = DirectionMap::from_png_bytes(&bytes)
                     .map_err(|error| map_error(&path, error))?;
-                size.check(&path, map.size())?;
+                size.add(&path, map.size());
                 Ok(map)
             }
         }
     }
+}
+
+/// A TOML reader's message with each line cut to 120 characters and its
+/// control characters escaped: it quotes the offending line of the file,
+/// which may be anything.
+fn shorten_lines(message: &str) -> String {
+    message
+        .lines()
+        .map(|line| {
+            if line.chars().count() > 120 || line.chars().any(char::is_control) {
+                anthesis_files::excerpt(line, 120)
+            } else {
+                line.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// Checks `format` and `version` in the parsed TOML table.
@@ -231,7 +344,10 @@ pub(super) fn check_header(table: &toml::Table, path: &Path) -> Result<(), Proje
         found => {
             return Err(ProjectError::WrongFormat {
                 path: path.to_path_buf(),
-                found: found.map_or_else(|| "missing".to_string(), |value| value.to_string()),
+                found: found.map_or_else(
+                    || "missing".to_string(),
+                    |value| anthesis_files::excerpt(&value.to_string(), QUOTED_CHARS),
+                ),
             });
         }
     }
@@ -252,7 +368,8 @@ pub(super) fn check_header(table: &toml::Table, path: &Path) -> Result<(), Proje
             "format version {version} does not exist; versions start at 1"
         ))),
         Some(other) => Err(invalid(format!(
-            "`version` must be a whole number, found {other}"
+            "`version` must be a whole number, found {}",
+            anthesis_files::excerpt(&other.to_string(), QUOTED_CHARS)
         ))),
         None => Err(invalid(format!(
             "the file has no `version`; write `version = {FORMAT_VERSION}` after `format`"

@@ -96,15 +96,16 @@ mod load;
 mod save;
 mod schema;
 
-use std::fs;
 use std::io;
 use std::path::Path;
 
 use crate::Project;
 
+use anthesis_files::FileError;
+pub use check::MAX_NAME_CHARS;
 pub use error::ProjectError;
-use error::io_error;
-use load::Loader;
+pub use load::MAX_PROJECT_BYTES;
+use load::{FileKind, Loader};
 use save::{plan_save, write_file};
 
 /// The value of the `format` field of every project file.
@@ -122,37 +123,77 @@ pub const MAP_FOLDER: &str = "maps";
 /// What [`parse_project`] calls the project text in its errors.
 pub const UNNAMED_PROJECT: &str = "(project text)";
 
+/// A loaded project and the warnings met loading it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedProject {
+    pub project: Project,
+    /// Things read past, each naming its file (e.g. an OBJ's loose edges).
+    pub warnings: Vec<String>,
+}
+
 /// Reads the project file at `path` and the meshes and PNG maps it names
-/// (paths relative to the project file's folder).
+/// (see [`load_project_with_warnings`]; warnings are dropped).
 pub fn load_project(path: &Path) -> Result<Project, ProjectError> {
-    let bytes = fs::read(path).map_err(|error| io_error(path, "cannot read", &error))?;
-    let text = String::from_utf8(bytes).map_err(|_| ProjectError::Syntax {
-        path: path.to_path_buf(),
-        message: "the file is not UTF-8 text".to_string(),
-    })?;
+    load_project_with_warnings(path).map(|loaded| loaded.project)
+}
+
+/// Reads the project file at `path` and the meshes and PNG maps it names,
+/// as a file from a stranger: only regular files within their size limits
+/// ([`MAX_PROJECT_BYTES`], `anthesis_mesh::obj::MAX_OBJ_BYTES`,
+/// `anthesis_maps::MAX_PNG_BYTES`), and only files inside the project's
+/// folder: a path that is absolute, climbs out with `..` or leads out
+/// through a symbolic link is refused, naming the entry and why.
+pub fn load_project_with_warnings(path: &Path) -> Result<LoadedProject, ProjectError> {
+    let text = anthesis_files::read_regular_text(path, MAX_PROJECT_BYTES, "a project file")
+        .map_err(|error| ProjectError::Io {
+            path: path.to_path_buf(),
+            message: error.to_string(),
+        })?;
     let folder = path.parent().unwrap_or(Path::new(""));
-    let read = |relative: &str| fs::read(folder.join(relative));
+    let read = |relative: &str, kind: FileKind| {
+        let resolved = anthesis_files::resolve_inside(folder, relative)?;
+        anthesis_files::read_regular(&resolved, kind.limit(), kind.what())
+    };
     let loader = Loader {
         project_path: path,
         folder,
         files: &read,
+        warnings: Default::default(),
     };
-    loader.load(&text)
+    let project = loader.load(&text)?;
+    Ok(LoadedProject {
+        project,
+        warnings: loader.warnings.into_inner(),
+    })
 }
 
 /// Reads a project from its TOML text; `files` returns the bytes of a mesh
 /// or map given its path as written in the file. For projects that are not
 /// on disk, e.g. embedded in the binary with `include_bytes!`. Errors call
 /// the project file [`UNNAMED_PROJECT`] and other files by their path as
-/// written.
+/// written. Paths follow the rules of [`load_project_with_warnings`] that
+/// need no disk (relative, not climbing out), and so do the size limits.
 pub fn parse_project(
     text: &str,
     files: &dyn Fn(&str) -> Result<Vec<u8>, io::Error>,
 ) -> Result<Project, ProjectError> {
+    let read = |relative: &str, kind: FileKind| {
+        anthesis_files::check_relative(Path::new(relative))?;
+        let bytes = files(relative).map_err(FileError::Io)?;
+        if bytes.len() as u64 > kind.limit() {
+            return Err(FileError::TooLarge {
+                size: bytes.len() as u64,
+                limit: kind.limit(),
+                what: kind.what(),
+            });
+        }
+        Ok(bytes)
+    };
     let loader = Loader {
         project_path: Path::new(UNNAMED_PROJECT),
         folder: Path::new(""),
-        files,
+        files: &read,
+        warnings: Default::default(),
     };
     loader.load(text)
 }

@@ -108,7 +108,7 @@ pub(super) fn template_file(
             } else {
                 let relative = map_relative(kind.name());
                 let path = folder.join(&relative);
-                size.check(&path, map.size())?;
+                size.add(&path, map.size());
                 if let Some(value) = map.values().iter().find(|v| !(0.0..=1.0).contains(*v)) {
                     return Err(out_of_range(&path, kind.name(), *value, "0 to 1"));
                 }
@@ -126,7 +126,7 @@ pub(super) fn template_file(
         } else {
             let relative = map_relative(anthesis_maps::DIRECTION_MAP_NAME);
             let path = folder.join(&relative);
-            size.check(&path, direction.size())?;
+            size.add(&path, direction.size());
             let components = direction.values().iter().flatten();
             if let Some(value) = components.into_iter().find(|v| !(-1.0..=1.0).contains(*v)) {
                 return Err(out_of_range(&path, "direction", *value, "-1 to 1"));
@@ -140,6 +140,7 @@ pub(super) fn template_file(
         key_file.direction = Some(entry);
         keys.push(key_file);
     }
+    size.finish()?;
 
     let region = &template.base_region;
     Ok(TemplateFile {
