@@ -1,6 +1,5 @@
 //! [`ProjectError`]: what can go wrong reading or writing a project.
 
-use std::io;
 use std::path::{Path, PathBuf};
 
 use anthesis_maps::MapError;
@@ -79,13 +78,6 @@ pub enum ProjectError {
     /// A value out of its range, e.g. a thickness of 0 or no map keys.
     #[error("{}: {message}", path.display())]
     Invalid { path: PathBuf, message: String },
-}
-
-pub(super) fn io_error(path: &Path, doing: &str, error: &io::Error) -> ProjectError {
-    ProjectError::Io {
-        path: path.to_path_buf(),
-        message: format!("{doing}: {error}"),
-    }
 }
 
 pub(super) fn map_error(path: &Path, error: MapError) -> ProjectError {
