@@ -10,6 +10,11 @@
 //!
 //! - A symbolic link at the destination is followed: the file it points to
 //!   is replaced and the link stays a link.
+//! - What is not ours to replace is never replaced: a character device or
+//!   a named pipe (`/dev/stdout`, `/dev/null`, a terminal, `mkfifo`) is
+//!   written to directly, as a shell redirection would; a block device or
+//!   a socket is refused ([`WriteError::NotAFile`]). Renaming over them
+//!   would put a plain file in their place (as root, `/dev/null` itself).
 //! - A replaced file keeps its permissions; a new file gets the usual
 //!   permissions for the user (`0o666` less the umask on Unix), as if
 //!   created with [`std::fs::File::create`].
@@ -29,6 +34,8 @@ pub enum WriteError {
     NotAFolder { path: PathBuf, folder: PathBuf },
     #[error("cannot write {}: a folder of that name exists", .path.display())]
     IsAFolder { path: PathBuf },
+    #[error("cannot write {}: it is {what}, not a file, and is left as it is", .path.display())]
+    NotAFile { path: PathBuf, what: &'static str },
     #[error("cannot write {}: the location is not writable ({source})", .path.display())]
     NotWritable { path: PathBuf, source: io::Error },
     #[error("cannot write {}: the disk is full or the quota is exceeded ({source})", .path.display())]
@@ -44,6 +51,7 @@ impl WriteError {
             WriteError::MissingFolder { path, .. }
             | WriteError::NotAFolder { path, .. }
             | WriteError::IsAFolder { path }
+            | WriteError::NotAFile { path, .. }
             | WriteError::NotWritable { path, .. }
             | WriteError::DiskFull { path, .. }
             | WriteError::Io { path, .. } => path,
@@ -88,6 +96,9 @@ impl PartialEq for WriteError {
                 a == b && f == g
             }
             (E::IsAFolder { path: a }, E::IsAFolder { path: b }) => a == b,
+            (E::NotAFile { path: a, what: w }, E::NotAFile { path: b, what: v }) => {
+                a == b && w == v
+            }
             (E::NotWritable { path: a, source: s }, E::NotWritable { path: b, source: t })
             | (E::DiskFull { path: a, source: s }, E::DiskFull { path: b, source: t })
             | (E::Io { path: a, source: s }, E::Io { path: b, source: t }) => {
@@ -110,9 +121,13 @@ pub fn folder_of(path: &Path) -> PathBuf {
 /// the complete new one, never a partial file. The folder must exist (see
 /// [`create_folder`]).
 ///
+/// A character device or named pipe at `path` is written to directly and
+/// a block device or socket refused (see the module documentation).
+///
 /// Errors name the path: [`WriteError::MissingFolder`],
 /// [`WriteError::NotAFolder`] (a parent is a file),
-/// [`WriteError::IsAFolder`], [`WriteError::NotWritable`] (permissions or
+/// [`WriteError::IsAFolder`], [`WriteError::NotAFile`] (a block device or
+/// a socket), [`WriteError::NotWritable`] (permissions or
 /// a read-only file system), [`WriteError::DiskFull`], or
 /// [`WriteError::Io`] for anything else.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
@@ -131,6 +146,9 @@ pub fn write_atomic_with(
 ) -> Result<(), WriteError> {
     let path = resolve_symlink(path);
     check_destination(&path)?;
+    if is_stream(&path) {
+        return write_stream(&path, write);
+    }
     let folder = folder_of(&path);
     let mut temp = temp_file_beside(&path, &folder)?;
 
@@ -179,7 +197,64 @@ pub fn check_destination(path: &Path) -> Result<(), WriteError> {
             path: path.to_path_buf(),
         });
     }
+    if let Some(what) = refused_kind(path) {
+        return Err(WriteError::NotAFile {
+            path: path.to_path_buf(),
+            what,
+        });
+    }
     Ok(())
+}
+
+/// Whether `path` (links followed) is a character device or a named pipe,
+/// which are written to rather than replaced.
+#[cfg(unix)]
+fn is_stream(path: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    fs::metadata(path).is_ok_and(|meta| {
+        let kind = meta.file_type();
+        kind.is_char_device() || kind.is_fifo()
+    })
+}
+
+#[cfg(not(unix))]
+fn is_stream(_path: &Path) -> bool {
+    false
+}
+
+/// What `path` (links followed) is when it may be neither replaced nor
+/// written to: a block device or a socket.
+#[cfg(unix)]
+fn refused_kind(path: &Path) -> Option<&'static str> {
+    use std::os::unix::fs::FileTypeExt;
+    let kind = fs::metadata(path).ok()?.file_type();
+    if kind.is_block_device() {
+        Some("a block device (a disk)")
+    } else if kind.is_socket() {
+        Some("a socket")
+    } else {
+        None
+    }
+}
+
+#[cfg(not(unix))]
+fn refused_kind(_path: &Path) -> Option<&'static str> {
+    None
+}
+
+/// Writes to the device or pipe at `path` in place. Opening a pipe waits
+/// for a reader, as a shell redirection does.
+fn write_stream(
+    path: &Path,
+    write: impl FnOnce(&mut File) -> io::Result<()>,
+) -> Result<(), WriteError> {
+    let mut file = File::options()
+        .write(true)
+        .open(path)
+        .map_err(|error| WriteError::from_io(path.to_path_buf(), error))?;
+    write(&mut file)
+        .and_then(|()| file.flush())
+        .map_err(|error| WriteError::from_io(path.to_path_buf(), error))
 }
 
 /// Creates `folder` and its missing parents, as [`fs::create_dir_all`], with

@@ -281,4 +281,96 @@ mod unix {
         write_atomic(&link, b"new").expect("write");
         assert_eq!(fs::read(&link).expect("read"), b"new");
     }
+
+    /// Makes a device node or named pipe at `path` with the system's
+    /// `mknod` (`kind` is `c`, `b` or `p`; devices need root, as CI runs).
+    fn mknod(path: &Path, args: &[&str]) {
+        let status = std::process::Command::new("mknod")
+            .arg(path)
+            .args(args)
+            .status()
+            .expect("mknod runs");
+        assert!(status.success(), "mknod {} {args:?}", path.display());
+    }
+
+    fn file_type(path: &Path) -> fs::FileType {
+        fs::symlink_metadata(path).expect("meta").file_type()
+    }
+
+    #[test]
+    fn a_character_device_is_written_to_and_stays_a_device() {
+        use std::os::unix::fs::FileTypeExt;
+        // The null device (1, 3) made in a temporary folder, as /dev/null.
+        let dir = tempfile::tempdir().expect("tempdir");
+        let device = dir.path().join("null");
+        mknod(&device, &["c", "1", "3"]);
+        write_atomic(&device, b"statistics").expect("written to the device");
+        assert!(file_type(&device).is_char_device(), "not replaced");
+        // Through a link, as /dev/stdout is one: the link stays a link and
+        // the device a device.
+        let link = dir.path().join("stats.json");
+        symlink(&device, &link).expect("symlink");
+        write_atomic(&link, b"statistics").expect("written through the link");
+        assert!(file_type(&link).is_symlink());
+        assert!(file_type(&device).is_char_device());
+        assert!(leftover_temp_files(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn a_named_pipe_is_written_to_and_stays_a_pipe() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = tempfile::tempdir().expect("tempdir");
+        let pipe = dir.path().join("pipe");
+        mknod(&pipe, &["p"]);
+        let reader = {
+            let pipe = pipe.clone();
+            std::thread::Builder::new()
+                .name("pipe reader".into())
+                .spawn(move || fs::read(&pipe).expect("read the pipe"))
+                .expect("spawn")
+        };
+        write_atomic(&pipe, b"through the pipe").expect("written to the pipe");
+        assert_eq!(reader.join().expect("reader"), b"through the pipe");
+        assert!(file_type(&pipe).is_fifo(), "not replaced");
+        assert!(leftover_temp_files(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn a_block_device_or_socket_is_refused_and_left_alone() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = tempfile::tempdir().expect("tempdir");
+        // A loop device node (7, 0): refused before it is opened.
+        let disk = dir.path().join("disk");
+        mknod(&disk, &["b", "7", "0"]);
+        let error = write_atomic(&disk, b"x").expect_err("a disk is refused");
+        assert_eq!(
+            error,
+            WriteError::NotAFile {
+                path: disk.clone(),
+                what: "a block device (a disk)"
+            }
+        );
+        assert_eq!(
+            error.to_string(),
+            format!(
+                "cannot write {}: it is a block device (a disk), not a file, and is left as it is",
+                disk.display()
+            )
+        );
+        assert!(file_type(&disk).is_block_device());
+        assert_eq!(check_destination(&disk), Err(error));
+
+        let socket_path = dir.path().join("socket");
+        let _socket = std::os::unix::net::UnixListener::bind(&socket_path).expect("bind a socket");
+        let error = write_atomic(&socket_path, b"x").expect_err("a socket is refused");
+        assert!(matches!(
+            error,
+            WriteError::NotAFile {
+                what: "a socket",
+                ..
+            }
+        ));
+        assert!(file_type(&socket_path).is_socket());
+        assert!(leftover_temp_files(dir.path()).is_empty());
+    }
 }
