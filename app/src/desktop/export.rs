@@ -74,6 +74,21 @@ impl Default for ExportDialog {
     }
 }
 
+/// A labelled row editing an angle in degrees within `[-limit, limit]`;
+/// returns the editor's response.
+fn angle_row(ui: &mut egui::Ui, name: &str, degrees: &mut f64, limit: f64) -> egui::Response {
+    let label = ui.label(name).id;
+    let response = ui
+        .add(
+            egui::DragValue::new(degrees)
+                .range(-limit..=limit)
+                .suffix("°"),
+        )
+        .labelled_by(label);
+    ui.end_row();
+    response
+}
+
 /// Whether `path` asks for a rendered animation (`.gif`).
 pub fn is_gif_path(path: &Path) -> bool {
     path.extension()
@@ -173,31 +188,10 @@ impl ExportDialog {
         ui.add(egui::DragValue::new(&mut self.animation_step).range(1..=1000))
             .labelled_by(label);
         ui.end_row();
-        let label = ui.label("Camera azimuth").id;
-        ui.add(
-            egui::DragValue::new(&mut a.azimuth_deg)
-                .range(-360.0..=360.0)
-                .suffix("°"),
-        )
-        .labelled_by(label);
-        ui.end_row();
-        let label = ui.label("Camera elevation").id;
-        ui.add(
-            egui::DragValue::new(&mut a.elevation_deg)
-                .range(-90.0..=90.0)
-                .suffix("°"),
-        )
-        .labelled_by(label);
-        ui.end_row();
-        let label = ui.label("Camera turn").id;
-        ui.add(
-            egui::DragValue::new(&mut a.turn_deg)
-                .range(-720.0..=720.0)
-                .suffix("°"),
-        )
-        .labelled_by(label)
-        .on_hover_text("How far the camera circles the flower over the animation");
-        ui.end_row();
+        angle_row(ui, "Camera azimuth", &mut a.azimuth_deg, 360.0);
+        angle_row(ui, "Camera elevation", &mut a.elevation_deg, 90.0);
+        angle_row(ui, "Camera turn", &mut a.turn_deg, 720.0)
+            .on_hover_text("How far the camera circles the flower over the animation");
         let label = ui.label("GIF frames per second").id;
         ui.add(
             egui::DragValue::new(&mut a.frames_per_second)
