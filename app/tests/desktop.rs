@@ -16,6 +16,8 @@ use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
+mod common;
+
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {
     let mut project = anthesis_sim::fixtures::whorl(6, 8, 14, 20);
@@ -768,4 +770,144 @@ fn closing_the_window_with_unsaved_changes_asks_first() {
         harness.state().document().is_dirty(),
         "the work is still there"
     );
+}
+
+/// The colour of `picture` around `(x, y)`: the mean of the 3x3 pixels
+/// there.
+fn colour_around(picture: &image::RgbaImage, x: f64, y: f64) -> [f64; 3] {
+    let (x, y) = (x.round() as i64, y.round() as i64);
+    let mut sum = [0.0; 3];
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let p = picture.get_pixel((x + dx) as u32, (y + dy) as u32);
+            for (s, c) in sum.iter_mut().zip(p.0) {
+                *s += f64::from(c) / 9.0;
+            }
+        }
+    }
+    sum
+}
+
+/// Where `point` lands in an image of `width x height` pixels.
+fn pixel_of(
+    camera: &anthesis_render::Camera,
+    point: glam::DVec3,
+    width: f64,
+    height: f64,
+) -> (f64, f64) {
+    let clip = camera.view_projection((width / height) as f32) * point.as_vec3().extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    (
+        (f64::from(ndc.x) + 1.0) * 0.5 * width,
+        (1.0 - f64::from(ndc.y)) * 0.5 * height,
+    )
+}
+
+#[test]
+fn the_window_and_anthesis_render_show_an_organ_in_the_same_colour() {
+    // Project colours are linear; both paths hand them to the renderer,
+    // which encodes once. A saturated orange, where a missing or a double
+    // conversion shows most.
+    let mut project = anthesis_sim::fixtures::whorl(2, 8, 14, 4);
+    project.flower.templates[0].color = [0.8, 0.3, 0.05, 1.0];
+    let (azimuth_deg, elevation_deg) = (project.flower.organs[0].placement.azimuth_deg, 20.0);
+    let bud = anthesis_sim::Simulation::new(&project, &Selection::All)
+        .expect("simulation")
+        .bud();
+    let all: Vec<glam::DVec3> = bud.positions_in_world.iter().flatten().copied().collect();
+    let bounds = all
+        .iter()
+        .fold((all[0], all[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    // The middle of organ 0 (the window highlights the selected organ, so
+    // organ 1 is selected; from organ 0's azimuth it is behind organ 0).
+    let template = &project.flower.templates[0];
+    let middle = (0..template.mesh.vertex_count())
+        .min_by(|&a, &b| {
+            let d = |i: usize| template.mesh.uvs[i].distance(glam::DVec2::new(0.5, 0.5));
+            d(a).total_cmp(&d(b))
+        })
+        .expect("vertices");
+    let point = bud.positions_in_world[0][middle];
+
+    // The command line.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("orange.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let out = common::anthesis(&[
+        "render",
+        path.to_str().expect("utf-8"),
+        "--frames",
+        "0",
+        "--out",
+        dir.path().to_str().expect("utf-8"),
+        "--size",
+        "320x240",
+        "--azimuth",
+        &azimuth_deg.to_string(),
+        "--elevation",
+        &elevation_deg.to_string(),
+    ]);
+    assert!(out.status.success(), "{}", common::text(&out.stderr));
+    let picture = image::open(dir.path().join("frame-000.png"))
+        .expect("the picture")
+        .to_rgba8();
+    let camera = anthesis_render::Camera::framing(bounds.0, bounds.1, azimuth_deg, elevation_deg);
+    let (x, y) = pixel_of(&camera, point, 320.0, 240.0);
+    let from_command_line = colour_around(&picture, x, y);
+
+    // The window, showing the same bud from the same direction.
+    let mut harness = harness(project);
+    harness.run();
+    let app = harness.state_mut();
+    app.select_organ(1);
+    let run = app.session().run();
+    let mut failures = Vec::new();
+    let session = app.session_mut();
+    session.accept(
+        Event::Started {
+            run,
+            organs: Vec::new(),
+            keyframes: 4,
+        },
+        &mut failures,
+    );
+    session.accept(
+        Event::Keyframe {
+            run,
+            keyframe: Arc::new(bud),
+        },
+        &mut failures,
+    );
+    assert!(failures.is_empty());
+    harness.run();
+    let camera = harness.state_mut().camera_mut();
+    camera.azimuth_deg = azimuth_deg;
+    camera.elevation_deg = elevation_deg;
+    camera.frame(bounds);
+    let camera = camera.camera();
+    harness.run();
+    let viewport = harness.get_by_label("3D viewport").rect();
+    let scale = f64::from(harness.ctx.pixels_per_point());
+    let screen = harness.render().expect("the window renders");
+    let (width, height) = (
+        f64::from(viewport.width()) * scale,
+        f64::from(viewport.height()) * scale,
+    );
+    let (x, y) = pixel_of(&camera, point, width, height);
+    let in_window = colour_around(
+        &screen,
+        f64::from(viewport.min.x) * scale + x,
+        f64::from(viewport.min.y) * scale + y,
+    );
+
+    assert!(
+        from_command_line[0] > from_command_line[2] + 60.0,
+        "the command line's pixel {from_command_line:?} is not the orange organ"
+    );
+    for channel in 0..3 {
+        assert!(
+            (from_command_line[channel] - in_window[channel]).abs() <= 6.0,
+            "window {in_window:?}, command line {from_command_line:?}"
+        );
+    }
 }

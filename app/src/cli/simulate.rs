@@ -5,7 +5,7 @@ use std::io::{IsTerminal, Write};
 use std::path::Path;
 use std::time::Instant;
 
-use anthesis_export::{GlbOptions, Track, TrackLook, UsdOptions};
+use anthesis_export::{GlbOptions, UsdOptions};
 use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
@@ -82,21 +82,12 @@ pub(super) fn simulate(
             .with_context(|| format!("cannot write statistics to {}", stats_path.display()))?;
     }
     if let Some(out) = out {
-        let names = sim.organs();
-        let looks = names
-            .iter()
-            .enumerate()
-            .map(|(i, name)| TrackLook::new(name, sim.triangles(i), sim.uvs(i), sim.color(i)));
-        let mut tracks = anthesis_export::organ_tracks(looks, frames.iter().map(Vec::as_slice));
+        let tracks = anthesis_export::flower_tracks(
+            &project.flower,
+            &selection.organs(project.flower.organs.len()),
+            frames.iter().map(Vec::as_slice),
+        );
         let kind = OutputKind::of(out);
-        if kind != OutputKind::ObjFolder {
-            let receptacle = anthesis_garden::receptacle_for(&project.flower);
-            tracks.push(Track::still(
-                "receptacle",
-                receptacle,
-                anthesis_garden::RECEPTACLE_COLOR,
-            ));
-        }
         match kind {
             OutputKind::Glb => anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
                 .with_context(|| format!("cannot write {}", out.display()))?,

@@ -249,19 +249,6 @@ pub fn dab_direction(
     });
 }
 
-/// The raster size shared by the template's painted maps, if any is a
-/// raster (the project format wants one size per template).
-pub fn template_raster_size(template: &Template) -> Option<(u32, u32)> {
-    template.maps.keys().iter().find_map(|key| {
-        let maps = &key.maps;
-        MapKind::ALL
-            .iter()
-            .map(|&k| maps.scalar(k).size())
-            .chain(std::iter::once(maps.direction.size()))
-            .find(|&size| size != (1, 1))
-    })
-}
-
 /// Makes a constant map paintable: a 1x1 map becomes a raster of `size`
 /// with the same value everywhere.
 pub fn ensure_scalar_raster(map: &mut ScalarMap, size: (u32, u32)) {
@@ -307,7 +294,10 @@ pub fn dab_template(
     centre_in_uv: DVec2,
     direction_in_uv: DVec2,
 ) {
-    let size = template_raster_size(template).unwrap_or((DEFAULT_PAINT_SIZE, DEFAULT_PAINT_SIZE));
+    let size = template
+        .maps
+        .raster_size()
+        .unwrap_or((DEFAULT_PAINT_SIZE, DEFAULT_PAINT_SIZE));
     let keys = template.maps.keys_mut();
     let Some(map_key) = keys.get_mut(key) else {
         return;

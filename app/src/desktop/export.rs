@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, channel};
 use std::sync::{Arc, Mutex};
 
-use anthesis_export::{Encoding, GlbOptions, Timing, Track, TrackLook, UsdOptions};
+use anthesis_export::{Encoding, GlbOptions, Timing, Track, UsdOptions};
 use anthesis_flower::Project;
 use anthesis_render::{OffscreenRenderer, OrganMesh};
 use anthesis_sim::Keyframe;
@@ -143,21 +143,13 @@ pub struct ExportRequests {
     pub export: bool,
 }
 
-/// The animation tracks of the computed keyframes: one per simulated organ.
+/// The animation tracks of the computed keyframes: one per simulated organ
+/// and the receptacle, as every export of a flower has them
+/// ([`anthesis_export::flower_tracks`]).
 pub fn tracks(project: &Project, organs: &[usize], keyframes: &[Arc<Keyframe>]) -> Vec<Track> {
-    let flower = &project.flower;
-    let looks = organs.iter().map(|&organ| {
-        let template = flower.template_of(organ);
-        let mesh = &template.mesh;
-        TrackLook::new(
-            &flower.organs[organ].name,
-            &mesh.triangles,
-            &mesh.uvs,
-            template.color,
-        )
-    });
-    anthesis_export::organ_tracks(
-        looks,
+    anthesis_export::flower_tracks(
+        &project.flower,
+        organs,
         keyframes.iter().map(|k| k.positions_in_world.as_slice()),
     )
 }
@@ -533,13 +525,20 @@ mod tests {
             .expect("sim")
             .bud();
         let tracks = tracks(&project, &[1], &[Arc::new(bud.clone())]);
-        assert_eq!(tracks.len(), 1);
+        assert_eq!(tracks.len(), 2, "the organ and the receptacle");
         let template = project.flower.template_of(1);
         assert_eq!(tracks[0].name, project.flower.organs[1].name);
         assert_eq!(tracks[0].triangles, template.mesh.triangles);
         assert_eq!(tracks[0].uvs, template.mesh.uvs);
         assert_eq!(tracks[0].base_color, template.color);
         assert_eq!(tracks[0].keyframes, bud.positions_in_world);
+        // The receptacle, as `anthesis simulate --out` exports it too.
+        let receptacle = anthesis_flower::receptacle_for(&project.flower);
+        assert_eq!(tracks[1].name, "receptacle");
+        assert_eq!(tracks[1].keyframes, vec![receptacle.positions]);
+        assert_eq!(tracks[1].base_color, anthesis_flower::RECEPTACLE_COLOR);
+        // Before the first keyframe there is nothing to export.
+        assert!(super::tracks(&project, &[1], &[]).is_empty());
     }
 
     #[test]
@@ -583,7 +582,11 @@ mod tests {
         let layer = std::fs::read_to_string(&usda).expect("layer written");
         assert_eq!(layer.len() as u64, bytes);
         assert!(layer.starts_with("#usda 1.0"));
-        assert_eq!(layer.matches("def Mesh ").count(), 2, "one mesh per organ");
+        assert_eq!(
+            layer.matches("def Mesh ").count(),
+            3,
+            "one mesh per organ and the receptacle"
+        );
         assert!(layer.contains("endTimeCode = 2"));
 
         let usdc = dir.path().join("out.usdc");

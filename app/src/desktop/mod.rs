@@ -126,6 +126,8 @@ pub struct AnthesisApp {
     has_gpu: bool,
     /// Increments whenever the scene is rebuilt.
     scene_revision: u64,
+    /// The selected organ's outline, kept between frames.
+    outline: viewport::Outline,
     title: String,
     ctx: egui::Context,
 }
@@ -201,6 +203,7 @@ impl AnthesisApp {
             needs_run: true,
             has_gpu,
             scene_revision: 0,
+            outline: viewport::Outline::default(),
             title: String::new(),
             ctx,
         };
@@ -437,7 +440,7 @@ impl AnthesisApp {
     fn load_map(&mut self, path: &Path) {
         let template = self.selected_template();
         let (key, target) = (self.paint.key, self.paint.target);
-        let size = brush::template_raster_size(&self.project().flower.templates[template]);
+        let size = self.project().flower.templates[template].maps.raster_size();
         let fits = |found: (u32, u32)| match size {
             Some(expected) if found != expected && found != (1, 1) => Err(format!(
                 "the map is {}x{} pixels but the template's maps are {}x{}",
@@ -920,6 +923,14 @@ impl AnthesisApp {
             ui.label("The 3D viewport needs the wgpu renderer.");
             return;
         }
+        let outline = self.outline.edges_of(
+            &self
+                .doc
+                .project()
+                .flower
+                .template_of(self.selected_organ)
+                .mesh,
+        );
         let response = viewport::viewport_ui(
             ui,
             &mut self.camera,
@@ -928,7 +939,7 @@ impl AnthesisApp {
             meshes,
             self.scene_revision,
             &self.view,
-            Some(self.selected_organ),
+            Some((self.selected_organ, outline)),
             Some(self.paint.key),
             self.paint.on_3d,
         );

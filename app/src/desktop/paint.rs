@@ -60,8 +60,7 @@ pub fn ramp(value: f32) -> Color32 {
 /// The picture of `target` in key `key`: scalar maps through [`ramp`],
 /// directions as grey (their arrows are drawn on top).
 fn map_image(template: &Template, key: usize, target: PaintTarget) -> egui::ColorImage {
-    let keys = template.maps.keys();
-    let maps = &keys[key.min(keys.len() - 1)].maps;
+    let maps = &template.maps.key_clamped(key).maps;
     match target {
         PaintTarget::Scalar(kind) => {
             let map = maps.scalar(kind);
@@ -147,7 +146,7 @@ impl PaintState {
         };
         let mut changed = false;
         ui.heading(format!("Paint “{}”", current.name));
-        self.key = self.key.min(current.maps.keys().len() - 1);
+        self.key = current.maps.clamped_index(self.key);
 
         egui::Grid::new("paint target")
             .num_columns(2)
@@ -436,8 +435,7 @@ impl PaintState {
             Stroke::new(1.0, Color32::from_white_alpha(90)),
         );
         if self.target == PaintTarget::Direction {
-            let keys = shown.maps.keys();
-            let map = &keys[self.key.min(keys.len() - 1)].maps.direction;
+            let map = &shown.maps.key_clamped(self.key).maps.direction;
             let n = 14;
             let cell = 1.0 / f64::from(n);
             for j in 0..n {

@@ -5,6 +5,7 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use anthesis_export::KeyframeBlend;
 use anthesis_flower::Project;
 use anthesis_sim::worker::{Event, RunId, Worker};
 use anthesis_sim::{Keyframe, KeyframeStats, Selection};
@@ -89,10 +90,7 @@ impl SimSession {
     /// current one. The keyframes shown so far are kept until the new run's
     /// bud arrives, so the view does not flash empty.
     pub fn start(&mut self, project: Arc<Project>, selection: Selection) -> RunId {
-        self.organs = match &selection {
-            Selection::All => (0..project.flower.organs.len()).collect(),
-            Selection::Only(i) => vec![*i],
-        };
+        self.organs = selection.organs(project.flower.organs.len());
         self.total = project.settings.keyframes;
         self.run = match &mut self.source {
             Source::Worker(worker) => worker.start(project, selection),
@@ -245,17 +243,14 @@ impl SimSession {
     /// interpolated linearly between the two keyframes around it; times
     /// past the newest keyframe show the newest. `None` before the bud.
     pub fn positions_at(&self, time_in_keyframes: f64) -> Option<Vec<Vec<glam::DVec3>>> {
-        let last = self.keyframes.len().checked_sub(1)?;
-        let time = time_in_keyframes.clamp(0.0, last as f64);
-        let below = (time.floor() as usize).min(last);
-        let above = (below + 1).min(last);
-        let t = time - below as f64;
-        let (a, b) = (&self.keyframes[below], &self.keyframes[above]);
+        let blend = KeyframeBlend::at(self.keyframes.len(), time_in_keyframes)?;
+        let (below, above) = (&self.keyframes[blend.below], &self.keyframes[blend.above]);
         Some(
-            a.positions_in_world
+            below
+                .positions_in_world
                 .iter()
-                .zip(&b.positions_in_world)
-                .map(|(pa, pb)| pa.iter().zip(pb).map(|(p, q)| p.lerp(*q, t)).collect())
+                .zip(&above.positions_in_world)
+                .map(|(a, b)| blend.positions(a, b))
                 .collect(),
         )
     }

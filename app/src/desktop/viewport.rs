@@ -11,6 +11,7 @@ use std::sync::Arc;
 
 use anthesis_flower::Project;
 use anthesis_maps::MapKind;
+use anthesis_mesh::{Mesh, Topology};
 use anthesis_render::{Camera, OrganMesh, OrganPipeline, RenderTarget, TargetFormat};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use eframe::egui_wgpu::{self, wgpu};
@@ -179,19 +180,13 @@ pub fn scene_bounds(scene: &[SceneOrgan]) -> Option<(DVec3, DVec3)> {
     Some(points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
 }
 
-/// Linear colour (the project's) to sRGB encoding (the renderer's input).
-fn linear_to_srgb(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 {
-        12.92 * c
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    }
-}
+/// The selection highlight, linear RGB (a warm yellow, sRGB 255, 219, 115).
+const HIGHLIGHT_LINEAR: [f32; 3] = [1.0, 0.71, 0.17];
 
-/// Meshes for the renderer: each organ in its template colour; the
-/// selected one tinted towards a warm highlight; organs not simulated
-/// (bud placeholders in preview) greyed; the overlay map as a ramp.
+/// Meshes for the renderer: each organ in its template colour (linear, as
+/// the renderer takes it); the selected one tinted towards a warm
+/// highlight; organs not simulated (bud placeholders in preview) washed out
+/// towards grey; the overlay map as a ramp.
 pub fn scene_meshes(
     project: &Project,
     scene: &[SceneOrgan],
@@ -202,23 +197,20 @@ pub fn scene_meshes(
         .iter()
         .map(|o| {
             let template = project.flower.template_of(o.organ);
-            let [r, g, b, a] = template.color;
-            let mut srgb = [linear_to_srgb(r), linear_to_srgb(g), linear_to_srgb(b), a];
+            let mut color_linear = template.color;
             if selected == Some(o.organ) {
-                let highlight = [1.0, 0.86, 0.45];
-                for c in 0..3 {
-                    srgb[c] = srgb[c] + 0.45 * (highlight[c] - srgb[c]);
+                for (c, h) in color_linear.iter_mut().zip(HIGHLIGHT_LINEAR) {
+                    *c += 0.45 * (h - *c);
                 }
             } else if !o.simulated {
-                for c in srgb.iter_mut().take(3) {
-                    *c = 0.55 + 0.3 * *c;
+                for c in color_linear.iter_mut().take(3) {
+                    *c = 0.26 + 0.43 * *c;
                 }
             }
-            let mesh = OrganMesh::from_positions(&o.positions_in_world, &o.triangles, srgb);
+            let mesh = OrganMesh::from_positions(&o.positions_in_world, &o.triangles, color_linear);
             match overlay {
                 Some((kind, key)) => {
-                    let keys = template.maps.keys();
-                    let map = keys[key.min(keys.len() - 1)].maps.scalar(kind);
+                    let map = template.maps.key_clamped(key).maps.scalar(kind);
                     let values = o.uvs.iter().map(|uv| map.sample(*uv) as f32).collect();
                     mesh.with_overlay(values)
                 }
@@ -324,7 +316,7 @@ pub fn viewport_ui(
     meshes: Arc<Vec<OrganMesh>>,
     revision: u64,
     options: &ViewOptions,
-    selected: Option<usize>,
+    selected: Option<(usize, &[[u32; 2]])>,
     direction_key: Option<usize>,
     paint_modifier: bool,
 ) -> ViewportResponse {
@@ -423,10 +415,12 @@ pub fn viewport_ui(
         }
         painter.extend(shapes);
     }
-    if let Some(o) = selected.and_then(|s| scene.iter().find(|o| o.organ == s)) {
+    if let Some((o, outline)) =
+        selected.and_then(|(s, outline)| Some((scene.iter().find(|o| o.organ == s)?, outline)))
+    {
         let stroke = Stroke::new(2.0, Color32::from_rgb(255, 170, 40));
         let mut shapes = Vec::new();
-        for [a, b] in boundary_edges(&o.triangles) {
+        for &[a, b] in outline {
             if let (Some(pa), Some(pb)) = (
                 to_screen(o.positions_in_world[a as usize]),
                 to_screen(o.positions_in_world[b as usize]),
@@ -453,21 +447,27 @@ pub fn viewport_ui(
     result
 }
 
-/// Edges used by one triangle only.
-pub fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut count = std::collections::HashMap::new();
-    for tri in triangles {
-        for (a, b) in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
-            *count.entry([a.min(b), a.max(b)]).or_insert(0_u32) += 1;
+/// The outline (boundary edges) of the selected organ's mesh, taken from
+/// its [`Topology`] and rebuilt only when the mesh's triangles change, not
+/// every frame.
+#[derive(Debug, Default)]
+pub struct Outline {
+    triangles: Vec<[u32; 3]>,
+    edges: Vec<[u32; 2]>,
+}
+
+impl Outline {
+    /// The boundary edges of `mesh` (none when it has no valid topology;
+    /// template meshes are validated when they are loaded).
+    pub fn edges_of(&mut self, mesh: &Mesh) -> &[[u32; 2]] {
+        if self.triangles != mesh.triangles {
+            self.edges = Topology::build(mesh)
+                .map(|topology| topology.boundary_edges().collect())
+                .unwrap_or_default();
+            self.triangles.clone_from(&mesh.triangles);
         }
+        &self.edges
     }
-    let mut edges: Vec<[u32; 2]> = count
-        .into_iter()
-        .filter(|&(_, n)| n == 1)
-        .map(|(e, _)| e)
-        .collect();
-    edges.sort_unstable();
-    edges
 }
 
 /// Arrows of the direction map on a sample of the organ's triangles: each
@@ -480,8 +480,7 @@ fn direction_arrows(
     to_screen: &dyn Fn(DVec3) -> Option<Pos2>,
 ) {
     let template = project.flower.template_of(organ.organ);
-    let keys = template.maps.keys();
-    let map = &keys[key.min(keys.len() - 1)].maps.direction;
+    let map = &template.maps.key_clamped(key).maps.direction;
     // About 60 arrows per organ, each a little shorter than an edge.
     let stride = (organ.triangles.len() / 60).max(2);
     let stroke = Stroke::new(1.2, Color32::from_rgb(20, 60, 160));
@@ -746,10 +745,31 @@ mod tests {
     }
 
     #[test]
-    fn a_square_has_four_boundary_edges() {
+    fn the_outline_of_a_square_is_its_four_sides_until_the_mesh_changes() {
+        let square = flat_square();
+        let mut mesh = Mesh {
+            positions: square.positions_in_world.clone(),
+            uvs: square.uvs.clone(),
+            triangles: square.triangles.clone(),
+        };
+        let mut outline = Outline::default();
+        let sorted = |outline: &mut Outline, mesh: &Mesh| {
+            let mut edges: Vec<[u32; 2]> = outline
+                .edges_of(mesh)
+                .iter()
+                .map(|&[a, b]| [a.min(b), a.max(b)])
+                .collect();
+            edges.sort_unstable();
+            edges
+        };
         assert_eq!(
-            boundary_edges(&flat_square().triangles),
-            vec![[0, 1], [0, 3], [1, 2], [2, 3]]
+            sorted(&mut outline, &mesh),
+            [[0, 1], [0, 3], [1, 2], [2, 3]]
         );
+        // One triangle left: its three sides.
+        mesh.triangles.truncate(1);
+        mesh.positions.truncate(3);
+        mesh.uvs.truncate(3);
+        assert_eq!(sorted(&mut outline, &mesh), [[0, 1], [0, 2], [1, 2]]);
     }
 }

@@ -48,6 +48,7 @@
 //! See [`Encoding`] for the three storage modes and [`glb_size_report`] for
 //! the file size in each.
 
+mod between;
 mod error;
 mod glb;
 mod obj;
@@ -60,11 +61,12 @@ use std::path::Path;
 
 use glam::{DVec2, DVec3};
 
+pub use between::KeyframeBlend;
 pub use error::{ExportError, TrackProblem};
 pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
 pub use report::{GlbSize, GlbSizeReport, glb_size_report};
-pub use tracks::{TrackLook, organ_tracks};
+pub use tracks::{TrackLook, flower_tracks, organ_tracks};
 pub use usd::{
     USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, write_usd,
 };

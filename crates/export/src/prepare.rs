@@ -4,7 +4,7 @@
 use glam::DVec3;
 
 use crate::error::{ExportError, TrackProblem};
-use crate::{GlbOptions, Timing, Track};
+use crate::{GlbOptions, KeyframeBlend, Timing, Track};
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
 
@@ -158,19 +158,13 @@ pub(crate) fn sample_positions(keyframe_count: usize, max_targets: usize) -> Vec
 }
 
 /// Positions at keyframe position `x` (in keyframe units), linearly
-/// interpolated between the neighbouring keyframes.
+/// interpolated between the neighbouring keyframes ([`KeyframeBlend`]).
+/// `keyframes` is not empty (the tracks are validated first).
 pub(crate) fn sample_keyframes(keyframes: &[Vec<DVec3>], x: f64) -> Vec<DVec3> {
-    let last = keyframes.len() - 1;
-    let below = (x.floor().max(0.0) as usize).min(last);
-    let fraction = x - below as f64;
-    if below == last || fraction <= 0.0 {
-        return keyframes[below].clone();
+    match KeyframeBlend::at(keyframes.len(), x) {
+        Some(blend) => blend.positions(&keyframes[blend.below], &keyframes[blend.above]),
+        None => Vec::new(),
     }
-    keyframes[below]
-        .iter()
-        .zip(&keyframes[below + 1])
-        .map(|(a, b)| a.lerp(*b, fraction))
-        .collect()
 }
 
 /// Name of the morph target holding keyframe position `x`.

@@ -1,7 +1,9 @@
 //! Building [`Track`]s: from the keyframes of a simulation, which hands out
 //! the positions of every organ keyframe by keyframe, and from a mesh that
-//! does not move.
+//! does not move; [`flower_tracks`] is the one rule every export of a
+//! flower follows (the desktop's and the command line's).
 
+use anthesis_flower::{Flower, RECEPTACLE_COLOR, receptacle_for};
 use anthesis_mesh::Mesh;
 use glam::{DVec2, DVec3};
 
@@ -73,6 +75,41 @@ pub fn organ_tracks<'a, 'k>(
             track.keyframes.push(positions.clone());
         }
     }
+    tracks
+}
+
+/// What an export of `flower` holds: one track per simulated organ (`organs`
+/// are indices into `flower.organs`, in the order the keyframes hold their
+/// positions), named after the organ and drawn with its template's mesh,
+/// UVs and colour, followed by the receptacle the organs sit on
+/// ([`receptacle_for`]) as a still track named `receptacle`.
+///
+/// `keyframes` are as [`organ_tracks`] takes them: keyframe 0 (the bud)
+/// first. Without keyframes there is nothing to export: no tracks.
+pub fn flower_tracks<'k>(
+    flower: &Flower,
+    organs: &[usize],
+    keyframes: impl IntoIterator<Item = &'k [Vec<DVec3>]>,
+) -> Vec<Track> {
+    let mut keyframes = keyframes.into_iter().peekable();
+    if keyframes.peek().is_none() {
+        return Vec::new();
+    }
+    let looks = organs.iter().map(|&organ| {
+        let template = flower.template_of(organ);
+        TrackLook::new(
+            &flower.organs[organ].name,
+            &template.mesh.triangles,
+            &template.mesh.uvs,
+            template.color,
+        )
+    });
+    let mut tracks = organ_tracks(looks, keyframes);
+    tracks.push(Track::still(
+        "receptacle",
+        receptacle_for(flower),
+        RECEPTACLE_COLOR,
+    ));
     tracks
 }
 

@@ -3,7 +3,10 @@
 //! The project file format that stores all this is in [`project`].
 
 pub mod project;
+mod receptacle;
 pub mod scale;
+
+pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
 
 use anthesis_maps::KeyedMaps;
 use anthesis_mesh::Mesh;

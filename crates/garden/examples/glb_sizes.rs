@@ -1,8 +1,9 @@
 //! Simulates the built-in lily and prints the .glb size in every encoding,
-//! with the receptacle as a static mesh, as `anthesis simulate --out` writes it:
+//! with the tracks every export of a flower has (the organs and the
+//! receptacle, `anthesis_export::flower_tracks`):
 //! `cargo run --release -p anthesis-garden --example glb_sizes [-- OUT.glb]`.
 
-use anthesis_export::{GlbOptions, Track, TrackLook, glb_size_report, organ_tracks};
+use anthesis_export::{GlbOptions, flower_tracks, glb_size_report};
 use anthesis_sim::{Selection, run};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -11,17 +12,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sim = run(&project, &Selection::All, &mut |_, k| {
         frames.push(k.positions_in_world.clone())
     })?;
-    let names = sim.organs();
-    let looks = names
-        .iter()
-        .enumerate()
-        .map(|(i, name)| TrackLook::new(name, sim.triangles(i), sim.uvs(i), sim.color(i)));
-    let mut tracks = organ_tracks(looks, frames.iter().map(Vec::as_slice));
-    tracks.push(Track::still(
-        "receptacle",
-        anthesis_garden::receptacle_for(&project.flower),
-        anthesis_garden::RECEPTACLE_COLOR,
-    ));
+    let organs = Selection::All.organs(sim.organs().len());
+    let tracks = flower_tracks(&project.flower, &organs, frames.iter().map(Vec::as_slice));
     let report = glb_size_report(&tracks, &GlbOptions::default())?;
     println!("{report}");
     // With a path argument, also write the default (dense) file there.

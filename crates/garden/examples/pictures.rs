@@ -9,7 +9,8 @@
 
 use std::time::Instant;
 
-use anthesis_garden::{flowers, receptacle_mesh, shape};
+use anthesis_flower::{RECEPTACLE_COLOR, receptacle_mesh};
+use anthesis_garden::{flowers, shape};
 use anthesis_render::{Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
 use anthesis_sim::{Selection, run};
 use glam::DVec3;
@@ -169,7 +170,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             organs.push(OrganMesh::from_positions(
                 &receptacle.positions,
                 &receptacle.triangles,
-                [0.45, 0.62, 0.3, 1.0],
+                RECEPTACLE_COLOR,
             ));
             organs
         })

@@ -11,8 +11,6 @@
 //! - [`shape`]: numeric shape descriptors (opening angles, turning,
 //!   cupping, corolla profile) that tests use to check each flower's
 //!   character;
-//! - [`receptacle_mesh`]: a receptacle for pictures and exports, and
-//!   [`receptacle_for`] one sized to a flower;
 //! - [`builtin`]: the committed projects of `assets/flowers/`, embedded in
 //!   the binary.
 //!
@@ -24,7 +22,6 @@ pub mod arrangement;
 pub mod buds;
 pub mod flowers;
 pub mod paint;
-mod receptacle;
 pub mod shape;
 
 use std::io;
@@ -33,7 +30,6 @@ use anthesis_flower::Project;
 use anthesis_flower::project::{ProjectError, parse_project};
 
 pub use flowers::{Cultivar, FLOWER_NAMES, GardenError};
-pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
 
 /// One embedded file: its path inside its flower's folder and its bytes.
 type EmbeddedFile = (&'static str, &'static [u8]);

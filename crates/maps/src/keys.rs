@@ -130,6 +130,32 @@ impl KeyedMaps {
         &self.keys
     }
 
+    /// Key `index`, or the last key when `index` is past the end (as an
+    /// index a panel kept while keys were removed can be).
+    pub fn key_clamped(&self, index: usize) -> &MapKey {
+        &self.keys[self.clamped_index(index)]
+    }
+
+    /// `index` if there is such a key, else the index of the last key.
+    pub fn clamped_index(&self, index: usize) -> usize {
+        // There is always at least one key.
+        index.min(self.keys.len().saturating_sub(1))
+    }
+
+    /// The one size all raster maps of these keys have (a project keeps one
+    /// size per template; 1x1 maps are constants and fit any size): the
+    /// first raster's, `None` when every map is a constant.
+    pub fn raster_size(&self) -> Option<(u32, u32)> {
+        self.keys.iter().find_map(|key| {
+            let maps = &key.maps;
+            MapKind::ALL
+                .iter()
+                .map(|&kind| maps.scalar(kind).size())
+                .chain(std::iter::once(maps.direction.size()))
+                .find(|&size| size != (1, 1))
+        })
+    }
+
     /// The keys, for editing their maps. Changing a key's `step` here must
     /// keep the steps sorted and distinct (use [`KeyedMaps::remove`] and
     /// [`KeyedMaps::insert`] to move a key); if it does not, blending picks

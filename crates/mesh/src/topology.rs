@@ -120,6 +120,15 @@ impl Topology {
         self.edges.iter().filter(|e| e.is_boundary()).count()
     }
 
+    /// The edges of one triangle only (the outline of the surface), as
+    /// vertex pairs in the winding of their triangle.
+    pub fn boundary_edges(&self) -> impl Iterator<Item = [u32; 2]> + '_ {
+        self.edges
+            .iter()
+            .filter(|e| e.is_boundary())
+            .map(|e| e.vertices)
+    }
+
     /// For each vertex, its neighbours along edges (sorted, deduplicated).
     pub fn vertex_neighbours(&self, vertex_count: usize) -> Vec<Vec<u32>> {
         let mut nb = vec![Vec::new(); vertex_count];
@@ -162,6 +171,20 @@ mod tests {
         // Left triangle 0 walks 2 -> 0, right triangle 1 walks 0 -> 2.
         assert_eq!(interior.hinge(), Some([2, 0, 1, 3]));
         assert_eq!(topo.triangle_edges[0][2], topo.triangle_edges[1][0]);
+        // The outline: the four sides, each in its triangle's winding.
+        let mut outline: Vec<[u32; 2]> = topo.boundary_edges().collect();
+        outline.sort_unstable();
+        assert_eq!(outline.len(), 4);
+        assert!(!outline.contains(&[0, 2]) && !outline.contains(&[2, 0]));
+        for [a, b] in outline {
+            assert!(
+                unit_square()
+                    .triangles
+                    .iter()
+                    .any(|t| (0..3).any(|i| [t[i], t[(i + 1) % 3]] == [a, b])),
+                "{a} -> {b} is not a side of a triangle"
+            );
+        }
     }
 
     #[test]

@@ -14,10 +14,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let size: u32 = args.next().map_or(Ok(800), |s| s.parse())?;
 
     let petal = test_petal(10.0, 5.0, 14, 28);
+    // Linear RGBA (pale pink, white, pink).
     let colors = [
-        [0.98, 0.80, 0.86, 1.0],
-        [0.97, 0.97, 0.95, 1.0],
-        [0.95, 0.62, 0.75, 1.0],
+        [0.96, 0.6, 0.71, 1.0],
+        [0.93, 0.93, 0.89, 1.0],
+        [0.89, 0.34, 0.52, 1.0],
     ];
     let azimuth_deg: f64 = args.next().map_or(Ok(25.0), |s| s.parse())?;
     let elevation_deg: f64 = args.next().map_or(Ok(35.0), |s| s.parse())?;

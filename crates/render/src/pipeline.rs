@@ -135,15 +135,6 @@ pub struct OrganPipeline {
     background: Background,
 }
 
-fn srgb_to_linear(encoded: f32) -> f32 {
-    let c = encoded.clamp(0.0, 1.0);
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 fn round_up(value: u64, alignment: u64) -> u64 {
     value.div_ceil(alignment.max(1)) * alignment.max(1)
 }
@@ -366,9 +357,8 @@ impl OrganPipeline {
         let stride = self.organ_uniform_stride as usize;
         let mut uniform_bytes = vec![0_u8; stride * organs.len()];
         for (i, mesh) in organs.iter().enumerate() {
-            let [r, g, b, a] = mesh.color_srgb;
             let uniform = OrganUniform {
-                color_linear: [srgb_to_linear(r), srgb_to_linear(g), srgb_to_linear(b), a],
+                color_linear: mesh.color_linear,
                 overlay_mix: [
                     if mesh.overlay.is_some() { 1.0 } else { 0.0 },
                     0.0,
@@ -579,12 +569,5 @@ mod tests {
         assert_eq!(size_of_struct("Frame"), size_of::<FrameUniform>());
         assert_eq!(size_of_struct("Organ"), size_of::<OrganUniform>());
         assert_eq!(size_of::<Vertex>(), 28);
-    }
-
-    #[test]
-    fn srgb_round_trip_points() {
-        assert_eq!(srgb_to_linear(0.0), 0.0);
-        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-6);
-        assert!((srgb_to_linear(0.5) - 0.214).abs() < 1e-3);
     }
 }

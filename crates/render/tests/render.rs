@@ -22,14 +22,14 @@ fn renderer() -> OffscreenRenderer {
 
 /// A square `[-h, h]^2` in the plane z = `z`, wound counter-clockwise seen
 /// from +Z, so its normal (the front side) faces +Z.
-fn square(half: f64, z: f64, color_srgb: [f32; 4]) -> OrganMesh {
+fn square(half: f64, z: f64, color_linear: [f32; 4]) -> OrganMesh {
     let positions = [
         DVec3::new(-half, -half, z),
         DVec3::new(half, -half, z),
         DVec3::new(half, half, z),
         DVec3::new(-half, half, z),
     ];
-    OrganMesh::from_positions(&positions, &[[0, 1, 2], [0, 2, 3]], color_srgb)
+    OrganMesh::from_positions(&positions, &[[0, 1, 2], [0, 2, 3]], color_linear)
 }
 
 /// Looks at the origin from +Z (`from_front`) or -Z, 5 units away, with a
@@ -44,8 +44,9 @@ fn camera(from_front: bool) -> Camera {
     }
 }
 
-const RED: [f32; 4] = [0.9, 0.1, 0.1, 1.0];
-const GREEN: [f32; 4] = [0.1, 0.8, 0.1, 1.0];
+/// Linear colours (sRGB 0.9, 0.1, 0.1 and 0.1, 0.8, 0.1).
+const RED: [f32; 4] = [0.79, 0.01, 0.01, 1.0];
+const GREEN: [f32; 4] = [0.01, 0.6, 0.01, 1.0];
 
 fn centre(image: &RgbaImage) -> Rgba<u8> {
     *image.get_pixel(image.width() / 2, image.height() / 2)

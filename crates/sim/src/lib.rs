@@ -33,6 +33,17 @@ pub enum Selection {
     Only(usize),
 }
 
+impl Selection {
+    /// The chosen organs of a flower of `organ_count` organs, as indices in
+    /// the order a run's keyframes hold them (not checked against the count).
+    pub fn organs(&self, organ_count: usize) -> Vec<usize> {
+        match self {
+            Selection::All => (0..organ_count).collect(),
+            Selection::Only(i) => vec![*i],
+        }
+    }
+}
+
 /// Statistics of one keyframe.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct KeyframeStats {
@@ -136,11 +147,12 @@ pub struct Simulation {
 impl Simulation {
     pub fn new(project: &Project, selection: &Selection) -> Result<Simulation, SimError> {
         let flower = &project.flower;
-        let chosen: Vec<usize> = match selection {
-            Selection::All => (0..flower.organs.len()).collect(),
-            Selection::Only(i) if *i < flower.organs.len() => vec![*i],
-            Selection::Only(i) => return Err(SimError::NoSuchOrgan(*i)),
-        };
+        if let Selection::Only(i) = selection
+            && *i >= flower.organs.len()
+        {
+            return Err(SimError::NoSuchOrgan(*i));
+        }
+        let chosen = selection.organs(flower.organs.len());
         let organs = chosen
             .iter()
             .map(|&i| OrganSim::new(&flower.organs[i], flower.template_of(i), &project.settings))

@@ -284,3 +284,22 @@ fn blend_serialises_in_snake_case_with_a_default_steepness() {
     let kind: MapKind = serde_json::from_str("\"e_growth_in\"").expect("parses");
     assert_eq!(kind, MapKind::EGrowthIn);
 }
+
+#[test]
+fn a_key_past_the_end_is_the_last_key() {
+    let maps = keyed(&[0, 40, 60], Blend::Linear);
+    assert_eq!(maps.key_clamped(1).step, 40);
+    assert_eq!(maps.key_clamped(2).step, 60);
+    assert_eq!(maps.key_clamped(3).step, 60);
+    assert_eq!(maps.key_clamped(usize::MAX).step, 60);
+    assert_eq!(maps.clamped_index(0), 0);
+    assert_eq!(maps.clamped_index(7), 2);
+}
+
+#[test]
+fn the_raster_size_is_the_first_rasters_and_constants_have_none() {
+    let mut maps = keyed(&[0, 40], Blend::Linear);
+    assert_eq!(maps.raster_size(), None, "all constants");
+    maps.keys_mut()[1].maps.bend = ScalarMap::from_fn(8, 4, |_| 0.5);
+    assert_eq!(maps.raster_size(), Some((8, 4)));
+}

@@ -3,9 +3,10 @@
 
 use std::f64::consts::{PI, TAU};
 
-use anthesis_flower::Flower;
 use anthesis_mesh::Mesh;
 use glam::{DVec2, DVec3};
+
+use crate::Flower;
 
 /// Segments around the axis.
 const SEGMENTS: usize = 32;
@@ -120,10 +121,10 @@ mod tests {
 
     #[test]
     fn the_receptacle_for_a_flower_reaches_just_past_its_organs() {
-        let organ_at = |x: f64, z: f64| anthesis_flower::Organ {
+        let organ_at = |x: f64, z: f64| crate::Organ {
             name: format!("at {x} {z}"),
             template: 0,
-            placement: anthesis_flower::Placement {
+            placement: crate::Placement {
                 position: DVec3::new(x, 0.2, z),
                 azimuth_deg: 0.0,
                 joint_angle_deg: 0.0,
