@@ -8,8 +8,8 @@
 //! UI types. Dropping the handle cancels the job and joins the thread.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, Sender, SyncSender, channel, sync_channel};
-use std::sync::{Arc, Mutex};
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
@@ -65,42 +65,86 @@ impl Event {
     }
 }
 
-enum Command {
-    Run {
-        run: RunId,
-        project: Arc<Project>,
-        selection: Selection,
-    },
-    Shutdown,
+/// A run asked for and not yet started.
+struct RunRequest {
+    run: RunId,
+    project: Arc<Project>,
+    selection: Selection,
+}
+
+/// What waits for the worker thread: at most one run, the newest (a newer
+/// request replaces an older one that has not started: latest wins, and
+/// the newest is never dropped), and whether to shut down.
+#[derive(Default)]
+struct Inbox {
+    next_run: Option<RunRequest>,
+    shutdown: bool,
+}
+
+/// The worker's command queue: a one-slot inbox and the condition variable
+/// the thread waits on.
+#[derive(Default)]
+struct Mailbox {
+    inbox: Mutex<Inbox>,
+    posted: Condvar,
+}
+
+impl Mailbox {
+    /// Changes the inbox and wakes the thread. A poisoned lock (a panic
+    /// while holding it) still holds a consistent inbox: every change is
+    /// one assignment.
+    fn post(&self, change: impl FnOnce(&mut Inbox)) {
+        let mut inbox = self.inbox.lock().unwrap_or_else(PoisonError::into_inner);
+        change(&mut inbox);
+        self.posted.notify_one();
+    }
+
+    /// Waits for the next run; `None` once shutdown is asked for.
+    fn next(&self) -> Option<RunRequest> {
+        let mut inbox = self.inbox.lock().unwrap_or_else(PoisonError::into_inner);
+        loop {
+            if inbox.shutdown {
+                return None;
+            }
+            if let Some(request) = inbox.next_run.take() {
+                return Some(request);
+            }
+            inbox = self
+                .posted
+                .wait(inbox)
+                .unwrap_or_else(PoisonError::into_inner);
+        }
+    }
 }
 
 type Wake = Box<dyn Fn() + Send + Sync>;
 
 /// Handle to the worker thread.
 pub struct Worker {
-    commands: SyncSender<Command>,
+    mailbox: Arc<Mailbox>,
     events: Receiver<Event>,
     /// The newest run requested; a job whose id differs is stale and stops.
     current: Arc<AtomicU64>,
     thread: Option<JoinHandle<()>>,
 }
 
-/// Commands waiting at most; older `Run` commands are skipped anyway.
-const COMMAND_CAPACITY: usize = 16;
-
 impl Worker {
     /// Spawns the thread `anthesis-sim`. `wake` is called after each event.
     pub fn spawn(wake: impl Fn() + Send + Sync + 'static) -> std::io::Result<Worker> {
-        let (commands, command_rx) = sync_channel(COMMAND_CAPACITY);
+        let mailbox = Arc::new(Mailbox::default());
+        let inbox = Arc::clone(&mailbox);
+        // Unbounded on purpose: every event of the current run matters (the
+        // keyframes are the result) and the owner drains them each frame;
+        // a bound would stall the simulation on a busy UI.
         let (event_tx, events) = channel();
         let current = Arc::new(AtomicU64::new(0));
         let shared = Arc::clone(&current);
         let wake: Wake = Box::new(wake);
         let thread = std::thread::Builder::new()
             .name("anthesis-sim".into())
-            .spawn(move || serve(command_rx, event_tx, shared, wake))?;
+            .spawn(move || serve(&inbox, event_tx, shared, wake))?;
         Ok(Worker {
-            commands,
+            mailbox,
             events,
             current,
             thread: Some(thread),
@@ -111,11 +155,12 @@ impl Worker {
     /// new run's id. Never blocks on the simulation.
     pub fn start(&self, project: Arc<Project>, selection: Selection) -> RunId {
         let run = self.current.fetch_add(1, Ordering::SeqCst) + 1;
-        // The channel only fills if the thread is gone; then nothing runs.
-        let _ = self.commands.try_send(Command::Run {
-            run,
-            project,
-            selection,
+        self.mailbox.post(|inbox| {
+            inbox.next_run = Some(RunRequest {
+                run,
+                project,
+                selection,
+            });
         });
         run
     }
@@ -144,14 +189,14 @@ impl Worker {
 impl Drop for Worker {
     fn drop(&mut self) {
         self.cancel();
-        let _ = self.commands.try_send(Command::Shutdown);
+        self.mailbox.post(|inbox| inbox.shutdown = true);
         if let Some(thread) = self.thread.take() {
             let _ = thread.join();
         }
     }
 }
 
-fn serve(commands: Receiver<Command>, events: Sender<Event>, current: Arc<AtomicU64>, wake: Wake) {
+fn serve(mailbox: &Mailbox, events: Sender<Event>, current: Arc<AtomicU64>, wake: Wake) {
     let send = Mutex::new(move |event: Event| {
         let _ = events.send(event);
         wake();
@@ -161,21 +206,17 @@ fn serve(commands: Receiver<Command>, events: Sender<Event>, current: Arc<Atomic
             send(event);
         }
     };
-    while let Ok(command) = commands.recv() {
-        match command {
-            Command::Shutdown => return,
-            Command::Run {
-                run,
-                project,
-                selection,
-            } => {
-                if current.load(Ordering::SeqCst) != run {
-                    // Superseded before it started.
-                    continue;
-                }
-                run_job(run, &project, &selection, &current, &emit);
-            }
+    while let Some(RunRequest {
+        run,
+        project,
+        selection,
+    }) = mailbox.next()
+    {
+        if current.load(Ordering::SeqCst) != run {
+            // Cancelled before it started.
+            continue;
         }
+        run_job(run, &project, &selection, &current, &emit);
     }
 }
 
@@ -313,6 +354,42 @@ mod tests {
             "the long run must report its cancellation"
         );
         assert!(matches!(events.last(), Some(Event::Finished { run, .. }) if *run == short));
+    }
+
+    #[test]
+    fn a_burst_of_starts_while_busy_runs_the_newest() {
+        let worker = Worker::spawn(|| {}).expect("thread");
+        worker.start(Arc::new(whorl(1, 14, 28, 100_000)), Selection::All);
+        // Wait until the long run is really computing, then ask for many
+        // more runs than any queue would hold before it notices.
+        loop {
+            if let Some(Event::Keyframe { keyframe, .. }) =
+                worker.wait_event(Duration::from_secs(60))
+                && keyframe.index >= 1
+            {
+                break;
+            }
+        }
+        let project = Arc::new(whorl(1, 6, 10, 2));
+        let mut newest = 0;
+        for _ in 0..100 {
+            newest = worker.start(Arc::clone(&project), Selection::All);
+        }
+        let events = collect_until_end(&worker, newest);
+        assert!(
+            matches!(events.last(), Some(Event::Finished { run, .. }) if *run == newest),
+            "the newest run must finish: {:?}",
+            events.last()
+        );
+        // The runs in between were replaced before they started.
+        let started: Vec<RunId> = events
+            .iter()
+            .filter_map(|e| match e {
+                Event::Started { run, .. } => Some(*run),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(started, [newest]);
     }
 
     #[test]
