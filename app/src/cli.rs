@@ -121,10 +121,29 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", one_line(&format!("{e:#}")));
+            eprintln!("error: {}", one_line(&error_message(&e)));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error and its causes, outermost first, joined by `: `, each said
+/// once: a cause whose text an earlier part already holds is left out, and
+/// a context that only repeats the start of its cause gives way to it
+/// ("cannot write x.glb" before "cannot write x.glb: no such folder").
+fn error_message(error: &anyhow::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for cause in error.chain() {
+        let text = cause.to_string();
+        if parts.iter().any(|part| part.contains(&text)) {
+            continue;
+        }
+        match parts.last_mut() {
+            Some(last) if text.starts_with(last.as_str()) => *last = text,
+            _ => parts.push(text),
+        }
+    }
+    parts.join(": ")
 }
 
 /// Folds a multi-line message (TOML errors quote the offending line) into
@@ -195,7 +214,19 @@ fn load(path: &Path) -> Result<Project> {
         };
     }
     // The project error names the file itself.
-    load_project(path).context("cannot open project")
+    let project = load_project(path).context("cannot open project")?;
+    check_units(&project)?;
+    Ok(project)
+}
+
+/// Refuses a project with a mesh in another unit than the project (see
+/// `anthesis_flower::scale`): it would fail at the first keyframe with a
+/// message that says nothing about the cause.
+fn check_units(project: &Project) -> Result<()> {
+    match anthesis_flower::scale::check_flower(&project.flower).first() {
+        Some(mismatch) => bail!("{mismatch}"),
+        None => Ok(()),
+    }
 }
 
 /// All organs, or the one named `organ` (an error lists the names).
@@ -214,5 +245,25 @@ fn selection(project: &Project, organ: Option<&str>) -> Result<Selection> {
                 .collect();
             bail!("no organ named `{name}` (organs: {})", names.join(", "));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_cause_is_said_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "No such file or directory");
+        // What `cannot write /proc/x.glb` used to print twice over.
+        let error = anyhow::Error::new(io)
+            .context("cannot write /proc/x.glb: No such file or directory")
+            .context("cannot write /proc/x.glb");
+        assert_eq!(
+            error_message(&error),
+            "cannot write /proc/x.glb: No such file or directory"
+        );
+        let error = anyhow::anyhow!("not converged").context("keyframe 3");
+        assert_eq!(error_message(&error), "keyframe 3: not converged");
     }
 }

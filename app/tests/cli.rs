@@ -114,8 +114,8 @@ fn simulate_writes_a_usd_layer_with_every_organ_and_the_receptacle() {
 fn simulate_one_organ_and_obj_output() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = saved_whorl(dir.path(), 2, 2);
+    // A missing folder whose parent exists is created.
     let objs = dir.path().join("objs");
-    std::fs::create_dir(&objs).expect("mkdir");
     let out = anthesis(&[
         "simulate",
         path.to_str().expect("utf-8"),
@@ -190,6 +190,48 @@ fn bad_input_gives_one_line_and_a_non_zero_exit() {
     );
     assert!(!usdc.exists());
 
+    // Every output argument and limit is checked before the simulation
+    // starts (stderr has no "simulated" line), each with its own message.
+    let glb = dir.path().join("flower.glb");
+    let glb = glb.to_str().expect("utf-8");
+    let missing_stats = dir.path().join("no/such/stats.json");
+    let early: Vec<(Vec<&str>, String)> = vec![
+        (
+            vec![p, "--keyframes", "1000000000"],
+            "--keyframes 1000000000 is more than the limit of 10000".into(),
+        ),
+        (
+            vec![
+                p,
+                "--stats",
+                missing_stats.to_str().expect("utf-8"),
+                "--out",
+                glb,
+            ],
+            format!(
+                "the folder {} does not exist",
+                dir.path().join("no").display()
+            ),
+        ),
+        (
+            vec![p, "--out", glb, "--fps", "1e-300"],
+            "too close together or too far apart in time".into(),
+        ),
+        (
+            vec![p, "--out", glb, "--max-targets", "0"],
+            "morph target".into(),
+        ),
+    ];
+    for (args, expected) in early {
+        let mut all = vec!["simulate"];
+        all.extend(&args);
+        let out = one_line_error(&all);
+        let stderr = text(&out.stderr);
+        assert!(stderr.contains(&expected), "{args:?}: {stderr}");
+        assert!(!stderr.contains("simulated"), "{args:?} ran: {stderr}");
+    }
+    assert!(!Path::new(glb).exists());
+
     let out = anthesis(&["simulate"]);
     assert_eq!(
         out.status.code(),
@@ -251,4 +293,28 @@ fn the_built_in_lily_needs_no_files() {
     let stderr = text(&out.stderr);
     assert!(stderr.contains("no built-in flower `tulip`"), "{stderr}");
     assert_eq!(stderr.trim_end().lines().count(), 1);
+}
+
+#[test]
+fn a_mesh_in_another_unit_is_named_before_the_run() {
+    // The whorl's petal mesh made in another unit: ×100 on the mesh alone
+    // (thickness and positions as they were).
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut project = anthesis_sim::fixtures::whorl(1, 8, 14, 2);
+    for p in &mut project.flower.templates[0].mesh.positions {
+        *p *= 100.0;
+    }
+    let path = dir.path().join("mm.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let p = path.to_str().expect("utf-8");
+    for command in ["info", "simulate"] {
+        let out = one_line_error(&[command, p]);
+        let stderr = text(&out.stderr);
+        assert!(
+            stderr.contains("times too large, perhaps made in")
+                && stderr.contains("Scale the mesh"),
+            "{command}: {stderr}"
+        );
+        assert!(!stderr.contains("simulated"), "{stderr}");
+    }
 }

@@ -243,7 +243,8 @@ fn render_refuses_bad_input_with_one_line() {
     let folder = dir.path().join("pictures");
     std::fs::create_dir(&folder).expect("mkdir");
     let out_dir = utf8(&folder);
-    let missing_folder = dir.path().join("missing").display().to_string();
+    // A missing folder is created only when its parent exists.
+    let missing_folder = dir.path().join("missing/pictures").display().to_string();
     let a_file = project.display().to_string();
     let missing_project = dir.path().join("nope.anthesis.toml").display().to_string();
     let mut cases: Vec<(Vec<&str>, &str)> = vec![

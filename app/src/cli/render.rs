@@ -12,7 +12,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbaImage;
 
-use super::simulate::run_keyframes;
+use super::simulate::{run_keyframes, set_keyframes};
 use super::{load, selection};
 use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
@@ -87,12 +87,7 @@ pub struct RenderArgs {
 
 pub fn render(args: &RenderArgs) -> Result<()> {
     let mut project = load(&args.project)?;
-    if let Some(n) = args.keyframes {
-        if n == 0 {
-            bail!("--keyframes must be at least 1");
-        }
-        project.settings.keyframes = n;
-    }
+    set_keyframes(&mut project, args.keyframes)?;
     let selection = selection(&project, args.organ.as_deref())?;
     let last_keyframe = project.settings.keyframes;
     let (width, height) = parse_size(&args.size)?;
@@ -283,7 +278,8 @@ fn simulate_scenes(
         if frames.binary_search(&keyframe.index).is_ok() {
             scenes.push((keyframe.index, organs_at(&keyframe.positions_in_world)));
         }
-    })?;
+    })
+    .into_result()?;
     Ok(scenes)
 }
 
@@ -328,13 +324,23 @@ fn parse_size(size: &str) -> Result<(u32, u32)> {
     }
 }
 
-/// Fails before the simulation when `folder` is missing or not writable.
+/// Fails before the simulation when `folder` is not writable; creates it
+/// when it is missing but its parent exists.
 fn check_folder(folder: &Path) -> Result<()> {
     if !folder.is_dir() {
         if folder.exists() {
             bail!("--out {} is not a folder", folder.display());
         }
-        bail!("--out folder {} does not exist", folder.display());
+        let parent = anthesis_files::folder_of(folder);
+        if !parent.is_dir() {
+            bail!(
+                "--out {}: cannot create the folder, {} does not exist",
+                folder.display(),
+                parent.display()
+            );
+        }
+        std::fs::create_dir(folder)
+            .with_context(|| format!("cannot create the --out folder {}", folder.display()))?;
     }
     let probe = folder.join(format!(".anthesis-write-test-{}", std::process::id()));
     std::fs::write(&probe, b"")

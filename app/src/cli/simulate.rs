@@ -6,6 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anthesis_export::{GlbOptions, UsdOptions};
+use anthesis_flower::MAX_KEYFRAMES;
 use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
@@ -49,25 +50,28 @@ pub(super) fn simulate(
     glb: &GlbOptions,
 ) -> Result<()> {
     let mut project = load(path)?;
-    if let Some(n) = keyframes {
-        if n == 0 {
-            bail!("--keyframes must be at least 1");
-        }
-        project.settings.keyframes = n;
-    }
+    set_keyframes(&mut project, keyframes)?;
     let selection = selection(&project, organ)?;
+    // Every output is checked before the run: a typo must not cost a
+    // simulation.
+    if let Some(stats_path) = stats_path {
+        anthesis_files::check_destination(stats_path)?;
+    }
     if let Some(out) = out {
-        check_output(out)?;
+        check_output(out, glb, project.settings.keyframes)?;
     }
 
     let mut sim = Simulation::new(&project, &selection)?;
     let total = sim.keyframe_count();
     let mut frames: Vec<Vec<Vec<DVec3>>> = vec![sim.bud().positions_in_world];
-    let mut stats = Vec::with_capacity(total as usize);
-    let seconds = run_keyframes(&mut sim, total, &mut |keyframe| {
+    let mut stats = Vec::new();
+    let run = run_keyframes(&mut sim, total, &mut |keyframe| {
         stats.push(keyframe.stats);
         frames.push(keyframe.positions_in_world);
-    })?;
+    });
+    // What was computed is kept even when the run failed part way.
+    let done = run.done;
+    let seconds = run.seconds;
 
     if let Some(stats_path) = stats_path {
         let file = StatsFile {
@@ -78,10 +82,13 @@ pub(super) fn simulate(
             threads: rayon_threads(),
         };
         let json = serde_json::to_string_pretty(&file)?;
-        anthesis_files::write_atomic(stats_path, json.as_bytes())
-            .with_context(|| format!("cannot write statistics to {}", stats_path.display()))?;
+        // The error names the file.
+        anthesis_files::write_atomic(stats_path, json.as_bytes())?;
     }
-    if let Some(out) = out {
+    let mut written = None;
+    if let Some(out) = out
+        && done > 0
+    {
         let tracks = anthesis_export::flower_tracks(
             &project.flower,
             &selection.organs(project.flower.organs.len()),
@@ -100,30 +107,88 @@ pub(super) fn simulate(
                     .with_context(|| format!("cannot write {}", out.display()))?
             }
             OutputKind::ObjFolder => {
+                if !out.is_dir() {
+                    std::fs::create_dir(out)
+                        .with_context(|| format!("cannot create the folder {}", out.display()))?;
+                }
                 anthesis_export::write_obj_sequence(out, &tracks)
                     .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
             }
         }
-        eprintln!("wrote {}", out.display());
+        eprintln!("wrote {} (keyframes 0 to {done})", out.display());
+        written = Some(out);
+    }
+    match (run.failure, written) {
+        (None, _) => Ok(()),
+        (Some(failure), Some(out)) => Err(failure.context(format!(
+            "the keyframes before it were written to {} (keyframes 0 to {done})",
+            out.display()
+        ))),
+        (Some(failure), None) if out.is_some() => {
+            Err(failure.context("no keyframe was computed, nothing was written"))
+        }
+        (Some(failure), None) => Err(failure),
+    }
+}
+
+/// Sets the run's keyframe count from `--keyframes`, within the limits
+/// (a billion keyframes aborted on a 40 GB allocation).
+pub(super) fn set_keyframes(
+    project: &mut anthesis_flower::Project,
+    keyframes: Option<u32>,
+) -> Result<()> {
+    if let Some(n) = keyframes {
+        if n == 0 {
+            bail!("--keyframes must be at least 1");
+        }
+        if n > MAX_KEYFRAMES {
+            bail!("--keyframes {n} is more than the limit of {MAX_KEYFRAMES}");
+        }
+        project.settings.keyframes = n;
     }
     Ok(())
 }
 
+/// How far a run got: the keyframes computed, the wall time, and why it
+/// stopped early if it did.
+pub(super) struct Run {
+    pub done: u32,
+    pub seconds: f64,
+    pub failure: Option<anyhow::Error>,
+}
+
+impl Run {
+    /// The run as a result: an error if it stopped early.
+    pub fn into_result(self) -> Result<f64> {
+        match self.failure {
+            None => Ok(self.seconds),
+            Some(failure) => Err(failure),
+        }
+    }
+}
+
 /// Steps `sim` through keyframe `last` (at most its keyframe count), handing
 /// each keyframe to `on_keyframe`. Shows progress with the time left when
-/// stderr is a terminal and ends with a summary line on stderr. Returns the
-/// wall time in seconds.
+/// stderr is a terminal and ends with a summary line on stderr. A failed
+/// step ends the run; the keyframes before it have been handed over.
 pub(super) fn run_keyframes(
     sim: &mut Simulation,
     last: u32,
     on_keyframe: &mut dyn FnMut(Keyframe),
-) -> Result<f64> {
+) -> Run {
     let last = last.min(sim.keyframe_count());
     let started = Instant::now();
     let show_progress = std::io::stderr().is_terminal();
     let mut done = 0;
+    let mut failure = None;
     while done < last && !sim.finished() {
-        let keyframe = sim.step(&|| false, &mut |_| {})?;
+        let keyframe = match sim.step(&|| false, &mut |_| {}) {
+            Ok(keyframe) => keyframe,
+            Err(error) => {
+                failure = Some(anyhow::Error::new(error));
+                break;
+            }
+        };
         done = keyframe.index;
         if show_progress {
             let elapsed = started.elapsed().as_secs_f64();
@@ -137,11 +202,17 @@ pub(super) fn run_keyframes(
     if show_progress && done > 0 {
         eprintln!();
     }
-    eprintln!(
-        "simulated {done} keyframes of {} organ(s) in {seconds:.2} s",
-        sim.organs().len()
-    );
-    Ok(seconds)
+    if failure.is_none() {
+        eprintln!(
+            "simulated {done} keyframes of {} organ(s) in {seconds:.2} s",
+            sim.organs().len()
+        );
+    }
+    Run {
+        done,
+        seconds,
+        failure,
+    }
 }
 
 /// What `--out` asks for, by its extension.
@@ -167,28 +238,33 @@ impl OutputKind {
     }
 }
 
-/// Fails early, before a long simulation, when the output cannot be written.
-fn check_output(out: &Path) -> Result<()> {
+/// Fails early, before a long simulation, when `--out` cannot be written:
+/// a .glb needs a folder and export options that fit `keyframes`; a folder
+/// for OBJ files may be missing if its parent exists (it is created when
+/// the files are written).
+fn check_output(out: &Path, glb: &GlbOptions, keyframes: u32) -> Result<()> {
     match OutputKind::of(out) {
         OutputKind::Glb => {
-            let parent = out
-                .parent()
-                .filter(|p| !p.as_os_str().is_empty())
-                .unwrap_or(Path::new("."));
-            if !parent.is_dir() {
-                bail!(
-                    "cannot write {}: folder {} does not exist",
-                    out.display(),
-                    parent.display()
-                );
-            }
+            anthesis_files::check_destination(out)?;
+            // The bud and every keyframe.
+            glb.check(keyframes as usize + 1)?;
         }
         OutputKind::Usd => anthesis_export::check_usd_destination(out)?,
         OutputKind::ObjFolder if out.exists() && !out.is_dir() => bail!(
             "--out {} must be a .glb or .usda file or a folder for OBJ files",
             out.display()
         ),
-        OutputKind::ObjFolder => {}
+        OutputKind::ObjFolder if out.is_dir() => {}
+        OutputKind::ObjFolder => {
+            let parent = anthesis_files::folder_of(out);
+            if !parent.is_dir() {
+                bail!(
+                    "--out {}: cannot create the folder, {} does not exist",
+                    out.display(),
+                    parent.display()
+                );
+            }
+        }
     }
     Ok(())
 }

@@ -187,6 +187,20 @@ impl Default for GlbOptions {
     }
 }
 
+impl GlbOptions {
+    /// Checks the options for an animation of `keyframe_count` keyframes
+    /// (the bud included) the way [`glb_bytes`] does, without any data: a
+    /// frame rate or duration that is not a positive number, or that puts
+    /// the keyframes too close or too far apart for the file's 32-bit times,
+    /// and no morph targets for an animation. For checking command-line
+    /// options before a long simulation.
+    pub fn check(&self, keyframe_count: usize) -> Result<(), ExportError> {
+        prepare::validate_options(self, keyframe_count)?;
+        let positions = prepare::sample_positions(keyframe_count, self.max_morph_targets);
+        prepare::animation_times(self.timing, keyframe_count, &positions).map(|_| ())
+    }
+}
+
 /// Builds the .glb (see [`glb_bytes`]) and writes it to `path` atomically
 /// (see [`anthesis_files::write_atomic`]): an existing file at `path` is replaced only by a
 /// completely written new one. `progress` goes from 0 to 1.

@@ -193,8 +193,13 @@ pub(crate) fn animation_times(
         .map(|&x| (x * seconds_per_keyframe) as f32)
         .collect();
     if times.iter().any(|t| !t.is_finite()) || times.windows(2).any(|w| w[0] >= w[1]) {
+        let timing = match timing {
+            Timing::FramesPerSecond(fps) => format!("a frame rate of {fps:?} keyframes per second"),
+            Timing::Duration(seconds) => format!("a duration of {seconds:?} seconds"),
+        };
         return Err(ExportError::InvalidOptions(format!(
-            "{timing:?} puts the keyframes too close together or too far apart in time to store"
+            "{timing} puts the keyframes too close together or too far apart in time to store \
+             (glTF keeps times as 32-bit numbers)"
         )));
     }
     Ok(times)
@@ -359,6 +364,30 @@ mod tests {
         assert!(validate_options(&no_targets, 10).is_err());
         assert!(validate_options(&no_targets, 1).is_ok());
         assert!(validate_options(&GlbOptions::default(), 10).is_ok());
+    }
+
+    #[test]
+    fn options_are_checked_without_data_as_the_export_would() {
+        let fps = |fps| GlbOptions {
+            timing: Timing::FramesPerSecond(fps),
+            ..GlbOptions::default()
+        };
+        assert!(GlbOptions::default().check(101).is_ok());
+        assert!(fps(1e-30).check(101).is_ok(), "far apart but storable");
+        let error = fps(1e-300).check(101).expect_err("1e300 s is no f32");
+        assert_eq!(
+            error.to_string(),
+            "invalid export option: a frame rate of 1e-300 keyframes per second puts the \
+             keyframes too close together or too far apart in time to store (glTF keeps times \
+             as 32-bit numbers)"
+        );
+        assert!(fps(1e300).check(101).is_err(), "all at time 0");
+        let no_targets = GlbOptions {
+            max_morph_targets: 0,
+            ..GlbOptions::default()
+        };
+        assert!(no_targets.check(101).is_err());
+        assert!(no_targets.check(1).is_ok(), "a still needs no targets");
     }
 
     #[test]
