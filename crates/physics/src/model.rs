@@ -29,10 +29,10 @@ use crate::growth::BendRule;
 /// documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Model {
-    /// Converges under mesh refinement.
+    /// Converges under mesh refinement; the default.
+    #[default]
     Consistent,
     /// The paper's rules, kept for comparison.
-    #[default]
     Paper,
 }
 
