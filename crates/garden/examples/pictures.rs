@@ -83,10 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut project = project;
     if no_midrib {
         for t in &mut project.flower.templates {
-            t.maps = flowers::lily_maps(flowers::LilyExcess {
-                midrib_early: 0.0,
-                ..flowers::LilyExcess::PETAL
-            })?;
+            t.maps = flowers::lily_maps(flowers::LilyExcess::PETAL.without_midrib_warping())?;
         }
     }
     let selection = only.map_or(Selection::All, Selection::Only);

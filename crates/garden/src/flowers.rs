@@ -46,9 +46,9 @@ pub fn flower(name: &str) -> Option<Result<Project, GardenError>> {
 /// fine enough that every flower's final shape lies within 5 % (tip
 /// distance over midrib length) of the same flower at four times the
 /// particles (README, refinement table). At the paper's own meshes the
-/// lily's midrib band is only about four triangles wide and the tip lands
-/// 7 % away.
-pub const EDGE_SCALE: f64 = 0.7;
+/// lily's midrib band is only about four triangles wide and its tip lands
+/// 9 % away; at 0.7 of them, 5.6 %; at 0.6, 2.4 %.
+pub const EDGE_SCALE: f64 = 0.6;
 
 /// Builds the default flower called `name` with every bud remeshed at
 /// `edge_scale` times the paper's mean edge (Table 1; the default flowers
@@ -113,28 +113,40 @@ const LILY_MIDRIB_HALF_WIDTH: f64 = 0.12;
 /// grow.
 const LILY_BASE_V: f64 = 0.06;
 
-/// How much e-growth-in exceeds e-growth on the lily's tepals.
+/// How much e-growth-in exceeds e-growth on the lily's tepals (negative:
+/// the outer side grows more).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LilyExcess {
     /// On the midrib, early (steps 1–40); late it is 0.
     pub midrib_early: f64,
-    /// On the lamina, early and late.
-    pub lamina: f64,
+    /// On the lamina, early.
+    pub lamina_early: f64,
+    /// On the lamina, late (steps 50–100).
+    pub lamina_late: f64,
+    /// On the bottom region, early and late.
+    pub bottom: f64,
 }
 
 impl LilyExcess {
     /// The petal's.
     pub const PETAL: LilyExcess = LilyExcess {
-        midrib_early: 0.4,
-        lamina: 0.035,
+        midrib_early: 0.5,
+        lamina_early: 0.06,
+        lamina_late: 0.01,
+        bottom: -0.25,
     };
-    /// The sepal's: a little less, since the narrower sepal is less cupped
-    /// and bends back more easily; with the petal's excess it would end
-    /// curled right under while the petals only reflex.
-    pub const SEPAL: LilyExcess = LilyExcess {
-        midrib_early: 0.3,
-        lamina: 0.025,
-    };
+    /// The sepal's: the petal's ("the opening behavior of a sepal is almost
+    /// the same as that of a petal").
+    pub const SEPAL: LilyExcess = LilyExcess::PETAL;
+
+    /// The control of the paper's Fig. 13: the midrib grows like the lamina
+    /// beside it.
+    pub fn without_midrib_warping(self) -> LilyExcess {
+        LilyExcess {
+            midrib_early: self.lamina_early,
+            ..self
+        }
+    }
 }
 
 /// The lily's growth maps (paper §6.1, Fig. 2), painted alike for petals
@@ -146,14 +158,22 @@ impl LilyExcess {
 ///   (`v` below about 0.15) and the *lamina* (the rest);
 /// - e-growth elongates midrib and lamina equally, the bottom less;
 /// - early (steps 1–40) e-growth-in exceeds e-growth strongly on the midrib
-///   and slightly on the lamina; late (50–100) they are equal on the midrib
-///   and the lamina keeps its slight excess; linear blend in between;
+///   ("the midrib reflexes strongly and pulls the lamina behind") and
+///   slightly on the lamina; late (50–100) they are equal on the midrib
+///   ("the midrib gradually stops warping") and the lamina keeps a slight
+///   excess; linear blend in between;
+/// - the bottom region's outer side grows more than its inner one, so the
+///   tepals' claws stay upright around the pistil and stamens: the flower
+///   keeps a cupped base while the joint (+23°) and the blades open;
 /// - w-growth and w-growth-in are slightly larger on the lamina;
 /// - direction along the parallel venation, fanning a little to the
 ///   margins; the midrib is stiffer than the lamina.
-pub fn lily_maps(midrib_excess: LilyExcess) -> Result<KeyedMaps, MapError> {
-    const E: f64 = 0.6;
-    const E_BOTTOM: f64 = 0.25;
+///
+/// The maps are clamped to `[0, 1]`, so the midrib's early inner growth
+/// (`E + midrib_early`) is at most 1: e-growth is 0.5 to leave it room.
+pub fn lily_maps(excess: LilyExcess) -> Result<KeyedMaps, MapError> {
+    const E: f64 = 0.5;
+    const E_BOTTOM: f64 = 0.4;
     const W_MIDRIB: f64 = 0.15;
     const W_LAMINA: f64 = 0.3;
     const W_IN_EXCESS: f64 = 0.12;
@@ -168,13 +188,13 @@ pub fn lily_maps(midrib_excess: LilyExcess) -> Result<KeyedMaps, MapError> {
     };
     let w_in =
         move |uv: DVec2| w(uv) + grows(uv) * (1.0 - bottom(uv)) * W_IN_EXCESS * (1.0 - midrib(uv));
-    let lamina_excess = midrib_excess.lamina;
-    let excess = move |uv: DVec2, midrib: f64| {
-        let m = midrib_band(uv.x, LILY_MIDRIB_HALF_WIDTH);
-        grows(uv) * (1.0 - bottom(uv)) * (midrib * m + lamina_excess * (1.0 - m))
+    let e_in = move |uv: DVec2, midrib_excess: f64, lamina_excess: f64| {
+        let m = midrib(uv);
+        let blade = midrib_excess * m + lamina_excess * (1.0 - m);
+        e(uv) + grows(uv) * (blade * (1.0 - bottom(uv)) + excess.bottom * bottom(uv))
     };
-    let e_in_early = move |uv: DVec2| e(uv) + excess(uv, midrib_excess.midrib_early);
-    let e_in_late = move |uv: DVec2| e(uv) + excess(uv, 0.0);
+    let e_in_early = move |uv: DVec2| e_in(uv, excess.midrib_early, excess.lamina_early);
+    let e_in_late = move |uv: DVec2| e_in(uv, 0.0, excess.lamina_late);
     let stiffness = move |uv: DVec2| 0.3 + (1.0 - 0.3) * midrib(uv);
     let direction = |uv: DVec2| DVec2::new(0.15 * (uv.x - 0.5) * uv.y, 1.0);
     let key = |e_in: &dyn Fn(DVec2) -> f64| {
@@ -276,7 +296,7 @@ fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, color: [f32; 4]) ->
 }
 
 /// The lily petal template: [`lily_petal_bud`] meshed at [`EDGE_SCALE`]
-/// times Table 1's edge 1.3 (about twice the paper's 388 particles),
+/// times Table 1's edge 1.3 (about 2.6 times the paper's 388 particles),
 /// [`lily_maps`], Table 1's material.
 pub fn lily_petal_template() -> Result<Template, GardenError> {
     lily_petal_template_at(EDGE_SCALE)
@@ -293,7 +313,7 @@ fn lily_petal_template_at(edge_scale: f64) -> Result<Template, GardenError> {
 }
 
 /// The lily sepal template: [`lily_sepal_bud`] meshed at [`EDGE_SCALE`]
-/// times Table 1's edge 1.4 (about twice the paper's 323 particles), the
+/// times Table 1's edge 1.4 (about 2.6 times the paper's 323 particles), the
 /// petal's maps.
 pub fn lily_sepal_template() -> Result<Template, GardenError> {
     lily_sepal_template_at(EDGE_SCALE)
@@ -535,8 +555,8 @@ pub fn eustoma_maps(cultivar: Cultivar) -> Result<KeyedMaps, MapError> {
 }
 
 /// The Eustoma petal template of `cultivar`: [`eustoma_petal_bud`] meshed
-/// at [`EDGE_SCALE`] times Table 1's edge 2.0 (about twice the paper's 261
-/// particles), the cultivar's maps,
+/// at [`EDGE_SCALE`] times Table 1's edge 2.0 (about 2.6 times the paper's
+/// 261 particles), the cultivar's maps,
 /// Table 1's material.
 pub fn eustoma_petal_template(cultivar: Cultivar) -> Result<Template, GardenError> {
     eustoma_petal_template_at(cultivar, EDGE_SCALE)

@@ -134,11 +134,9 @@ fn lily_midrib_leads_and_swells_the_petal() {
     // against the same petal whose midrib grows like its lamina.
     let project = lily();
     let mut control = project.clone();
-    control.flower.templates[0].maps = flowers::lily_maps(flowers::LilyExcess {
-        midrib_early: 0.0,
-        ..flowers::LilyExcess::PETAL
-    })
-    .expect("control maps");
+    control.flower.templates[0].maps =
+        flowers::lily_maps(flowers::LilyExcess::PETAL.without_midrib_warping())
+            .expect("control maps");
     let lily = shapes(&project, &Selection::Only(0), &[0]);
     let flat_midrib = shapes(&control, &Selection::Only(0), &[0]);
     print("lily petal", &lily);

@@ -239,31 +239,44 @@ impl EdgeSmoothedMembrane {
         for d in &self.domains {
             let (s, v) = Self::strains(d, x, rest_lengths);
             let r = Self::stresses(d, &s);
+            // Summed per pair of the domain's (three or four) particles
+            // first, then added to the sparse matrix once per pair.
+            let particles = d.count.div_ceil(2) + 1;
+            let mut local = [[DMat3::ZERO; 4]; 4];
             for a in 0..d.count {
-                let [pa, pb] = d.pairs[a];
+                let [la, lb] = SLOT_PARTICLES[a];
                 if r[a] > 0.0 {
                     let block = DMat3::IDENTITY * r[a];
-                    pattern.add_block(values, pa, pa, &block);
-                    pattern.add_block(values, pb, pb, &block);
-                    pattern.add_block(values, pa, pb, &(-block));
+                    local[la][la] += block;
+                    local[lb][lb] += block;
+                    local[la][lb] -= block;
+                    local[lb][la] -= block;
                 }
                 for b in 0..d.count {
-                    let [qa, qb] = d.pairs[b];
+                    let [qa, qb] = SLOT_PARTICLES[b];
+                    // ∇s_a is +v_a at la and −v_a at lb.
                     let block = outer(v[a], v[b]) * d.q[a][b];
-                    // ∇s_a is +v_a at pa and −v_a at pb. Each unordered
-                    // particle pair is added once: add_block mirrors it.
-                    for (p, sign_p) in [(pa, 1.0), (pb, -1.0)] {
-                        for (q, sign_q) in [(qa, 1.0), (qb, -1.0)] {
-                            if p <= q {
-                                pattern.add_block(values, p, q, &(block * (sign_p * sign_q)));
-                            }
-                        }
-                    }
+                    local[la][qa] += block;
+                    local[la][qb] -= block;
+                    local[lb][qa] -= block;
+                    local[lb][qb] += block;
+                }
+            }
+            let ids = [d.pairs[0][0], d.pairs[0][1], d.pairs[1][1], d.pairs[3][1]];
+            for p in 0..particles {
+                for q in p..particles {
+                    // add_block mirrors (p, q) to (q, p); for p == q only
+                    // the upper triangle of the (symmetric) block is used.
+                    pattern.add_block(values, ids[p], ids[q], &local[p][q]);
                 }
             }
         }
     }
 }
+
+/// The domain's particles `i, j, k, l` (local 0–3) at the ends of each edge
+/// slot: `i -> j`, `j -> k`, `k -> i`, `i -> l`, `l -> j`.
+const SLOT_PARTICLES: [[usize; 2]; 5] = [[0, 1], [1, 2], [2, 0], [0, 3], [3, 1]];
 
 #[cfg(test)]
 mod tests {
