@@ -123,21 +123,27 @@ pub struct LilyExcess {
     pub lamina_early: f64,
     /// On the lamina, late (steps 50–100).
     pub lamina_late: f64,
-    /// On the bottom region, early and late.
-    pub bottom: f64,
+    /// On the bottom region, early; late it is 0.
+    pub bottom_early: f64,
 }
 
 impl LilyExcess {
     /// The petal's.
     pub const PETAL: LilyExcess = LilyExcess {
         midrib_early: 0.5,
-        lamina_early: 0.06,
+        lamina_early: 0.08,
         lamina_late: 0.01,
-        bottom: -0.25,
+        bottom_early: -0.4,
     };
-    /// The sepal's: the petal's ("the opening behavior of a sepal is almost
-    /// the same as that of a petal").
-    pub const SEPAL: LilyExcess = LilyExcess::PETAL;
+    /// The sepal's: a little less on the blade, since the narrower, less
+    /// cupped sepal bends back more easily; with the petal's excess it ends
+    /// 40° further reflexed while the paper has them open alike.
+    pub const SEPAL: LilyExcess = LilyExcess {
+        midrib_early: 0.45,
+        lamina_early: 0.05,
+        lamina_late: 0.005,
+        bottom_early: -0.4,
+    };
 
     /// The control of the paper's Fig. 13: the midrib grows like the lamina
     /// beside it.
@@ -162,9 +168,10 @@ impl LilyExcess {
 ///   slightly on the lamina; late (50–100) they are equal on the midrib
 ///   ("the midrib gradually stops warping") and the lamina keeps a slight
 ///   excess; linear blend in between;
-/// - the bottom region's outer side grows more than its inner one, so the
-///   tepals' claws stay upright around the pistil and stamens: the flower
-///   keeps a cupped base while the joint (+23°) and the blades open;
+/// - early, the bottom region's outer side grows more than its inner one,
+///   so the tepals' claws turn back up around the pistil and stamens while
+///   the joint (+23° over steps 1–60) tilts them out: the flower keeps a
+///   cupped base while the blades reflex;
 /// - w-growth and w-growth-in are slightly larger on the lamina;
 /// - direction along the parallel venation, fanning a little to the
 ///   margins; the midrib is stiffer than the lamina.
@@ -188,13 +195,20 @@ pub fn lily_maps(excess: LilyExcess) -> Result<KeyedMaps, MapError> {
     };
     let w_in =
         move |uv: DVec2| w(uv) + grows(uv) * (1.0 - bottom(uv)) * W_IN_EXCESS * (1.0 - midrib(uv));
-    let e_in = move |uv: DVec2, midrib_excess: f64, lamina_excess: f64| {
+    let e_in = move |uv: DVec2, midrib_excess: f64, lamina_excess: f64, bottom_excess: f64| {
         let m = midrib(uv);
         let blade = midrib_excess * m + lamina_excess * (1.0 - m);
-        e(uv) + grows(uv) * (blade * (1.0 - bottom(uv)) + excess.bottom * bottom(uv))
+        e(uv) + grows(uv) * (blade * (1.0 - bottom(uv)) + bottom_excess * bottom(uv))
     };
-    let e_in_early = move |uv: DVec2| e_in(uv, excess.midrib_early, excess.lamina_early);
-    let e_in_late = move |uv: DVec2| e_in(uv, 0.0, excess.lamina_late);
+    let e_in_early = move |uv: DVec2| {
+        e_in(
+            uv,
+            excess.midrib_early,
+            excess.lamina_early,
+            excess.bottom_early,
+        )
+    };
+    let e_in_late = move |uv: DVec2| e_in(uv, 0.0, excess.lamina_late, 0.0);
     let stiffness = move |uv: DVec2| 0.3 + (1.0 - 0.3) * midrib(uv);
     let direction = |uv: DVec2| DVec2::new(0.15 * (uv.x - 0.5) * uv.y, 1.0);
     let key = |e_in: &dyn Fn(DVec2) -> f64| {
