@@ -120,6 +120,9 @@ pub fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // A reader that stopped reading (`anthesis info … | head -1`) is not
+        // an error worth a message.
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", one_line(&error_message(&e)));
             ExitCode::FAILURE
@@ -144,6 +147,15 @@ fn error_message(error: &anyhow::Error) -> String {
         }
     }
     parts.join(": ")
+}
+
+/// Whether `error` comes from writing to a pipe whose reader has gone.
+fn is_broken_pipe(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 /// Folds a multi-line message (TOML errors quote the offending line) into

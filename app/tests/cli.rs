@@ -318,3 +318,20 @@ fn a_mesh_in_another_unit_is_named_before_the_run() {
         assert!(!stderr.contains("simulated"), "{stderr}");
     }
 }
+
+#[test]
+fn a_reader_that_stops_reading_ends_the_output_quietly() {
+    // `anthesis info builtin:lily | head -1`: the pipe's reader is gone
+    // before the first line is written.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        .args(["info", "builtin:lily"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("the binary ends");
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(stderr.is_empty(), "nothing on stderr, got: {stderr}");
+}

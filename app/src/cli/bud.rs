@@ -2,6 +2,7 @@
 //! petal, a bicubic Bézier patch or a PDE sweep surface), remeshed by
 //! `anthesis-bud` and written as OBJ, with its quality on one line.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anthesis_bud::{
@@ -166,7 +167,7 @@ pub fn bud(args: &BudArgs) -> Result<()> {
     if let Some(out) = &args.out {
         anthesis_files::write_atomic(out, anthesis_mesh::obj_string(&mesh).as_bytes())?;
     }
-    println!("{}", quality_line(&quality));
+    writeln!(std::io::stdout().lock(), "{}", quality_line(&quality))?;
     if let Some(out) = &args.out {
         eprintln!("wrote {}", out.display());
     }

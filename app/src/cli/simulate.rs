@@ -16,18 +16,20 @@ use super::{load, selection};
 pub(super) fn info(path: &Path) -> Result<()> {
     let project = load(path)?;
     let flower = &project.flower;
+    let mut stdout = std::io::stdout().lock();
     for (i, organ) in flower.organs.iter().enumerate() {
         let template = flower.template_of(i);
         let topology = anthesis_mesh::validate(&template.mesh)
             .with_context(|| format!("template `{}` has a bad mesh", template.name))?;
-        println!(
+        writeln!(
+            stdout,
             "{} {} {} {} {}",
             organ.name,
             template.name,
             template.mesh.vertex_count(),
             template.mesh.triangle_count(),
             topology.edges.len()
-        );
+        )?;
     }
     Ok(())
 }

@@ -1,64 +1,131 @@
-//! Refinement study: runs one organ (or the whole flower) of a default
-//! flower at several mesh resolutions and prints how far each run's final
-//! shape lies from the finest one.
+//! Convergence study of a default flower: runs it (one organ, or the whole
+//! flower with `--whole`) under several resolutions, time steps or solver
+//! tolerances and prints how far each run's final shape lies from the last
+//! (the most accurate) one, as a percentage of its midrib length.
 //!
-//!   cargo run --release -p anthesis-garden --example refine -- FLOWER [SCALES] [--whole]
+//! ```text
+//! cargo run --release -p anthesis-garden --example refine -- FLOWER [--scales 1,0.6,0.3]
+//! cargo run --release -p anthesis-garden --example refine -- FLOWER --keyframes 50,100,200
+//! cargo run --release -p anthesis-garden --example refine -- FLOWER --tolerances 1e-5,1e-6,1e-8
+//! ```
 //!
-//! SCALES: comma-separated edge scales (default 1,0.707,0.5; 0.5 is about
-//! four times the particles).
+//! `--scales`: mesh edge as a fraction of Table 1's (the default flowers use
+//! `EDGE_SCALE`; half of it is four times the particles). `--keyframes N`:
+//! the same opening in N steps (dg, time keys and joint schedule scaled so
+//! that dg·N and the keys' place in the opening stay fixed). `--tolerances`:
+//! the solver's relative tolerance. Add `--whole` for the whole flower
+//! (organ 0 is measured), `--paper` for the paper's model.
 use std::time::Instant;
 
-use anthesis_garden::flowers::flower_at_resolution;
+use anthesis_flower::Project;
+use anthesis_garden::flowers::{EDGE_SCALE, flower_at_resolution};
 use anthesis_garden::shape::{UvSampler, organ_shape};
 use anthesis_sim::{Selection, run};
 use glam::{DVec2, DVec3};
 
+/// Points compared between runs: the tip, the middle of the midrib and two
+/// lamina points.
+const PROBES: [(f64, f64); 4] = [(0.5, 1.0), (0.5, 0.5), (0.2, 0.7), (0.8, 0.7)];
+
+fn list(args: &[String], flag: &str) -> Option<Vec<f64>> {
+    let at = args.iter().position(|a| a == flag)?;
+    let values = args
+        .get(at + 1)
+        .expect("a comma-separated list after the flag");
+    Some(
+        values
+            .split(',')
+            .map(|v| v.parse().expect("a number"))
+            .collect(),
+    )
+}
+
+/// The same opening in `keyframes` steps instead of the project's.
+fn in_steps(mut project: Project, keyframes: u32) -> Project {
+    let factor = f64::from(keyframes) / f64::from(project.settings.keyframes);
+    let scale = |step: u32| (f64::from(step) * factor).round() as u32;
+    project.settings.keyframes = keyframes;
+    for template in &mut project.flower.templates {
+        template.dg /= factor;
+        for key in template.maps.keys_mut() {
+            key.step = scale(key.step);
+        }
+        for ramp in &mut template.joint_schedule {
+            ramp.from_step = scale(ramp.from_step);
+            ramp.to_step = scale(ramp.to_step);
+        }
+    }
+    project
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let name = args.first().map_or("lily", String::as_str);
-    let scales: Vec<f64> = args
-        .get(1)
-        .filter(|a| !a.starts_with("--"))
-        .map_or("1,0.707,0.5", String::as_str)
-        .split(',')
-        .map(|s| s.parse().expect("scale"))
-        .collect();
-    let whole = args.iter().any(|a| a == "--whole");
-    let selection = if whole {
+    let build = |scale: f64| {
+        let mut project = flower_at_resolution(name, scale)
+            .expect("a default flower's name")
+            .expect("the flower builds");
+        if args.iter().any(|a| a == "--paper") {
+            project.settings.model = anthesis_physics::Model::Paper;
+        }
+        project
+    };
+    let variants: Vec<(String, Project)> = if let Some(keyframes) = list(&args, "--keyframes") {
+        keyframes
+            .iter()
+            .map(|&n| {
+                (
+                    format!("{n:4} keyframes"),
+                    in_steps(build(EDGE_SCALE), n as u32),
+                )
+            })
+            .collect()
+    } else if let Some(tolerances) = list(&args, "--tolerances") {
+        tolerances
+            .iter()
+            .map(|&t| {
+                let mut project = build(EDGE_SCALE);
+                project.settings.solver.relative_tolerance = t;
+                (format!("tolerance {t:.0e}"), project)
+            })
+            .collect()
+    } else {
+        list(&args, "--scales")
+            .unwrap_or(vec![1.0, EDGE_SCALE, 0.5 * EDGE_SCALE])
+            .iter()
+            .map(|&s| (format!("edge scale {s:4.2}"), build(s)))
+            .collect()
+    };
+    let selection = if args.iter().any(|a| a == "--whole") {
         Selection::All
     } else {
         Selection::Only(0)
     };
+
     let mut results = Vec::new();
-    for &scale in &scales {
-        let mut project = flower_at_resolution(name, scale)
-            .expect("known flower")
-            .expect("builds");
-        if args.iter().any(|a| a == "--paper") {
-            project.settings.model = anthesis_physics::Model::Paper;
-        }
-        if args.iter().any(|a| a == "--from-rest") {
-            project.settings.bend_base = anthesis_physics::BendBase::RestAngle;
-        }
+    for (label, project) in &variants {
         let mesh = project.flower.templates[0].mesh.clone();
         let started = Instant::now();
         let mut last = Vec::new();
-        let outcome = run(&project, &selection, &mut |_, k| {
-            last = k.positions_in_world[0].clone();
-        });
-        let seconds = started.elapsed().as_secs_f64();
-        if let Err(e) = outcome {
-            println!("scale {scale}: {e}");
+        if let Err(e) = run(project, &selection, &mut |_, k| {
+            last.clone_from(&k.positions_in_world[0]);
+        }) {
+            println!("{label}: {e}");
             continue;
         }
-        let shape = organ_shape(&mesh, &last).expect("shape");
+        let seconds = started.elapsed().as_secs_f64();
+        let shape = organ_shape(&mesh, &last).expect("measurable");
         let sampler = UvSampler::new(&mesh);
-        let probes: Vec<DVec3> = [(0.5, 1.0), (0.5, 0.5), (0.2, 0.7), (0.8, 0.7)]
+        let probes: Vec<DVec3> = PROBES
             .iter()
-            .map(|&(u, v)| sampler.point(&last, DVec2::new(u, v)).expect("probe"))
+            .map(|&(u, v)| {
+                sampler
+                    .point(&last, DVec2::new(u, v))
+                    .expect("on the organ")
+            })
             .collect();
         println!(
-            "scale {scale:5.3}: {:5} particles {:6.2} s  turning {:7.1}°  angles {:6.1} {:6.1} {:6.1}  cupping {:+.3}  length {:.2}",
+            "{label}: {:5} particles {:6.2} s  turning {:6.1}°  angles {:5.1} {:5.1} {:5.1}  cupping {:+.3}",
             mesh.vertex_count(),
             seconds,
             shape.midrib_turning_deg,
@@ -66,22 +133,22 @@ fn main() {
             shape.midrib_angles_deg[1],
             shape.midrib_angles_deg[2],
             shape.cupping,
-            shape.midrib_length
         );
-        results.push((scale, mesh.vertex_count(), probes, shape.midrib_length));
+        results.push((label.clone(), probes, shape.midrib_length));
     }
-    if let Some((_, n, finest, length)) = results.last().cloned() {
-        println!("distance to the finest run ({n} particles), over its midrib length {length:.2}:");
-        for (scale, count, probes, _) in &results {
-            let d: Vec<String> = probes
-                .iter()
-                .zip(&finest)
-                .map(|(a, b)| format!("{:5.1} %", 100.0 * a.distance(*b) / length))
-                .collect();
-            println!(
-                "  scale {scale:5.3} ({count:5} particles): tip {}  mid {}  lamina {} {}",
-                d[0], d[1], d[2], d[3]
-            );
-        }
+    let Some((reference, finest, length)) = results.last().cloned() else {
+        return;
+    };
+    println!(
+        "distance to the {reference} run at keyframe 100, over its midrib length {length:.1}:"
+    );
+    println!("| run | tip | midrib middle | lamina | lamina |\n|---|---|---|---|---|");
+    for (label, probes, _) in &results {
+        let d: Vec<String> = probes
+            .iter()
+            .zip(&finest)
+            .map(|(a, b)| format!("{:.1} %", 100.0 * a.distance(*b) / length))
+            .collect();
+        println!("| {label} | {} |", d.join(" | "));
     }
 }
