@@ -18,7 +18,7 @@ use anthesis_maps::{
 };
 use anthesis_mesh::MeshError;
 use anthesis_mesh::generate::test_petal;
-use anthesis_physics::SolverSettings;
+use anthesis_physics::{Model, SolverSettings};
 use glam::{DVec2, DVec3};
 
 /// A value a 16-bit greyscale PNG holds exactly, as the map loader reads it.
@@ -236,7 +236,7 @@ fn saved_files_have_stable_names_and_constants_stay_numbers() {
     let text = fs::read_to_string(&path).expect("read");
     for line in [
         "format = \"anthesis-project\"",
-        "version = 1",
+        "version = 2",
         "w_growth = 0.2",
         "direction = [0.25, 0.75]",
         "e_growth = \"maps/petal-step0-e_growth.png\"",
@@ -383,21 +383,21 @@ fn a_newer_version_says_so() {
     // A newer version may have fields this build does not know: the version
     // error must win over the unknown field.
     edit(&path, |text| {
-        replace_once(text, "version = 1", "version = 2\nwind = \"strong\"")
+        replace_once(text, "version = 2", "version = 3\nwind = \"strong\"")
     });
     let error = load_project(&path).expect_err("newer");
     assert_eq!(
         error,
         ProjectError::NewerVersion {
             path: path.clone(),
-            found: 2,
+            found: 3,
             supported: FORMAT_VERSION,
         }
     );
     assert_eq!(
         error.to_string(),
         format!(
-            "{} was written by a newer Anthesis (format version 2; this build reads up to 1)",
+            "{} was written by a newer Anthesis (format version 3; this build reads up to 2)",
             path.display()
         )
     );
@@ -408,7 +408,7 @@ fn version_zero_or_text_is_invalid() {
     for version in ["0", "\"1\""] {
         let (_folder, path) = saved_lily();
         edit(&path, |text| {
-            replace_once(text, "version = 1", &format!("version = {version}"))
+            replace_once(text, "version = 2", &format!("version = {version}"))
         });
         let error = load_project(&path).expect_err("bad version");
         assert!(matches!(error, ProjectError::Invalid { .. }), "{error:?}");
@@ -762,7 +762,14 @@ template = "petal"
     let project = parse_project(text, &resolver).expect("parses");
 
     assert_eq!(project.name, "embedded");
-    assert_eq!(project.settings, SimulationSettings::default());
+    // A version 1 file names no model: it was made with the paper's.
+    assert_eq!(
+        project.settings,
+        SimulationSettings {
+            model: Model::Paper,
+            ..SimulationSettings::default()
+        }
+    );
     let template = &project.flower.templates[0];
     assert_eq!(template.mesh, mesh);
     assert_eq!(template.thickness, 1.0);
@@ -1155,5 +1162,66 @@ fn obj_warnings_reach_the_caller_naming_the_file() {
             && loaded.warnings[0].contains("2 line (`l`) statements ignored"),
         "{:?}",
         loaded.warnings
+
+#[test]
+fn the_model_is_read_from_the_file_and_version_1_files_keep_the_papers() {
+    use anthesis_physics::BendBase;
+    let (_folder, path) = saved_lily();
+    let text = fs::read_to_string(&path).expect("saved");
+    assert!(text.contains("version = 2"), "{text}");
+    assert!(text.contains("model = \"consistent\""), "{text}");
+    assert!(text.contains("bend_from = \"dihedral\""), "{text}");
+    let settings = |path: &Path| load_project(path).expect("loads").settings;
+    assert_eq!(settings(&path).model, Model::Consistent);
+
+    // Without a model, version 2 means the default and version 1 the
+    // paper's, which is what a version 1 file was made with.
+    edit(&path, |t| replace_once(t, "model = \"consistent\"\n", ""));
+    assert_eq!(settings(&path).model, Model::Consistent);
+    edit(&path, |t| replace_once(t, "version = 2", "version = 1"));
+    assert_eq!(settings(&path).model, Model::Paper);
+
+    edit(&path, |t| {
+        replace_once(
+            t,
+            "bend_from = \"dihedral\"",
+            "model = \"paper\"\nbend_from = \"rest_angle\"",
+        )
+    });
+    let read = settings(&path);
+    assert_eq!(
+        (read.model, read.bend_base),
+        (Model::Paper, BendBase::RestAngle)
+    );
+
+    edit(&path, |t| {
+        replace_once(t, "model = \"paper\"", "model = \"exact\"")
+    });
+    let error = load_project(&path).expect_err("unknown model");
+    assert!(matches!(error, ProjectError::Syntax { .. }), "{error:?}");
+    assert!(error.to_string().contains("exact"), "{error}");
+}
+
+/// A project saved by the release that wrote format version 1 (the
+/// Pinocchio asset as it was then, kept byte for byte) still opens, with the
+/// paper's model it was made with.
+#[test]
+fn a_version_1_project_from_the_previous_release_opens() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/version-1-pinocchio/eustoma-pinocchio.anthesis.toml");
+    assert!(
+        fs::read_to_string(&path)
+            .expect("fixture")
+            .contains("version = 1"),
+        "the fixture must stay a version 1 file"
+    );
+    let project = load_project(&path).expect("a version 1 project opens");
+    assert_eq!(project.name, "Eustoma 'Pinocchio'");
+    assert_eq!(project.flower.organs.len(), 5);
+    assert_eq!(project.flower.templates.len(), 1);
+    assert_eq!(project.settings.model, Model::Paper);
+    assert_eq!(
+        project.settings.bend_base,
+        anthesis_physics::BendBase::Dihedral
     );
 }

@@ -159,7 +159,7 @@ impl Loader<'_> {
                 organs,
                 overlaps,
             },
-            settings: SimulationSettings::from(&file.simulation),
+            settings: file.simulation.settings(file.version),
         })
     }
 

@@ -4,7 +4,7 @@
 //!
 //! ```toml
 //! format = "anthesis-project"
-//! version = 1
+//! version = 2
 //! name = "Asiatic lily"
 //!
 //! [simulation]                 # optional; each field defaults as shown
@@ -12,6 +12,11 @@
 //! relative_tolerance = 0.000001
 //! max_iterations = 50
 //! collision_offset = 0.01
+//! model = "consistent"         # or "paper" (see anthesis_physics::model);
+//!                              # version 1 files, which have no model, are
+//!                              # read as "paper", the model they were made with
+//! bend_from = "dihedral"       # or "rest_angle": what a hinge's growth adds
+//!                              # to, its current dihedral or its rest angle
 //!
 //! [[templates]]
 //! name = "petal"
@@ -112,7 +117,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// Where saved meshes go, relative to the project file.
 pub const MESH_FOLDER: &str = "meshes";

@@ -4,7 +4,7 @@
 use std::fmt;
 
 use anthesis_maps::{Blend, MapKind};
-use anthesis_physics::SolverSettings;
+use anthesis_physics::{BendBase, Model, SolverSettings};
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 
@@ -33,11 +33,36 @@ pub(super) struct SimulationFile {
     pub(super) relative_tolerance: f64,
     pub(super) max_iterations: u32,
     pub(super) collision_offset: f64,
+    /// Absent in version 1 files, which were made with the paper's model.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(super) model: Option<ModelFile>,
+    pub(super) bend_from: BendFromFile,
+}
+
+/// [`Model`] in the file.
+#[derive(Serialize, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum ModelFile {
+    Consistent,
+    Paper,
+}
+
+/// [`BendBase`] in the file.
+#[derive(Serialize, Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum BendFromFile {
+    #[default]
+    Dihedral,
+    RestAngle,
 }
 
 impl Default for SimulationFile {
+    /// What a missing field means; `model` is left to the format version.
     fn default() -> Self {
-        SimulationFile::from(&SimulationSettings::default())
+        SimulationFile {
+            model: None,
+            ..SimulationFile::from(&SimulationSettings::default())
+        }
     }
 }
 
@@ -268,6 +293,34 @@ impl From<&SimulationSettings> for SimulationFile {
             relative_tolerance: settings.solver.relative_tolerance,
             max_iterations: settings.solver.max_iterations,
             collision_offset: settings.collision_offset,
+            model: Some(match settings.model {
+                Model::Consistent => ModelFile::Consistent,
+                Model::Paper => ModelFile::Paper,
+            }),
+            bend_from: match settings.bend_base {
+                BendBase::Dihedral => BendFromFile::Dihedral,
+                BendBase::RestAngle => BendFromFile::RestAngle,
+            },
+        }
+    }
+}
+
+impl SimulationFile {
+    /// The settings this table describes in a file of format `version`: a
+    /// version 1 file names no model and was made with the paper's.
+    pub(super) fn settings(&self, version: u32) -> SimulationSettings {
+        let model = match (self.model, version) {
+            (Some(ModelFile::Consistent), _) => Model::Consistent,
+            (Some(ModelFile::Paper), _) | (None, 1) => Model::Paper,
+            (None, _) => Model::default(),
+        };
+        SimulationSettings {
+            model,
+            bend_base: match self.bend_from {
+                BendFromFile::Dihedral => BendBase::Dihedral,
+                BendFromFile::RestAngle => BendBase::RestAngle,
+            },
+            ..SimulationSettings::from(self)
         }
     }
 }
