@@ -441,8 +441,11 @@ pub const EUSTOMA_DG: f64 = 0.003;
 pub const EUSTOMA_THICKNESS: f64 = 0.1;
 pub const EUSTOMA_STIFFNESS: f64 = 10.0;
 pub const EUSTOMA_EDGE: f64 = 2.0;
-/// How much further out each petal's left margin lies than its right one.
-pub const EUSTOMA_CONTORTION: f64 = 2.4;
+/// How much further out each petal's left margin lies than its right one:
+/// enough that where neighbours overlap in the bud they lie about 2.6
+/// thicknesses apart, wrapped around each other as in a real contorted bud
+/// (with more, the petals never meet and collisions never act).
+pub const EUSTOMA_CONTORTION: f64 = 0.6;
 
 /// The Eustoma petal of the closed, contorted bud shared by the three
 /// cultivars: a narrow claw, an obovate blade widest at about two thirds of
@@ -479,40 +482,55 @@ fn eustoma_regions(v: f64) -> [f64; 3] {
     [lower, 1.0 - lower - upper, upper]
 }
 
-/// One cultivar's growth: per stage (early, late), per region (lower,
-/// middle, upper): e-growth, e-growth-in excess; and the w-growth and
-/// w-growth-in excess, per stage.
-struct EustomaGrowth {
-    e: [[f64; 3]; 2],
-    e_in_excess: [[f64; 3]; 2],
-    w: [f64; 2],
-    w_in_excess: [[f64; 3]; 2],
+/// One cultivar's growth: per stage (early, late) and per region (lower,
+/// middle, upper), the e-growth, the w-growth and how much the inner side
+/// outgrows the base along (e-growth-in excess) and across (w-growth-in
+/// excess) the growth direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EustomaGrowth {
+    pub e: [[f64; 3]; 2],
+    pub e_in_excess: [[f64; 3]; 2],
+    pub w: [[f64; 3]; 2],
+    pub w_in_excess: [[f64; 3]; 2],
     /// How much the growth direction fans out towards the margins.
-    fan: f64,
+    pub fan: f64,
+    /// Stretch and bend stiffness of the upper region, relative to the
+    /// lower one.
+    pub top_stiffness: f64,
 }
 
-fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
+/// The growth of `cultivar` (see [`eustoma_maps`]).
+pub fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
     match cultivar {
         // Bell: growth is larger late, when the inner upper region expands
-        // much more than the outer lower and middle: the tips reflex while
-        // the lower part stays a tube.
+        // more than the outer and the inner middle a little more: the tips
+        // flare out and reflex without rolling up, while the lower part
+        // stays a tube. The petals broaden almost as fast as they lengthen,
+        // so the tube keeps its contorted overlap.
         Cultivar::MellowYellow => EustomaGrowth {
             e: [[0.3, 0.3, 0.3], [0.6, 0.6, 0.7]],
-            e_in_excess: [[0.0, 0.02, 0.06], [0.0, 0.02, 0.25]],
-            w: [0.2, 0.4],
+            e_in_excess: [[0.0, 0.02, 0.06], [0.0, 0.06, 0.14]],
+            w: [[0.9; 3], [0.8; 3]],
             w_in_excess: [[0.0, 0.0, 0.05], [0.0, 0.0, 0.15]],
             fan: 0.0,
+            top_stiffness: 0.5,
         },
         // Funnel: growth larger early, no inner excess in the lower region
-        // and a small, nearly uniform one above it that just undoes the
-        // bud's inward curl: the petal straightens and flattens (w-growth-in
-        // excess across) and opens as a cone. Veins fan out more.
+        // and a small one above it that undoes the bud's inward curl: the
+        // petal straightens (late, w-growth-in excess across flattens it a
+        // little). The petals broaden as fast as the maps allow early, so
+        // they stay wrapped around each other and press on their
+        // neighbours: the corolla opens as a narrow cone of overlapping
+        // petals, not a saucer. Veins fan out more.
         Cultivar::MaiteLady => EustomaGrowth {
             e: [[0.7, 0.7, 0.7], [0.3, 0.3, 0.3]],
-            e_in_excess: [[0.0, 0.025, 0.05], [0.0, 0.008, 0.016]],
-            w: [0.8, 0.4],
-            w_in_excess: [[0.09, 0.09, 0.09], [0.03, 0.03, 0.03]],
+            e_in_excess: [[0.0, 0.05, 0.1], [0.0, 0.016, 0.03]],
+            w: [[1.0; 3], [0.6; 3]],
+            // Early the width growth is at the maps' maximum (1), which
+            // the inner side cannot exceed.
+            w_in_excess: [[0.0; 3], [0.03; 3]],
             fan: 0.6,
+            top_stiffness: 0.5,
         },
         // Shallow ball: uniform growth, but the inner lower regions
         // elongate more than the outer (the paper: inner lower and middle,
@@ -524,9 +542,10 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
         Cultivar::Pinocchio => EustomaGrowth {
             e: [[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]],
             e_in_excess: [[0.11, 0.0, -0.02], [0.03, 0.0, -0.02]],
-            w: [0.8, 0.8],
+            w: [[0.8; 3], [0.8; 3]],
             w_in_excess: [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
             fan: 0.0,
+            top_stiffness: 0.5,
         },
     }
 }
@@ -538,20 +557,25 @@ fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
 /// harder than the top); direction along the venation, Maite Lady's
 /// fanning out more than the others'.
 pub fn eustoma_maps(cultivar: Cultivar) -> Result<KeyedMaps, MapError> {
-    let growth = eustoma_growth(cultivar);
+    eustoma_maps_of(&eustoma_growth(cultivar))
+}
+
+/// The growth maps painted from `growth` (see [`eustoma_maps`]).
+pub fn eustoma_maps_of(growth: &EustomaGrowth) -> Result<KeyedMaps, MapError> {
     let grows = |uv: DVec2| above_base(uv.y, EUSTOMA_BASE_V, 0.05);
     let by_region = |values: [f64; 3], v: f64| {
         let r = eustoma_regions(v);
         r[0] * values[0] + r[1] * values[1] + r[2] * values[2]
     };
-    let stiffness = |uv: DVec2| 1.0 - 0.5 * smoothstep(0.2, 0.8, uv.y);
+    let top = growth.top_stiffness;
+    let stiffness = move |uv: DVec2| 1.0 - (1.0 - top) * smoothstep(0.2, 0.8, uv.y);
     let fan = growth.fan;
     let direction = move |uv: DVec2| DVec2::new(fan * (uv.x - 0.5) * uv.y, 1.0);
     let mut keys = Vec::new();
     for (stage, step) in [(0, 40), (1, 60)] {
         let e = |uv: DVec2| grows(uv) * by_region(growth.e[stage], uv.y);
         let e_in = |uv: DVec2| e(uv) + grows(uv) * by_region(growth.e_in_excess[stage], uv.y);
-        let w = |uv: DVec2| grows(uv) * growth.w[stage];
+        let w = |uv: DVec2| grows(uv) * by_region(growth.w[stage], uv.y);
         let w_in = |uv: DVec2| w(uv) + grows(uv) * by_region(growth.w_in_excess[stage], uv.y);
         let maps = Painting {
             e_growth: &e,
@@ -577,9 +601,23 @@ pub fn eustoma_petal_template(cultivar: Cultivar) -> Result<Template, GardenErro
 }
 
 fn eustoma_petal_template_at(cultivar: Cultivar, edge_scale: f64) -> Result<Template, GardenError> {
+    eustoma_petal_template_of(
+        cultivar,
+        &eustoma_growth(cultivar),
+        &eustoma_petal_bud(),
+        edge_scale,
+    )
+}
+
+fn eustoma_petal_template_of(
+    cultivar: Cultivar,
+    growth: &EustomaGrowth,
+    bud: &RingOrgan,
+    edge_scale: f64,
+) -> Result<Template, GardenError> {
     let spec = TemplateSpec {
         organ: "Eustoma petal",
-        bud: eustoma_petal_bud(),
+        bud: *bud,
         edge: EUSTOMA_EDGE * edge_scale,
         dg: EUSTOMA_DG,
         thickness: EUSTOMA_THICKNESS,
@@ -588,7 +626,7 @@ fn eustoma_petal_template_at(cultivar: Cultivar, edge_scale: f64) -> Result<Temp
         joint: EUSTOMA_JOINT,
         color: cultivar.color(),
     };
-    template("petal", &spec, eustoma_maps(cultivar))
+    template("petal", &spec, eustoma_maps_of(growth))
 }
 
 /// One Eustoma cultivar: five contorted petals, each one's right side
@@ -598,8 +636,25 @@ pub fn eustoma(cultivar: Cultivar) -> Result<Project, GardenError> {
 }
 
 fn eustoma_at(cultivar: Cultivar, edge_scale: f64) -> Result<Project, GardenError> {
-    let bud = eustoma_petal_bud();
-    let arrangement = contorted_whorl(&ring_whorl("petal", 0, &bud, 5, 0.0)).ok_or_else(|| {
+    eustoma_of(
+        cultivar,
+        &eustoma_growth(cultivar),
+        &eustoma_petal_bud(),
+        edge_scale,
+    )
+}
+
+/// An Eustoma of five contorted petals of shape `bud` growing by `growth`,
+/// meshed at `edge_scale` times Table 1's edge, named and coloured as
+/// `cultivar`: the default cultivars are this with [`eustoma_growth`] and
+/// [`eustoma_petal_bud`]; other values are for exploring the maps.
+pub fn eustoma_of(
+    cultivar: Cultivar,
+    growth: &EustomaGrowth,
+    bud: &RingOrgan,
+    edge_scale: f64,
+) -> Result<Project, GardenError> {
+    let arrangement = contorted_whorl(&ring_whorl("petal", 0, bud, 5, 0.0)).ok_or_else(|| {
         GardenError::Arrangement(format!(
             "the Eustoma petals span ±{:.0}° each: five of them must overlap their neighbours \
              and no more",
@@ -609,7 +664,9 @@ fn eustoma_at(cultivar: Cultivar, edge_scale: f64) -> Result<Project, GardenErro
     Ok(Project {
         name: cultivar.project_name().to_string(),
         flower: Flower {
-            templates: vec![eustoma_petal_template_at(cultivar, edge_scale)?],
+            templates: vec![eustoma_petal_template_of(
+                cultivar, growth, bud, edge_scale,
+            )?],
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
         },

@@ -17,7 +17,10 @@
 //! angles lean in towards the axis (a closed bud's tip). The *turning* of a
 //! line is how much that angle grows from its first piece to its last:
 //! positive when the organ bends outwards (towards reflexing) along its
-//! length, negative when it curls in.
+//! length, negative when it curls in. The *cone angle* is the opening angle
+//! of the midrib's chord from the base to `v = 0.75`: the half-angle of the
+//! cone the organ's lower three quarters make (about 40° for a funnel, 70°
+//! and more for a saucer).
 //!
 //! # Cross-sections
 //!
@@ -26,6 +29,17 @@
 //! `u = 0.9`) divided by that chord, signed along the organ's inner normal:
 //! positive when the margins lie towards the inner side (a cup open to the
 //! flower axis), negative when the lamina bulges towards the inner side.
+//!
+//! # Neighbours
+//!
+//! The *margin overlap* of two neighbouring organs at `v` is how far, in
+//! azimuth about the axis, the row `v` of one organ reaches past where the
+//! row `v` of the next organ counter-clockwise (seen from above) begins:
+//! positive where they overlap seen from above (a contorted corolla),
+//! negative where a gap opens between them. *Wrong-side depths* check
+//! collisions geometrically: the signed distance of each particle of one
+//! organ from the nearest point of the other organ's triangles, where that
+//! point lies on the organ and not on its rim.
 
 use anthesis_mesh::Mesh;
 use glam::{DVec2, DVec3};
@@ -140,6 +154,13 @@ pub struct OrganShape {
     pub midrib_angles_deg: [f64; 3],
     /// Turning of the midrib, degrees.
     pub midrib_turning_deg: f64,
+    /// Turning of the midrib's upper half (`v` from 0.5 to 1), degrees: a
+    /// flaring tip turns outwards by tens of degrees, a rolled-up one past
+    /// 180°.
+    pub upper_turning_deg: f64,
+    /// Opening angle of the chord from the base to `v = 0.75` (the cone
+    /// angle, see the module documentation), degrees.
+    pub cone_angle_deg: f64,
     /// Mean turning of the two lamina lines (`u = 0.25`, `u = 0.75`).
     pub lamina_turning_deg: f64,
     /// Cupping of the cross-section at `v = 0.5` (see the module docs).
@@ -225,6 +246,8 @@ pub fn organ_shape(mesh: &Mesh, positions_in_world: &[DVec3]) -> Result<OrganSha
     Ok(OrganShape {
         midrib_angles_deg,
         midrib_turning_deg: turning_deg(&midrib),
+        upper_turning_deg: turning_deg(&midrib[20..]),
+        cone_angle_deg: opening_angle_deg(midrib[0], midrib[30]),
         lamina_turning_deg,
         cupping,
         swelling,
@@ -277,6 +300,8 @@ impl FlowerShape {
         let mean = OrganShape {
             midrib_angles_deg: [0, 1, 2].map(|k| mean_of(&|o| o.midrib_angles_deg[k])),
             midrib_turning_deg: mean_of(&|o| o.midrib_turning_deg),
+            upper_turning_deg: mean_of(&|o| o.upper_turning_deg),
+            cone_angle_deg: mean_of(&|o| o.cone_angle_deg),
             lamina_turning_deg: mean_of(&|o| o.lamina_turning_deg),
             cupping: mean_of(&|o| o.cupping),
             swelling: mean_of(&|o| o.swelling),
@@ -286,6 +311,225 @@ impl FlowerShape {
         };
         FlowerShape { organs, mean }
     }
+}
+
+/// The azimuth of `p` about the flower axis (+Y), in degrees, as organs
+/// are placed: 0 on +Z, 90 on +X.
+pub fn azimuth_deg(p: DVec3) -> f64 {
+    p.x.atan2(p.z).to_degrees()
+}
+
+/// The signed difference `a − b` of two azimuths, in `(−180, 180]` degrees.
+fn azimuth_difference_deg(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(360.0);
+    if d > 180.0 { d - 360.0 } else { d }
+}
+
+/// How far the row `v` of an organ reaches on either side of its midrib, in
+/// azimuth: `(towards decreasing, towards increasing)` azimuth, degrees
+/// from the midrib's azimuth at `v`, each the extreme over the row.
+fn row_reach_deg(
+    mesh: &Mesh,
+    positions_in_world: &[DVec3],
+    v: f64,
+) -> Result<(f64, f64, f64), ShapeError> {
+    let sampler = UvSampler::new(mesh);
+    let at = |u: f64| {
+        sampler
+            .point(positions_in_world, DVec2::new(u, v))
+            .ok_or(ShapeError::UvNotCovered { u, v })
+    };
+    let centre = azimuth_deg(at(0.5)?);
+    let (mut low, mut high) = (0.0f64, 0.0f64);
+    for k in 0..=ROW_SAMPLES {
+        let d = azimuth_difference_deg(
+            azimuth_deg(at(f64::from(k) / f64::from(ROW_SAMPLES))?),
+            centre,
+        );
+        low = low.min(d);
+        high = high.max(d);
+    }
+    Ok((centre, low, high))
+}
+
+/// Points sampled across a row for [`margin_overlap_deg`].
+const ROW_SAMPLES: u32 = 40;
+
+/// The margin overlap at `v` (see the module documentation) of an organ
+/// (`organ`: template mesh and world positions) and the next organ
+/// counter-clockwise seen from above (`next`), in degrees: positive where
+/// they overlap, negative where a gap opens between them.
+pub fn margin_overlap_deg(
+    organ: (&Mesh, &[DVec3]),
+    next: (&Mesh, &[DVec3]),
+    v: f64,
+) -> Result<f64, ShapeError> {
+    for (mesh, positions) in [organ, next] {
+        if positions.len() != mesh.vertex_count() {
+            return Err(ShapeError::WrongCount {
+                positions: positions.len(),
+                vertices: mesh.vertex_count(),
+            });
+        }
+    }
+    let (centre, _, reach) = row_reach_deg(organ.0, organ.1, v)?;
+    let (next_centre, next_reach, _) = row_reach_deg(next.0, next.1, v)?;
+    Ok(reach - next_reach - azimuth_difference_deg(next_centre, centre))
+}
+
+/// Where the particles of one organ lie relative to a neighbour's surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SideCheck {
+    /// Particles whose nearest point on the neighbour lies on it (not on its
+    /// rim) within the search distance.
+    pub over: usize,
+    /// The smallest signed distance among them, along the neighbour's
+    /// normal towards the side the particles belong on: negative when some
+    /// particle is on the wrong side (`f64::INFINITY` when none is over).
+    pub closest: f64,
+    /// How many of them lie on the wrong side by more than the tolerance.
+    pub wrong: usize,
+}
+
+/// Checks geometrically that the particles of organ `moving` lie on their
+/// side of organ `other`'s triangle surface (see [`side_distances`]):
+/// particles flagged in `skip` (e.g. the base particles the receptacle
+/// places) are left out, and a particle is wrong when its signed distance
+/// is below `−tolerance`.
+pub fn side_check(
+    moving: &[DVec3],
+    skip: &[bool],
+    other: &[DVec3],
+    other_mesh: &Mesh,
+    side: f64,
+    reach: f64,
+    tolerance: f64,
+) -> SideCheck {
+    let mut check = SideCheck {
+        over: 0,
+        closest: f64::INFINITY,
+        wrong: 0,
+    };
+    let distances = side_distances(moving, other, other_mesh, side, reach);
+    for (i, distance) in distances.into_iter().enumerate() {
+        let Some(distance) = distance else { continue };
+        if skip.get(i).copied().unwrap_or(false) {
+            continue;
+        }
+        check.over += 1;
+        check.closest = check.closest.min(distance);
+        if distance < -tolerance {
+            check.wrong += 1;
+        }
+    }
+    check
+}
+
+/// The signed distance of each particle of organ `moving` from organ
+/// `other`'s triangle surface, along `other`'s normal towards the side
+/// `moving` belongs on: `side` is +1 if that is `other`'s inner side
+/// (`moving` lies inside it), −1 if its outer side. Inner normals follow the
+/// triangles' winding, as in the organ template frame. Each particle is
+/// measured from its nearest point on `other`'s triangles (brute force,
+/// independent of the simulator's tracking); `None` when that point is
+/// farther than `reach` or lies on `other`'s rim (the particle is beyond
+/// the organ, not over it).
+pub fn side_distances(
+    moving: &[DVec3],
+    other: &[DVec3],
+    other_mesh: &Mesh,
+    side: f64,
+    reach: f64,
+) -> Vec<Option<f64>> {
+    let rim = rim_vertices(other_mesh);
+    moving
+        .iter()
+        .map(|x| {
+            let mut best: Option<(f64, usize, [f64; 3])> = None;
+            for (t, tri) in other_mesh.triangles.iter().enumerate() {
+                let [a, b, c] = tri.map(|k| other[k as usize]);
+                let (point, weights) = closest_point_on_triangle(*x, a, b, c);
+                let d2 = point.distance_squared(*x);
+                if best.is_none_or(|(bd, _, _)| d2 < bd) {
+                    best = Some((d2, t, weights));
+                }
+            }
+            let (d2, t, weights) = best?;
+            if d2 > reach * reach {
+                return None;
+            }
+            let tri = other_mesh.triangles[t];
+            // On the rim: every corner the nearest point leans on is a rim
+            // particle (a point on an interior edge or corner is inside).
+            let on_rim = weights.iter().any(|&w| w <= 0.0)
+                && (0..3).all(|k| weights[k] <= 0.0 || rim[tri[k] as usize]);
+            if on_rim {
+                return None;
+            }
+            let [a, b, c] = tri.map(|k| other[k as usize]);
+            let normal = (b - a).cross(c - a).normalize_or_zero() * side;
+            let point: DVec3 = (0..3).map(|k| weights[k] * other[tri[k] as usize]).sum();
+            Some((*x - point).dot(normal))
+        })
+        .collect()
+}
+
+/// Which particles of `mesh` lie on its rim (a boundary edge).
+fn rim_vertices(mesh: &Mesh) -> Vec<bool> {
+    let mut count = std::collections::HashMap::new();
+    for tri in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let mut rim = vec![false; mesh.vertex_count()];
+    for ((a, b), n) in count {
+        if n == 1 {
+            rim[a as usize] = true;
+            rim[b as usize] = true;
+        }
+    }
+    rim
+}
+
+/// The point of triangle `abc` nearest `p` and its barycentric weights
+/// (the standard region test over the triangle's corners, edges and face;
+/// small enough to write here rather than pull in a geometry crate).
+fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, [f64; 3]) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, [1.0, 0.0, 0.0]);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, [0.0, 1.0, 0.0]);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + ab * v, [1.0 - v, v, 0.0]);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, [0.0, 0.0, 1.0]);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + ac * w, [1.0 - w, 0.0, w]);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * w, [0.0, 1.0 - w, w]);
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (a + ab * v + ac * w, [1.0 - v - w, v, w])
 }
 
 #[cfg(test)]
@@ -299,6 +543,8 @@ mod tests {
         let shape = |x: f64| OrganShape {
             midrib_angles_deg: [x, 2.0 * x, 3.0 * x],
             midrib_turning_deg: x,
+            upper_turning_deg: 0.5 * x,
+            cone_angle_deg: 4.0 * x,
             lamina_turning_deg: -x,
             cupping: 0.25 * x,
             swelling: 0.5 * x,
@@ -401,5 +647,85 @@ mod tests {
                 vertices: mesh.vertex_count()
             })
         );
+    }
+
+    /// The upright organ tilted outwards by `tilt_deg` about its base and
+    /// turned about the axis by `azimuth_deg`.
+    fn placed(mesh: &Mesh, tilt_deg: f64, azimuth_deg: f64) -> Vec<DVec3> {
+        let tilt = glam::DQuat::from_rotation_x(tilt_deg.to_radians());
+        let turn = glam::DQuat::from_rotation_y(azimuth_deg.to_radians());
+        let base = DVec3::new(0.0, 0.0, 5.0);
+        mesh.positions
+            .iter()
+            .map(|&p| turn * (base + tilt * (p - base)))
+            .collect()
+    }
+
+    #[test]
+    fn a_flat_organ_tilted_out_has_that_cone_angle_and_no_turning() {
+        let mesh = upright(0.0);
+        for tilt in [0.0, 20.0, 55.0] {
+            let positions = placed(&mesh, tilt, 0.0);
+            let shape = organ_shape(&mesh, &positions).expect("measurable");
+            assert!(
+                (shape.cone_angle_deg - tilt).abs() < 1e-6,
+                "{tilt}: {shape:?}"
+            );
+            assert!(shape.upper_turning_deg.abs() < 1e-6, "{shape:?}");
+        }
+    }
+
+    #[test]
+    fn margin_overlap_is_the_azimuth_two_neighbours_share() {
+        // Each upright sheet 10 wide at radius 5 spans ±45° about its
+        // midrib (atan(5/5)); neighbours 80° apart share 10°, 100° apart
+        // leave a 10° gap.
+        let mesh = upright(0.0);
+        let organ = placed(&mesh, 0.0, 0.0);
+        for (apart, expected) in [(80.0, 10.0), (100.0, -10.0)] {
+            let next = placed(&mesh, 0.0, apart);
+            let overlap =
+                margin_overlap_deg((&mesh, &organ), (&mesh, &next), 0.5).expect("measurable");
+            assert!((overlap - expected).abs() < 1e-6, "{apart}: {overlap}");
+        }
+    }
+
+    #[test]
+    fn side_check_finds_particles_on_the_wrong_side_of_a_neighbour() {
+        // A sheet facing the axis (inner side −Z) and a copy 0.2 further in
+        // lies on its inner side; 0.2 further out, on the wrong side.
+        let mesh = upright(0.0);
+        let shifted = |dz: f64| -> Vec<DVec3> {
+            mesh.positions
+                .iter()
+                .map(|&p| p + DVec3::new(0.0, 0.0, dz))
+                .collect()
+        };
+        let skip = vec![false; mesh.vertex_count()];
+        let inside = side_check(
+            &shifted(-0.2),
+            &skip,
+            &mesh.positions,
+            &mesh,
+            1.0,
+            1.0,
+            0.01,
+        );
+        assert!(inside.over > 0 && inside.wrong == 0, "{inside:?}");
+        assert!((inside.closest - 0.2).abs() < 1e-9, "{inside:?}");
+        let outside = side_check(&shifted(0.2), &skip, &mesh.positions, &mesh, 1.0, 1.0, 0.01);
+        assert_eq!(outside.wrong, outside.over, "{outside:?}");
+        assert!(outside.over > 0 && (outside.closest + 0.2).abs() < 1e-9);
+        // Beyond `reach`, nothing is over.
+        let far = side_check(
+            &shifted(-2.0),
+            &skip,
+            &mesh.positions,
+            &mesh,
+            1.0,
+            1.0,
+            0.01,
+        );
+        assert_eq!(far.over, 0);
     }
 }

@@ -3,13 +3,13 @@
 //! `anthesis_garden::shape`: the lily's tepals reflex early, led by the
 //! midrib, around a cupped base, swollen near keyframe 75; one Eustoma bud
 //! opens to a bell, a funnel or a shallow ball depending on the cultivar's
-//! maps.
+//! maps, the bell's tube and the funnel keeping their contorted overlap.
 
 use std::time::Instant;
 
 use anthesis_flower::Project;
 use anthesis_garden::flowers::{self, Cultivar};
-use anthesis_garden::shape::{FlowerShape, OrganShape, flower_shape};
+use anthesis_garden::shape::{FlowerShape, OrganShape, flower_shape, margin_overlap_deg};
 use anthesis_sim::{Selection, run};
 
 /// The keyframes the tests look at.
@@ -82,11 +82,50 @@ fn lily() -> Project {
     flowers::lily().expect("lily")
 }
 
-fn eustoma(cultivar: Cultivar) -> Vec<FlowerShape> {
+/// An Eustoma cultivar run whole: its shapes at [`FRAMES`] and, at each of
+/// them, the smallest margin overlap of neighbouring petals (see
+/// `anthesis_garden::shape`) at mid-height (`v = 0.4`).
+struct EustomaRun {
+    shapes: Vec<FlowerShape>,
+    overlap_mid_deg: Vec<f64>,
+}
+
+fn eustoma(cultivar: Cultivar) -> EustomaRun {
     let project = flowers::eustoma(cultivar).expect("Eustoma");
-    let shapes = shapes(&project, &Selection::All, &[0, 1, 2, 3, 4]);
-    print(cultivar.folder_name(), &shapes);
-    shapes
+    let mesh = &project.flower.templates[0].mesh;
+    let mut run = EustomaRun {
+        shapes: Vec::new(),
+        overlap_mid_deg: Vec::new(),
+    };
+    let result = anthesis_sim::run(&project, &Selection::All, &mut |_, keyframe| {
+        if !FRAMES.contains(&keyframe.index) {
+            return;
+        }
+        let petals = &keyframe.positions;
+        let smallest_overlap = |v: f64| {
+            (0..petals.len())
+                .map(|i| {
+                    let next = (i + 1) % petals.len();
+                    margin_overlap_deg((mesh, &petals[i]), (mesh, &petals[next]), v)
+                        .expect("measurable")
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        run.overlap_mid_deg.push(smallest_overlap(0.4));
+        run.shapes
+            .push(flower_shape(petals.iter().map(|p| (mesh, p.as_slice()))).expect("measurable"));
+    });
+    if let Err(error) = result {
+        panic!("{}: {error}", project.name);
+    }
+    print(cultivar.folder_name(), &run.shapes);
+    eprintln!(
+        "{}: overlap at v 0.4 {:?}",
+        cultivar.folder_name(),
+        run.overlap_mid_deg
+    );
+    assert_eq!(run.shapes.len(), FRAMES.len());
+    run
 }
 
 #[test]
@@ -202,43 +241,45 @@ fn one_eustoma_bud_opens_to_a_bell_a_funnel_and_a_shallow_ball() {
     let funnel = eustoma(Cultivar::MaiteLady);
     let ball = eustoma(Cultivar::Pinocchio);
     // One bud.
-    assert_eq!(frame(&bell, 0), frame(&funnel, 0));
-    assert_eq!(frame(&bell, 0), frame(&ball, 0));
-    let (b, f, p) = (frame(&bell, 100), frame(&funnel, 100), frame(&ball, 100));
+    assert_eq!(frame(&bell.shapes, 0), frame(&funnel.shapes, 0));
+    assert_eq!(frame(&bell.shapes, 0), frame(&ball.shapes, 0));
+    let bud = frame(&bell.shapes, 0);
+    let (b, f, p) = (
+        frame(&bell.shapes, 100),
+        frame(&funnel.shapes, 100),
+        frame(&ball.shapes, 100),
+    );
 
     // Mellow Yellow, a bell: the lower petal stays a steep tube and the
-    // tips flare out and reflex below horizontal.
+    // tips flare out and reflex below horizontal without rolling up (the
+    // upper half turns outwards by less than half a turn).
     assert!(
         b.midrib_angles_deg[0] < 50.0 && b.midrib_angles_deg[1] < 40.0,
         "{b:?}"
     );
-    assert!(b.midrib_angles_deg[2] > 100.0, "{b:?}");
-    for petal in &bell[FRAMES.len() - 1].organs {
-        assert!(petal.midrib_angles_deg[2] > 90.0, "{petal:?}");
+    assert!(b.midrib_angles_deg[2] > 95.0, "{b:?}");
+    for petal in &bell.shapes[FRAMES.len() - 1].organs {
+        assert!(petal.midrib_angles_deg[2] > 80.0, "{petal:?}");
+        assert!(petal.upper_turning_deg < 170.0, "rolled up: {petal:?}");
     }
     // Its reflexing comes late (§6.2: the upper inner region grows late).
-    assert!(frame(&bell, 50).midrib_angles_deg[2] < 30.0);
+    assert!(frame(&bell.shapes, 50).midrib_angles_deg[2] < 30.0);
 
-    // Maite Lady, a funnel: flat, straight petals opening as a cone.
-    let spread = f
-        .midrib_angles_deg
-        .iter()
-        .fold(f64::NEG_INFINITY, |a, &b| a.max(b))
-        - f.midrib_angles_deg
-            .iter()
-            .fold(f64::INFINITY, |a, &b| a.min(b));
-    assert!(spread < 20.0, "not straight: {f:?}");
-    assert!(f.midrib_turning_deg.abs() < 25.0, "{f:?}");
+    // Maite Lady, a funnel: straight petals opening as a narrow cone, tips
+    // not reflexed.
+    assert!(f.midrib_turning_deg.abs() < 25.0, "not straight: {f:?}");
     assert!(
-        (40.0..80.0).contains(&f.midrib_angles_deg[1]),
-        "cone angle: {f:?}"
+        (bud.cone_angle_deg + 4.0..35.0).contains(&f.cone_angle_deg),
+        "cone angle {:.1} (bud {:.1})",
+        f.cone_angle_deg,
+        bud.cone_angle_deg
     );
-    assert!(f.cupping.abs() < 0.05, "not flat: {f:?}");
+    assert!(f.midrib_angles_deg[2] < 45.0, "{f:?}");
 
     // Pinocchio, a shallow ball: the base opens widest, the cupped petals
     // turn their tips back in.
     assert!(
-        p.midrib_angles_deg[0] > f.midrib_angles_deg[0] + 5.0,
+        p.midrib_angles_deg[0] > f.midrib_angles_deg[0] + 20.0,
         "{p:?} vs {f:?}"
     );
     assert!(
@@ -252,9 +293,22 @@ fn one_eustoma_bud_opens_to_a_bell_a_funnel_and_a_shallow_ball() {
     );
     assert!(p.midrib_turning_deg < -20.0, "{p:?}");
 
-    // And they differ from each other as the paper's forms do.
+    // And they differ from each other as the paper's forms do: the funnel's
+    // cone is far narrower than the ball's saucer-wide base, the bell's
+    // tips reflex where the others' do not.
+    assert!(p.cone_angle_deg > f.cone_angle_deg + 40.0, "{p:?} vs {f:?}");
     assert!(b.midrib_angles_deg[2] > f.midrib_angles_deg[2] + 40.0);
     assert!(b.midrib_angles_deg[2] > p.midrib_angles_deg[2] + 40.0);
-    assert!(p.cupping > f.cupping + 0.1);
-    assert!(b.midrib_angles_deg[1] < f.midrib_angles_deg[1] - 20.0);
+
+    // The bell's tube and the funnel keep the bud's contorted overlap all
+    // through the opening (seen from above, each petal's margin still lies
+    // over its neighbour's at mid-height); the ball opens saucer-wide and
+    // its petals part.
+    for (name, run) in [("bell", &bell), ("funnel", &funnel)] {
+        for (k, overlap) in FRAMES.iter().zip(&run.overlap_mid_deg) {
+            assert!(*overlap > 2.0, "{name} kf {k}: overlap {overlap:.1}°");
+        }
+    }
+    let parted = ball.overlap_mid_deg.last().expect("frames");
+    assert!(*parted < 0.0, "ball: overlap {parted:.1}°");
 }

@@ -170,6 +170,18 @@ fn an_inner_organ_driven_twice_as_hard_presses_on_the_outer_one_without_cutting_
         pressed >= 10,
         "the organs pressed on each other in only {pressed} keyframes"
     );
+    // The keyframe statistics report it: particles in contact (within
+    // twice the collision offset) over many keyframes, and particles pushed
+    // back.
+    let reported = keyframes
+        .iter()
+        .filter(|k| k.stats.contact_particles >= 3)
+        .count();
+    assert!(
+        reported >= 10,
+        "contacts reported in {reported} keyframes (pressing seen in {pressed})"
+    );
+    assert!(keyframes.iter().any(|k| k.stats.pushed_particles > 0));
     assert_eq!(shape_problem(&project, &keyframes), None);
 }
 
