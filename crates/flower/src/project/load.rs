@@ -14,9 +14,7 @@ use super::check::{SizeCheck, check_names, check_project, check_unique};
 use super::error::{ProjectError, map_error};
 use super::schema::{DirectionEntry, ProjectFile, ScalarEntry, TemplateFile};
 use super::{FORMAT_NAME, FORMAT_VERSION};
-use crate::{
-    BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings, Template,
-};
+use crate::{BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, Template};
 
 /// The largest project file read, in bytes; a project file names its
 /// meshes and maps, so even a garden of templates is a few kilobytes.
