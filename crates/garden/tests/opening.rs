@@ -101,7 +101,7 @@ fn eustoma(cultivar: Cultivar) -> EustomaRun {
         if !FRAMES.contains(&keyframe.index) {
             return;
         }
-        let petals = &keyframe.positions;
+        let petals = &keyframe.positions_in_world;
         let smallest_overlap = |v: f64| {
             (0..petals.len())
                 .map(|i| {

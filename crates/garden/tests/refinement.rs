@@ -16,7 +16,7 @@ fn final_petal(edge_scale: f64) -> (anthesis_mesh::Mesh, Vec<DVec3>) {
         .expect("builds");
     let mut last = Vec::new();
     run(&project, &Selection::Only(0), &mut |_, keyframe| {
-        last.clone_from(&keyframe.positions[0]);
+        last.clone_from(&keyframe.positions_in_world[0]);
     })
     .expect("runs");
     (project.flower.templates[0].mesh.clone(), last)

@@ -46,8 +46,8 @@ fn the_funnels_petals_press_on_each_other_and_stay_on_their_sides() {
 
     // Collisions change the shape: petal 0 run whole ends away from petal 0
     // run alone by more than 2 % of its midrib length.
-    let last_whole = &whole.last().expect("keyframes").positions[0];
-    let last_alone = &alone.last().expect("keyframes").positions[0];
+    let last_whole = &whole.last().expect("keyframes").positions_in_world[0];
+    let last_alone = &alone.last().expect("keyframes").positions_in_world[0];
     let apart = last_whole
         .iter()
         .zip(last_alone)
@@ -71,7 +71,7 @@ fn the_funnels_petals_press_on_each_other_and_stay_on_their_sides() {
     let reach = 1.0;
     let mut checked = 0;
     for keyframe in whole.iter().step_by(5) {
-        let petals: &[Vec<DVec3>] = &keyframe.positions;
+        let petals: &[Vec<DVec3>] = &keyframe.positions_in_world;
         for i in 0..petals.len() {
             let next = (i + 1) % petals.len();
             let beneath = side_check(&petals[i], &skip, &petals[next], mesh, 1.0, reach, 1e-6);
