@@ -102,13 +102,19 @@ fn every_encoding_of_the_lily_plays_in_three_js_like_anthesis_renders_it() {
         ]);
         files.push(json!({ "name": encoding, "path": path }));
     }
-    // The compressed lily with normals stays within 2 MB (dense: 5.5 MB).
-    let meshopt_bytes = std::fs::metadata(d("lily-meshopt.glb"))
-        .expect("meshopt file")
-        .len();
+    // The compressed lily with normals is at most 0.364 of the dense file:
+    // the budget, 2 MB against the 5.49 MB dense lily meshed at
+    // Table 1's edge, stated independently of the mesh resolution (the
+    // default lily is meshed finer for converged shapes).
+    let bytes = |encoding: &str| {
+        std::fs::metadata(d(&format!("lily-{encoding}.glb")))
+            .expect("exported file")
+            .len() as f64
+    };
+    let (meshopt_bytes, dense_bytes) = (bytes("meshopt"), bytes("dense"));
     assert!(
-        meshopt_bytes <= 2_000_000,
-        "meshopt lily: {meshopt_bytes} bytes"
+        meshopt_bytes <= 0.364 * dense_bytes,
+        "meshopt lily: {meshopt_bytes} bytes, dense {dense_bytes}"
     );
     let renders = d("anthesis");
     std::fs::create_dir(&renders).expect("mkdir");

@@ -1162,6 +1162,8 @@ fn obj_warnings_reach_the_caller_naming_the_file() {
             && loaded.warnings[0].contains("2 line (`l`) statements ignored"),
         "{:?}",
         loaded.warnings
+    );
+}
 
 #[test]
 fn the_model_is_read_from_the_file_and_version_1_files_keep_the_papers() {
