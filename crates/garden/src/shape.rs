@@ -188,6 +188,8 @@ pub enum ShapeError {
     UvNotCovered { u: f64, v: f64 },
     #[error("{positions} positions for a mesh of {vertices} vertices")]
     WrongCount { positions: usize, vertices: usize },
+    #[error("the organ's mesh has no surface topology: {0}")]
+    Mesh(#[from] anthesis_mesh::MeshError),
 }
 
 /// Measures one organ: `mesh` is its template mesh (for UVs and
@@ -404,13 +406,13 @@ pub fn side_check(
     side: f64,
     reach: f64,
     tolerance: f64,
-) -> SideCheck {
+) -> Result<SideCheck, ShapeError> {
     let mut check = SideCheck {
         over: 0,
         closest: f64::INFINITY,
         wrong: 0,
     };
-    let distances = side_distances(moving, other, other_mesh, side, reach);
+    let distances = side_distances(moving, other, other_mesh, side, reach)?;
     for (i, distance) in distances.into_iter().enumerate() {
         let Some(distance) = distance else { continue };
         if skip.get(i).copied().unwrap_or(false) {
@@ -422,7 +424,7 @@ pub fn side_check(
             check.wrong += 1;
         }
     }
-    check
+    Ok(check)
 }
 
 /// The signed distance of each particle of organ `moving` from organ
@@ -440,57 +442,36 @@ pub fn side_distances(
     other_mesh: &Mesh,
     side: f64,
     reach: f64,
-) -> Vec<Option<f64>> {
-    let rim = rim_vertices(other_mesh);
-    moving
-        .iter()
-        .map(|x| {
-            let mut best: Option<(f64, usize, [f64; 3])> = None;
-            for (t, tri) in other_mesh.triangles.iter().enumerate() {
-                let [a, b, c] = tri.map(|k| other[k as usize]);
-                let (point, weights) = closest_point_on_triangle(*x, a, b, c);
-                let d2 = point.distance_squared(*x);
-                if best.is_none_or(|(bd, _, _)| d2 < bd) {
-                    best = Some((d2, t, weights));
-                }
-            }
-            let (d2, t, weights) = best?;
-            if d2 > reach * reach {
-                return None;
-            }
-            let tri = other_mesh.triangles[t];
-            // On the rim: every corner the nearest point leans on is a rim
-            // particle (a point on an interior edge or corner is inside).
-            let on_rim = weights.iter().any(|&w| w <= 0.0)
-                && (0..3).all(|k| weights[k] <= 0.0 || rim[tri[k] as usize]);
-            if on_rim {
-                return None;
-            }
+) -> Result<Vec<Option<f64>>, ShapeError> {
+    let mut rim = vec![false; other_mesh.vertex_count()];
+    for edge in anthesis_mesh::Topology::build(other_mesh)?.boundary_edges() {
+        for vertex in edge {
+            rim[vertex as usize] = true;
+        }
+    }
+    let distance = |x: DVec3| {
+        let mut best: Option<(f64, [u32; 3], DVec3, [f64; 3])> = None;
+        for tri in &other_mesh.triangles {
             let [a, b, c] = tri.map(|k| other[k as usize]);
-            let normal = (b - a).cross(c - a).normalize_or_zero() * side;
-            let point: DVec3 = (0..3).map(|k| weights[k] * other[tri[k] as usize]).sum();
-            Some((*x - point).dot(normal))
-        })
-        .collect()
-}
-
-/// Which particles of `mesh` lie on its rim (a boundary edge).
-fn rim_vertices(mesh: &Mesh) -> Vec<bool> {
-    let mut count = std::collections::HashMap::new();
-    for tri in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            let (point, weights) = closest_point_on_triangle(x, a, b, c);
+            let d2 = point.distance_squared(x);
+            if best.is_none_or(|(bd, ..)| d2 < bd) {
+                best = Some((d2, *tri, point, weights));
+            }
         }
-    }
-    let mut rim = vec![false; mesh.vertex_count()];
-    for ((a, b), n) in count {
-        if n == 1 {
-            rim[a as usize] = true;
-            rim[b as usize] = true;
+        let (d2, tri, point, weights) = best?;
+        // On the rim: every corner the nearest point leans on is a rim
+        // particle (a point on an interior edge or corner is inside).
+        let on_rim = weights.iter().any(|&w| w <= 0.0)
+            && (0..3).all(|k| weights[k] <= 0.0 || rim[tri[k] as usize]);
+        if d2 > reach * reach || on_rim {
+            return None;
         }
-    }
-    rim
+        let [a, b, c] = tri.map(|k| other[k as usize]);
+        let normal = (b - a).cross(c - a).normalize_or_zero() * side;
+        Some((x - point).dot(normal))
+    };
+    Ok(moving.iter().map(|&x| distance(x)).collect())
 }
 
 /// The point of triangle `abc` nearest `p` and its barycentric weights
@@ -710,10 +691,12 @@ mod tests {
             1.0,
             1.0,
             0.01,
-        );
+        )
+        .expect("measurable");
         assert!(inside.over > 0 && inside.wrong == 0, "{inside:?}");
         assert!((inside.closest - 0.2).abs() < 1e-9, "{inside:?}");
-        let outside = side_check(&shifted(0.2), &skip, &mesh.positions, &mesh, 1.0, 1.0, 0.01);
+        let outside = side_check(&shifted(0.2), &skip, &mesh.positions, &mesh, 1.0, 1.0, 0.01)
+            .expect("measurable");
         assert_eq!(outside.wrong, outside.over, "{outside:?}");
         assert!(outside.over > 0 && (outside.closest + 0.2).abs() < 1e-9);
         // Beyond `reach`, nothing is over.
@@ -725,7 +708,8 @@ mod tests {
             1.0,
             1.0,
             0.01,
-        );
+        )
+        .expect("measurable");
         assert_eq!(far.over, 0);
     }
 }

@@ -74,8 +74,10 @@ fn the_funnels_petals_press_on_each_other_and_stay_on_their_sides() {
         let petals: &[Vec<DVec3>] = &keyframe.positions_in_world;
         for i in 0..petals.len() {
             let next = (i + 1) % petals.len();
-            let beneath = side_check(&petals[i], &skip, &petals[next], mesh, 1.0, reach, 1e-6);
-            let over = side_check(&petals[next], &skip, &petals[i], mesh, -1.0, reach, 1e-6);
+            let beneath = side_check(&petals[i], &skip, &petals[next], mesh, 1.0, reach, 1e-6)
+                .expect("measurable");
+            let over = side_check(&petals[next], &skip, &petals[i], mesh, -1.0, reach, 1e-6)
+                .expect("measurable");
             for (what, check) in [("beneath", beneath), ("over", over)] {
                 assert_eq!(
                     check.wrong, 0,
