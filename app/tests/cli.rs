@@ -335,3 +335,71 @@ fn a_reader_that_stops_reading_ends_the_output_quietly() {
     assert!(out.status.success(), "{:?}: {stderr}", out.status);
     assert!(stderr.is_empty(), "nothing on stderr, got: {stderr}");
 }
+
+/// The number of keyframes in a .glb written by `simulate`: the length of
+/// the animation's time track.
+fn glb_keyframe_count(bytes: &[u8]) -> u64 {
+    assert_eq!(&bytes[..4], b"glTF");
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().expect("4 bytes")) as usize;
+    let json: serde_json::Value =
+        serde_json::from_slice(&bytes[20..20 + json_len]).expect("glTF JSON");
+    let input = json["animations"][0]["samplers"][0]["input"]
+        .as_u64()
+        .expect("an animated file");
+    json["accessors"][input as usize]["count"]
+        .as_u64()
+        .expect("a time track")
+}
+
+#[test]
+fn a_step_that_fails_part_way_keeps_the_keyframes_before_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 6);
+    let glb = dir.path().join("kept.glb");
+    // A panic inside keyframe 4 (the test-only hook of crates/sim/src/fault.rs;
+    // a bug, the worst way a step can fail).
+    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        .args([
+            "simulate",
+            path.to_str().expect("utf-8"),
+            "--out",
+            glb.to_str().expect("utf-8"),
+        ])
+        .env("ANTHESIS_TEST_FAULT", "panic-at-keyframe:4")
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("the binary runs");
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    let last = stderr.trim_end().lines().last().expect("an error line");
+    assert_eq!(
+        last,
+        format!(
+            "error: the keyframes before it were written to {} (keyframes 0 to 3): keyframe 4: \
+             internal error, the simulation stopped (a bug in Anthesis; please report it): \
+             forced fault at keyframe 4 (test hook)",
+            glb.display()
+        )
+    );
+    let bytes = std::fs::read(&glb).expect("the file was written");
+    assert_eq!(
+        glb_keyframe_count(&bytes),
+        4,
+        "the bud and keyframes 1 to 3"
+    );
+
+    // Without the fault the same project writes all seven keyframes, so the
+    // count above is the failure's doing.
+    let whole = dir.path().join("whole.glb");
+    let out = anthesis(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--out",
+        whole.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(
+        glb_keyframe_count(&std::fs::read(&whole).expect("written")),
+        7
+    );
+}

@@ -316,4 +316,60 @@ mod tests {
         // Half a second per keyframe, one done, three to go.
         assert_eq!(session.seconds_left(), Some(1.5));
     }
+
+    /// Feeds a real worker's events of `run` into `session` until the run
+    /// ends; returns the failures reported.
+    fn follow(worker: &Worker, session: &mut SimSession, run: RunId) -> Vec<String> {
+        let mut failures = Vec::new();
+        loop {
+            let event = worker
+                .wait_event(Duration::from_secs(60))
+                .expect("the worker answers");
+            let end = event.run() == run
+                && matches!(
+                    event,
+                    Event::Finished { .. } | Event::Failed { .. } | Event::Cancelled { .. }
+                );
+            session.accept(event, &mut failures);
+            if end {
+                return failures;
+            }
+        }
+    }
+
+    #[test]
+    fn a_panic_in_the_worker_is_a_message_and_the_work_stays() {
+        use anthesis_sim::fault::Fault;
+        let project = Arc::new(anthesis_sim::fixtures::whorl(1, 6, 10, 4));
+        let before = (*project).clone();
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let mut session = SimSession::recorded();
+
+        let run = session.start(Arc::clone(&project), Selection::All);
+        let worker_run = worker.start_with_fault(
+            Arc::clone(&project),
+            Selection::All,
+            Fault::PanicAtKeyframe(3),
+        );
+        assert_eq!(run, worker_run, "both count runs from 1");
+        let failures = follow(&worker, &mut session, run);
+        let expected = format!(
+            "run {run}, keyframe 3: internal error, the simulation stopped (a bug in Anthesis; \
+             please report it): forced fault at keyframe 3 (test hook)"
+        );
+        assert_eq!(failures.len(), 1, "one message for the log");
+        assert_eq!(failures[0], expected);
+        assert_eq!(*session.status(), RunStatus::Failed { message: expected });
+        // The keyframes computed before the panic stay on the timeline and
+        // the document the run read is as it was.
+        assert_eq!(session.last_index(), Some(2));
+        assert_eq!(*project, before);
+
+        // The same worker runs the next request to the end.
+        let next = session.start(Arc::clone(&project), Selection::All);
+        assert_eq!(worker.start(project, Selection::All), next);
+        assert!(follow(&worker, &mut session, next).is_empty());
+        assert!(matches!(session.status(), RunStatus::Finished { .. }));
+        assert_eq!(session.last_index(), Some(4));
+    }
 }

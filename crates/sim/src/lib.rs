@@ -9,10 +9,13 @@
 //! whatever the thread count.
 
 pub mod collide;
+#[cfg(any(test, feature = "fault-hook"))]
+pub mod fault;
 pub mod fixtures;
 mod organ;
 pub mod worker;
 
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::Instant;
 
 use anthesis_flower::Project;
@@ -108,8 +111,42 @@ pub enum SimError {
         iterations: u32,
         relative_gradient: f64,
     },
+    /// A bug: the simulation panicked. Caught so the worker and the
+    /// command line survive it and keep what was computed before.
+    #[error("{}", describe_panic(*.run, *.keyframe, .message))]
+    Panicked {
+        /// The worker's run, when the worker caught it.
+        run: Option<u64>,
+        /// The keyframe being computed, if the panic came from a step.
+        keyframe: Option<u32>,
+        message: String,
+    },
     #[error("cancelled")]
     Cancelled,
+}
+
+fn describe_panic(run: Option<u64>, keyframe: Option<u32>, message: &str) -> String {
+    let place = match (run, keyframe) {
+        (Some(run), Some(keyframe)) => format!("run {run}, keyframe {keyframe}"),
+        (Some(run), None) => format!("run {run}, before its first keyframe"),
+        (None, Some(keyframe)) => format!("keyframe {keyframe}"),
+        (None, None) => "the simulation".to_string(),
+    };
+    format!(
+        "{place}: internal error, the simulation stopped (a bug in Anthesis; please report it): {message}"
+    )
+}
+
+/// The text of a caught panic's payload (`panic!` gives a `&str` or a
+/// `String`).
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(text) = payload.downcast_ref::<&str>() {
+        (*text).to_string()
+    } else if let Some(text) = payload.downcast_ref::<String>() {
+        text.clone()
+    } else {
+        "a panic without a message".to_string()
+    }
 }
 
 /// Progress inside a keyframe, reported after every iteration.
@@ -142,6 +179,11 @@ pub struct Simulation {
     next_step: u32,
     /// Energy per organ at the previous keyframe, to spot blow-ups.
     previous_energy: Vec<f64>,
+    /// The keyframe whose step panicked: the organs may be half updated,
+    /// so no further step runs.
+    panicked_at: Option<u32>,
+    #[cfg(any(test, feature = "fault-hook"))]
+    fault: Option<fault::Fault>,
 }
 
 impl Simulation {
@@ -173,7 +215,18 @@ impl Simulation {
             settings: project.settings,
             next_step: 1,
             previous_energy,
+            panicked_at: None,
+            #[cfg(all(feature = "fault-hook", not(test)))]
+            fault: fault::Fault::from_env(),
+            #[cfg(test)]
+            fault: None,
         })
+    }
+
+    /// Forces `fault` on this simulation (tests only).
+    #[cfg(any(test, feature = "fault-hook"))]
+    pub fn inject(&mut self, fault: Option<fault::Fault>) {
+        self.fault = fault;
     }
 
     /// Names of the simulated organs, in keyframe order.
@@ -231,14 +284,52 @@ impl Simulation {
     /// Computes the next keyframe. `cancel` is polled between iterations;
     /// when it returns true the step stops with [`SimError::Cancelled`] and
     /// the simulation must not be stepped again.
+    ///
+    /// A panic inside the step (a bug) is caught and returned as
+    /// [`SimError::Panicked`] naming the keyframe; the keyframes returned
+    /// before stay good, and every later call returns the same error.
     pub fn step(
+        &mut self,
+        cancel: &dyn Fn() -> bool,
+        progress: &mut dyn FnMut(IterationProgress),
+    ) -> Result<Keyframe, SimError> {
+        let step = self.next_step;
+        let panicked = |keyframe: u32, message: String| SimError::Panicked {
+            run: None,
+            keyframe: Some(keyframe),
+            message,
+        };
+        if let Some(keyframe) = self.panicked_at {
+            return Err(panicked(
+                keyframe,
+                "an earlier step failed; the simulation cannot go on".to_string(),
+            ));
+        }
+        // Unwind safety: after a panic the organs may be half updated;
+        // `panicked_at` stops every later step from reading them.
+        match catch_unwind(AssertUnwindSafe(|| self.step_unguarded(cancel, progress))) {
+            Ok(result) => result,
+            Err(payload) => {
+                self.panicked_at = Some(step);
+                Err(panicked(step, panic_message(payload.as_ref())))
+            }
+        }
+    }
+
+    fn step_unguarded(
         &mut self,
         cancel: &dyn Fn() -> bool,
         progress: &mut dyn FnMut(IterationProgress),
     ) -> Result<Keyframe, SimError> {
         let started = Instant::now();
         let step = self.next_step;
-        self.organs.par_iter_mut().for_each(|o| {
+        #[cfg(any(test, feature = "fault-hook"))]
+        let fault = self.fault;
+        self.organs.par_iter_mut().enumerate().for_each(|(_i, o)| {
+            #[cfg(any(test, feature = "fault-hook"))]
+            if _i == 0 && fault == Some(fault::Fault::PanicAtKeyframe(step)) {
+                panic!("forced fault at keyframe {step} (test hook)");
+            }
             o.grow(step);
             o.attach(step);
         });
@@ -538,4 +629,46 @@ pub fn run(
         on_keyframe(&sim, &keyframe);
     }
     Ok(sim)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fault::Fault;
+    use crate::fixtures::whorl;
+
+    #[test]
+    fn a_panicking_step_is_an_error_naming_its_keyframe_and_the_run_stops_there() {
+        let project = whorl(2, 6, 10, 4);
+        let mut sim = Simulation::new(&project, &Selection::All).expect("valid");
+        sim.inject(Some(Fault::PanicAtKeyframe(2)));
+        let first = sim
+            .step(&|| false, &mut |_| {})
+            .expect("keyframe 1 is fine");
+        assert_eq!(first.index, 1);
+        let error = sim
+            .step(&|| false, &mut |_| {})
+            .expect_err("keyframe 2 panics");
+        assert!(
+            matches!(
+                &error,
+                SimError::Panicked { run: None, keyframe: Some(2), message }
+                    if message == "forced fault at keyframe 2 (test hook)"
+            ),
+            "{error:?}"
+        );
+        assert!(error.to_string().starts_with("keyframe 2: internal error"));
+        // The organs may be half grown: no later step runs on them.
+        let again = sim.step(&|| false, &mut |_| {}).expect_err("still stopped");
+        assert!(
+            matches!(
+                again,
+                SimError::Panicked {
+                    keyframe: Some(2),
+                    ..
+                }
+            ),
+            "{again:?}"
+        );
+    }
 }

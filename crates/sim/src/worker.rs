@@ -6,7 +6,12 @@
 //! events of superseded runs. The worker wakes its owner through a plain
 //! callback (a UI passes something like `ctx.request_repaint`), never through
 //! UI types. Dropping the handle cancels the job and joins the thread.
+//!
+//! A panic inside a job (a bug) ends that job with a `Failed` event naming
+//! the run; the thread lives on and serves the next run. Jobs read an
+//! immutable snapshot, so the owner's document is untouched by it.
 
+use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender, channel};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
@@ -15,7 +20,9 @@ use std::time::Instant;
 
 use anthesis_flower::Project;
 
-use crate::{IterationProgress, Keyframe, Selection, SimError, Simulation};
+#[cfg(any(test, feature = "fault-hook"))]
+use crate::fault::Fault;
+use crate::{IterationProgress, Keyframe, Selection, SimError, Simulation, panic_message};
 
 /// Identifies one job; later jobs have larger ids.
 pub type RunId = u64;
@@ -70,6 +77,8 @@ struct RunRequest {
     run: RunId,
     project: Arc<Project>,
     selection: Selection,
+    #[cfg(any(test, feature = "fault-hook"))]
+    fault: Option<Fault>,
 }
 
 /// What waits for the worker thread: at most one run, the newest (a newer
@@ -154,14 +163,35 @@ impl Worker {
     /// Starts simulating `project`, cancelling whatever runs now. Returns the
     /// new run's id. Never blocks on the simulation.
     pub fn start(&self, project: Arc<Project>, selection: Selection) -> RunId {
+        self.post_run(|run| RunRequest {
+            run,
+            project,
+            selection,
+            #[cfg(any(test, feature = "fault-hook"))]
+            fault: None,
+        })
+    }
+
+    /// [`Worker::start`] with a forced fault (tests only).
+    #[cfg(any(test, feature = "fault-hook"))]
+    pub fn start_with_fault(
+        &self,
+        project: Arc<Project>,
+        selection: Selection,
+        fault: Fault,
+    ) -> RunId {
+        self.post_run(|run| RunRequest {
+            run,
+            project,
+            selection,
+            fault: Some(fault),
+        })
+    }
+
+    fn post_run(&self, request: impl FnOnce(RunId) -> RunRequest) -> RunId {
         let run = self.current.fetch_add(1, Ordering::SeqCst) + 1;
-        self.mailbox.post(|inbox| {
-            inbox.next_run = Some(RunRequest {
-                run,
-                project,
-                selection,
-            });
-        });
+        let request = request(run);
+        self.mailbox.post(|inbox| inbox.next_run = Some(request));
         run
     }
 
@@ -201,34 +231,47 @@ fn serve(mailbox: &Mailbox, events: Sender<Event>, current: Arc<AtomicU64>, wake
         let _ = events.send(event);
         wake();
     });
+    // A panic while sending (in `wake`) poisons the lock; the sender is
+    // still whole, so later events still go out.
     let emit = |event: Event| {
-        if let Ok(send) = send.lock() {
-            send(event);
-        }
+        let send = send.lock().unwrap_or_else(PoisonError::into_inner);
+        send(event);
     };
-    while let Some(RunRequest {
-        run,
-        project,
-        selection,
-    }) = mailbox.next()
-    {
+    while let Some(request) = mailbox.next() {
+        let run = request.run;
         if current.load(Ordering::SeqCst) != run {
             // Cancelled before it started.
             continue;
         }
-        run_job(run, &project, &selection, &current, &emit);
+        // Unwind safety: the job owns its simulation and reads an
+        // immutable project; nothing it leaves half done outlives it.
+        let job = catch_unwind(AssertUnwindSafe(|| run_job(&request, &current, &emit)));
+        if let Err(payload) = job {
+            emit(Event::Failed {
+                run,
+                error: SimError::Panicked {
+                    run: Some(run),
+                    keyframe: None,
+                    message: panic_message(payload.as_ref()),
+                },
+            });
+        }
     }
 }
 
-fn run_job(
-    run: RunId,
-    project: &Project,
-    selection: &Selection,
-    current: &AtomicU64,
-    emit: &dyn Fn(Event),
-) {
+fn run_job(request: &RunRequest, current: &AtomicU64, emit: &dyn Fn(Event)) {
+    let RunRequest {
+        run,
+        ref project,
+        ref selection,
+        ..
+    } = *request;
     let started = Instant::now();
     let stale = || current.load(Ordering::SeqCst) != run;
+    #[cfg(any(test, feature = "fault-hook"))]
+    if request.fault == Some(Fault::PanicBeforeStart) {
+        panic!("forced fault before run {run} started (test hook)");
+    }
     let mut sim = match Simulation::new(project, selection) {
         Ok(sim) => sim,
         Err(error) => {
@@ -236,6 +279,10 @@ fn run_job(
             return;
         }
     };
+    #[cfg(any(test, feature = "fault-hook"))]
+    if request.fault.is_some() {
+        sim.inject(request.fault);
+    }
     emit(Event::Started {
         run,
         organs: sim.organs().iter().map(|s| s.to_string()).collect(),
@@ -256,6 +303,19 @@ fn run_job(
             }),
             Err(SimError::Cancelled) => {
                 emit(Event::Cancelled { run });
+                return;
+            }
+            Err(SimError::Panicked {
+                keyframe, message, ..
+            }) => {
+                emit(Event::Failed {
+                    run,
+                    error: SimError::Panicked {
+                        run: Some(run),
+                        keyframe,
+                        message,
+                    },
+                });
                 return;
             }
             Err(error) => {
@@ -409,6 +469,118 @@ mod tests {
         let good = worker.start(Arc::new(whorl(1, 6, 10, 2)), Selection::All);
         let events = collect_until_end(&worker, good);
         assert!(matches!(events.last(), Some(Event::Finished { .. })));
+    }
+
+    /// The keyframe indices a run delivered.
+    fn keyframe_indices(events: &[Event]) -> Vec<u32> {
+        events
+            .iter()
+            .filter_map(|e| match e {
+                Event::Keyframe { keyframe, .. } => Some(keyframe.index),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_panic_in_a_step_fails_that_run_by_name_and_the_worker_serves_the_next() {
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let project = Arc::new(whorl(2, 6, 10, 5));
+        let run = worker.start_with_fault(
+            Arc::clone(&project),
+            Selection::All,
+            Fault::PanicAtKeyframe(3),
+        );
+        let events = collect_until_end(&worker, run);
+        // The keyframes before the panic arrived; the panic is the run's end.
+        assert_eq!(keyframe_indices(&events), [0, 1, 2]);
+        let Some(Event::Failed { run: failed, error }) = events.last() else {
+            panic!("the run must fail: {:?}", events.last());
+        };
+        assert_eq!(*failed, run);
+        assert_eq!(
+            *error,
+            SimError::Panicked {
+                run: Some(run),
+                keyframe: Some(3),
+                message: "forced fault at keyframe 3 (test hook)".to_string(),
+            }
+        );
+        let message = error.to_string();
+        assert!(
+            message.starts_with(&format!("run {run}, keyframe 3: internal error")),
+            "{message}"
+        );
+
+        // The same thread runs the same project to the end afterwards: the
+        // project snapshot was not touched by the failed run.
+        let next = worker.start(Arc::clone(&project), Selection::All);
+        let events = collect_until_end(&worker, next);
+        assert_eq!(keyframe_indices(&events), [0, 1, 2, 3, 4, 5]);
+        assert!(matches!(
+            events.last(),
+            Some(Event::Finished { keyframes: 5, .. })
+        ));
+        assert_eq!(*project, whorl(2, 6, 10, 5));
+    }
+
+    #[test]
+    fn a_panic_outside_the_steps_is_caught_too() {
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let project = Arc::new(whorl(1, 6, 10, 2));
+        let run = worker.start_with_fault(
+            Arc::clone(&project),
+            Selection::All,
+            Fault::PanicBeforeStart,
+        );
+        let events = collect_until_end(&worker, run);
+        assert_eq!(events.len(), 1, "{events:?}");
+        let Some(Event::Failed { error, .. }) = events.last() else {
+            panic!("the run must fail: {events:?}");
+        };
+        assert!(
+            error.to_string().starts_with(&format!(
+                "run {run}, before its first keyframe: internal error"
+            )),
+            "{error}"
+        );
+        let next = worker.start(project, Selection::All);
+        let events = collect_until_end(&worker, next);
+        assert!(matches!(
+            events.last(),
+            Some(Event::Finished { keyframes: 2, .. })
+        ));
+    }
+
+    #[test]
+    fn a_panicking_wake_callback_does_not_silence_the_worker() {
+        let calls = Arc::new(AtomicUsize::new(0));
+        let counter = Arc::clone(&calls);
+        let worker = Worker::spawn(move || {
+            if counter.fetch_add(1, Ordering::SeqCst) == 0 {
+                panic!("the owner's wake callback failed");
+            }
+        })
+        .expect("thread");
+        let project = Arc::new(whorl(1, 6, 10, 2));
+        let first = worker.start(Arc::clone(&project), Selection::All);
+        let events = collect_until_end(&worker, first);
+        assert!(
+            matches!(
+                events.last(),
+                Some(Event::Failed {
+                    error: SimError::Panicked { .. },
+                    ..
+                })
+            ),
+            "{events:?}"
+        );
+        let next = worker.start(project, Selection::All);
+        let events = collect_until_end(&worker, next);
+        assert!(
+            matches!(events.last(), Some(Event::Finished { .. })),
+            "{events:?}"
+        );
     }
 
     #[test]
