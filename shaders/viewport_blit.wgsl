@@ -1,6 +1,7 @@
-// Copies the viewport's offscreen image (anthesis-app, app/src/desktop/
-// viewport.rs) into egui's render pass. egui sets the pass viewport to the
-// widget's rectangle, so a full-screen triangle covers exactly the widget.
+// Copies the viewport's offscreen image into egui's render pass
+// (anthesis-render's BlitPipeline, used by app/src/desktop/viewport/gpu.rs).
+// egui sets the pass viewport to the widget's rectangle, so a full-screen
+// triangle covers exactly the widget.
 //
 // The offscreen image is `Rgba8Unorm` holding sRGB-encoded colours (the
 // organ shader encodes them itself). `fs_blit_encoded` passes them on to a

@@ -911,3 +911,80 @@ fn the_window_and_anthesis_render_show_an_organ_in_the_same_colour() {
         );
     }
 }
+
+#[test]
+fn edits_applied_as_commands_are_undone_and_redone_by_the_undo_and_redo_commands() {
+    use anthesis_app::desktop::{Command, ProjectEdit};
+    let mut harness = harness(small_flower());
+    harness.run();
+    let original = harness.state().project().clone();
+    let mut thicker = original.flower.templates[0].clone();
+    thicker.thickness *= 2.0;
+    let edits = [
+        ProjectEdit::Template {
+            template: 0,
+            value: Box::new(thicker),
+            keyframes: original.settings.keyframes + 1,
+        },
+        ProjectEdit::Blend {
+            template: 0,
+            blend: anthesis_maps::Blend::Smooth,
+        },
+        ProjectEdit::RemoveKey {
+            template: 0,
+            key: 0,
+        },
+    ];
+    let app = harness.state_mut();
+    let run = app.session().run();
+    for (i, edit) in edits.into_iter().enumerate() {
+        app.apply(Command::Edit {
+            label: format!("edit {i}"),
+            edit,
+        });
+    }
+    harness.run();
+    assert!(
+        harness.state().session().run() > run,
+        "the edits restarted the run"
+    );
+    let app = harness.state_mut();
+    let edited = app.project().clone();
+    assert_ne!(edited, original);
+    assert_eq!(app.document().undo_label(), Some("edit 2"));
+    for _ in 0..3 {
+        app.apply(Command::Undo);
+    }
+    assert_eq!(
+        app.project(),
+        &original,
+        "three undos give the project back"
+    );
+    assert!(!app.document().is_dirty());
+    for _ in 0..3 {
+        app.apply(Command::Redo);
+    }
+    assert_eq!(app.project(), &edited);
+    harness.run();
+    assert_eq!(harness.state().project(), &edited);
+}
+
+#[test]
+fn preview_and_selection_commands_choose_what_the_next_run_simulates() {
+    use anthesis_app::desktop::Command;
+    let mut harness = harness(small_flower());
+    harness.run();
+    let run = harness.state().session().run();
+    harness.state_mut().apply(Command::SelectOrgan(3));
+    harness
+        .state_mut()
+        .apply(Command::SetSingleOrganPreview(true));
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.selection(), Selection::Only(3));
+    assert!(app.session().run() > run);
+    assert_eq!(app.session().organs(), &[3]);
+    // An organ that does not exist is not selected.
+    harness.state_mut().apply(Command::SelectOrgan(99));
+    assert_eq!(harness.state().selected_organ(), 3);
+}

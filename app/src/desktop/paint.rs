@@ -1,16 +1,16 @@
 //! The UV paint canvas: the selected template's UV layout over the selected
 //! map of the selected time key, with pan and zoom; brush settings; time
-//! keys (add, remove, pick, blend). Strokes go through [`Document::edit`]
-//! (one undo step per stroke) and restart the simulation. The brush
-//! arithmetic is in [`super::brush`].
+//! keys (add, remove, pick, blend). Dabs and key changes become
+//! [`Command::Edit`]s (a stroke is one undo step) and restart the
+//! simulation. The brush arithmetic is in [`super::brush`].
 
-use anthesis_flower::Template;
+use anthesis_flower::{Project, Template};
 use anthesis_maps::{Blend, MapKey, MapKind};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use glam::DVec2;
 
-use super::brush::{Brush, BrushMode, PaintTarget, dab_template};
-use super::document::Document;
+use super::brush::{Brush, BrushMode, PaintTarget};
+use super::command::{Command, ProjectEdit};
 
 /// The paint panel's state.
 pub struct PaintState {
@@ -89,10 +89,15 @@ fn map_image(template: &Template, key: usize, target: PaintTarget) -> egui::Colo
 }
 
 impl PaintState {
-    /// One dab at `point_in_uv` on template `template` (from the canvas or
-    /// the 3D organ); the stroke direction comes from the previous dab.
-    /// Returns whether the project changed.
-    pub fn dab(&mut self, doc: &mut Document, template: usize, point_in_uv: DVec2) -> bool {
+    /// One dab at `point_in_uv` on template `template` of `project` (from
+    /// the canvas or the 3D organ); the stroke direction comes from the
+    /// previous dab. `None` while a direction stroke has no direction yet.
+    pub fn dab(
+        &mut self,
+        project: &Project,
+        template: usize,
+        point_in_uv: DVec2,
+    ) -> Option<Command> {
         let direction = self.last_uv.map_or(DVec2::ZERO, |last| point_in_uv - last);
         if self.target == PaintTarget::Direction
             && matches!(self.brush.mode, BrushMode::Set | BrushMode::Add)
@@ -102,33 +107,25 @@ impl PaintState {
             if self.last_uv.is_none() {
                 self.last_uv = Some(point_in_uv);
             }
-            return false;
+            return None;
         }
         self.last_uv = Some(point_in_uv);
         let (key, target, brush) = (self.key, self.target, self.brush);
-        let Some(name) = doc
-            .project()
-            .flower
-            .templates
-            .get(template)
-            .map(|t| t.name.clone())
-        else {
-            return false;
-        };
-        let label = format!(
-            "{} stroke on {} of {name}",
-            brush.mode.label(),
-            target.label()
-        );
-        doc.edit(&label, |p| {
-            dab_template(
-                &mut p.flower.templates[template],
+        let name = &project.flower.templates.get(template)?.name;
+        Some(Command::Edit {
+            label: format!(
+                "{} stroke on {} of {name}",
+                brush.mode.label(),
+                target.label()
+            ),
+            edit: ProjectEdit::Dab {
+                template,
                 key,
                 target,
-                &brush,
+                brush,
                 point_in_uv,
-                direction,
-            );
+                direction_in_uv: direction,
+            },
         })
     }
 
@@ -137,14 +134,14 @@ impl PaintState {
         self.last_uv = None;
     }
 
-    /// The paint panel for template `template`. Returns whether the project
-    /// changed.
-    pub fn ui(&mut self, ui: &mut egui::Ui, doc: &mut Document, template: usize) -> bool {
-        let Some(current) = doc.project().flower.templates.get(template).cloned() else {
+    /// The paint panel for template `template` of `project`; returns the
+    /// edits the user made.
+    pub fn ui(&mut self, ui: &mut egui::Ui, project: &Project, template: usize) -> Vec<Command> {
+        let Some(current) = project.flower.templates.get(template) else {
             ui.label("No template.");
-            return false;
+            return Vec::new();
         };
-        let mut changed = false;
+        let mut chosen = Vec::new();
         ui.heading(format!("Paint “{}”", current.name));
         self.key = current.maps.clamped_index(self.key);
 
@@ -201,22 +198,17 @@ impl PaintState {
                         )
                         .clicked()
                     {
+                        // The new key starts from the selected key's maps;
+                        // applying it selects it for painting.
                         let maps = current.maps.keys()[self.key].maps.clone();
                         let step = self.new_key_step;
-                        let name = current.name.clone();
-                        changed |= doc.edit(&format!("add key {step} to {name}"), |p| {
-                            let _ = p.flower.templates[template]
-                                .maps
-                                .insert(MapKey { step, maps });
+                        chosen.push(Command::Edit {
+                            label: format!("add key {step} to {}", current.name),
+                            edit: ProjectEdit::AddKey {
+                                template,
+                                key: Box::new(MapKey { step, maps }),
+                            },
                         });
-                        if let Some(i) = doc.project().flower.templates[template]
-                            .maps
-                            .keys()
-                            .iter()
-                            .position(|k| k.step == step)
-                        {
-                            self.key = i;
-                        }
                     }
                     if ui
                         .add_enabled(
@@ -226,10 +218,12 @@ impl PaintState {
                         .on_hover_text("Remove the selected key (the last key cannot go)")
                         .clicked()
                     {
-                        let key = self.key;
-                        let name = current.name.clone();
-                        changed |= doc.edit(&format!("remove key from {name}"), |p| {
-                            let _ = p.flower.templates[template].maps.remove(key);
+                        chosen.push(Command::Edit {
+                            label: format!("remove key from {}", current.name),
+                            edit: ProjectEdit::RemoveKey {
+                                template,
+                                key: self.key,
+                            },
                         });
                         self.key = self.key.saturating_sub(1);
                     }
@@ -254,20 +248,20 @@ impl PaintState {
                     .labelled_by(label)
                     .on_hover_text("How the maps change from one key to the next");
                 if blend != current.maps.blend {
-                    let name = current.name.clone();
-                    changed |= doc.edit(&format!("blend of {name}"), |p| {
-                        p.flower.templates[template].maps.blend = blend;
+                    chosen.push(Command::Edit {
+                        label: format!("blend of {}", current.name),
+                        edit: ProjectEdit::Blend { template, blend },
                     });
                 }
                 ui.end_row();
             });
 
-        changed |= self.canvas(ui, doc, template, &current);
+        chosen.extend(self.canvas(ui, project, template, current));
         ui.separator();
         egui::ScrollArea::vertical()
             .id_salt("brush settings")
             .show(ui, |ui| self.brush_ui(ui));
-        changed
+        chosen
     }
 
     /// Brush mode, radius, strength, hardness, value, mirror, 3D painting.
@@ -327,10 +321,10 @@ impl PaintState {
     fn canvas(
         &mut self,
         ui: &mut egui::Ui,
-        doc: &mut Document,
+        project: &Project,
         template: usize,
         current: &Template,
-    ) -> bool {
+    ) -> Option<Command> {
         let side = ui
             .available_width()
             .min(0.6 * ui.available_height())
@@ -376,17 +370,19 @@ impl PaintState {
             )
         };
 
-        let mut changed = false;
-        let painting = response.dragged_by(egui::PointerButton::Primary)
+        // A dab where the pointer is pressed or moves while held: holding
+        // still does not paint again on every redraw.
+        let fresh = ui.input(|i| i.pointer.primary_pressed() || i.pointer.delta() != Vec2::ZERO);
+        let painting = (response.dragged_by(egui::PointerButton::Primary) && fresh)
             || (response.clicked() && !response.double_clicked());
-        if painting && let Some(pointer) = response.interact_pointer_pos() {
-            changed |= self.dab(doc, template, to_uv(pointer));
-        }
-
-        // Draw what the document holds now (after this frame's dab).
-        let Some(shown) = doc.project().flower.templates.get(template) else {
-            return changed;
+        let dab = match response.interact_pointer_pos() {
+            Some(pointer) if painting => self.dab(project, template, to_uv(pointer)),
+            _ => None,
         };
+
+        // The document as it is before this frame's dab (the app draws
+        // again once the dab is applied).
+        let shown = current;
         let image = map_image(shown, self.key, self.target);
         let options = egui::TextureOptions::NEAREST;
         match &mut self.texture {
@@ -464,13 +460,24 @@ impl PaintState {
                 );
             }
         }
-        changed
+        dab
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::desktop::document::Document;
+
+    /// A dab on template 0 applied to `doc` as the app applies it: whether
+    /// the project changed.
+    fn dab(paint: &mut PaintState, doc: &mut Document, point_in_uv: DVec2) -> bool {
+        match paint.dab(doc.project(), 0, point_in_uv) {
+            Some(Command::Edit { label, edit }) => doc.edit(&label, |p| edit.apply(p)),
+            Some(other) => panic!("a dab is an edit, not {other:?}"),
+            None => false,
+        }
+    }
 
     #[test]
     fn a_stroke_is_one_undo_step_and_direction_waits_for_movement() {
@@ -480,7 +487,11 @@ mod tests {
             ..PaintState::default()
         };
         for i in 0..5 {
-            assert!(paint.dab(&mut doc, 0, DVec2::new(0.3 + 0.02 * f64::from(i), 0.5)));
+            assert!(dab(
+                &mut paint,
+                &mut doc,
+                DVec2::new(0.3 + 0.02 * f64::from(i), 0.5)
+            ));
         }
         paint.end_stroke();
         doc.seal();
@@ -489,10 +500,10 @@ mod tests {
 
         paint.target = PaintTarget::Direction;
         assert!(
-            !paint.dab(&mut doc, 0, DVec2::new(0.3, 0.5)),
+            !dab(&mut paint, &mut doc, DVec2::new(0.3, 0.5)),
             "no direction yet"
         );
-        assert!(paint.dab(&mut doc, 0, DVec2::new(0.4, 0.5)));
+        assert!(dab(&mut paint, &mut doc, DVec2::new(0.4, 0.5)));
         let keys = doc.project().flower.templates[0].maps.keys();
         let d = keys[0].maps.direction.sample(DVec2::new(0.4, 0.5));
         assert!(d.x > 0.3, "painted towards +u: {d}");

@@ -1,12 +1,12 @@
 //! The parameters panel: the selected organ's template (dg, thickness,
 //! Ks, Kb, joint schedule, base region) and the project's keyframe count,
-//! each with a tooltip saying what it does. Edits go through
-//! [`Document::edit`], so each is undoable and restarts the simulation.
+//! each with a tooltip saying what it does. An edit becomes a
+//! [`Command::Edit`], so each is undoable and restarts the simulation.
 
-use anthesis_flower::{JointRamp, Template};
+use anthesis_flower::{JointRamp, Project, Template};
 use eframe::egui::{self, DragValue};
 
-use super::document::Document;
+use super::command::{Command, ProjectEdit};
 
 /// A labelled number row; returns whether it changed.
 fn number(
@@ -32,13 +32,12 @@ fn number(
     changed
 }
 
-/// Shows the panel for template `template` and applies edits to `doc`.
-/// Returns whether the project changed.
-pub fn parameters_ui(ui: &mut egui::Ui, doc: &mut Document, template: usize) -> bool {
-    let project = doc.project();
+/// Shows the panel for template `template` of `project`; returns the edit
+/// the user made, if any.
+pub fn parameters_ui(ui: &mut egui::Ui, project: &Project, template: usize) -> Option<Command> {
     let Some(original) = project.flower.templates.get(template) else {
         ui.label("No organ selected.");
-        return false;
+        return None;
     };
     let mut draft: Template = original.clone();
     let mut keyframes = project.settings.keyframes;
@@ -230,12 +229,13 @@ pub fn parameters_ui(ui: &mut egui::Ui, doc: &mut Document, template: usize) -> 
         mark(true, "add joint ramp");
     }
 
-    let Some(field) = changed_field else {
-        return false;
-    };
-    let label = format!("{field} of {name}");
-    doc.edit(&label, |p| {
-        p.flower.templates[template] = draft;
-        p.settings.keyframes = keyframes;
+    let field = changed_field?;
+    Some(Command::Edit {
+        label: format!("{field} of {name}"),
+        edit: ProjectEdit::Template {
+            template,
+            value: Box::new(draft),
+            keyframes,
+        },
     })
 }

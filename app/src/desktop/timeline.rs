@@ -5,6 +5,7 @@
 
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, StrokeKind, Vec2};
 
+use super::command::Command;
 use super::session::{RunStatus, SimSession};
 
 /// Keyframes per second at speed 1 (the glTF export's default frame rate).
@@ -145,20 +146,14 @@ pub fn status_line(session: &SimSession) -> String {
     }
 }
 
-/// What the user asked the timeline for this frame.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
-pub struct TimelineRequests {
-    pub stop: bool,
-    pub resimulate: bool,
-}
-
-/// The timeline panel.
+/// The timeline panel: the scrubber moves `playback` directly; the
+/// buttons' commands are returned.
 pub fn timeline_ui(
     ui: &mut egui::Ui,
     playback: &mut Playback,
     session: &SimSession,
-) -> TimelineRequests {
-    let mut requests = TimelineRequests::default();
+) -> Vec<Command> {
+    let mut chosen = Vec::new();
     let computed = session.last_index();
     let total = session.total().max(1);
     ui.horizontal(|ui| {
@@ -167,14 +162,14 @@ pub fn timeline_ui(
             .on_hover_text("First keyframe (Home)")
             .clicked()
         {
-            playback.go_to_start();
+            chosen.push(Command::GoToStart);
         }
         if ui
             .button("Prev")
             .on_hover_text("Previous keyframe (←)")
             .clicked()
         {
-            playback.step(-1, computed);
+            chosen.push(Command::StepKeyframe(-1));
         }
         let play_label = if playback.playing { "Pause" } else { "Play" };
         if ui
@@ -182,21 +177,21 @@ pub fn timeline_ui(
             .on_hover_text("Play or pause (Space)")
             .clicked()
         {
-            playback.toggle_play(computed);
+            chosen.push(Command::TogglePlay);
         }
         if ui
             .button("Next")
             .on_hover_text("Next keyframe (→)")
             .clicked()
         {
-            playback.step(1, computed);
+            chosen.push(Command::StepKeyframe(1));
         }
         if ui
             .button("End")
             .on_hover_text("Newest keyframe, and follow new ones (End)")
             .clicked()
         {
-            playback.go_to_end(computed);
+            chosen.push(Command::GoToEnd);
         }
         ui.toggle_value(&mut playback.looping, "Loop")
             .on_hover_text("Start again from the bud at the end");
@@ -227,20 +222,20 @@ pub fn timeline_ui(
                     .on_hover_text("Stop simulating; the keyframes so far stay")
                     .clicked()
                 {
-                    requests.stop = true;
+                    chosen.push(Command::StopSimulation);
                 }
             } else if ui
                 .button("Simulate")
                 .on_hover_text("Simulate again from the bud")
                 .clicked()
             {
-                requests.resimulate = true;
+                chosen.push(Command::Resimulate);
             }
         });
     });
     scrubber(ui, playback, computed, total);
     stats_plot(ui, session, playback.time_in_keyframes);
-    requests
+    chosen
 }
 
 /// The scrubber: one cell per keyframe, filled where computed; the

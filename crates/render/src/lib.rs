@@ -13,11 +13,14 @@
 //! - [`OffscreenRenderer`] creates its own headless device (any backend;
 //!   the software Vulkan adapter lavapipe is fine) and renders organs to an
 //!   [`image::RgbaImage`].
+//! - [`BlitPipeline`] copies a [`RenderTarget`]'s image into another pass
+//!   (the desktop viewport draws into egui's pass with it).
 //!
 //! Depth is reversed (near = 1, infinitely far = 0, compare
 //! `GreaterEqual`): a pass that draws organs must clear its depth to
 //! [`DEPTH_CLEAR_VALUE`].
 
+mod blit;
 mod camera;
 mod error;
 mod mesh;
@@ -25,6 +28,7 @@ mod offscreen;
 mod pipeline;
 mod target;
 
+pub use blit::{BLIT_SHADER_SOURCE, BLIT_SOURCE_FORMAT, BlitPipeline};
 pub use camera::Camera;
 pub use error::RenderError;
 pub use mesh::{OrganMesh, organs_bounds_in_world};

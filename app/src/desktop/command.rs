@@ -1,0 +1,468 @@
+//! Every user action as a value. Menus, keyboard shortcuts, buttons, file
+//! drops and tests make a [`Command`]; [`AnthesisApp::apply`] carries it
+//! out, in this one place. A change to the project is a [`ProjectEdit`],
+//! applied through [`Document::edit`] so that it is one undo step and
+//! restarts the simulation.
+//!
+//! Continuous widget state that is not the document — the camera being
+//! dragged, the playhead being scrubbed, brush and export settings — is
+//! changed by its widget directly; everything that also has a menu entry,
+//! a shortcut or a button goes through here.
+
+use std::path::PathBuf;
+
+use anthesis_flower::{Project, Template};
+use anthesis_maps::{Blend, DirectionMap, MapKey, MapKind, ScalarMap};
+use anthesis_mesh::Mesh;
+use glam::DVec2;
+
+use super::brush::{Brush, PaintTarget, dab_template};
+use super::files::DialogPurpose;
+use super::prompts::Pending;
+use super::viewport::ViewOptions;
+use super::{AnthesisApp, Document};
+
+/// One user action.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// A new project from the default flower (asks about unsaved changes).
+    NewProject,
+    /// Open a project: this file, or ask for one (asks about unsaved
+    /// changes first).
+    OpenProject(Option<PathBuf>),
+    /// Save to the project's file, or ask for one.
+    Save,
+    /// Ask where to save, then save.
+    SaveAs,
+    /// Close the window (asks about unsaved changes).
+    Quit,
+    /// A file dropped on the window (project, mesh or map).
+    DropFile(PathBuf),
+    /// Show the export dialog.
+    OpenExportDialog,
+    /// Ask where to export.
+    BrowseExportPath,
+    /// Export the computed keyframes with the dialog's settings.
+    StartExport,
+    Undo,
+    Redo,
+    /// Change the project, as one undo step named `label`.
+    Edit {
+        label: String,
+        edit: ProjectEdit,
+    },
+    /// Select an organ (index into the project's organs).
+    SelectOrgan(usize),
+    /// Simulate only the selected organ (fast, no collisions) or all.
+    SetSingleOrganPreview(bool),
+    /// Simulate again from the bud.
+    Resimulate,
+    /// Stop simulating; the keyframes so far stay.
+    StopSimulation,
+    TogglePlay,
+    /// One keyframe forwards (+1) or back (−1).
+    StepKeyframe(i32),
+    GoToStart,
+    /// The newest keyframe, following new ones.
+    GoToEnd,
+    /// Frame the camera on the whole scene.
+    FrameAll,
+    /// What the viewport shows.
+    SetView(ViewOptions),
+    /// Show or hide the log panel.
+    ShowLog(bool),
+}
+
+/// A change to the project. Indices are into the project's templates and a
+/// template's time keys.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProjectEdit {
+    /// The parameters panel: a template's fields and the project's
+    /// keyframe count.
+    Template {
+        template: usize,
+        value: Box<Template>,
+        keyframes: u32,
+    },
+    /// One brush dab on a map of a time key.
+    Dab {
+        template: usize,
+        key: usize,
+        target: PaintTarget,
+        brush: Brush,
+        point_in_uv: DVec2,
+        /// The stroke's direction (used by the direction map).
+        direction_in_uv: DVec2,
+    },
+    /// A time key (an existing step is left alone).
+    AddKey { template: usize, key: Box<MapKey> },
+    /// Remove a time key (the last one stays).
+    RemoveKey { template: usize, key: usize },
+    /// How maps change from one key to the next.
+    Blend { template: usize, blend: Blend },
+    /// Replace a template's mesh.
+    Mesh { template: usize, mesh: Box<Mesh> },
+    /// Replace one map of a time key.
+    Map {
+        template: usize,
+        key: usize,
+        map: Box<LoadedMap>,
+    },
+}
+
+/// A map read from a file, with the map it replaces.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LoadedMap {
+    Scalar(MapKind, ScalarMap),
+    Direction(DirectionMap),
+}
+
+impl ProjectEdit {
+    /// Applies the edit; an index that does not exist changes nothing.
+    pub fn apply(self, project: &mut Project) {
+        let templates = &mut project.flower.templates;
+        match self {
+            ProjectEdit::Template {
+                template,
+                value,
+                keyframes,
+            } => {
+                if let Some(t) = templates.get_mut(template) {
+                    *t = *value;
+                    project.settings.keyframes = keyframes;
+                }
+            }
+            ProjectEdit::Dab {
+                template,
+                key,
+                target,
+                brush,
+                point_in_uv,
+                direction_in_uv,
+            } => {
+                if let Some(t) = templates.get_mut(template) {
+                    dab_template(t, key, target, &brush, point_in_uv, direction_in_uv);
+                }
+            }
+            ProjectEdit::AddKey { template, key } => {
+                if let Some(t) = templates.get_mut(template) {
+                    // A key at an existing step is refused by the maps and
+                    // the project stays as it was.
+                    let _ = t.maps.insert(*key);
+                }
+            }
+            ProjectEdit::RemoveKey { template, key } => {
+                if let Some(t) = templates.get_mut(template) {
+                    // The last key cannot go; nothing changes then.
+                    let _ = t.maps.remove(key);
+                }
+            }
+            ProjectEdit::Blend { template, blend } => {
+                if let Some(t) = templates.get_mut(template) {
+                    t.maps.blend = blend;
+                }
+            }
+            ProjectEdit::Mesh { template, mesh } => {
+                if let Some(t) = templates.get_mut(template) {
+                    t.mesh = *mesh;
+                }
+            }
+            ProjectEdit::Map { template, key, map } => {
+                let Some(k) = templates
+                    .get_mut(template)
+                    .and_then(|t| t.maps.keys_mut().get_mut(key))
+                else {
+                    return;
+                };
+                match *map {
+                    LoadedMap::Scalar(kind, map) => *k.maps.scalar_mut(kind) = map,
+                    LoadedMap::Direction(map) => k.maps.direction = map,
+                }
+            }
+        }
+    }
+}
+
+impl AnthesisApp {
+    /// Carries out `command`.
+    pub fn apply(&mut self, command: Command) {
+        match command {
+            Command::NewProject => self.request(Pending::New),
+            Command::OpenProject(path) => self.request(Pending::Open(path)),
+            Command::Save => {
+                self.save();
+            }
+            Command::SaveAs => self.save_as(),
+            Command::Quit => self.request(Pending::Quit),
+            Command::DropFile(path) => self.drop_file(&path),
+            Command::OpenExportDialog => self.open_export(),
+            Command::BrowseExportPath => self.ask_for_path(DialogPurpose::ExportGlb),
+            Command::StartExport => self.start_export(),
+            Command::Undo => self.undo(),
+            Command::Redo => self.redo(),
+            Command::Edit { label, edit } => {
+                self.edit(&label, edit);
+            }
+            Command::SelectOrgan(organ) => self.select_organ(organ),
+            Command::SetSingleOrganPreview(on) => self.set_single_organ_preview(on),
+            Command::Resimulate => self.needs_run = true,
+            Command::StopSimulation => {
+                self.session.cancel();
+                self.log.info("simulation stopped");
+            }
+            Command::TogglePlay => self.playback.toggle_play(self.session.last_index()),
+            Command::StepKeyframe(direction) => {
+                self.playback.step(direction, self.session.last_index());
+            }
+            Command::GoToStart => self.playback.go_to_start(),
+            Command::GoToEnd => self.playback.go_to_end(self.session.last_index()),
+            Command::FrameAll => self.frame_all(),
+            Command::SetView(view) => self.view = view,
+            Command::ShowLog(on) => self.settings.show_log = on,
+        }
+    }
+
+    /// Applies the commands the panels queued this frame, in order.
+    pub(super) fn apply_queued(&mut self) {
+        let queued = std::mem::take(&mut self.queued);
+        if queued.is_empty() {
+            return;
+        }
+        for command in queued {
+            self.apply(command);
+        }
+        // The panels were drawn before the change: draw them again.
+        self.ctx.request_repaint();
+    }
+
+    /// Applies `edit` as one undo step named `label` (see
+    /// [`Document::edit`]); returns whether the project changed.
+    pub fn edit(&mut self, label: &str, edit: ProjectEdit) -> bool {
+        let added_step = match &edit {
+            ProjectEdit::AddKey { template, key } => Some((*template, key.step)),
+            _ => None,
+        };
+        let changed = self.doc.edit(label, |project| edit.apply(project));
+        if changed {
+            self.needs_run = true;
+        }
+        if let Some((template, step)) = added_step
+            && let Some(index) = self
+                .project()
+                .flower
+                .templates
+                .get(template)
+                .and_then(|t| t.maps.keys().iter().position(|k| k.step == step))
+        {
+            // Paint the new key next.
+            self.paint.key = index;
+        }
+        changed
+    }
+
+    pub fn undo(&mut self) {
+        match self.doc.undo() {
+            Some(label) => {
+                self.log.info(format!("undid {label}"));
+                self.after_history_change();
+            }
+            None => self.log.info("nothing to undo"),
+        }
+    }
+
+    pub fn redo(&mut self) {
+        match self.doc.redo() {
+            Some(label) => {
+                self.log.info(format!("redid {label}"));
+                self.after_history_change();
+            }
+            None => self.log.info("nothing to redo"),
+        }
+    }
+
+    fn after_history_change(&mut self) {
+        let organs = self.project().flower.organs.len();
+        self.selected_organ = self.selected_organ.min(organs.saturating_sub(1));
+        self.needs_run = true;
+    }
+
+    pub fn select_organ(&mut self, organ: usize) {
+        if organ < self.project().flower.organs.len() && organ != self.selected_organ {
+            self.selected_organ = organ;
+            if self.single_organ_preview {
+                self.needs_run = true;
+            }
+        }
+    }
+
+    pub fn set_single_organ_preview(&mut self, on: bool) {
+        if on != self.single_organ_preview {
+            self.single_organ_preview = on;
+            self.needs_run = true;
+        }
+    }
+}
+
+/// Applies `edit` to `doc` as one sealed undo step (for tests and for
+/// callers without an app).
+pub fn edit_document(doc: &mut Document, label: &str, edit: ProjectEdit) -> bool {
+    let changed = doc.edit(label, |project| edit.apply(project));
+    doc.seal();
+    changed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::desktop::brush::BrushMode;
+    use anthesis_maps::GrowthMaps;
+
+    fn project() -> Project {
+        anthesis_sim::fixtures::whorl(2, 4, 6, 3)
+    }
+
+    /// Every kind of edit, each of which changes the fixture project.
+    fn edits(project: &Project) -> Vec<ProjectEdit> {
+        let template = &project.flower.templates[0];
+        let mut changed = template.clone();
+        changed.dg = 0.0123;
+        changed.thickness = 0.31;
+        let mut mesh = template.mesh.clone();
+        for p in &mut mesh.positions {
+            p.x *= 1.5;
+        }
+        let painted_size = 16;
+        vec![
+            ProjectEdit::Template {
+                template: 0,
+                value: Box::new(changed),
+                keyframes: project.settings.keyframes + 7,
+            },
+            ProjectEdit::Dab {
+                template: 0,
+                key: 0,
+                target: PaintTarget::Scalar(MapKind::Bend),
+                brush: Brush {
+                    mode: BrushMode::Set,
+                    value: 0.1,
+                    ..Brush::default()
+                },
+                point_in_uv: DVec2::new(0.3, 0.5),
+                direction_in_uv: DVec2::ZERO,
+            },
+            ProjectEdit::Dab {
+                template: 0,
+                key: 0,
+                target: PaintTarget::Direction,
+                brush: Brush::default(),
+                point_in_uv: DVec2::new(0.5, 0.5),
+                direction_in_uv: DVec2::new(0.1, 0.0),
+            },
+            ProjectEdit::AddKey {
+                template: 0,
+                key: Box::new(MapKey {
+                    step: 77,
+                    maps: GrowthMaps::default(),
+                }),
+            },
+            ProjectEdit::Blend {
+                template: 0,
+                blend: Blend::logistic(),
+            },
+            ProjectEdit::Mesh {
+                template: 0,
+                mesh: Box::new(mesh),
+            },
+            ProjectEdit::Map {
+                template: 0,
+                key: 0,
+                map: Box::new(LoadedMap::Scalar(
+                    MapKind::Stretch,
+                    ScalarMap::from_fn(painted_size, painted_size, |uv| uv.x as f32),
+                )),
+            },
+        ]
+    }
+
+    #[test]
+    fn each_edit_changes_the_project_and_undo_gives_it_back_and_redo_again() {
+        let original = project();
+        for edit in edits(&original) {
+            let mut doc = Document::new(original.clone(), None);
+            assert!(
+                edit_document(&mut doc, "edit", edit.clone()),
+                "{edit:?} changed nothing"
+            );
+            let edited = doc.project().clone();
+            assert_ne!(edited, original);
+            assert!(doc.undo().is_some());
+            assert_eq!(doc.project(), &original, "undo of {edit:?}");
+            assert!(!doc.is_dirty());
+            assert!(doc.redo().is_some());
+            assert_eq!(doc.project(), &edited, "redo of {edit:?}");
+        }
+    }
+
+    #[test]
+    fn removing_a_key_is_undone_and_the_last_key_stays() {
+        let mut doc = Document::new(project(), None);
+        let add = ProjectEdit::AddKey {
+            template: 0,
+            key: Box::new(MapKey {
+                step: 45,
+                maps: GrowthMaps::default(),
+            }),
+        };
+        assert!(edit_document(&mut doc, "add key", add));
+        let with_added = doc.project().clone();
+        let remove = |key| ProjectEdit::RemoveKey { template: 0, key };
+        let count = with_added.flower.templates[0].maps.keys().len();
+        for removed in 1..count {
+            assert!(edit_document(&mut doc, "remove key", remove(0)));
+            assert_eq!(
+                doc.project().flower.templates[0].maps.keys().len(),
+                count - removed
+            );
+        }
+        assert!(
+            !edit_document(&mut doc, "remove key", remove(0)),
+            "the last key cannot go"
+        );
+        for _ in 1..count {
+            doc.undo();
+        }
+        assert_eq!(doc.project(), &with_added);
+    }
+
+    #[test]
+    fn an_edit_of_a_template_that_does_not_exist_changes_nothing() {
+        let original = project();
+        let missing = original.flower.templates.len() + 3;
+        let mut doc = Document::new(original.clone(), None);
+        let edits = [
+            ProjectEdit::Template {
+                template: missing,
+                value: Box::new(original.flower.templates[0].clone()),
+                keyframes: 9,
+            },
+            ProjectEdit::Dab {
+                template: missing,
+                key: 0,
+                target: PaintTarget::Scalar(MapKind::Bend),
+                brush: Brush::default(),
+                point_in_uv: DVec2::splat(0.5),
+                direction_in_uv: DVec2::ZERO,
+            },
+            ProjectEdit::Map {
+                template: 0,
+                key: 5,
+                map: Box::new(LoadedMap::Direction(DirectionMap::constant(DVec2::X))),
+            },
+        ];
+        for edit in edits {
+            assert!(!edit_document(&mut doc, "edit", edit));
+        }
+        assert_eq!(doc.project(), &original);
+        assert!(!doc.is_dirty());
+    }
+}

@@ -1,0 +1,140 @@
+//! The panels around the viewport and the viewport panel itself. Each
+//! draws from the app's state and queues [`Command`]s for what the user
+//! asked; none changes the project directly.
+
+use std::sync::Arc;
+
+use eframe::egui;
+
+use super::AnthesisApp;
+use super::command::Command;
+use super::params;
+use super::timeline;
+use super::viewport;
+
+impl AnthesisApp {
+    /// The left panel: organs, preview switch and the parameters.
+    pub(super) fn organs_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Organs");
+        let mut chosen = Vec::new();
+        egui::ScrollArea::vertical()
+            .id_salt("organ list")
+            .max_height(160.0)
+            .show(ui, |ui| {
+                for (i, organ) in self.project().flower.organs.iter().enumerate() {
+                    if ui
+                        .selectable_label(i == self.selected_organ, &organ.name)
+                        .on_hover_text("Select this organ (or click it in the viewport)")
+                        .clicked()
+                    {
+                        chosen.push(Command::SelectOrgan(i));
+                    }
+                }
+            });
+        let mut preview = self.single_organ_preview;
+        if ui
+            .checkbox(&mut preview, "Single-organ preview  (P)")
+            .on_hover_text(
+                "Simulate only the selected organ, without collisions: much faster while \
+                 painting. Off: the whole flower with collisions.",
+            )
+            .changed()
+        {
+            chosen.push(Command::SetSingleOrganPreview(preview));
+        }
+        ui.separator();
+        let template = self.selected_template();
+        egui::ScrollArea::vertical()
+            .id_salt("parameters")
+            .show(ui, |ui| {
+                chosen.extend(params::parameters_ui(ui, self.doc.project(), template));
+            });
+        self.queued.extend(chosen);
+    }
+
+    /// The timeline panel (the playhead is scrubbed directly; buttons
+    /// queue commands).
+    pub(super) fn timeline_panel(&mut self, ui: &mut egui::Ui) {
+        let chosen = timeline::timeline_ui(ui, &mut self.playback, &self.session);
+        self.queued.extend(chosen);
+    }
+
+    /// The paint panel for the selected organ's template.
+    pub(super) fn paint_panel(&mut self, ui: &mut egui::Ui) {
+        let template = self.selected_template();
+        let chosen = self.paint.ui(ui, self.doc.project(), template);
+        self.queued.extend(chosen);
+    }
+
+    /// The export dialog, when open.
+    pub(super) fn export_window(&mut self, ctx: &egui::Context) {
+        let requests = self
+            .export
+            .ui(ctx, self.session.keyframes().len(), self.session.total());
+        if requests.browse {
+            self.queued.push(Command::BrowseExportPath);
+        }
+        if requests.export {
+            self.queued.push(Command::StartExport);
+        }
+    }
+
+    /// The 3D viewport: the scene at the playhead, the camera, picking and
+    /// painting on the organ.
+    pub(super) fn viewport_panel(&mut self, ui: &mut egui::Ui) {
+        self.log.banner_ui(ui);
+        let scene = viewport::build_scene(
+            self.doc.project(),
+            &self.session,
+            self.playback.time_in_keyframes,
+            self.shows_others(),
+        );
+        self.frame_automatically(&scene);
+        let overlay = self.view.overlay.map(|kind| (kind, self.paint.key));
+        let meshes = Arc::new(viewport::scene_meshes(
+            self.doc.project(),
+            &scene,
+            Some(self.selected_organ),
+            overlay,
+        ));
+        self.scene_revision += 1;
+        if !self.has_gpu {
+            ui.label("The 3D viewport needs the wgpu renderer.");
+            return;
+        }
+        let outline = self.outline.edges_of(
+            &self
+                .doc
+                .project()
+                .flower
+                .template_of(self.selected_organ)
+                .mesh,
+        );
+        let response = viewport::viewport_ui(
+            ui,
+            &mut self.camera,
+            self.doc.project(),
+            &scene,
+            meshes,
+            self.scene_revision,
+            &self.view,
+            Some((self.selected_organ, outline)),
+            Some(self.paint.key),
+            self.paint.on_3d,
+        );
+        let template = self.selected_template();
+        match response.painting {
+            Some(hit) if self.project().flower.organs[hit.organ].template == template => {
+                let dab = self
+                    .paint
+                    .dab(self.doc.project(), template, hit.point_in_uv);
+                self.queued.extend(dab);
+            }
+            _ => {
+                if let Some(hit) = response.clicked {
+                    self.queued.push(Command::SelectOrgan(hit.organ));
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,235 @@
+//! Project files: open, save, save as, dropped files, the file dialogs'
+//! answers and starting an export. Errors are shown in the log and the
+//! user's work stays.
+
+use std::path::{Path, PathBuf};
+
+use anthesis_flower::project::{load_project, save_project};
+
+use super::AnthesisApp;
+use super::brush::PaintTarget;
+use super::command::{LoadedMap, ProjectEdit};
+use super::document::Document;
+use super::export;
+use super::files::DialogPurpose;
+use super::prompts::Pending;
+
+impl AnthesisApp {
+    /// Opens the project at `path`; on failure the current work stays and
+    /// the error is shown.
+    pub fn open_path(&mut self, path: &Path) {
+        match load_project(path) {
+            Ok(project) => {
+                self.settings.remember(path);
+                self.replace_document(Document::new(project, Some(path.to_path_buf())));
+                self.log.info(format!("opened {}", path.display()));
+            }
+            Err(e) => {
+                self.log.error(format!("cannot open the project: {e}"));
+                if !path.exists() {
+                    self.settings.forget(path);
+                }
+            }
+        }
+    }
+
+    /// A file dropped on the window: a project (`.toml`) opens after the
+    /// unsaved-changes prompt, an OBJ mesh replaces the selected organ's
+    /// template mesh, a PNG replaces the map being painted. Anything that
+    /// cannot be used is reported and changes nothing.
+    pub fn drop_file(&mut self, path: &Path) {
+        let extension = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_lowercase())
+            .unwrap_or_default();
+        match extension.as_str() {
+            "toml" => self.request(Pending::Open(Some(path.to_path_buf()))),
+            "obj" => self.replace_mesh(path),
+            "png" => self.load_map(path),
+            _ => self.log.warn(format!(
+                "cannot use {}: drop a project (.toml), a mesh (.obj) or a map (.png)",
+                path.display()
+            )),
+        }
+    }
+
+    fn replace_mesh(&mut self, path: &Path) {
+        let template = self.selected_template();
+        match anthesis_mesh::load_obj(path) {
+            Ok(mesh) => {
+                let name = self.project().flower.templates[template].name.clone();
+                self.edit(
+                    &format!("mesh of {name}"),
+                    ProjectEdit::Mesh {
+                        template,
+                        mesh: Box::new(mesh),
+                    },
+                );
+                self.doc.seal();
+                self.log
+                    .info(format!("{name} now uses the mesh of {}", path.display()));
+            }
+            Err(e) => self
+                .log
+                .error(format!("cannot use {} as a mesh: {e}", path.display())),
+        }
+    }
+
+    fn load_map(&mut self, path: &Path) {
+        let template = self.selected_template();
+        let (key, target) = (self.paint.key, self.paint.target);
+        let size = self.project().flower.templates[template].maps.raster_size();
+        let fits = |found: (u32, u32)| match size {
+            Some(expected) if found != expected && found != (1, 1) => Err(format!(
+                "the map is {}x{} pixels but the template's maps are {}x{}",
+                found.0, found.1, expected.0, expected.1
+            )),
+            _ => Ok(()),
+        };
+        let loaded = match target {
+            PaintTarget::Scalar(kind) => anthesis_maps::ScalarMap::load_png(path)
+                .map_err(|e| e.to_string())
+                .and_then(|map| fits(map.size()).map(|()| LoadedMap::Scalar(kind, map))),
+            PaintTarget::Direction => anthesis_maps::DirectionMap::load_png(path)
+                .map_err(|e| e.to_string())
+                .and_then(|map| fits(map.size()).map(|()| LoadedMap::Direction(map))),
+        };
+        match loaded {
+            Ok(map) => {
+                let name = self.project().flower.templates[template].name.clone();
+                self.edit(
+                    &format!("{} map of {name}", target.label()),
+                    ProjectEdit::Map {
+                        template,
+                        key,
+                        map: Box::new(map),
+                    },
+                );
+                self.doc.seal();
+                self.log.info(format!(
+                    "loaded the {} map of {name} from {}",
+                    target.label(),
+                    path.display()
+                ));
+            }
+            Err(e) => self
+                .log
+                .error(format!("cannot use {} as a map: {e}", path.display())),
+        }
+    }
+
+    pub(super) fn replace_document(&mut self, doc: Document) {
+        self.doc = doc;
+        self.selected_organ = 0;
+        self.framed = false;
+        self.needs_run = true;
+        self.playback.time_in_keyframes = 0.0;
+        self.playback.follow = true;
+    }
+
+    fn project_folder(&self) -> Option<PathBuf> {
+        self.doc
+            .path
+            .as_ref()
+            .and_then(|p| p.parent())
+            .map(Path::to_path_buf)
+    }
+
+    /// Opens the file dialog for `purpose`, starting in the project's
+    /// folder; the answer arrives in a later frame.
+    pub(super) fn ask_for_path(&mut self, purpose: DialogPurpose) {
+        let folder = self.project_folder();
+        let wake = self.ctx.clone();
+        self.dialogs
+            .open(purpose, folder.as_deref(), move || wake.request_repaint());
+    }
+
+    /// Saves to the document's path, or asks for one. Returns whether the
+    /// project was written.
+    pub fn save(&mut self) -> bool {
+        match self.doc.path.clone() {
+            Some(path) => self.save_to(&path),
+            None => {
+                self.save_as();
+                false
+            }
+        }
+    }
+
+    pub fn save_as(&mut self) {
+        self.ask_for_path(DialogPurpose::SaveProjectAs);
+    }
+
+    /// Writes the project to `path`; errors are shown, the work stays.
+    pub fn save_to(&mut self, path: &Path) -> bool {
+        match save_project(self.doc.project(), path) {
+            Ok(()) => {
+                self.doc.mark_saved(path.to_path_buf());
+                self.settings.remember(path);
+                self.log.info(format!("saved {}", path.display()));
+                true
+            }
+            Err(e) => {
+                self.log.error(format!("cannot save: {e}"));
+                false
+            }
+        }
+    }
+
+    pub(super) fn handle_dialog_answers(&mut self) {
+        let Some((purpose, answer)) = self.dialogs.poll() else {
+            return;
+        };
+        let Some(path) = answer else {
+            // Cancelled: a pending action waiting for "save as" is dropped.
+            if purpose == DialogPurpose::SaveProjectAs {
+                self.pending = None;
+            }
+            return;
+        };
+        match purpose {
+            DialogPurpose::OpenProject => self.open_path(&path),
+            DialogPurpose::SaveProjectAs => {
+                if self.save_to(&path)
+                    && let Some(action) = self.pending.take()
+                {
+                    self.perform(action);
+                }
+            }
+            DialogPurpose::ExportGlb => {
+                self.export.path = path.display().to_string();
+            }
+        }
+    }
+
+    /// Shows the export dialog, suggesting a .glb beside the project.
+    pub fn open_export(&mut self) {
+        self.export.open = true;
+        if self.export.path.trim().is_empty() {
+            let folder = self.project_folder().unwrap_or_default();
+            let stem: String = self
+                .project()
+                .name
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            self.export.path = folder.join(format!("{stem}.glb")).display().to_string();
+        }
+    }
+
+    pub(super) fn start_export(&mut self) {
+        let tracks = export::tracks(
+            self.doc.project(),
+            self.session.organs(),
+            self.session.keyframes(),
+        );
+        let wake = self.ctx.clone();
+        self.export.start(tracks, move || wake.request_repaint());
+    }
+}
