@@ -9,7 +9,7 @@ pub mod write;
 
 pub use read::{
     FileError, check_relative, excerpt, human_bytes, read_regular, read_regular_text,
-    resolve_inside,
+    resolve_inside, short_number,
 };
 pub use write::{
     WriteError, check_destination, create_folder, folder_of, write_atomic, write_atomic_with,

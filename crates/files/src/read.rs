@@ -242,6 +242,18 @@ pub fn excerpt(text: &str, max_chars: usize) -> String {
     shown
 }
 
+/// A number as a message may show it: as Rust writes it when that is short
+/// (`0.06`, `-5`, `NaN`), in exponent form when not (`1e-320` written out
+/// is 322 characters).
+pub fn short_number(value: f64) -> String {
+    let plain = value.to_string();
+    if plain.len() <= 24 {
+        plain
+    } else {
+        format!("{value:e}")
+    }
+}
+
 /// A byte count in words: "512 bytes", "1.5 KiB", "256 MiB", "8.0 GiB".
 pub fn human_bytes(bytes: u64) -> String {
     const UNITS: [&str; 5] = ["KiB", "MiB", "GiB", "TiB", "PiB"];

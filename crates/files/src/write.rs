@@ -334,7 +334,18 @@ fn temp_file_beside(path: &Path, folder: &Path) -> Result<tempfile::NamedTempFil
     }
     builder
         .tempfile_in(folder)
-        .map_err(|error| WriteError::from_io(path.to_path_buf(), error))
+        .map_err(|error| WriteError::from_io(path.to_path_buf(), without_temp_path(error)))
+}
+
+/// tempfile's errors end in `at path ".NAME.XXXXXX.tmp"`, a file that was
+/// never made and that the user never named: keep the system's own words
+/// (and the error's kind).
+fn without_temp_path(error: io::Error) -> io::Error {
+    let text = error.to_string();
+    match text.rfind(" at path \"") {
+        Some(end) if error.get_ref().is_some() => io::Error::new(error.kind(), &text[..end]),
+        _ => error,
+    }
 }
 
 #[cfg(test)]

@@ -75,10 +75,10 @@ impl fmt::Display for ScaleMismatch {
             self.template,
             significant(self.length),
             significant(self.length / self.thickness),
-            self.thickness,
+            anthesis_files::short_number(self.thickness),
             unit_guess(self.factor),
-            1.0 / self.factor,
-            self.factor
+            anthesis_files::short_number(1.0 / self.factor),
+            anthesis_files::short_number(self.factor)
         )
     }
 }

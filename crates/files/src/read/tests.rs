@@ -205,3 +205,13 @@ fn byte_counts_read_well() {
     assert_eq!(human_bytes(8 << 30), "8 GiB");
     assert_eq!(human_bytes(40_000_000_000), "37.3 GiB");
 }
+
+#[test]
+fn numbers_in_messages_stay_short() {
+    assert_eq!(short_number(0.06), "0.06");
+    assert_eq!(short_number(-5.0), "-5");
+    assert_eq!(short_number(f64::NAN), "NaN");
+    assert_eq!(short_number(1e-320), "1e-320");
+    assert_eq!(short_number(1e300), "1e300");
+    assert_eq!(short_number(0.1 + 0.2), "0.30000000000000004");
+}

@@ -374,3 +374,16 @@ mod unix {
         assert!(leftover_temp_files(dir.path()).is_empty());
     }
 }
+
+#[test]
+fn a_folder_that_takes_no_new_files_is_named_without_the_temporary_file() {
+    // /proc exists but no file can be made in it.
+    let error = write_atomic(Path::new("/proc/x.glb"), b"data").expect_err("refused");
+    let message = error.to_string();
+    assert!(
+        message.starts_with("cannot write /proc/x.glb: "),
+        "{message}"
+    );
+    assert!(!message.contains(".tmp"), "{message}");
+    assert!(message.contains("os error"), "{message}");
+}

@@ -3,6 +3,7 @@
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
+use anthesis_files::short_number;
 use anthesis_maps::{Blend, MapKind};
 
 use super::error::ProjectError;
@@ -148,7 +149,7 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
     {
         return invalid(format!(
             "simulation: relative_tolerance must be a positive number, found {}",
-            settings.solver.relative_tolerance
+            short_number(settings.solver.relative_tolerance)
         ));
     }
     if settings.solver.max_iterations == 0 {
@@ -157,7 +158,7 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
     if !(settings.collision_offset >= 0.0 && settings.collision_offset.is_finite()) {
         return invalid(format!(
             "simulation: collision_offset must be 0 or more, found {}",
-            settings.collision_offset
+            short_number(settings.collision_offset)
         ));
     }
 
@@ -222,7 +223,7 @@ fn template_problem(template: &Template) -> Option<String> {
         return Some(format!(
             "dg must be a number greater than -1 (a growth rate 1 + dg × map value must stay \
              positive), found {}",
-            template.dg
+            short_number(template.dg)
         ));
     }
     let scales = [
@@ -232,7 +233,10 @@ fn template_problem(template: &Template) -> Option<String> {
     ];
     for (field, value) in scales {
         if !positive(value) {
-            return Some(format!("{field} must be greater than 0, found {value}"));
+            return Some(format!(
+                "{field} must be greater than 0, found {}",
+                short_number(value)
+            ));
         }
     }
     let region = &template.base_region;
@@ -240,13 +244,16 @@ fn template_problem(template: &Template) -> Option<String> {
     if !(in_unit(region.v_max) && in_unit(region.u_min) && in_unit(region.u_max)) {
         return Some(format!(
             "base_region v_max, u_min and u_max must lie in [0, 1], found {}, {}, {}",
-            region.v_max, region.u_min, region.u_max
+            short_number(region.v_max),
+            short_number(region.u_min),
+            short_number(region.u_max)
         ));
     }
     if region.u_min > region.u_max {
         return Some(format!(
             "base_region u_min ({}) is greater than u_max ({})",
-            region.u_min, region.u_max
+            short_number(region.u_min),
+            short_number(region.u_max)
         ));
     }
     let base = region.particles(&template.mesh).len();
@@ -254,7 +261,9 @@ fn template_problem(template: &Template) -> Option<String> {
         return Some(format!(
             "the base region (v <= {}, u from {} to {}) holds {base} particle(s) of the mesh; at \
              least 3 are needed to attach the organ",
-            region.v_max, region.u_min, region.u_max
+            short_number(region.v_max),
+            short_number(region.u_min),
+            short_number(region.u_max)
         ));
     }
     if template.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
@@ -268,7 +277,9 @@ fn template_problem(template: &Template) -> Option<String> {
             return Some(format!(
                 "joint_schedule ramp from step {} to step {} by {} degrees: from_step must not \
                  exceed to_step and degrees must be finite",
-                ramp.from_step, ramp.to_step, ramp.angle_deg
+                ramp.from_step,
+                ramp.to_step,
+                short_number(ramp.angle_deg)
             ));
         }
     }
@@ -276,7 +287,8 @@ fn template_problem(template: &Template) -> Option<String> {
         && !steepness.is_finite()
     {
         return Some(format!(
-            "blend steepness must be a finite number, found {steepness}"
+            "blend steepness must be a finite number, found {}",
+            short_number(steepness)
         ));
     }
     for key in template.maps.keys() {
@@ -284,9 +296,10 @@ fn template_problem(template: &Template) -> Option<String> {
             let values = key.maps.scalar(kind).values();
             if let Some(value) = values.iter().find(|value| !value.is_finite()) {
                 return Some(format!(
-                    "map key at step {}: the {} map holds {value}; map values must be finite",
+                    "map key at step {}: the {} map holds {}; map values must be finite",
                     key.step,
-                    kind.name()
+                    kind.name(),
+                    short_number(f64::from(*value))
                 ));
             }
             // A negative growth value shrinks an organ the user meant to
@@ -295,10 +308,11 @@ fn template_problem(template: &Template) -> Option<String> {
             // 0 to 1) scale a rate or stiffness up.
             if let Some(value) = values.iter().find(|value| **value < 0.0) {
                 return Some(format!(
-                    "map key at step {}: the {} map holds {value}; map values must be 0 or \
+                    "map key at step {}: the {} map holds {}; map values must be 0 or \
                      more (for shrinkage, give the template a negative dg)",
                     key.step,
-                    kind.name()
+                    kind.name(),
+                    short_number(f64::from(*value))
                 ));
             }
         }
