@@ -84,6 +84,7 @@ fn harness(project: Project) -> Harness<'static, AnthesisApp> {
                     restore: false,
                 },
             )
+            .expect("the app starts")
         })
 }
 
@@ -314,7 +315,10 @@ fn new_with_unsaved_changes_asks_first_and_dont_save_discards() {
     harness.run();
     let app = harness.state();
     assert!(!app.document().is_dirty());
-    assert_eq!(app.project(), &anthesis_app::desktop::default_project());
+    assert_eq!(
+        app.project(),
+        &anthesis_app::desktop::default_project().expect("a default flower")
+    );
 }
 
 #[test]
@@ -475,7 +479,7 @@ fn a_stroke_on_the_uv_canvas_paints_the_map_restarts_and_undoes_in_one_step() {
 fn dragging_on_the_direction_map_paints_the_stroke_direction() {
     let mut harness = harness(small_flower());
     harness.run();
-    harness.state_mut().paint_mut().target = anthesis_app::desktop::brush::PaintTarget::Direction;
+    harness.state_mut().paint_mut().target = anthesis_maps::brush::PaintTarget::Direction;
     harness.run();
     stroke_on_canvas(&mut harness, egui::vec2(0.2, 0.5), egui::vec2(0.4, 0.5));
     let keys = harness.state().project().flower.templates[0].maps.keys();
@@ -492,7 +496,7 @@ fn dragging_on_the_direction_map_paints_the_stroke_direction() {
 
 #[test]
 fn the_default_project_is_the_built_in_lily() {
-    let lily = anthesis_app::desktop::default_project();
+    let lily = anthesis_app::desktop::default_project().expect("a default flower");
     assert!(lily.name.to_lowercase().contains("lily"), "{}", lily.name);
     assert!(lily.flower.organs.len() >= 6);
 }
@@ -633,6 +637,7 @@ fn the_last_project_and_view_are_remembered_between_launches() {
                     restore: true,
                 },
             )
+            .expect("the app starts")
         });
     let app = second.state();
     assert_eq!(app.project().name, "Kept flower");
@@ -670,7 +675,7 @@ fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
     app.camera_mut().distance = 40.0;
     app.paint_mut().on_3d = true;
     app.paint_mut().target =
-        anthesis_app::desktop::brush::PaintTarget::Scalar(anthesis_maps::MapKind::Bend);
+        anthesis_maps::brush::PaintTarget::Scalar(anthesis_maps::MapKind::Bend);
     harness.run();
     let before = harness.state().project().clone();
     let centre = harness.get_by_label("3D viewport").rect().center();

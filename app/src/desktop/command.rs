@@ -16,11 +16,11 @@ use anthesis_maps::{Blend, DirectionMap, MapKey, MapKind, ScalarMap};
 use anthesis_mesh::Mesh;
 use glam::DVec2;
 
-use super::brush::{Brush, PaintTarget, dab_template};
 use super::files::DialogPurpose;
 use super::prompts::Pending;
 use super::viewport::ViewOptions;
 use super::{AnthesisApp, Document};
+use anthesis_maps::brush::{Brush, PaintTarget, dab_keyed};
 
 /// One user action.
 #[derive(Debug, Clone, PartialEq)]
@@ -141,7 +141,14 @@ impl ProjectEdit {
                 direction_in_uv,
             } => {
                 if let Some(t) = templates.get_mut(template) {
-                    dab_template(t, key, target, &brush, point_in_uv, direction_in_uv);
+                    dab_keyed(
+                        &mut t.maps,
+                        key,
+                        target,
+                        &brush,
+                        point_in_uv,
+                        direction_in_uv,
+                    );
                 }
             }
             ProjectEdit::AddKey { template, key } => {
@@ -314,8 +321,8 @@ pub fn edit_document(doc: &mut Document, label: &str, edit: ProjectEdit) -> bool
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::desktop::brush::BrushMode;
     use anthesis_maps::GrowthMaps;
+    use anthesis_maps::brush::BrushMode;
 
     fn project() -> Project {
         anthesis_sim::fixtures::whorl(2, 4, 6, 3)

@@ -5,8 +5,10 @@
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 
+use anthesis_render::OrbitCamera;
+
 use super::timeline::Playback;
-use super::viewport::{OrbitCamera, ViewOptions};
+use super::viewport::ViewOptions;
 
 /// Most recent files remembered.
 pub const RECENT_LIMIT: usize = 10;

@@ -10,7 +10,6 @@
 //! framing in `framing`. No engine logic lives here: simulation, maps,
 //! project files and export are the engine crates'.
 
-pub mod brush;
 pub mod command;
 pub mod document;
 pub mod export;
@@ -36,6 +35,7 @@ use anthesis_sim::Selection;
 use anyhow::{Result, anyhow};
 use eframe::egui;
 
+use anthesis_render::OrbitCamera;
 pub use command::{Command, ProjectEdit};
 use document::Document;
 use export::ExportDialog;
@@ -44,15 +44,16 @@ use log::Log;
 use paint::PaintState;
 use session::{DRAIN_BUDGET, SimSession};
 use timeline::Playback;
-use viewport::{OrbitCamera, ViewOptions, ViewportGpu};
+use viewport::{ViewOptions, ViewportGpu};
 
-/// The flower shown at first launch: the built-in Asiatic lily, or (should
-/// this build lack it) a generated six-organ whorl.
-pub fn default_project() -> Project {
-    anthesis_garden::builtin_lily().unwrap_or_else(|_| {
-        let mut project = anthesis_sim::fixtures::whorl(6, 14, 28, 100);
-        project.name = "Default flower".to_string();
-        project
+/// The flower shown at first launch and by File → New: the Asiatic lily
+/// embedded in the binary or, should this build lack it, the same lily
+/// built by `anthesis-garden`.
+pub fn default_project() -> Result<Project> {
+    anthesis_garden::builtin_lily().or_else(|embedded| {
+        anthesis_garden::flowers::lily().map_err(|built| {
+            anyhow!("no default flower: the embedded lily: {embedded}; building it: {built}")
+        })
     })
 }
 
@@ -72,7 +73,10 @@ pub fn run() -> Result<()> {
     eframe::run_native(
         "Anthesis",
         options,
-        Box::new(|cc| Ok(Box::new(AnthesisApp::new(cc, Startup::default())))),
+        Box::new(|cc| {
+            let app = AnthesisApp::new(cc, Startup::default()).map_err(|e| e.to_string())?;
+            Ok(Box::new(app))
+        }),
     )
     .map_err(|e| anyhow!("cannot open the window: {e}"))
 }
@@ -140,7 +144,9 @@ pub struct AnthesisApp {
 }
 
 impl AnthesisApp {
-    pub fn new(cc: &eframe::CreationContext<'_>, startup: Startup) -> AnthesisApp {
+    /// The app as `startup` asks. Fails only when there is no project to
+    /// show: none given, none to reopen and no default flower.
+    pub fn new(cc: &eframe::CreationContext<'_>, startup: Startup) -> Result<AnthesisApp> {
         let ctx = cc.egui_ctx.clone();
         let settings: Settings = if startup.restore {
             cc.storage
@@ -179,10 +185,10 @@ impl AnthesisApp {
                     Ok(project) => (project, Some(path.clone())),
                     Err(e) => {
                         log.warn(format!("could not reopen the last project: {e}"));
-                        (default_project(), None)
+                        (default_project()?, None)
                     }
                 },
-                None => (default_project(), None),
+                None => (default_project()?, None),
             },
         };
         let playback = Playback {
@@ -216,7 +222,7 @@ impl AnthesisApp {
             ctx,
         };
         app.log.info(format!("opened {}", app.doc.title()));
-        app
+        Ok(app)
     }
 
     pub fn document(&self) -> &Document {

@@ -2,15 +2,15 @@
 //! map of the selected time key, with pan and zoom; brush settings; time
 //! keys (add, remove, pick, blend). Dabs and key changes become
 //! [`Command::Edit`]s (a stroke is one undo step) and restart the
-//! simulation. The brush arithmetic is in [`super::brush`].
+//! simulation. The brush arithmetic is in [`anthesis_maps::brush`].
 
 use anthesis_flower::{Project, Template};
 use anthesis_maps::{Blend, MapKey, MapKind};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use glam::DVec2;
 
-use super::brush::{Brush, BrushMode, PaintTarget};
 use super::command::{Command, ProjectEdit};
+use anthesis_maps::brush::{Brush, BrushMode, PaintTarget};
 
 /// The paint panel's state.
 pub struct PaintState {

@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 use anthesis_flower::project::{load_project, save_project};
 
 use super::AnthesisApp;
-use super::brush::PaintTarget;
 use super::command::{LoadedMap, ProjectEdit};
 use super::document::Document;
 use super::export;
 use super::files::DialogPurpose;
 use super::prompts::Pending;
+use anthesis_maps::brush::PaintTarget;
 
 impl AnthesisApp {
     /// Opens the project at `path`; on failure the current work stays and

@@ -29,9 +29,10 @@ impl AnthesisApp {
     /// Carries out `action` without asking.
     pub(super) fn perform(&mut self, action: Pending) {
         match action {
-            Pending::New => {
-                self.replace_document(Document::new(default_project(), None));
-            }
+            Pending::New => match default_project() {
+                Ok(project) => self.replace_document(Document::new(project, None)),
+                Err(e) => self.log.error(format!("cannot start a new project: {e}")),
+            },
             Pending::Open(Some(path)) => self.open_path(&path),
             Pending::Open(None) => self.ask_for_path(DialogPurpose::OpenProject),
             Pending::Quit => {

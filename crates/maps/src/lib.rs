@@ -33,6 +33,7 @@
 //!   value ≈ 2·(c / max) − 1, but with the 50 % grey of paint programs (128)
 //!   exactly zero, and zero survives a save and load exactly.
 
+pub mod brush;
 mod error;
 mod growth;
 mod keys;

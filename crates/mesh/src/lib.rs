@@ -11,6 +11,7 @@
 mod error;
 pub mod generate;
 pub mod obj;
+pub mod ray;
 mod topology;
 pub mod validate;
 

@@ -1,5 +1,7 @@
 use glam::dcamera::rh::{proj::directx, view};
-use glam::{DVec3, Mat4};
+use glam::{DMat4, DVec2, DVec3, DVec4, Mat4};
+
+use crate::orbit::orbit_directions;
 
 /// A perspective camera looking from `eye` at `target`.
 ///
@@ -32,11 +34,7 @@ impl Camera {
     ) -> Camera {
         let fov_y_deg: f64 = 30.0;
         let target = 0.5 * (bounds_min + bounds_max);
-        let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
-        let towards_eye = DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
-        // The derivative of `towards_eye` with respect to elevation: always
-        // perpendicular to the view direction, +Y-ish except from the poles.
-        let up = DVec3::new(-el.sin() * az.sin(), el.cos(), -el.sin() * az.cos());
+        let (towards_eye, up) = orbit_directions(azimuth_deg, elevation_deg);
         let right = up.cross(towards_eye);
         // A corner at height `a` (along towards_eye) and offsets `x`, `y`
         // across the view is inside when max(|x|, |y|) <= tan(fov/2) (d - a),
@@ -101,6 +99,18 @@ impl Camera {
         );
         (projection * view).as_mat4()
     }
+
+    /// The ray from the eye through the image point `ndc` (x right, y up,
+    /// both in `[-1, 1]`) of an image of `aspect` (width / height): its
+    /// origin (the eye) and unit direction.
+    pub fn ray_through(&self, aspect: f32, ndc: DVec2) -> (DVec3, DVec3) {
+        let inverse: DMat4 = self.view_projection(aspect).as_dmat4().inverse();
+        let on_near = inverse * DVec4::new(ndc.x, ndc.y, 1.0, 1.0);
+        let further = inverse * DVec4::new(ndc.x, ndc.y, 0.5, 1.0);
+        let a = on_near.truncate() / on_near.w;
+        let b = further.truncate() / further.w;
+        (self.eye, (b - a).normalize_or(DVec3::NEG_Z))
+    }
 }
 
 #[cfg(test)]
@@ -156,5 +166,28 @@ mod tests {
         let right = to_ndc(&camera, 1.0, DVec3::X * 0.5);
         assert!(above.y > 0.1 && above.x.abs() < 1e-6, "{above}");
         assert!(right.x > 0.1 && right.y.abs() < 1e-6, "{right}");
+    }
+
+    #[test]
+    fn rays_leave_the_eye_towards_the_target_and_the_image_edge_at_half_the_field_of_view() {
+        let camera = Camera {
+            eye: DVec3::new(0.0, 0.0, 10.0),
+            target: DVec3::ZERO,
+            up: DVec3::Y,
+            fov_y_deg: 30.0,
+        };
+        let (origin, direction) = camera.ray_through(1.5, DVec2::ZERO);
+        assert_eq!(origin, camera.eye);
+        assert!((direction - DVec3::NEG_Z).length() < 1e-9, "{direction}");
+        // A wide image: the fov is vertical, so the top edge is 15° up.
+        let (_, up_edge) = camera.ray_through(1.5, DVec2::new(0.0, 1.0));
+        let angle = up_edge.angle_between(DVec3::NEG_Z).to_degrees();
+        assert!((angle - 15.0).abs() < 1e-6, "{angle}");
+        assert!(up_edge.y > 0.0);
+        // Round trip: the ray's points project back onto the same image point.
+        let ndc = DVec2::new(0.3, -0.6);
+        let (origin, direction) = camera.ray_through(1.5, ndc);
+        let back = to_ndc(&camera, 1.5, origin + 7.0 * direction);
+        assert!((back.truncate() - ndc).length() < 1e-9, "{back}");
     }
 }

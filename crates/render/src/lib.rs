@@ -25,6 +25,7 @@ mod camera;
 mod error;
 mod mesh;
 mod offscreen;
+mod orbit;
 mod pipeline;
 mod target;
 
@@ -33,6 +34,7 @@ pub use camera::Camera;
 pub use error::RenderError;
 pub use mesh::{OrganMesh, organs_bounds_in_world};
 pub use offscreen::OffscreenRenderer;
+pub use orbit::{ORBIT_FOV_DEG, OrbitCamera};
 pub use pipeline::{Background, DEPTH_CLEAR_VALUE, OrganPipeline, SHADER_SOURCE, TargetFormat};
 pub use target::RenderTarget;
 

@@ -1,5 +1,6 @@
-//! The 3D viewport: an orbit camera, picking (ray → triangle → UV) and
-//! the widget that handles the camera and draws the organs. The organs
+//! The 3D viewport: the widget that turns the orbit camera
+//! (`anthesis_render::OrbitCamera`), picks organs (ray casting from
+//! `anthesis_mesh::ray`, giving the UV under the pointer) and draws them. The organs
 //! shown are built in [`scene`], drawn on the GPU by [`gpu`] (through
 //! `anthesis-render`), with egui overlays from [`overlays`].
 
@@ -11,96 +12,15 @@ use std::sync::Arc;
 
 use anthesis_flower::Project;
 use anthesis_maps::MapKind;
-use anthesis_render::{Camera, OrganMesh};
+use anthesis_mesh::ray::nearest_hit;
+use anthesis_render::{OrbitCamera, OrganMesh};
 use eframe::egui::{self, Pos2, Sense, Vec2};
 use eframe::egui_wgpu;
-use glam::{DMat4, DVec2, DVec3, DVec4};
+use glam::{DVec2, DVec3};
 
 pub use gpu::ViewportGpu;
 pub use overlays::Outline;
 pub use scene::{SceneOrgan, build_scene, scene_bounds, scene_meshes};
-
-/// An orbit camera around `target`.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct OrbitCamera {
-    pub target: DVec3,
-    pub distance: f64,
-    /// Around +Y, 0 = looking from +Z.
-    pub azimuth_deg: f64,
-    /// Above the XZ plane.
-    pub elevation_deg: f64,
-}
-
-impl Default for OrbitCamera {
-    fn default() -> Self {
-        OrbitCamera {
-            target: DVec3::new(0.0, 15.0, 0.0),
-            distance: 90.0,
-            azimuth_deg: 30.0,
-            elevation_deg: 25.0,
-        }
-    }
-}
-
-/// Field of view of the viewport across its shorter side.
-const FOV_DEG: f64 = 30.0;
-
-impl OrbitCamera {
-    fn towards_eye(&self) -> DVec3 {
-        let (az, el) = (
-            self.azimuth_deg.to_radians(),
-            self.elevation_deg.to_radians(),
-        );
-        DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos())
-    }
-
-    pub fn camera(&self) -> Camera {
-        let el = self.elevation_deg.to_radians();
-        let az = self.azimuth_deg.to_radians();
-        Camera {
-            eye: self.target + self.distance * self.towards_eye(),
-            target: self.target,
-            up: DVec3::new(-el.sin() * az.sin(), el.cos(), -el.sin() * az.cos()),
-            fov_y_deg: FOV_DEG,
-        }
-    }
-
-    /// Looks at the box `[min, max]` from the current direction so that
-    /// all of it is in view.
-    pub fn frame(&mut self, bounds_in_world: (DVec3, DVec3)) {
-        let framed = Camera::framing(
-            bounds_in_world.0,
-            bounds_in_world.1,
-            self.azimuth_deg,
-            self.elevation_deg,
-        );
-        self.target = framed.target;
-        self.distance = framed.eye.distance(framed.target).max(1e-3);
-    }
-
-    pub fn orbit(&mut self, drag_in_points: Vec2) {
-        self.azimuth_deg = (self.azimuth_deg - 0.4 * f64::from(drag_in_points.x)) % 360.0;
-        self.elevation_deg =
-            (self.elevation_deg + 0.4 * f64::from(drag_in_points.y)).clamp(-89.0, 89.0);
-    }
-
-    /// Moves the target with the image: `drag` in points over a viewport
-    /// `height` points tall.
-    pub fn pan(&mut self, drag_in_points: Vec2, height_in_points: f32) {
-        let camera = self.camera();
-        let towards_eye = self.towards_eye();
-        let right = camera.up.cross(towards_eye).normalize_or_zero();
-        let world_per_point = 2.0 * self.distance * (0.5 * FOV_DEG.to_radians()).tan()
-            / f64::from(height_in_points.max(1.0));
-        self.target += world_per_point
-            * (-f64::from(drag_in_points.x) * right + f64::from(drag_in_points.y) * camera.up);
-    }
-
-    /// `factor` > 1 moves closer.
-    pub fn zoom(&mut self, factor: f64) {
-        self.distance = (self.distance / factor.max(1e-3)).clamp(1e-3, 1e6);
-    }
-}
 
 /// What the viewport shows besides the organs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -125,52 +45,27 @@ pub struct Hit {
     pub distance: f64,
 }
 
-/// The ray from the eye through `ndc` (x right, y up, in [-1, 1]).
-pub fn ray_through(camera: &Camera, aspect: f32, ndc: DVec2) -> (DVec3, DVec3) {
-    let inverse: DMat4 = camera.view_projection(aspect).as_dmat4().inverse();
-    let on_near = inverse * DVec4::new(ndc.x, ndc.y, 1.0, 1.0);
-    let further = inverse * DVec4::new(ndc.x, ndc.y, 0.5, 1.0);
-    let a = on_near.truncate() / on_near.w;
-    let b = further.truncate() / further.w;
-    (camera.eye, (b - a).normalize_or(DVec3::NEG_Z))
+/// The nearest organ triangle the ray `origin + t direction` meets
+/// (anthesis-mesh's ray casting), with the UV of the point hit.
+pub fn pick(scene: &[SceneOrgan], origin: DVec3, direction: DVec3) -> Option<Hit> {
+    scene
+        .iter()
+        .filter_map(|o| {
+            let hit = nearest_hit(origin, direction, &o.positions_in_world, &o.triangles)?;
+            let corners = o.triangles[hit.triangle].map(|i| o.uvs[i as usize]);
+            Some(Hit {
+                organ: o.organ,
+                triangle: hit.triangle,
+                point_in_uv: hit.interpolate(corners),
+                distance: hit.distance,
+            })
+        })
+        .min_by(|a, b| a.distance.total_cmp(&b.distance))
 }
 
-/// The nearest triangle the ray `origin + t direction` hits (Möller–Trumbore).
-pub fn pick(scene: &[SceneOrgan], origin: DVec3, direction: DVec3) -> Option<Hit> {
-    let mut best: Option<Hit> = None;
-    for o in scene {
-        for (t, tri) in o.triangles.iter().enumerate() {
-            let [p0, p1, p2] = tri.map(|i| o.positions_in_world[i as usize]);
-            let (e1, e2) = (p1 - p0, p2 - p0);
-            let h = direction.cross(e2);
-            let det = e1.dot(h);
-            if det.abs() < 1e-12 {
-                continue;
-            }
-            let s = origin - p0;
-            let u = s.dot(h) / det;
-            if !(0.0..=1.0).contains(&u) {
-                continue;
-            }
-            let q = s.cross(e1);
-            let v = direction.dot(q) / det;
-            if v < 0.0 || u + v > 1.0 {
-                continue;
-            }
-            let distance = e2.dot(q) / det;
-            if distance <= 0.0 || best.is_some_and(|b| b.distance <= distance) {
-                continue;
-            }
-            let [uv0, uv1, uv2] = tri.map(|i| o.uvs[i as usize]);
-            best = Some(Hit {
-                organ: o.organ,
-                triangle: t,
-                point_in_uv: uv0 + u * (uv1 - uv0) + v * (uv2 - uv0),
-                distance,
-            });
-        }
-    }
-    best
+/// A drag in egui points as a vector for the camera.
+fn points(drag: Vec2) -> DVec2 {
+    DVec2::new(f64::from(drag.x), f64::from(drag.y))
 }
 
 /// What happened in the viewport this frame.
@@ -216,15 +111,15 @@ pub fn viewport_ui(
     let fresh = ui.input(|i| i.pointer.primary_pressed() || i.pointer.delta() != Vec2::ZERO);
     if response.dragged_by(egui::PointerButton::Primary) && !painting {
         if shift && !paint_modifier {
-            camera.pan(response.drag_delta(), rect.height());
+            camera.pan(points(response.drag_delta()), f64::from(rect.height()));
         } else {
-            camera.orbit(response.drag_delta());
+            camera.orbit(points(response.drag_delta()));
         }
     }
     if response.dragged_by(egui::PointerButton::Secondary)
         || response.dragged_by(egui::PointerButton::Middle)
     {
-        camera.pan(response.drag_delta(), rect.height());
+        camera.pan(points(response.drag_delta()), f64::from(rect.height()));
     }
     if response.hovered() {
         let (scroll, zoom) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
@@ -248,7 +143,7 @@ pub fn viewport_ui(
             f64::from((pos.x - rect.left()) / rect.width() * 2.0 - 1.0),
             f64::from(1.0 - (pos.y - rect.top()) / rect.height() * 2.0),
         );
-        let (origin, direction) = ray_through(&render_camera, aspect, ndc);
+        let (origin, direction) = render_camera.ray_through(aspect, ndc);
         pick(scene, origin, direction)
     };
     if let Some(pos) = response.hover_pos() {
@@ -337,26 +232,15 @@ mod tests {
         orbit.target = DVec3::new(0.25, 0.75, 0.0);
         orbit.distance = 5.0;
         let camera = orbit.camera();
-        let (origin, direction) = ray_through(&camera, 1.5, DVec2::ZERO);
+        let (origin, direction) = camera.ray_through(1.5, DVec2::ZERO);
         let hit = pick(&scene, origin, direction).expect("hits the square");
         assert_eq!(hit.organ, 3);
         assert_eq!(hit.triangle, 1);
         assert!((hit.point_in_uv - DVec2::new(0.25, 0.75)).length() < 1e-9);
         assert!((hit.distance - 5.0).abs() < 1e-9);
         // Looking away from the square misses.
-        let (origin, direction) = ray_through(&camera, 1.5, DVec2::new(0.9, 0.9));
+        let (origin, direction) = camera.ray_through(1.5, DVec2::new(0.9, 0.9));
         assert!(pick(&scene, origin, direction).is_none());
-    }
-
-    #[test]
-    fn framing_puts_the_whole_box_in_front_of_the_camera() {
-        let mut orbit = OrbitCamera::default();
-        orbit.frame((DVec3::new(-5.0, 0.0, -5.0), DVec3::new(5.0, 30.0, 5.0)));
-        assert!((orbit.target - DVec3::new(0.0, 15.0, 0.0)).length() < 1e-9);
-        assert!(orbit.distance > 30.0, "{}", orbit.distance);
-        let before = orbit.distance;
-        orbit.zoom(2.0);
-        assert!((orbit.distance - before / 2.0).abs() < 1e-9);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 
 use anthesis_flower::Project;
 use anthesis_mesh::{Mesh, Topology};
+use anthesis_physics::growth::growth_direction;
 use eframe::egui::{self, Color32, Pos2, Rect, Stroke};
 use glam::{DMat4, DVec3};
 
@@ -50,8 +51,10 @@ impl Outline {
     }
 }
 
-/// Arrows of the direction map on a sample of the organ's triangles: each
-/// triangle's UV direction pushed through its UV → world Jacobian.
+/// Arrows of the direction map on a sample of the organ's triangles: the
+/// direction each triangle grows along, as the solver computes it
+/// (`anthesis_physics::growth::growth_direction`, the UV direction through
+/// the triangle's UV → world Jacobian), as long as the painted direction.
 pub fn direction_arrows(
     painter: &egui::Painter,
     project: &Project,
@@ -65,23 +68,16 @@ pub fn direction_arrows(
     let stride = (organ.triangles.len() / 60).max(2);
     let stroke = Stroke::new(1.2, Color32::from_rgb(20, 60, 160));
     for tri in organ.triangles.iter().step_by(stride) {
-        let [p0, p1, p2] = tri.map(|i| organ.positions_in_world[i as usize]);
-        let [u0, u1, u2] = tri.map(|i| organ.uvs[i as usize]);
-        let (du1, du2) = (u1 - u0, u2 - u0);
-        let det = du1.x * du2.y - du2.x * du1.y;
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let centre_uv = (u0 + u1 + u2) / 3.0;
-        let d = map.sample(centre_uv);
-        // Solve d = a du1 + b du2, then map to world with the edges.
-        let a = (d.x * du2.y - du2.x * d.y) / det;
-        let b = (du1.x * d.y - d.x * du1.y) / det;
-        let world = a * (p1 - p0) + b * (p2 - p0);
+        let corners = tri.map(|i| organ.positions_in_world[i as usize]);
+        let uvs = tri.map(|i| organ.uvs[i as usize]);
+        let [p0, p1, p2] = corners;
+        let d = map.sample((uvs[0] + uvs[1] + uvs[2]) / 3.0);
+        let normal = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        let along = growth_direction(corners, uvs, d, normal);
         let mean_edge = ((p1 - p0).length() + (p2 - p0).length()) * 0.5;
-        let direction = world.normalize_or_zero() * mean_edge * 0.8 * d.length().min(1.0);
+        let arrow = along * mean_edge * 0.8 * d.length().min(1.0);
         let centre = (p0 + p1 + p2) / 3.0;
-        if let (Some(from), Some(to)) = (to_screen(centre), to_screen(centre + direction)) {
+        if let (Some(from), Some(to)) = (to_screen(centre), to_screen(centre + arrow)) {
             painter.arrow(from, to - from, stroke);
         }
     }

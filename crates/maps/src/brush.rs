@@ -1,20 +1,18 @@
 //! Brushes on growth-map rasters, in UV space: set / add / subtract /
 //! smooth / reset with radius, strength and hardness, mirrored about the
-//! midrib (u = 0.5), and direction painting. Pure functions over
-//! `anthesis_maps` rasters, no UI.
-//!
-//! (This is engine logic that belongs in `anthesis-maps`; it lives here
-//! until that crate takes it.)
+//! midrib (u = 0.5), and direction painting. Pure functions over the
+//! rasters; the desktop app's paint panel and 3D painting call them.
 
-use anthesis_flower::Template;
-use anthesis_maps::{DirectionMap, MapKind, ScalarMap};
 use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::{DirectionMap, KeyedMaps, MapKind, ScalarMap};
 
 /// Resolution given to a constant (1x1) map when it is first painted and
 /// the template has no raster map to match.
 pub const DEFAULT_PAINT_SIZE: u32 = 128;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum BrushMode {
     /// Moves values towards the brush value.
     Set,
@@ -49,7 +47,7 @@ impl BrushMode {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Brush {
     pub mode: BrushMode,
     /// Radius in UV units (the UV square is 1 wide).
@@ -267,7 +265,7 @@ pub fn ensure_direction_raster(map: &mut DirectionMap, size: (u32, u32)) {
 }
 
 /// Which map a stroke paints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum PaintTarget {
     Scalar(MapKind),
     Direction,
@@ -282,24 +280,23 @@ impl PaintTarget {
     }
 }
 
-/// One dab of `brush` on map `target` of time key `key` of `template`:
-/// constant maps become rasters first (of the template's size, so all its
-/// maps keep one size). `direction_in_uv` is the stroke direction, used
-/// by the direction map.
-pub fn dab_template(
-    template: &mut Template,
+/// One dab of `brush` on map `target` of time key `key` of `maps` (a
+/// template's keyed maps): constant maps become rasters first, of the size
+/// the other maps have, so all maps of a template keep one size.
+/// `direction_in_uv` is the stroke direction, used by the direction map. A
+/// key that does not exist changes nothing.
+pub fn dab_keyed(
+    maps: &mut KeyedMaps,
     key: usize,
     target: PaintTarget,
     brush: &Brush,
     centre_in_uv: DVec2,
     direction_in_uv: DVec2,
 ) {
-    let size = template
-        .maps
+    let size = maps
         .raster_size()
         .unwrap_or((DEFAULT_PAINT_SIZE, DEFAULT_PAINT_SIZE));
-    let keys = template.maps.keys_mut();
-    let Some(map_key) = keys.get_mut(key) else {
+    let Some(map_key) = maps.keys_mut().get_mut(key) else {
         return;
     };
     match target {
@@ -432,23 +429,66 @@ mod tests {
     }
 
     #[test]
-    fn painting_a_constant_map_makes_a_raster_of_the_templates_size() {
-        let project = anthesis_sim::fixtures::whorl(1, 4, 6, 3);
-        let mut template = project.flower.templates[0].clone();
-        // The fixture paints e-growth etc. as 32x32; stretch is constant.
-        assert_eq!(template.maps.keys()[0].maps.stretch.size(), (1, 1));
+    fn painting_a_constant_map_makes_a_raster_of_the_other_maps_size() {
+        use crate::{Blend, GrowthMaps, MapKey};
+        let mut growth = GrowthMaps::uniform();
+        growth.e_growth = ScalarMap::from_fn(32, 24, |uv| uv.y as f32);
+        let mut maps = KeyedMaps::new(
+            vec![MapKey {
+                step: 0,
+                maps: growth,
+            }],
+            Blend::Linear,
+        )
+        .expect("one key");
+        assert_eq!(maps.keys()[0].maps.stretch.size(), (1, 1));
         let brush = hard(BrushMode::Set, 0.2);
-        dab_template(
-            &mut template,
+        let stretch = PaintTarget::Scalar(MapKind::Stretch);
+        dab_keyed(
+            &mut maps,
             0,
-            PaintTarget::Scalar(MapKind::Stretch),
+            stretch,
             &brush,
-            DVec2::new(0.5, 0.5),
+            DVec2::splat(0.5),
             DVec2::ZERO,
         );
-        let stretch = &template.maps.keys()[0].maps.stretch;
-        assert_eq!(stretch.size(), (32, 32));
-        assert!((stretch.sample(DVec2::new(0.5, 0.5)) - 0.2).abs() < 1e-6);
-        assert_eq!(stretch.sample(DVec2::new(0.05, 0.95)), 1.0);
+        let painted = &maps.keys()[0].maps.stretch;
+        assert_eq!(painted.size(), (32, 24));
+        assert!((painted.sample(DVec2::new(0.5, 0.5)) - 0.2).abs() < 1e-6);
+        assert_eq!(painted.sample(DVec2::new(0.05, 0.95)), 1.0);
+        // A key that does not exist: nothing changes.
+        let before = maps.clone();
+        dab_keyed(
+            &mut maps,
+            3,
+            stretch,
+            &brush,
+            DVec2::splat(0.5),
+            DVec2::ZERO,
+        );
+        assert_eq!(maps, before);
+    }
+
+    #[test]
+    fn the_falloff_is_a_smoothstep_from_the_hard_core_to_the_rim() {
+        let brush = Brush {
+            radius_in_uv: 0.2,
+            hardness: 0.5,
+            strength: 0.6,
+            ..Brush::default()
+        };
+        // s = (t - hardness) / (1 - hardness); weight = strength (1 - 3s² + 2s³).
+        for (distance, s) in [(0.1, 0.0), (0.125, 0.25), (0.15, 0.5), (0.175, 0.75)] {
+            let expected = 0.6 * (1.0 - s * s * (3.0 - 2.0 * s));
+            let weight = f64::from(brush.weight(distance));
+            assert!(
+                (weight - expected).abs() < 1e-6,
+                "{distance}: {weight} vs {expected}"
+            );
+        }
+        assert!(
+            (f64::from(brush.weight(0.15)) - 0.3).abs() < 1e-6,
+            "half way: half strength"
+        );
     }
 }
