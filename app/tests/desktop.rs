@@ -993,3 +993,47 @@ fn preview_and_selection_commands_choose_what_the_next_run_simulates() {
     harness.state_mut().apply(Command::SelectOrgan(99));
     assert_eq!(harness.state().selected_organ(), 3);
 }
+
+#[test]
+fn orbiting_the_camera_keeps_the_scene_and_a_new_keyframe_or_edit_rebuilds_it() {
+    use anthesis_app::desktop::Command;
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    let built = harness.state().scene_rebuilds();
+    let camera = *harness.state_mut().camera_mut();
+    // Orbit: drag across the viewport over many frames.
+    let centre = harness.get_by_label("3D viewport").rect().center();
+    harness.hover_at(centre);
+    harness.run();
+    harness.drag_at(centre);
+    harness.run();
+    for i in 1..=10 {
+        harness.hover_at(centre + egui::vec2(8.0 * i as f32, 2.0 * i as f32));
+        harness.run();
+    }
+    harness.drop_at(centre + egui::vec2(80.0, 20.0));
+    harness.run();
+    assert_ne!(*harness.state_mut().camera_mut(), camera, "the camera turned");
+    assert_eq!(
+        harness.state().scene_rebuilds(),
+        built,
+        "turning the camera rebuilt the scene"
+    );
+    // A step in time shows another keyframe: one rebuild.
+    harness.state_mut().apply(Command::StepKeyframe(-1));
+    harness.run();
+    assert_eq!(harness.state().scene_rebuilds(), built + 1);
+    // A new overlay: one more.
+    let mut view = *harness.state().view_options();
+    view.overlay = Some(anthesis_maps::MapKind::Bend);
+    harness.state_mut().apply(Command::SetView(view));
+    harness.run();
+    assert_eq!(harness.state().scene_rebuilds(), built + 2);
+    // The wireframe is drawn over the scene: no rebuild.
+    view.wireframe = true;
+    harness.state_mut().apply(Command::SetView(view));
+    harness.run();
+    assert_eq!(harness.state().scene_rebuilds(), built + 2);
+}

@@ -2,6 +2,7 @@
 //! it has unsaved changes, and undo/redo of every edit.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use anthesis_flower::Project;
 
@@ -13,6 +14,12 @@ pub const UNDO_LIMIT: usize = 200;
 struct Step {
     label: String,
     before: Project,
+}
+
+/// A number no other project state of this process has had.
+fn next_revision() -> u64 {
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 /// The project being edited, with its history.
@@ -28,6 +35,9 @@ pub struct Document {
     open_step: bool,
     /// Edits since the last save (the history position of the saved state).
     saved_at: Option<usize>,
+    /// Changes whenever the project does (edit, undo, redo) and differs
+    /// between documents, so views can keep what they built from it.
+    revision: u64,
 }
 
 impl Document {
@@ -40,7 +50,14 @@ impl Document {
             redo: Vec::new(),
             open_step: false,
             saved_at: Some(0),
+            revision: next_revision(),
         }
+    }
+
+    /// Identifies the project as it is now: equal revisions, equal
+    /// projects (see the field).
+    pub fn revision(&self) -> u64 {
+        self.revision
     }
 
     pub fn project(&self) -> &Project {
@@ -57,6 +74,7 @@ impl Document {
         if self.project == before {
             return false;
         }
+        self.revision = next_revision();
         let merge = self.open_step && self.undo.last().is_some_and(|s| s.label == label);
         if !merge {
             self.undo.push(Step {
@@ -86,6 +104,7 @@ impl Document {
     pub fn undo(&mut self) -> Option<String> {
         let step = self.undo.pop()?;
         let after = std::mem::replace(&mut self.project, step.before);
+        self.revision = next_revision();
         self.redo.push(Step {
             label: step.label.clone(),
             before: after,
@@ -98,6 +117,7 @@ impl Document {
     pub fn redo(&mut self) -> Option<String> {
         let step = self.redo.pop()?;
         let before = std::mem::replace(&mut self.project, step.before);
+        self.revision = next_revision();
         self.undo.push(Step {
             label: step.label.clone(),
             before,
@@ -198,5 +218,25 @@ mod tests {
         assert!(doc.is_dirty());
         assert!(doc.redo().is_none());
         assert_eq!(doc.title(), "x.anthesis.toml *");
+    }
+
+    #[test]
+    fn the_revision_changes_with_the_project_only() {
+        let mut doc = doc();
+        let other = super::Document::new(doc.project().clone(), None);
+        assert_ne!(doc.revision(), other.revision(), "another document");
+        let opened = doc.revision();
+        assert!(!doc.edit("thickness", |p| p.flower.templates[0].thickness = 0.2));
+        doc.seal();
+        assert_eq!(doc.revision(), opened, "no change, same revision");
+        doc.edit("dg", |p| p.flower.templates[0].dg = 0.02);
+        let edited = doc.revision();
+        assert_ne!(edited, opened);
+        doc.undo();
+        assert_ne!(doc.revision(), edited);
+        doc.redo();
+        doc.mark_saved(PathBuf::from("/tmp/y.anthesis.toml"));
+        let saved = doc.revision();
+        assert_eq!(doc.revision(), saved, "saving changes no project");
     }
 }

@@ -133,8 +133,8 @@ pub struct AnthesisApp {
     needs_run: bool,
     /// The viewport's GPU state is installed.
     has_gpu: bool,
-    /// Increments whenever the scene is rebuilt.
-    scene_revision: u64,
+    /// The viewport's scene, rebuilt only when what it shows changes.
+    scene: viewport::SceneCache,
     /// The selected organ's outline, kept between frames.
     outline: viewport::Outline,
     /// Commands the panels asked for this frame, applied after drawing.
@@ -215,7 +215,7 @@ impl AnthesisApp {
             may_close: false,
             needs_run: true,
             has_gpu,
-            scene_revision: 0,
+            scene: viewport::SceneCache::default(),
             outline: viewport::Outline::default(),
             queued: Vec::new(),
             title: String::new(),
@@ -289,6 +289,12 @@ impl AnthesisApp {
 
     pub fn single_organ_preview(&self) -> bool {
         self.single_organ_preview
+    }
+
+    /// How many times the viewport's scene has been built (for tests and
+    /// measurements).
+    pub fn scene_rebuilds(&self) -> u64 {
+        self.scene.builds()
     }
 
     pub fn pending(&self) -> Option<&Pending> {

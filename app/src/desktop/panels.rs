@@ -2,8 +2,6 @@
 //! draws from the app's state and queues [`Command`]s for what the user
 //! asked; none changes the project directly.
 
-use std::sync::Arc;
-
 use eframe::egui;
 
 use super::AnthesisApp;
@@ -83,21 +81,24 @@ impl AnthesisApp {
     /// painting on the organ.
     pub(super) fn viewport_panel(&mut self, ui: &mut egui::Ui) {
         self.log.banner_ui(ui);
-        let scene = viewport::build_scene(
-            self.doc.project(),
-            &self.session,
-            self.playback.time_in_keyframes,
-            self.shows_others(),
-        );
-        self.frame_automatically(&scene);
         let overlay = self.view.overlay.map(|kind| (kind, self.paint.key));
-        let meshes = Arc::new(viewport::scene_meshes(
-            self.doc.project(),
-            &scene,
-            Some(self.selected_organ),
+        let key = viewport::SceneKey {
+            document_revision: self.doc.revision(),
+            run: self.session.run(),
+            keyframes_received: self.session.keyframes().len(),
+            time_in_keyframes: self.playback.time_in_keyframes,
+            selected_organ: self.selected_organ,
             overlay,
-        ));
-        self.scene_revision += 1;
+            show_others: self.shows_others(),
+        };
+        let (project, session) = (self.doc.project(), &self.session);
+        let (scene, meshes, revision) = self.scene.get(key, || {
+            let scene =
+                viewport::build_scene(project, session, key.time_in_keyframes, key.show_others);
+            let meshes = viewport::scene_meshes(project, &scene, Some(key.selected_organ), overlay);
+            (scene, meshes)
+        });
+        self.frame_automatically(&scene);
         if !self.has_gpu {
             ui.label("The 3D viewport needs the wgpu renderer.");
             return;
@@ -116,7 +117,7 @@ impl AnthesisApp {
             self.doc.project(),
             &scene,
             meshes,
-            self.scene_revision,
+            revision,
             &self.view,
             Some((self.selected_organ, outline)),
             Some(self.paint.key),

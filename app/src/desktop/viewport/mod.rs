@@ -20,7 +20,7 @@ use glam::{DVec2, DVec3};
 
 pub use gpu::ViewportGpu;
 pub use overlays::Outline;
-pub use scene::{SceneOrgan, build_scene, scene_bounds, scene_meshes};
+pub use scene::{SceneCache, SceneKey, SceneOrgan, build_scene, scene_bounds, scene_meshes};
 
 /// What the viewport shows besides the organs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]

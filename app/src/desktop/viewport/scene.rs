@@ -1,11 +1,16 @@
 //! The scene the viewport shows: the organs at the playhead (simulated or
 //! in their bud placement), their bounds, and the meshes handed to the
-//! renderer (template colour, selection highlight, map overlay).
+//! renderer (template colour, selection highlight, map overlay), kept in a
+//! [`SceneCache`] while what they show does not change.
+
+use std::sync::Arc;
 
 use anthesis_flower::Project;
 use anthesis_maps::MapKind;
 use anthesis_render::OrganMesh;
 use glam::{DVec2, DVec3};
+
+use anthesis_sim::worker::RunId;
 
 use crate::desktop::session::SimSession;
 
@@ -110,4 +115,126 @@ pub fn scene_meshes(
             }
         })
         .collect()
+}
+
+/// What the scene depends on. While none of it changes (the camera turns,
+/// the pointer moves, a panel is used) the scene, its meshes (with their
+/// normals) and their GPU upload are kept.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneKey {
+    /// [`crate::desktop::document::Document::revision`]: which project,
+    /// as changed so far.
+    pub document_revision: u64,
+    /// The run shown and how many of its keyframes have arrived.
+    pub run: RunId,
+    pub keyframes_received: usize,
+    pub time_in_keyframes: f64,
+    pub selected_organ: usize,
+    /// The overlaid map and its time key.
+    pub overlay: Option<(MapKind, usize)>,
+    pub show_others: bool,
+}
+
+/// The scene shown last and what it was built from.
+#[derive(Default)]
+pub struct SceneCache {
+    key: Option<SceneKey>,
+    scene: Arc<Vec<SceneOrgan>>,
+    meshes: Arc<Vec<OrganMesh>>,
+    /// Counts the builds; the GPU side uploads the meshes when it changes.
+    revision: u64,
+}
+
+impl SceneCache {
+    /// The scene for `key`, its meshes and their revision; `build` runs only
+    /// when `key` differs from the previous call's.
+    pub fn get(
+        &mut self,
+        key: SceneKey,
+        build: impl FnOnce() -> (Vec<SceneOrgan>, Vec<OrganMesh>),
+    ) -> (Arc<Vec<SceneOrgan>>, Arc<Vec<OrganMesh>>, u64) {
+        if self.key != Some(key) {
+            let (scene, meshes) = build();
+            self.scene = Arc::new(scene);
+            self.meshes = Arc::new(meshes);
+            self.key = Some(key);
+            self.revision += 1;
+        }
+        (
+            Arc::clone(&self.scene),
+            Arc::clone(&self.meshes),
+            self.revision,
+        )
+    }
+
+    /// How many times the scene has been built.
+    pub fn builds(&self) -> u64 {
+        self.revision
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key() -> SceneKey {
+        SceneKey {
+            document_revision: 7,
+            run: 2,
+            keyframes_received: 10,
+            time_in_keyframes: 4.5,
+            selected_organ: 1,
+            overlay: None,
+            show_others: true,
+        }
+    }
+
+    #[test]
+    fn the_scene_is_built_again_only_when_what_it_shows_changes() {
+        let mut cache = SceneCache::default();
+        let mut builds = 0;
+        let mut get = |cache: &mut SceneCache, key: SceneKey| {
+            cache
+                .get(key, || {
+                    builds += 1;
+                    (Vec::new(), Vec::new())
+                })
+                .2
+        };
+        assert_eq!(get(&mut cache, key()), 1);
+        assert_eq!(get(&mut cache, key()), 1, "same key: kept");
+        let changes = [
+            SceneKey {
+                document_revision: 8,
+                ..key()
+            },
+            SceneKey { run: 3, ..key() },
+            SceneKey {
+                keyframes_received: 11,
+                ..key()
+            },
+            SceneKey {
+                time_in_keyframes: 4.6,
+                ..key()
+            },
+            SceneKey {
+                selected_organ: 0,
+                ..key()
+            },
+            SceneKey {
+                overlay: Some((MapKind::Bend, 0)),
+                ..key()
+            },
+            SceneKey {
+                show_others: false,
+                ..key()
+            },
+        ];
+        for (i, changed) in changes.into_iter().enumerate() {
+            assert_eq!(get(&mut cache, changed), 2 + 2 * i as u64, "{changed:?}");
+            assert_eq!(get(&mut cache, key()), 3 + 2 * i as u64, "back");
+        }
+        assert_eq!(builds, 15);
+        assert_eq!(cache.builds(), 15);
+    }
 }
