@@ -1015,7 +1015,11 @@ fn orbiting_the_camera_keeps_the_scene_and_a_new_keyframe_or_edit_rebuilds_it() 
     }
     harness.drop_at(centre + egui::vec2(80.0, 20.0));
     harness.run();
-    assert_ne!(*harness.state_mut().camera_mut(), camera, "the camera turned");
+    assert_ne!(
+        *harness.state_mut().camera_mut(),
+        camera,
+        "the camera turned"
+    );
     assert_eq!(
         harness.state().scene_rebuilds(),
         built,
