@@ -3,7 +3,7 @@
 //! `anthesis-export` and reports progress, then the result or the error.
 
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{Receiver, channel};
+use std::sync::mpsc::{Receiver, sync_channel};
 use std::sync::{Arc, Mutex};
 
 use anthesis_export::{Encoding, GlbOptions, Timing, Track, UsdOptions};
@@ -228,7 +228,9 @@ impl ExportDialog {
         let options = self.options();
         let animation = self.animation;
         let animation_step = self.animation_step;
-        let (send, receive) = channel();
+        // Progress is dropped while the window has not taken the last few
+        // (newer progress follows); the end waits for room.
+        let (send, receive) = sync_channel(4);
         let target = path.clone();
         let wake = Arc::new(wake);
         let progress_wake = Arc::clone(&wake);
@@ -242,7 +244,7 @@ impl ExportDialog {
                     if p - last >= 0.01 {
                         last = p;
                         if let Ok(send) = progress_send.lock() {
-                            let _ = send.send(Message::Progress(p));
+                            let _ = send.try_send(Message::Progress(p));
                         }
                         (*progress_wake)();
                     }

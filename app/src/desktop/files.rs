@@ -3,7 +3,7 @@
 //! eframe persists between launches.
 
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{Receiver, TryRecvError, channel};
+use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_render::OrbitCamera;
 
@@ -47,7 +47,8 @@ impl Dialogs {
         if self.pending.is_some() {
             return;
         }
-        let (send, receive) = channel();
+        // One answer per dialog.
+        let (send, receive) = sync_channel(1);
         let folder = folder.map(Path::to_path_buf);
         let spawned = std::thread::Builder::new()
             .name("anthesis-dialog".into())

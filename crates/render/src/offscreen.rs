@@ -191,7 +191,8 @@ impl OffscreenRenderer {
         );
         self.queue.submit([encoder.finish()]);
 
-        let (sender, receiver) = mpsc::channel();
+        // One mapping result.
+        let (sender, receiver) = mpsc::sync_channel(1);
         readback.map_async(wgpu::MapMode::Read, .., move |result| {
             // The receiver waits below; a failed send only means it gave up.
             let _ = sender.send(result);

@@ -75,6 +75,10 @@ fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
         w_growth_in: ScalarMap::from_fn(32, 32, |uv| (0.45 * above_base(uv.y)) as f32),
         ..early.clone()
     };
+    #[allow(
+        clippy::expect_used,
+        reason = "two literal keys at distinct steps cannot fail"
+    )]
     let maps = KeyedMaps::new(
         vec![
             MapKey {

@@ -145,6 +145,10 @@ impl Worker {
         // Unbounded on purpose: every event of the current run matters (the
         // keyframes are the result) and the owner drains them each frame;
         // a bound would stall the simulation on a busy UI.
+        #[allow(
+            clippy::disallowed_methods,
+            reason = "every event of the current run is kept; see above"
+        )]
         let (event_tx, events) = channel();
         let current = Arc::new(AtomicU64::new(0));
         let shared = Arc::clone(&current);
