@@ -124,14 +124,20 @@ struct Case {
     prepare: fn(&Path) -> Vec<String>,
     /// What the error line must say.
     expect: &'static str,
+    /// Environment of the run.
+    env: &'static [(&'static str, &'static str)],
 }
 
 macro_rules! case {
     ($name:expr, $prepare:expr, $expect:expr) => {
+        case!($name, $prepare, $expect, &[])
+    };
+    ($name:expr, $prepare:expr, $expect:expr, $env:expr) => {
         Case {
             name: $name,
             prepare: $prepare,
             expect: $expect,
+            env: $env,
         }
     };
 }
@@ -553,6 +559,19 @@ fn catalogue() -> Vec<Case> {
             },
             "disk.glb: it is a block device (a disk), not a file, and is left as it is"
         ),
+        // ------------------------------------------------------------ memory
+        case!(
+            "a run larger than the memory it may use",
+            |d| simulate(d, &[]),
+            "of 364 triangles, 28 KiB for 4 keyframes), but only 1 MiB of memory is available",
+            &[("ANTHESIS_MEMORY_LIMIT_MIB", "1")]
+        ),
+        case!(
+            "a memory limit that is not a number",
+            |d| simulate(d, &[]),
+            "ANTHESIS_MEMORY_LIMIT_MIB must be a whole number of MiB above 0, found lots",
+            &[("ANTHESIS_MEMORY_LIMIT_MIB", "lots")]
+        ),
         // ------------------------------------------------------------ solver
         case!(
             "a solver that does not converge",
@@ -566,10 +585,11 @@ fn catalogue() -> Vec<Case> {
 }
 
 /// Runs the binary, killing it after [`MAX_SECONDS`].
-fn run_bounded(args: &[String]) -> (Option<i32>, String, Duration) {
+fn run_bounded(args: &[String], env: &[(&str, &str)]) -> (Option<i32>, String, Duration) {
     let started = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_anthesis"))
         .args(args)
+        .envs(env.iter().copied())
         .env("RUST_BACKTRACE", "0")
         .stdin(Stdio::null())
         .stdout(Stdio::null())
@@ -603,7 +623,7 @@ fn every_bad_input_gets_its_message_and_exit_code_1() {
         valid_project(dir.path());
         let args = (case.prepare)(dir.path());
         let expected = case.expect;
-        let (code, stderr, took) = run_bounded(&args);
+        let (code, stderr, took) = run_bounded(&args, case.env);
         let last = stderr.trim_end().lines().last().unwrap_or("").to_string();
         if discover {
             eprintln!(

@@ -12,6 +12,7 @@ pub mod collide;
 #[cfg(any(test, feature = "fault-hook"))]
 pub mod fault;
 pub mod fixtures;
+pub mod memory;
 mod organ;
 pub mod worker;
 
