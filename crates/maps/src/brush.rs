@@ -444,28 +444,17 @@ mod tests {
         assert_eq!(maps.keys()[0].maps.stretch.size(), (1, 1));
         let brush = hard(BrushMode::Set, 0.2);
         let stretch = PaintTarget::Scalar(MapKind::Stretch);
-        dab_keyed(
-            &mut maps,
-            0,
-            stretch,
-            &brush,
-            DVec2::splat(0.5),
-            DVec2::ZERO,
-        );
+        let dab = |maps: &mut KeyedMaps, key| {
+            dab_keyed(maps, key, stretch, &brush, DVec2::splat(0.5), DVec2::ZERO);
+        };
+        dab(&mut maps, 0);
         let painted = &maps.keys()[0].maps.stretch;
         assert_eq!(painted.size(), (32, 24));
         assert!((painted.sample(DVec2::new(0.5, 0.5)) - 0.2).abs() < 1e-6);
         assert_eq!(painted.sample(DVec2::new(0.05, 0.95)), 1.0);
         // A key that does not exist: nothing changes.
         let before = maps.clone();
-        dab_keyed(
-            &mut maps,
-            3,
-            stretch,
-            &brush,
-            DVec2::splat(0.5),
-            DVec2::ZERO,
-        );
+        dab(&mut maps, 3);
         assert_eq!(maps, before);
     }
 
