@@ -11,9 +11,13 @@ use crate::orbit::orbit_directions;
 /// plane is [`Camera::near_clip`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Camera {
+    /// Where the camera is, in world space.
     pub eye: DVec3,
+    /// The point it looks at, in world space.
     pub target: DVec3,
+    /// Which way is up in the image (need not be perpendicular to the view).
     pub up: DVec3,
+    /// Field of view across the image's shorter side, in degrees.
     pub fov_y_deg: f64,
 }
 

@@ -8,23 +8,45 @@ pub enum RenderError {
          install Mesa's software Vulkan driver (`apt-get install mesa-vulkan-drivers libvulkan1`); \
          an empty WGPU_BACKEND variable is ignored, any other value restricts the backends"
     )]
+    /// No adapter of the allowed backends.
     NoAdapter {
+        /// The backends that were searched.
         backends: String,
+        /// What wgpu said.
         #[source]
         source: wgpu::RequestAdapterError,
     },
     #[error("the graphics device could not be created on adapter {adapter}: {source}")]
+    /// The adapter was found but refused a device.
     DeviceRequest {
+        /// The adapter's name and backend.
         adapter: String,
+        /// What wgpu said.
         #[source]
         source: wgpu::RequestDeviceError,
     },
     #[error("image size {width}x{height} is invalid (each side must be 1..={max})")]
-    InvalidSize { width: u32, height: u32, max: u32 },
+    /// An image side is 0 or larger than the device allows.
+    InvalidSize {
+        /// Asked width in pixels.
+        width: u32,
+        /// Asked height in pixels.
+        height: u32,
+        /// The device's largest texture side.
+        max: u32,
+    },
     #[error("organ {organ}: {reason}")]
-    InvalidMesh { organ: usize, reason: String },
+    /// An organ's mesh cannot be drawn.
+    InvalidMesh {
+        /// Index of the organ in the list given.
+        organ: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
     #[error("reading the rendered image back failed: {0}")]
+    /// The rendered image could not be copied back from the GPU.
     Readback(String),
     #[error("the GPU reported an error: {0}")]
+    /// The GPU reported a validation or out-of-memory error.
     Gpu(String),
 }

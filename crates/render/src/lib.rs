@@ -20,6 +20,8 @@
 //! `GreaterEqual`): a pass that draws organs must clear its depth to
 //! [`DEPTH_CLEAR_VALUE`].
 
+#![warn(missing_docs)]
+
 mod blit;
 mod camera;
 mod error;

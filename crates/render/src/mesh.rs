@@ -8,8 +8,11 @@ use glam::DVec3;
 /// side slightly darker.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OrganMesh {
+    /// Vertex positions in world space.
     pub positions_in_world: Vec<[f32; 3]>,
+    /// Unit vertex normals in world space, one per position.
     pub normals_in_world: Vec<[f32; 3]>,
+    /// Vertex indices, three per triangle.
     pub triangles: Vec<[u32; 3]>,
     /// Linear RGBA in `[0, 1]`, as project files and exports hold colours;
     /// the renderer encodes for the target once, at the end of its shader.

@@ -100,10 +100,13 @@ impl OffscreenRenderer {
         &self.adapter_info
     }
 
+    /// The device this renderer created (for callers that add their own
+    /// passes).
     pub fn device(&self) -> &wgpu::Device {
         &self.device
     }
 
+    /// The device's queue.
     pub fn queue(&self) -> &wgpu::Queue {
         &self.queue
     }
@@ -113,6 +116,7 @@ impl OffscreenRenderer {
         self.pipeline.format()
     }
 
+    /// The gradient drawn behind the organs from the next render on.
     pub fn set_background(&mut self, background: Background) {
         self.pipeline.set_background(background);
     }

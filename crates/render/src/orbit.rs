@@ -13,7 +13,9 @@ pub const ORBIT_FOV_DEG: f64 = 30.0;
 /// A camera on a sphere around `target`, looking at it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct OrbitCamera {
+    /// The point looked at and orbited, in world space.
     pub target: DVec3,
+    /// From the target to the eye, in world units.
     pub distance: f64,
     /// Around +Y, 0 = looking from +Z, 90 = from +X.
     pub azimuth_deg: f64,

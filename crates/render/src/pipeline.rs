@@ -45,7 +45,9 @@ impl Default for TargetFormat {
 /// A vertical gradient behind the organs, sRGB-encoded RGB in `[0, 1]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Background {
+    /// The colour at the top of the image.
     pub top_srgb: [f32; 3],
+    /// The colour at the bottom of the image.
     pub bottom_srgb: [f32; 3],
 }
 
@@ -320,6 +322,7 @@ impl OrganPipeline {
         self.background = background;
     }
 
+    /// The gradient drawn behind the organs.
     pub fn background(&self) -> Background {
         self.background
     }

@@ -74,6 +74,7 @@ impl RenderTarget {
         }
     }
 
+    /// The formats the textures were made with.
     pub fn format(&self) -> TargetFormat {
         self.format
     }
