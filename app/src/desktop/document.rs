@@ -139,6 +139,12 @@ impl Document {
         self.saved_at != Some(self.undo.len())
     }
 
+    /// Marks the project as changed since it was saved (recovered work
+    /// that is not in its file).
+    pub fn mark_unsaved(&mut self) {
+        self.saved_at = None;
+    }
+
     /// Records that the project is now saved at `path`.
     pub fn mark_saved(&mut self, path: PathBuf) {
         self.path = Some(path);

@@ -116,6 +116,8 @@ pub struct Settings {
     pub looping: bool,
     pub speed: f64,
     pub show_log: bool,
+    /// Unsaved work is saved for recovery at most this often, in seconds.
+    pub autosave_seconds: u64,
 }
 
 impl Default for Settings {
@@ -130,6 +132,7 @@ impl Default for Settings {
             looping: playback.looping,
             speed: playback.speed,
             show_log: true,
+            autosave_seconds: super::autosave::DEFAULT_INTERVAL_SECONDS,
         }
     }
 }

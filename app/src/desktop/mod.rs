@@ -10,6 +10,7 @@
 //! framing in `framing`. No engine logic lives here: simulation, maps,
 //! project files and export are the engine crates'.
 
+pub mod autosave;
 pub mod command;
 pub mod document;
 pub mod export;
@@ -35,6 +36,7 @@ use anthesis_sim::Selection;
 use anyhow::{Result, anyhow};
 use eframe::egui;
 
+use anthesis_flower::project::recovery::RecoveryFolder;
 use anthesis_render::OrbitCamera;
 pub use command::{Command, ProjectEdit};
 use document::Document;
@@ -57,6 +59,23 @@ pub fn default_project() -> Result<Project> {
     })
 }
 
+/// The name eframe keeps the app's data under (settings, and the
+/// recovery folder beside them).
+const APP_ID: &str = "Anthesis";
+
+/// The environment variable that sets the autosave interval in seconds
+/// (over the settings' `autosave_seconds`), e.g. for a crash test.
+const AUTOSAVE_VARIABLE: &str = "ANTHESIS_AUTOSAVE_SECONDS";
+
+/// How often unsaved work is saved for recovery, at most.
+fn autosave_interval(settings: &Settings) -> std::time::Duration {
+    let seconds = std::env::var(AUTOSAVE_VARIABLE)
+        .ok()
+        .and_then(|text| text.trim().parse::<u64>().ok())
+        .unwrap_or(settings.autosave_seconds);
+    std::time::Duration::from_secs(seconds)
+}
+
 /// The key under which [`Settings`] are stored.
 const SETTINGS_KEY: &str = "anthesis-settings";
 
@@ -71,10 +90,19 @@ pub fn run() -> Result<()> {
         ..Default::default()
     };
     eframe::run_native(
-        "Anthesis",
+        APP_ID,
         options,
         Box::new(|cc| {
-            let app = AnthesisApp::new(cc, Startup::default()).map_err(|e| e.to_string())?;
+            let mut app = AnthesisApp::new(cc, Startup::default()).map_err(|e| e.to_string())?;
+            match eframe::storage_dir(APP_ID) {
+                Some(data) => app.enable_autosave(
+                    RecoveryFolder::new(data.join("recovery")),
+                    autosave_interval(&app.settings),
+                ),
+                None => app
+                    .log
+                    .warn("no data folder for this user: autosave is off; save your work often"),
+            }
             Ok(Box::new(app))
         }),
     )
@@ -139,6 +167,10 @@ pub struct AnthesisApp {
     outline: viewport::Outline,
     /// Commands the panels asked for this frame, applied after drawing.
     queued: Vec<Command>,
+    /// Writes unsaved work for recovery (off until enabled).
+    autosave: Option<autosave::Autosave>,
+    /// Work recovered after a crash, waiting for "recover or discard?".
+    recovery_offer: Option<anthesis_flower::project::recovery::Recovery>,
     title: String,
     ctx: egui::Context,
 }
@@ -218,6 +250,8 @@ impl AnthesisApp {
             scene: viewport::SceneCache::default(),
             outline: viewport::Outline::default(),
             queued: Vec::new(),
+            autosave: None,
+            recovery_offer: None,
             title: String::new(),
             ctx,
         };
@@ -405,6 +439,8 @@ impl eframe::App for AnthesisApp {
         self.export_window(&ctx);
         self.apply_queued();
         self.unsaved_prompt(&ctx);
+        self.recovery_prompt(&ctx);
+        self.autosave_tick(&ctx);
 
         if self.needs_run {
             self.restart_simulation();
@@ -428,5 +464,17 @@ impl eframe::App for AnthesisApp {
         self.settings.looping = self.playback.looping;
         self.settings.speed = self.playback.speed;
         eframe::set_value(storage, SETTINGS_KEY, &self.settings);
+    }
+
+    /// A clean exit (the user answered any "save changes?"): the recovery
+    /// files are no longer needed. Unless a recovery still waits for an
+    /// answer: then it stays for the next launch.
+    fn on_exit(&mut self) {
+        if self.recovery_offer.is_none() {
+            self.discard_recovery();
+        }
+        if let Some(autosave) = self.autosave.as_mut() {
+            autosave.finish();
+        }
     }
 }

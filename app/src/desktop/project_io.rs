@@ -21,6 +21,9 @@ impl AnthesisApp {
         match load_project(path) {
             Ok(project) => {
                 self.settings.remember(path);
+                // The work open before was saved or thrown away (the
+                // "save changes?" prompt came first).
+                self.discard_recovery();
                 self.replace_document(Document::new(project, Some(path.to_path_buf())));
                 self.log.info(format!("opened {}", path.display()));
             }
@@ -165,6 +168,7 @@ impl AnthesisApp {
         match save_project(self.doc.project(), path) {
             Ok(()) => {
                 self.doc.mark_saved(path.to_path_buf());
+                self.discard_recovery();
                 self.settings.remember(path);
                 self.log.info(format!("saved {}", path.display()));
                 true

@@ -30,7 +30,10 @@ impl AnthesisApp {
     pub(super) fn perform(&mut self, action: Pending) {
         match action {
             Pending::New => match default_project() {
-                Ok(project) => self.replace_document(Document::new(project, None)),
+                Ok(project) => {
+                    self.discard_recovery();
+                    self.replace_document(Document::new(project, None));
+                }
                 Err(e) => self.log.error(format!("cannot start a new project: {e}")),
             },
             Pending::Open(Some(path)) => self.open_path(&path),

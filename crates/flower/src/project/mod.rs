@@ -98,6 +98,7 @@
 mod check;
 mod error;
 mod load;
+pub mod recovery;
 mod save;
 mod schema;
 

@@ -1,0 +1,285 @@
+//! Recovery files: the open document saved now and then into a folder of
+//! the user's data directory (never beside the user's own files), so that
+//! after a crash the next launch can offer the work back.
+//!
+//! The folder holds at most one recovery, `latest/`: a project saved as
+//! usual (`recovered.anthesis.toml`, its meshes and maps) and
+//! `recovery.toml` saying when it was saved and where the project lives.
+//! A new recovery is written whole into a fresh `writing-*` folder and then
+//! takes the place of `latest/` by renames, so a crash while writing leaves
+//! the previous recovery readable (as `latest/`, or `previous/` between the
+//! two renames).
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::{ProjectError, load_project, save_project};
+use crate::Project;
+
+const LATEST: &str = "latest";
+const PREVIOUS: &str = "previous";
+const WRITING_PREFIX: &str = "writing-";
+const PROJECT_FILE: &str = "recovered.anthesis.toml";
+const ABOUT_FILE: &str = "recovery.toml";
+
+/// What `recovery.toml` records.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+struct About {
+    /// Seconds since the Unix epoch when the recovery was written.
+    saved_at_unix_seconds: u64,
+    /// The project file the work belongs to; absent for a project never
+    /// saved.
+    original: Option<PathBuf>,
+}
+
+/// A recovery found in the folder.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Recovery {
+    /// The recovered project file (inside the recovery folder).
+    pub project_file: PathBuf,
+    /// The project file the work belongs to, if it had been saved.
+    pub original: Option<PathBuf>,
+    /// Seconds since the Unix epoch when it was written.
+    pub saved_at_unix_seconds: u64,
+}
+
+impl Recovery {
+    /// Reads the recovered project (as any project: confined to its folder).
+    pub fn load(&self) -> Result<Project, ProjectError> {
+        load_project(&self.project_file)
+    }
+}
+
+/// The folder recovery files live in.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RecoveryFolder {
+    dir: PathBuf,
+}
+
+impl RecoveryFolder {
+    pub fn new(dir: impl Into<PathBuf>) -> RecoveryFolder {
+        RecoveryFolder { dir: dir.into() }
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Writes `project` as the recovery, replacing the previous one only
+    /// once the new one is complete.
+    pub fn write(
+        &self,
+        project: &Project,
+        original: Option<&Path>,
+        saved_at_unix_seconds: u64,
+    ) -> Result<(), ProjectError> {
+        let io = |path: &Path, error: std::io::Error| ProjectError::Io {
+            path: path.to_path_buf(),
+            message: error.to_string(),
+        };
+        fs::create_dir_all(&self.dir).map_err(|e| io(&self.dir, e))?;
+        let writing = self
+            .dir
+            .join(format!("{WRITING_PREFIX}{}", std::process::id()));
+        if writing.exists() {
+            fs::remove_dir_all(&writing).map_err(|e| io(&writing, e))?;
+        }
+        save_project(project, &writing.join(PROJECT_FILE))?;
+        let about = About {
+            saved_at_unix_seconds,
+            original: original.map(Path::to_path_buf),
+        };
+        let text = toml::to_string(&about).map_err(|e| ProjectError::Io {
+            path: writing.join(ABOUT_FILE),
+            message: e.to_string(),
+        })?;
+        anthesis_files::write_atomic(&writing.join(ABOUT_FILE), text.as_bytes()).map_err(|e| {
+            ProjectError::Io {
+                path: writing.join(ABOUT_FILE),
+                message: e.to_string(),
+            }
+        })?;
+        let latest = self.dir.join(LATEST);
+        let previous = self.dir.join(PREVIOUS);
+        if previous.exists() {
+            fs::remove_dir_all(&previous).map_err(|e| io(&previous, e))?;
+        }
+        if latest.exists() {
+            fs::rename(&latest, &previous).map_err(|e| io(&latest, e))?;
+        }
+        fs::rename(&writing, &latest).map_err(|e| io(&latest, e))?;
+        if previous.exists() {
+            fs::remove_dir_all(&previous).map_err(|e| io(&previous, e))?;
+        }
+        Ok(())
+    }
+
+    /// The recovery waiting in the folder, if any: `latest/`, or
+    /// `previous/` when a write stopped between its two renames.
+    /// Half-written folders are never offered.
+    pub fn find(&self) -> Option<Recovery> {
+        [LATEST, PREVIOUS]
+            .iter()
+            .find_map(|name| read_recovery(&self.dir.join(name)))
+    }
+
+    /// Removes every recovery (after a save, a clean exit, or when the user
+    /// discards it).
+    pub fn discard(&self) -> std::io::Result<()> {
+        let entries = match fs::read_dir(&self.dir) {
+            Ok(entries) => entries,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+            Err(e) => return Err(e),
+        };
+        for entry in entries {
+            let entry = entry?;
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name == LATEST || name == PREVIOUS || name.starts_with(WRITING_PREFIX) {
+                fs::remove_dir_all(entry.path())?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn read_recovery(folder: &Path) -> Option<Recovery> {
+    let project_file = folder.join(PROJECT_FILE);
+    if !project_file.is_file() {
+        return None;
+    }
+    let text =
+        anthesis_files::read_regular_text(&folder.join(ABOUT_FILE), 64 << 10, "a recovery note")
+            .ok()?;
+    let about: About = toml::from_str(&text).ok()?;
+    Some(Recovery {
+        project_file,
+        original: about.original,
+        saved_at_unix_seconds: about.saved_at_unix_seconds,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Flower, SimulationSettings};
+
+    /// A small valid project: one template, one organ.
+    fn project(name: &str) -> Project {
+        let mesh = anthesis_mesh::generate::test_petal(4.0, 1.5, 4, 6);
+        let template = crate::Template {
+            name: "petal".into(),
+            mesh,
+            maps: anthesis_maps::KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
+            dg: 0.003,
+            thickness: 0.02,
+            stretch_stiffness: 20.0,
+            bend_stiffness: 20.0,
+            base_region: crate::BaseRegion {
+                v_max: 0.2,
+                u_min: 0.0,
+                u_max: 1.0,
+            },
+            joint_schedule: Vec::new(),
+            color: [1.0, 0.5, 0.5, 1.0],
+        };
+        Project {
+            name: name.into(),
+            flower: Flower {
+                templates: vec![template],
+                organs: vec![crate::Organ {
+                    name: "petal-1".into(),
+                    template: 0,
+                    placement: crate::Placement {
+                        position: glam::DVec3::ZERO,
+                        azimuth_deg: 0.0,
+                        joint_angle_deg: 0.0,
+                    },
+                }],
+                overlaps: Vec::new(),
+            },
+            settings: SimulationSettings::default(),
+        }
+    }
+
+    #[test]
+    fn a_written_recovery_is_found_and_loads_as_the_project_it_saved() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let folder = RecoveryFolder::new(dir.path().join("recovery"));
+        assert_eq!(folder.find(), None, "nothing before the first write");
+        let work = project("work");
+        let original = dir.path().join("mine/flower.anthesis.toml");
+        folder
+            .write(&work, Some(&original), 1_700_000_000)
+            .expect("write");
+        let found = folder.find().expect("a recovery");
+        assert_eq!(found.original.as_deref(), Some(original.as_path()));
+        assert_eq!(found.saved_at_unix_seconds, 1_700_000_000);
+        assert!(found.project_file.starts_with(folder.dir()));
+        assert_eq!(found.load().expect("load"), work);
+        // The user's folder was not touched.
+        assert!(!dir.path().join("mine").exists());
+    }
+
+    #[test]
+    fn a_newer_write_replaces_the_older_and_discard_removes_it() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let folder = RecoveryFolder::new(dir.path());
+        folder.write(&project("first"), None, 1).expect("write");
+        folder.write(&project("second"), None, 2).expect("write");
+        let found = folder.find().expect("a recovery");
+        assert_eq!(found.saved_at_unix_seconds, 2);
+        assert_eq!(found.original, None);
+        assert_eq!(found.load().expect("load").name, "second");
+        folder.discard().expect("discard");
+        assert_eq!(folder.find(), None);
+        // Discarding nothing is fine, and so is a folder never made.
+        folder.discard().expect("discard again");
+        RecoveryFolder::new(dir.path().join("never"))
+            .discard()
+            .expect("no folder");
+    }
+
+    #[test]
+    fn a_write_cut_short_leaves_the_previous_recovery() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let folder = RecoveryFolder::new(dir.path());
+        folder.write(&project("kept"), None, 1).expect("write");
+        // A crash while writing: a half-made folder beside the recovery,
+        // its note missing.
+        let half = dir.path().join("writing-99999");
+        save_project(&project("half"), &half.join(PROJECT_FILE)).expect("save");
+        assert_eq!(
+            folder.find().expect("found").load().expect("load").name,
+            "kept"
+        );
+        // A crash between the two renames: only `previous/` is there.
+        fs::rename(dir.path().join(LATEST), dir.path().join(PREVIOUS)).expect("rename");
+        assert_eq!(
+            folder.find().expect("found").load().expect("load").name,
+            "kept"
+        );
+        // The next write tidies up and wins.
+        folder.write(&project("new"), None, 2).expect("write");
+        assert_eq!(
+            folder.find().expect("found").load().expect("load").name,
+            "new"
+        );
+        folder.discard().expect("discard");
+        assert_eq!(fs::read_dir(dir.path()).expect("list").count(), 0);
+    }
+
+    #[test]
+    fn a_damaged_note_is_not_offered() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let folder = RecoveryFolder::new(dir.path());
+        folder.write(&project("work"), None, 1).expect("write");
+        fs::write(
+            dir.path().join(LATEST).join(ABOUT_FILE),
+            "saved_at_unix_seconds = \"x",
+        )
+        .expect("write");
+        assert_eq!(folder.find(), None);
+    }
+}
