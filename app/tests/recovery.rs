@@ -138,6 +138,15 @@ fn a_stroke_survives_a_crash_and_is_recovered_at_the_next_launch() {
         anthesis_flower::project::load_project(&path).expect("load"),
         painted
     );
+    // The version saved over stays as a backup beside it.
+    let backup = path
+        .parent()
+        .expect("folder")
+        .join("backup/flower.anthesis.toml");
+    assert_eq!(
+        anthesis_flower::project::load_project(&backup).expect("backup"),
+        project
+    );
     let deadline = Instant::now() + Duration::from_secs(30);
     while folder.find().is_some() {
         assert!(Instant::now() < deadline, "the recovery stays after a save");

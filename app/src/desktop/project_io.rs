@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anthesis_flower::project::{load_project, save_project};
+use anthesis_flower::project::{keep_backup, load_project, save_project};
 
 use super::AnthesisApp;
 use super::command::{LoadedMap, ProjectEdit};
@@ -165,6 +165,13 @@ impl AnthesisApp {
 
     /// Writes the project to `path`; errors are shown, the work stays.
     pub fn save_to(&mut self, path: &Path) -> bool {
+        // The version saved before stays in backup/ beside it; failing to
+        // keep it must not stop the save.
+        if let Err(e) = keep_backup(path) {
+            self.log.warn(format!(
+                "could not keep the previous version as a backup: {e}"
+            ));
+        }
         match save_project(self.doc.project(), path) {
             Ok(()) => {
                 self.doc.mark_saved(path.to_path_buf());

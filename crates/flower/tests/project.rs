@@ -319,6 +319,47 @@ fn saving_over_a_project_replaces_it() {
 }
 
 #[test]
+fn saving_over_a_project_can_keep_the_previous_version_as_a_backup() {
+    let (_folder, path) = saved_lily();
+    let before = load_project(&path).expect("load");
+    let mut project = lily();
+    project.name = "Renamed".to_string();
+    project.flower.templates[0].thickness = 0.25;
+    let backup = anthesis_flower::project::keep_backup(&path)
+        .expect("backup")
+        .expect("there was a project");
+    save_project(&project, &path).expect("save over");
+    assert_eq!(
+        backup,
+        path.parent()
+            .expect("folder")
+            .join("backup/lily.anthesis.toml")
+    );
+    assert_eq!(load_project(&backup).expect("the backup loads"), before);
+    assert_eq!(load_project(&path).expect("load"), project);
+
+    // The next save keeps the version just replaced, not the first.
+    let mut third = project.clone();
+    third.name = "Third".to_string();
+    anthesis_flower::project::keep_backup(&path).expect("backup");
+    save_project(&third, &path).expect("save over");
+    assert_eq!(load_project(&backup).expect("load").name, "Renamed");
+
+    // A file that no longer loads is kept as it is.
+    fs::write(&path, "format = \"anthesis-project\"\nversion = ").expect("write");
+    anthesis_flower::project::keep_backup(&path).expect("backup");
+    assert_eq!(
+        fs::read_to_string(&backup).expect("read"),
+        "format = \"anthesis-project\"\nversion = "
+    );
+    // Nothing to keep for a new file.
+    assert_eq!(
+        anthesis_flower::project::keep_backup(&path.with_file_name("new.anthesis.toml")),
+        Ok(None)
+    );
+}
+
+#[test]
 fn a_truncated_file_is_a_syntax_error_naming_the_file() {
     let (_folder, path) = saved_lily();
     edit(&path, |text| {

@@ -215,6 +215,40 @@ pub fn save_project(project: &Project, path: &Path) -> Result<(), ProjectError> 
     write_file(path, plan.toml.as_bytes())
 }
 
+/// The folder beside a project file where [`keep_backup`] keeps the
+/// version it replaces.
+pub const BACKUP_FOLDER: &str = "backup";
+
+/// Before saving over the project file at `path`: keeps the project there
+/// now, with its meshes and maps, as `backup/NAME` beside it (replacing an
+/// older backup), as Blender keeps `.blend1`. A project that no longer
+/// loads is kept as its file alone. Returns the backup's project file, or
+/// `None` when there was nothing to keep.
+pub fn keep_backup(path: &Path) -> Result<Option<std::path::PathBuf>, ProjectError> {
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let backup_folder = folder.join(BACKUP_FOLDER);
+    let io = |at: &Path, error: io::Error| ProjectError::Io {
+        path: at.to_path_buf(),
+        message: error.to_string(),
+    };
+    if backup_folder.exists() {
+        std::fs::remove_dir_all(&backup_folder).map_err(|e| io(&backup_folder, e))?;
+    }
+    let file_name = path.file_name().unwrap_or_default();
+    let backup = backup_folder.join(file_name);
+    match load_project(path) {
+        Ok(previous) => save_project(&previous, &backup)?,
+        Err(_) => {
+            std::fs::create_dir_all(&backup_folder).map_err(|e| io(&backup_folder, e))?;
+            std::fs::copy(path, &backup).map_err(|e| io(&backup, e))?;
+        }
+    }
+    Ok(Some(backup))
+}
+
 /// The TOML text [`save_project`] would write for `project` at `path`
 /// (checked the same way; no file is written).
 pub fn project_to_toml(project: &Project, path: &Path) -> Result<String, ProjectError> {
