@@ -13,7 +13,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbaImage;
 
-use super::simulate::{check_memory, run_keyframes, set_keyframes};
+use super::simulate::{run_keyframes, set_keyframes};
 use super::{load, selection};
 use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
@@ -257,7 +257,7 @@ fn simulate_scenes(
     selection: &Selection,
     frames: &[u32],
 ) -> Result<Vec<(u32, Vec<OrganMesh>)>> {
-    check_memory(project, selection, KeyframeCost::Kept)?;
+    anthesis_sim::memory::check_run(project, selection, KeyframeCost::Kept)?;
     let mut sim = Simulation::new(project, selection)?;
     let colors: Vec<[f32; 4]> = (0..sim.organs().len()).map(|i| sim.color(i)).collect();
     let triangles: Vec<Vec<[u32; 3]>> = (0..colors.len())

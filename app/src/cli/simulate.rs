@@ -69,7 +69,7 @@ pub(super) fn simulate(
         Some(OutputKind::Usd) => KeyframeCost::Usd,
         Some(OutputKind::ObjFolder) => KeyframeCost::Obj,
     };
-    check_memory(&project, &selection, cost)?;
+    memory::check_run(&project, &selection, cost)?;
 
     let mut sim = Simulation::new(&project, &selection)?;
     let total = sim.keyframe_count();
@@ -155,45 +155,6 @@ pub(super) fn set_keyframes(
             bail!("--keyframes {n} is more than the limit of {MAX_KEYFRAMES}");
         }
         project.settings.keyframes = n;
-    }
-    Ok(())
-}
-
-/// The environment variable that caps the memory a run may take, in MiB
-/// (for machines shared with other work); the system's available memory
-/// caps it anyway.
-pub(super) const MEMORY_LIMIT_VARIABLE: &str = "ANTHESIS_MEMORY_LIMIT_MIB";
-
-/// Refuses, before anything is built, a run whose estimated peak memory
-/// (`anthesis_sim::memory`) is more than the system has available now or
-/// than [`MEMORY_LIMIT_VARIABLE`] allows: the kernel would kill it part way.
-pub(super) fn check_memory(
-    project: &anthesis_flower::Project,
-    selection: &anthesis_sim::Selection,
-    cost: KeyframeCost,
-) -> Result<()> {
-    let limit = match std::env::var(MEMORY_LIMIT_VARIABLE) {
-        Ok(text) => Some(
-            text.trim()
-                .parse::<u64>()
-                .ok()
-                .filter(|&mib| mib > 0)
-                .with_context(|| {
-                    format!(
-                        "{MEMORY_LIMIT_VARIABLE} must be a whole number of MiB above 0, found {}",
-                        anthesis_files::excerpt(&text, 40)
-                    )
-                })?
-                .saturating_mul(1 << 20),
-        ),
-        Err(_) => None,
-    };
-    let available = [memory::available_bytes(), limit]
-        .into_iter()
-        .flatten()
-        .min();
-    if let Some(available) = available {
-        memory::check(memory::estimate(project, selection, cost), available)?;
     }
     Ok(())
 }

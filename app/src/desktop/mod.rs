@@ -347,8 +347,20 @@ impl AnthesisApp {
     /// Starts simulating the project as it is now (cancelling the running
     /// job), and follows the new keyframes.
     pub fn restart_simulation(&mut self) {
+        let selection = self.selection();
+        // A run too large for the memory would be killed by the kernel,
+        // taking the window and the user's work with it.
+        if let Err(e) = anthesis_sim::memory::check_run(
+            self.doc.project(),
+            &selection,
+            anthesis_sim::memory::KeyframeCost::Kept,
+        ) {
+            self.log.error(format!("the simulation did not start: {e}"));
+            self.needs_run = false;
+            return;
+        }
         let project = Arc::new(self.doc.project().clone());
-        self.session.start(project, self.selection());
+        self.session.start(project, selection);
         self.needs_run = false;
         if self.session.is_live() {
             self.playback.follow = true;

@@ -161,11 +161,56 @@ fn parse_mem_available(meminfo: &str) -> Option<u64> {
     Some(kib.saturating_mul(1024))
 }
 
+/// The environment variable that caps the memory a run may take, in MiB
+/// (for machines shared with other work); the system's available memory
+/// caps it anyway.
+pub const LIMIT_VARIABLE: &str = "ANTHESIS_MEMORY_LIMIT_MIB";
+
+/// Why a run may not start.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum MemoryError {
+    #[error(transparent)]
+    TooLarge(#[from] TooLarge),
+    #[error("{LIMIT_VARIABLE} must be a whole number of MiB above 0, found {0}")]
+    BadLimit(String),
+}
+
+/// The memory a new run may take: what the system has available now,
+/// capped by [`LIMIT_VARIABLE`]; `None` when neither is known.
+pub fn allowed_bytes() -> Result<Option<u64>, MemoryError> {
+    let limit = match std::env::var(LIMIT_VARIABLE) {
+        Ok(text) => Some(
+            text.trim()
+                .parse::<u64>()
+                .ok()
+                .filter(|&mib| mib > 0)
+                .ok_or_else(|| MemoryError::BadLimit(anthesis_files::excerpt(&text, 40)))?
+                .saturating_mul(1 << 20),
+        ),
+        Err(_) => None,
+    };
+    Ok([available_bytes(), limit].into_iter().flatten().min())
+}
+
+/// Refuses, before anything is built, a run of `project` whose estimated
+/// peak memory is more than [`allowed_bytes`]: the kernel would kill it
+/// part way. The one check the command line and the window apply.
+pub fn check_run(
+    project: &Project,
+    selection: &Selection,
+    cost: KeyframeCost,
+) -> Result<(), MemoryError> {
+    if let Some(allowed) = allowed_bytes()? {
+        check(estimate(project, selection, cost), allowed)?;
+    }
+    Ok(())
+}
+
 /// A run that would not fit in memory.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
     "this run needs {estimate}, but only {} of memory is available; simulate fewer organs \
-     (--organ) or keyframes, or use a coarser mesh",
+     (one organ alone) or keyframes, or use a coarser mesh",
     human_bytes(*.available)
 )]
 pub struct TooLarge {
