@@ -25,6 +25,8 @@
 //! edge flips (raising the smallest angle) and tangential smoothing in the
 //! parameter domain, with boundary vertices sliding along their boundary.
 
+#![warn(missing_docs)]
+
 mod examples;
 mod quality;
 mod remesh;
@@ -65,6 +67,7 @@ pub struct RemeshOptions {
     pub min_angle_floor_deg: f64,
     /// The mesh is refused if it would need more vertices than this.
     pub max_vertices: usize,
+    /// Which side of the surface the triangles' winding makes the inner one.
     pub inner_side: InnerSide,
     /// Check the finished mesh for self-intersections (cheap: a spatial hash).
     pub check_self_intersection: bool,
@@ -89,7 +92,9 @@ impl RemeshOptions {
 /// A remeshed organ and its quality.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bud {
+    /// The mesh, in the template frame, with UVs = surface parameters.
     pub mesh: Mesh,
+    /// Its edge lengths and angles.
     pub quality: MeshQuality,
 }
 
@@ -97,50 +102,80 @@ pub struct Bud {
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum BudError {
     #[error("the target edge length must be a positive number, got {0}")]
+    /// The target edge length is zero, negative or not finite.
     InvalidTargetEdge(f64),
     #[error("the surface has a non-finite point (NaN or infinite) at (u, v) = ({u:.3}, {v:.3})")]
-    NonFinitePoint { u: f64, v: f64 },
+    /// The surface is NaN or infinite somewhere.
+    NonFinitePoint {
+        /// Where, across.
+        u: f64,
+        /// Where, from base to tip.
+        v: f64,
+    },
     #[error(
         "the surface has no length from base to tip (its lines of constant u are single points)"
     )]
+    /// Base and tip coincide.
     ZeroLength,
     #[error(
         "the surface has zero width at v = {v:.3}; only the tip (v = 1) may come to a point, the base and the blade need a width"
     )]
-    ZeroWidth { v: f64 },
+    /// A row below the tip has no width.
+    ZeroWidth {
+        /// The row, from base (0) to tip (1).
+        v: f64,
+    },
     #[error(
         "target edge {target_edge} is too large for this organ ({length:.3} long from base to tip): it would get {rows} rows of vertices, at least 3 are needed"
     )]
+    /// The target edge is too long for the organ.
     TooFewRows {
+        /// The target edge length asked for.
         target_edge: f64,
+        /// The organ's length from base to tip.
         length: f64,
+        /// The rows it would get.
         rows: usize,
     },
     #[error(
         "target edge {target_edge} is too small for this organ (area {area:.3}): it would need about {estimated} vertices, more than the limit of {limit}"
     )]
+    /// The target edge is too short for the organ.
     TooManyVertices {
+        /// The target edge length asked for.
         target_edge: f64,
+        /// The surface's area.
         area: f64,
+        /// The vertices it would need, estimated from the area.
         estimated: usize,
+        /// [`RemeshOptions::max_vertices`].
         limit: usize,
     },
     #[error(
         "the mesh quality is below the floor: triangle {triangle} has a {angle_deg:.1}° angle, the smallest allowed is {floor_deg:.1}° (the shape may have a very sharp tip or corner, or the target edge is too large for its narrow parts)"
     )]
+    /// A triangle's smallest angle is below the floor.
     PoorQuality {
+        /// The worst triangle.
         triangle: usize,
+        /// Its smallest angle.
         angle_deg: f64,
+        /// [`RemeshOptions::min_angle_floor_deg`].
         floor_deg: f64,
     },
     #[error(
         "the surface intersects itself: triangles {first} and {second} of the mesh cross (near {near_in_template})"
     )]
+    /// Two triangles of the mesh cross.
     SelfIntersection {
+        /// One of them.
         first: usize,
+        /// The other.
         second: usize,
+        /// Roughly where, in the template frame.
         near_in_template: glam::DVec3,
     },
+    /// The finished mesh failed validation.
     #[error("the remeshed organ is not a valid mesh: {0}")]
     InvalidMesh(#[from] MeshError),
 }

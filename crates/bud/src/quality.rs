@@ -20,7 +20,9 @@ pub struct MeshQuality {
     pub edge_spread: f64,
     /// Fraction of triangles whose angles are all within 15° of 60°.
     pub near_equilateral: f64,
+    /// Number of vertices.
     pub vertices: usize,
+    /// Number of triangles.
     pub triangles: usize,
     /// Number of distinct edges.
     pub edges: usize,

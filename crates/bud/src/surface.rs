@@ -33,10 +33,12 @@ pub fn bernstein3(t: f64) -> [f64; 4] {
 /// type).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BezierCurve {
+    /// The four control points, in curve order.
     pub control: [DVec3; 4],
 }
 
 impl BezierCurve {
+    /// The curve of these control points.
     pub fn new(control: [DVec3; 4]) -> Self {
         BezierCurve { control }
     }
@@ -63,10 +65,12 @@ impl BezierCurve {
 /// `control[0][0]` is the point at `uv = (0, 0)`, `control[3][3]` at `(1, 1)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BezierPatch {
+    /// The control points, `control[j][i]` (see above).
     pub control: [[DVec3; 4]; 4],
 }
 
 impl BezierPatch {
+    /// The patch of these control points.
     pub fn new(control: [[DVec3; 4]; 4]) -> Self {
         BezierPatch { control }
     }
