@@ -453,7 +453,7 @@ pub fn side_distances(
         let mut best: Option<(f64, [u32; 3], DVec3, [f64; 3])> = None;
         for tri in &other_mesh.triangles {
             let [a, b, c] = tri.map(|k| other[k as usize]);
-            let (point, weights) = closest_point_on_triangle(x, a, b, c);
+            let (point, weights) = anthesis_mesh::nearest::closest_point_on_triangle(x, a, b, c);
             let d2 = point.distance_squared(x);
             if best.is_none_or(|(bd, ..)| d2 < bd) {
                 best = Some((d2, *tri, point, weights));
@@ -472,45 +472,6 @@ pub fn side_distances(
         Some((x - point).dot(normal))
     };
     Ok(moving.iter().map(|&x| distance(x)).collect())
-}
-
-/// The point of triangle `abc` nearest `p` and its barycentric weights
-/// (the standard region test over the triangle's corners, edges and face;
-/// small enough to write here rather than pull in a geometry crate).
-fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, [f64; 3]) {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, [0.0, 1.0, 0.0]);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (a + ab * v, [1.0 - v, v, 0.0]);
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, [0.0, 0.0, 1.0]);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (a + ac * w, [1.0 - w, 0.0, w]);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (b + (c - b) * w, [0.0, 1.0 - w, w]);
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    (a + ab * v + ac * w, [1.0 - v - w, v, w])
 }
 
 #[cfg(test)]

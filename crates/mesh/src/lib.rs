@@ -10,6 +10,7 @@
 
 mod error;
 pub mod generate;
+pub mod nearest;
 pub mod obj;
 pub mod ray;
 mod topology;
