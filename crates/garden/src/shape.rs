@@ -462,8 +462,7 @@ pub fn side_distances(
         let (d2, tri, point, weights) = best?;
         // On the rim: every corner the nearest point leans on is a rim
         // particle (a point on an interior edge or corner is inside).
-        let on_rim = weights.iter().any(|&w| w <= 0.0)
-            && (0..3).all(|k| weights[k] <= 0.0 || rim[tri[k] as usize]);
+        let on_rim = anthesis_mesh::nearest::on_rim(tri, weights, &rim);
         if d2 > reach * reach || on_rim {
             return None;
         }

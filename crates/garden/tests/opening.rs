@@ -62,7 +62,7 @@ fn print(name: &str, shapes: &[FlowerShape]) {
     for (k, s) in FRAMES.iter().zip(shapes) {
         let m = &s.mean;
         eprintln!(
-            "{name} kf {k:3}: angles {:6.1} {:6.1} {:6.1}  turning midrib {:6.1} lamina {:6.1}  cupping {:6.3} swelling {:6.3}  radius {:5.1} {:5.1} {:5.1} {:5.1}",
+            "{name} kf {k:3}: angles {:6.1} {:6.1} {:6.1}  turning midrib {:6.1} lamina {:6.1}  cupping {:6.3} swelling {:6.3}  cone {:5.1}  radius {:5.1} {:5.1} {:5.1} {:5.1}",
             m.midrib_angles_deg[0],
             m.midrib_angles_deg[1],
             m.midrib_angles_deg[2],
@@ -70,6 +70,7 @@ fn print(name: &str, shapes: &[FlowerShape]) {
             m.lamina_turning_deg,
             m.cupping,
             m.swelling,
+            m.cone_angle_deg,
             m.radius_profile[0],
             m.radius_profile[1],
             m.radius_profile[2],

@@ -42,6 +42,17 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVe
     (a + ab * v + ac * w, [1.0 - v - w, v, w])
 }
 
+/// Whether the point of triangle `corners` (vertex indices) with
+/// barycentric `weights` lies on the mesh's rim: on an edge or corner of
+/// the triangle every corner of which it leans on is a `rim` (boundary)
+/// vertex. A point inside the triangle, or on an edge with an interior
+/// corner, is not (an edge between two rim vertices across the mesh is
+/// taken as rim: meshes here do not have them).
+pub fn on_rim(corners: [u32; 3], weights: [f64; 3], rim: &[bool]) -> bool {
+    weights.iter().any(|&w| w <= 0.0)
+        && (0..3).all(|k| weights[k] <= 0.0 || rim[corners[k] as usize])
+}
+
 /// The triangles around each vertex (indices into `triangles`, ascending).
 pub fn triangles_around(triangles: &[[u32; 3]], vertex_count: usize) -> Vec<Vec<u32>> {
     let mut around = vec![Vec::new(); vertex_count];
@@ -101,9 +112,23 @@ mod tests {
     }
 
     #[test]
+    fn a_point_is_on_the_rim_only_on_an_edge_or_corner_of_rim_vertices() {
+        // Vertices 0 and 1 on the rim, 2 inside.
+        let rim = [true, true, false];
+        assert!(on_rim([0, 1, 2], [0.3, 0.7, 0.0], &rim));
+        assert!(on_rim([0, 1, 2], [1.0, 0.0, 0.0], &rim));
+        assert!(!on_rim([0, 1, 2], [0.3, 0.0, 0.7], &rim));
+        assert!(!on_rim([0, 1, 2], [0.2, 0.3, 0.5], &rim));
+        assert!(!on_rim([0, 1, 2], [0.0, 0.0, 1.0], &rim));
+    }
+
+    #[test]
     fn triangles_around_lists_each_triangle_at_its_three_corners() {
         let around = triangles_around(&[[0, 1, 2], [2, 1, 3]], 5);
-        assert_eq!(around, vec![vec![0], vec![0, 1], vec![0, 1], vec![1], vec![]]);
+        assert_eq!(
+            around,
+            vec![vec![0], vec![0, 1], vec![0, 1], vec![1], vec![]]
+        );
     }
 
     #[test]
@@ -118,7 +143,12 @@ mod tests {
                 DVec3::new(0.0, h, r).normalize() * r,
             ];
             let normals = corners.map(|c| c / r);
-            for w in [[1.0 / 3.0; 3], [0.5, 0.5, 0.0], [0.2, 0.1, 0.7], [0.0, 0.3, 0.7]] {
+            for w in [
+                [1.0 / 3.0; 3],
+                [0.5, 0.5, 0.0],
+                [0.2, 0.1, 0.7],
+                [0.0, 0.3, 0.7],
+            ] {
                 let flat: DVec3 = (0..3).map(|k| corners[k] * w[k]).sum();
                 let flat_error = (flat.length() - r).abs();
                 let phong_error = (phong_point(corners, normals, w).length() - r).abs();

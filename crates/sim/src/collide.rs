@@ -1,12 +1,19 @@
 //! Collisions between organs (paper §5.3): each particle tracks its nearest
 //! particle on the organs it overlaps; the floral arrangement says on which
-//! side of that organ it belongs.
+//! side of that organ it belongs. The side is taken at the nearest point of
+//! the organ's smooth surface (on the triangles around the tracked
+//! particle, curved by Phong tessellation), not on the tangent plane of the
+//! tracked particle: that plane strays from a curved organ by about
+//! κ·h²/2 at an edge h away, enough in a tightly wrapped bud to decide
+//! which keyframe two petals meet in, so the flower's shape depended on its
+//! mesh.
 //!
 //! During minimisation a violated side becomes a stiff one-sided penalty
 //! (`anthesis_physics::Contact`), so Newton's method sees the contact and
 //! converges; after convergence the paper's push-back moves every particle
 //! still short of its side onto it, `offset` past the neighbour.
 
+use anthesis_mesh::nearest::{closest_point_on_triangle, on_rim, phong_point};
 use anthesis_physics::Contact;
 use glam::DVec3;
 
@@ -15,6 +22,11 @@ pub struct Surface<'a> {
     pub positions: &'a [DVec3],
     /// Unit normals pointing to the organ's inner side.
     pub normals: &'a [DVec3],
+    pub triangles: &'a [[u32; 3]],
+    /// The triangles around each particle.
+    pub triangles_around: &'a [Vec<u32>],
+    /// Whether each particle is on the organ's rim (its boundary).
+    pub rim: &'a [bool],
     /// Mean edge length, which sets the search radius.
     pub mean_edge: f64,
 }
@@ -145,7 +157,13 @@ pub enum Violated {
 /// Contacts for the particles of `moving` against `other`: `side` is +1 if
 /// `moving` belongs on `other`'s inner side (it lies inside), -1 if on its
 /// outer side. Only particles within reach of `other` (two of its mean edges
-/// away, and over it rather than beyond its rim) get a contact.
+/// from its nearest particle) and over it get a contact: the point nearest
+/// them on the triangles around that particle, lifted onto the Phong
+/// surface, with the normal blended from the corners'. A particle whose
+/// nearest point is on `other`'s rim is over it only if it lies within the
+/// collision `offset` of the rim sideways; farther it is beside the organ,
+/// where nothing holds it (a fixed fraction of the mean edge instead made
+/// how far past a margin a petal was held depend on the mesh).
 pub fn contacts_against(
     moving: &Surface,
     other: &Surface,
@@ -155,21 +173,24 @@ pub fn contacts_against(
     violated: Violated,
     out: &mut Vec<Contact>,
 ) {
-    let lateral_limit = other.mean_edge;
     for (i, x) in moving.positions.iter().enumerate() {
         let Some(q) = tracker.nearest(*x, other.positions) else {
             continue;
         };
-        let point = other.positions[q as usize];
-        let normal = other.normals[q as usize] * side;
-        let d = *x - point;
-        let lateral = (d - normal * d.dot(normal)).length();
-        if lateral > lateral_limit {
+        let Some(nearest) = nearest_on_surface(*x, other, q) else {
             continue;
+        };
+        let normal = nearest.normal * side;
+        if nearest.on_rim {
+            let d = *x - nearest.point;
+            let beside = (d - normal * d.dot(normal)).length();
+            if beside > offset {
+                continue;
+            }
         }
         let mut contact = Contact {
             particle: i as u32,
-            point,
+            point: nearest.point,
             normal,
             offset,
         };
@@ -179,6 +200,43 @@ pub fn contacts_against(
         }
         out.push(contact);
     }
+}
+
+/// The point of an organ's surface nearest a particle.
+struct Nearest {
+    /// On the Phong surface.
+    point: DVec3,
+    /// Unit normal towards the organ's inner side.
+    normal: DVec3,
+    on_rim: bool,
+}
+
+/// The point of `surface` nearest `x` among the triangles around particle
+/// `q` (the normal blended from the corners' normals with the point's
+/// barycentric weights). `None` when `q` has no triangles or a zero normal.
+fn nearest_on_surface(x: DVec3, surface: &Surface, q: u32) -> Option<Nearest> {
+    let mut best: Option<(f64, [u32; 3], [f64; 3])> = None;
+    for &t in &surface.triangles_around[q as usize] {
+        let tri = surface.triangles[t as usize];
+        let [a, b, c] = tri.map(|k| surface.positions[k as usize]);
+        let (flat, weights) = closest_point_on_triangle(x, a, b, c);
+        let d2 = flat.distance_squared(x);
+        if best.is_none_or(|(bd, ..)| d2 < bd) {
+            best = Some((d2, tri, weights));
+        }
+    }
+    let (_, tri, weights) = best?;
+    let corners = tri.map(|k| surface.positions[k as usize]);
+    let normals = tri.map(|k| surface.normals[k as usize]);
+    let normal = (0..3)
+        .map(|k| normals[k] * weights[k])
+        .sum::<DVec3>()
+        .try_normalize()?;
+    Some(Nearest {
+        point: phong_point(corners, normals, weights),
+        normal,
+        on_rim: on_rim(tri, weights, surface.rim),
+    })
 }
 
 /// The largest violation over `contacts` (0 when none is violated).
@@ -247,6 +305,77 @@ mod tests {
                     assert!(d > 0.8, "missed a point at distance {d}");
                 }
             }
+        }
+    }
+
+    /// The contact a particle inside a cylinder of radius `radius` (the
+    /// outer organ, `cells` triangle columns over 90°) gets: how far it
+    /// lies on its side of the surface, along the contact's normal.
+    fn distance_inside_cylinder(x: DVec3, radius: f64, cells: usize) -> f64 {
+        let mesh = anthesis_mesh::generate::parametric_grid(cells + 1, cells + 1, |uv| {
+            let angle = std::f64::consts::FRAC_PI_2 * uv.x;
+            DVec3::new(radius * angle.cos(), 3.0 * uv.y, radius * angle.sin())
+        });
+        let mut normals = anthesis_mesh::vertex_normals(&mesh.positions, &mesh.triangles);
+        // The inner side faces the cylinder's axis.
+        if normals[0].dot(mesh.positions[0]) > 0.0 {
+            normals.iter_mut().for_each(|n| *n = -*n);
+        }
+        let around = anthesis_mesh::nearest::triangles_around(&mesh.triangles, mesh.vertex_count());
+        let mean_edge = radius * std::f64::consts::FRAC_PI_2 / cells as f64;
+        let other = Surface {
+            positions: &mesh.positions,
+            normals: &normals,
+            triangles: &mesh.triangles,
+            triangles_around: &around,
+            rim: &vec![false; mesh.vertex_count()],
+            mean_edge,
+        };
+        let moving = Surface {
+            positions: &[x],
+            normals: &[],
+            triangles: &[],
+            triangles_around: &[],
+            rim: &[],
+            mean_edge,
+        };
+        let tracker = Tracker::new(other.positions, 2.0 * mean_edge);
+        let mut out = Vec::new();
+        contacts_against(
+            &moving,
+            &other,
+            &tracker,
+            1.0,
+            0.0,
+            Violated::MoveAll,
+            &mut out,
+        );
+        assert_eq!(
+            out.len(),
+            1,
+            "one contact for the particle over the surface"
+        );
+        (x - out[0].point).dot(out[0].normal)
+    }
+
+    #[test]
+    fn a_contact_measures_from_the_curved_surface_whatever_the_mesh() {
+        let radius = 5.0;
+        // A particle 0.1 inside the cylinder, over the middle of a coarse
+        // cell (where the flat triangles sag most) and off the fine grid.
+        let angle = 0.37f64;
+        let x = DVec3::new(4.9 * angle.cos(), 1.43, 4.9 * angle.sin());
+        let coarse_cells = 6;
+        // How far the coarse triangles sag inside the cylinder (and a
+        // particle's tangent plane strays from it) at half a cell.
+        let half_cell = std::f64::consts::FRAC_PI_2 / coarse_cells as f64 / 2.0;
+        let sag = radius * (1.0 - half_cell.cos());
+        for cells in [coarse_cells, 2 * coarse_cells, 5 * coarse_cells] {
+            let distance = distance_inside_cylinder(x, radius, cells);
+            assert!(
+                (distance - 0.1).abs() < 0.05 * sag,
+                "{cells} cells: {distance} (sag {sag})"
+            );
         }
     }
 

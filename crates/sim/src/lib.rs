@@ -65,7 +65,8 @@ pub struct KeyframeStats {
     /// Particles the final push-back moved.
     pub pushed_particles: u32,
     /// Particles touching a neighbouring organ when the keyframe ends:
-    /// within the collision offset of its surface or pressed into it.
+    /// held off it by a contact force when the organs settled, or within
+    /// the collision offset of its surface or pressed into it after.
     pub contact_particles: u32,
 }
 
@@ -353,6 +354,7 @@ impl Simulation {
             push_back(&mut organ.positions, c, &mut moved);
         }
         let mut round = 1;
+        let mut pressed: Vec<Vec<bool>>;
         let pushed = loop {
             let mut round_iterations = 0;
             let mut converged = false;
@@ -401,6 +403,20 @@ impl Simulation {
             for organ in &mut self.organs {
                 organ.attach(step);
             }
+            // Particles the settled organs lean on a neighbour with.
+            pressed = self
+                .organs
+                .iter()
+                .zip(&contacts)
+                .map(|(o, c)| {
+                    let mut held = vec![false; o.positions.len()];
+                    for contact in c {
+                        let p = contact.particle as usize;
+                        held[p] |= contact.violation(o.positions[p]) > 0.0;
+                    }
+                    held
+                })
+                .collect();
             if self.overlaps.is_empty() {
                 break 0;
             }
@@ -456,27 +472,31 @@ impl Simulation {
                 relative_gradient: gradient,
                 seconds: started.elapsed().as_secs_f64(),
                 pushed_particles: pushed as u32,
-                contact_particles: self.particles_in_contact(),
+                contact_particles: self.particles_in_contact(&pressed),
             },
         })
     }
 
-    /// How many particles touch a neighbouring organ: their contact is
-    /// violated or short of it by less than the collision offset (a particle
-    /// with several neighbours counts once).
-    fn particles_in_contact(&self) -> u32 {
+    /// How many particles touch a neighbouring organ: `pressed` (held off
+    /// it by a contact force while the organs settled), or their contact
+    /// is violated or short of it by less than the collision offset now (a
+    /// particle with several neighbours counts once).
+    fn particles_in_contact(&self, pressed: &[Vec<bool>]) -> u32 {
         let offset = self.settings.collision_offset;
         self.contacts(Violated::MoveAll)
             .iter()
             .zip(&self.organs)
-            .map(|(contacts, organ)| {
-                let mut touching: Vec<u32> = contacts
-                    .iter()
-                    .filter(|c| c.violation(organ.positions[c.particle as usize]) > -offset)
-                    .map(|c| c.particle)
-                    .collect();
-                touching.dedup();
-                touching.len() as u32
+            .enumerate()
+            .map(|(i, (contacts, organ))| {
+                let mut touching = pressed
+                    .get(i)
+                    .cloned()
+                    .unwrap_or_else(|| vec![false; organ.positions.len()]);
+                for c in contacts {
+                    let p = c.particle as usize;
+                    touching[p] |= c.violation(organ.positions[p]) > -offset;
+                }
+                touching.iter().filter(|&&t| t).count() as u32
             })
             .sum()
     }
@@ -497,11 +517,7 @@ impl Simulation {
             .organs
             .iter()
             .zip(&normals)
-            .map(|(o, n)| Surface {
-                positions: &o.positions,
-                normals: n,
-                mean_edge: o.mean_edge,
-            })
+            .map(|(o, n)| o.surface(n))
             .collect();
         let trackers: Vec<Tracker> = surfaces
             .par_iter()
@@ -578,16 +594,8 @@ impl Simulation {
     fn contacts_between(&self, moving: usize, other: usize, side: f64) -> Vec<Contact> {
         let (m, o) = (&self.organs[moving], &self.organs[other]);
         let normals = anthesis_mesh::vertex_normals(&o.positions, &o.mesh.triangles);
-        let other_surface = Surface {
-            positions: &o.positions,
-            normals: &normals,
-            mean_edge: o.mean_edge,
-        };
-        let moving_surface = Surface {
-            positions: &m.positions,
-            normals: &[],
-            mean_edge: m.mean_edge,
-        };
+        let other_surface = o.surface(&normals);
+        let moving_surface = m.surface(&[]);
         let tracker = Tracker::new(&o.positions, 2.0 * o.mean_edge);
         let mut contacts = Vec::new();
         contacts_against(

@@ -1,6 +1,7 @@
 //! One organ in a running simulation: its growth maps sampled once per time
 //! key, its elastic state, solver and attachment.
 
+use crate::collide::Surface;
 use anthesis_flower::{Organ, Placement, Template, joint_angle_after};
 use anthesis_maps::{KeySchedule, ScalarMap};
 use anthesis_mesh::{Mesh, Topology};
@@ -104,6 +105,11 @@ pub(crate) struct OrganSim {
     bud_edge: f64,
     /// Whether each particle is a base particle.
     pub is_base: Vec<bool>,
+    /// The triangles around each particle, where collisions look for the
+    /// nearest point of this organ's surface.
+    pub triangles_around: Vec<Vec<u32>>,
+    /// Whether each particle is on the organ's rim.
+    rim: Vec<bool>,
     placement: Placement,
     schedule: Vec<anthesis_flower::JointRamp>,
     base: Vec<u32>,
@@ -183,6 +189,11 @@ impl OrganSim {
             is_base: (0..template.mesh.vertex_count() as u32)
                 .map(|i| base.contains(&i))
                 .collect(),
+            triangles_around: anthesis_mesh::nearest::triangles_around(
+                &template.mesh.triangles,
+                template.mesh.vertex_count(),
+            ),
+            rim: topology.boundary_vertices(template.mesh.vertex_count()),
             placement: organ.placement,
             schedule: template.joint_schedule.clone(),
             base_current: Vec::with_capacity(base.len()),
@@ -318,6 +329,18 @@ impl OrganSim {
         }
         self.elastic.contact_stiffness = CONTACT_STIFFNESS_FACTOR * mean_ks;
         self.elastic.anchor_stiffness = ANCHOR_FACTOR * mean_ks;
+    }
+
+    /// This organ's surface as collisions see it, with its unit normals.
+    pub fn surface<'a>(&'a self, normals: &'a [DVec3]) -> Surface<'a> {
+        Surface {
+            positions: &self.positions,
+            normals,
+            triangles: &self.mesh.triangles,
+            triangles_around: &self.triangles_around,
+            rim: &self.rim,
+            mean_edge: self.mean_edge,
+        }
     }
 
     /// One Newton iteration with the base held where the receptacle and the
