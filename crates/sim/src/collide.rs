@@ -211,19 +211,39 @@ struct Nearest {
     on_rim: bool,
 }
 
-/// The point of `surface` nearest `x` among the triangles around particle
+/// The point of `surface` nearest `x` among the triangles near particle
 /// `q` (the normal blended from the corners' normals with the point's
 /// barycentric weights). `None` when `q` has no triangles or a zero normal.
 fn nearest_on_surface(x: DVec3, surface: &Surface, q: u32) -> Option<Nearest> {
-    let mut best: Option<(f64, [u32; 3], [f64; 3])> = None;
-    for &t in &surface.triangles_around[q as usize] {
-        let tri = surface.triangles[t as usize];
-        let [a, b, c] = tri.map(|k| surface.positions[k as usize]);
-        let (flat, weights) = closest_point_on_triangle(x, a, b, c);
-        let d2 = flat.distance_squared(x);
-        if best.is_none_or(|(bd, ..)| d2 < bd) {
-            best = Some((d2, tri, weights));
+    let around = &surface.triangles_around;
+    let nearest_among = |triangles: &mut dyn Iterator<Item = u32>| {
+        let mut best: Option<(f64, [u32; 3], [f64; 3])> = None;
+        for t in triangles {
+            let tri = surface.triangles[t as usize];
+            let [a, b, c] = tri.map(|k| surface.positions[k as usize]);
+            let (flat, weights) = closest_point_on_triangle(x, a, b, c);
+            let d2 = flat.distance_squared(x);
+            if best.is_none_or(|(bd, ..)| d2 < bd) {
+                best = Some((d2, tri, weights));
+            }
         }
+        best
+    };
+    let mut best = nearest_among(&mut around[q as usize].iter().copied());
+    // Inside a triangle around `q` it is the nearest point near `q`. On
+    // an edge or corner it may lie on the next ring (the nearest particle's
+    // own triangles can miss the nearest point where the mesh is
+    // stretched, and a particle by a margin then looked beside it): look
+    // at the triangles around their corners too.
+    if best.is_some_and(|(_, _, w)| w.iter().any(|&w| w <= 0.0)) {
+        let mut ring: Vec<u32> = around[q as usize]
+            .iter()
+            .flat_map(|&t| surface.triangles[t as usize])
+            .flat_map(|v| around[v as usize].iter().copied())
+            .collect();
+        ring.sort_unstable();
+        ring.dedup();
+        best = nearest_among(&mut ring.into_iter());
     }
     let (_, tri, weights) = best?;
     let corners = tri.map(|k| surface.positions[k as usize]);

@@ -43,11 +43,11 @@ fn assert_on_their_sides(project: &Project, keyframes: &[Keyframe], exempt_base:
         for s in over_outer.iter().filter(|s| inner_checked[s.particle]) {
             assert!(
                 s.along_normal >= offset - 1e-6,
-                "keyframe {}: inner particle {} is {:.4} along the inner normal of outer particle {} (needs {offset})",
+                "keyframe {}: inner particle {} is {:.4} along the inner normal of outer triangle {} (needs {offset})",
                 keyframe.index,
                 s.particle,
                 s.along_normal,
-                s.nearest
+                s.nearest_triangle
             );
             closest = closest.min(s.along_normal);
         }
@@ -58,11 +58,11 @@ fn assert_on_their_sides(project: &Project, keyframes: &[Keyframe], exempt_base:
         {
             assert!(
                 -s.along_normal >= offset - 1e-6,
-                "keyframe {}: outer particle {} is {:.4} inside inner particle {} (needs {offset} outside)",
+                "keyframe {}: outer particle {} is {:.4} inside inner triangle {} (needs {offset} outside)",
                 keyframe.index,
                 s.particle,
                 s.along_normal,
-                s.nearest
+                s.nearest_triangle
             );
         }
     }

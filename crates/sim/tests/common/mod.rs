@@ -21,50 +21,75 @@ pub fn mean_edge(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
 }
 
 /// Where a particle of one organ lies relative to another organ: measured
-/// from the other organ's nearest particle, along that particle's normal
-/// (the other organ's inner side is positive).
+/// from the nearest point of the other organ's smooth surface (the flat
+/// triangles' nearest point lifted onto the Phong surface, as collisions
+/// define it), along the normal there (the other organ's inner side is
+/// positive).
 #[derive(Debug, Clone, Copy)]
 pub struct SideSample {
     pub particle: usize,
-    pub nearest: usize,
+    /// The triangle of the other organ the nearest point lies on.
+    pub nearest_triangle: usize,
     /// Signed distance along the other organ's inner normal.
     pub along_normal: f64,
 }
 
-/// The particles of `moving` that lie over `other` (nearest particle of
-/// `other` within two mean edges, and within one mean edge of that
-/// particle's normal line), with their signed distance along `other`'s
-/// inner normal. Brute force, independent of the simulator's tracker.
+/// The particles of `moving` that lie over `other`: their nearest point on
+/// `other`'s triangles is within two mean edges and not on its rim (a
+/// particle beside a margin is not over the organ). Brute force over every
+/// triangle, independent of the simulator's tracker and its search.
 pub fn particles_over(
     moving_in_world: &[DVec3],
     other_in_world: &[DVec3],
     other_triangles: &[[u32; 3]],
 ) -> Vec<SideSample> {
+    use anthesis_mesh::nearest::{closest_point_on_triangle, on_rim, phong_point};
     let normals = anthesis_mesh::vertex_normals(other_in_world, other_triangles);
-    let reach = mean_edge(other_in_world, other_triangles);
+    let reach = 2.0 * mean_edge(other_in_world, other_triangles);
+    // Rim particles: on an edge only one triangle has.
+    let mut edge_count = std::collections::HashMap::new();
+    for t in other_triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *edge_count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let mut rim = vec![false; other_in_world.len()];
+    for ((a, b), count) in edge_count {
+        if count == 1 {
+            rim[a as usize] = true;
+            rim[b as usize] = true;
+        }
+    }
     let mut over = Vec::new();
     for (particle, x) in moving_in_world.iter().enumerate() {
-        let Some((nearest, distance)) = other_in_world
+        let Some((triangle, distance, weights)) = other_triangles
             .iter()
             .enumerate()
-            .map(|(i, p)| (i, (*p - *x).length()))
+            .map(|(t, tri)| {
+                let [a, b, c] = tri.map(|k| other_in_world[k as usize]);
+                let (point, weights) = closest_point_on_triangle(*x, a, b, c);
+                (t, point.distance(*x), weights)
+            })
             .min_by(|a, b| a.1.total_cmp(&b.1))
         else {
             continue;
         };
-        if distance > 2.0 * reach {
+        let tri = other_triangles[triangle];
+        if distance > reach || on_rim(tri, weights, &rim) {
             continue;
         }
-        let normal = normals[nearest];
-        let d = *x - other_in_world[nearest];
-        let along_normal = d.dot(normal);
-        if (d - normal * along_normal).length() > reach {
-            continue;
-        }
+        let corners = tri.map(|k| other_in_world[k as usize]);
+        let corner_normals = tri.map(|k| normals[k as usize]);
+        let point = phong_point(corners, corner_normals, weights);
+        let normal = (0..3)
+            .map(|k| corner_normals[k] * weights[k])
+            .sum::<DVec3>()
+            .normalize();
         over.push(SideSample {
             particle,
-            nearest,
-            along_normal,
+            nearest_triangle: triangle,
+            along_normal: (*x - point).dot(normal),
         });
     }
     over
