@@ -10,7 +10,9 @@ use glam::DVec3;
 /// or exactly on a keyframe), `fraction` of the way from one to the other.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KeyframeBlend {
+    /// The keyframe at or before the time.
     pub below: usize,
+    /// The keyframe after it (or `below` again).
     pub above: usize,
     /// In `[0, 1)`; 0 when `below == above`.
     pub fraction: f64,

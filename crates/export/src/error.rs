@@ -9,30 +9,47 @@ pub enum ExportError {
     /// The file could not be written; the error names it and says why.
     #[error(transparent)]
     Write(#[from] anthesis_files::WriteError),
+    /// The glTF JSON could not be encoded.
     #[error("cannot encode the glTF JSON: {0}")]
     Json(#[from] serde_json::Error),
     #[error("nothing to export: there are no tracks")]
+    /// No tracks were given.
     NoTracks,
     #[error("track {track} ({name:?}): {problem}")]
+    /// One track's data is wrong.
     InvalidTrack {
+        /// Its index among the tracks given.
         track: usize,
+        /// Its name.
         name: String,
+        /// What is wrong.
         problem: TrackProblem,
     },
     #[error(
         "track {track} ({name:?}) has {found} keyframes but the animated tracks before it have {expected}: all animated tracks need the same keyframes"
     )]
+    /// Animated tracks have different keyframe counts.
     KeyframeCountMismatch {
+        /// The first track that differs.
         track: usize,
+        /// Its name.
         name: String,
+        /// The count of the animated tracks before it.
         expected: usize,
+        /// Its count.
         found: usize,
     },
     #[error("invalid export option: {0}")]
+    /// An option is out of range.
     InvalidOptions(String),
     #[error("the .glb would be {bytes} bytes, more than the 4 GiB the format allows")]
-    TooLarge { bytes: u64 },
+    /// The file would exceed the .glb format's 4 GiB.
+    TooLarge {
+        /// The size it would have.
+        bytes: u64,
+    },
     #[error("cannot build the USD layer: {0}")]
+    /// The USD layer could not be built.
     Usd(String),
 }
 
@@ -40,33 +57,65 @@ pub enum ExportError {
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum TrackProblem {
     #[error("it has no keyframes")]
+    /// The track has no keyframes.
     NoKeyframes,
     #[error("it has no vertices")]
+    /// The mesh has no vertices.
     NoVertices,
     #[error("it has no triangles")]
+    /// The mesh has no triangles.
     NoTriangles,
     #[error("it has {found} UVs for {expected} vertices: every vertex needs one UV")]
-    UvCount { expected: usize, found: usize },
-    #[error("keyframe {keyframe} has {found} vertices but keyframe 0 has {expected}")]
-    KeyframeVertexCount {
-        keyframe: usize,
+    /// Not one UV per vertex.
+    UvCount {
+        /// The vertex count.
         expected: usize,
+        /// The UV count.
+        found: usize,
+    },
+    #[error("keyframe {keyframe} has {found} vertices but keyframe 0 has {expected}")]
+    /// A keyframe has another vertex count than keyframe 0.
+    KeyframeVertexCount {
+        /// The keyframe.
+        keyframe: usize,
+        /// Keyframe 0's vertex count.
+        expected: usize,
+        /// Its vertex count.
         found: usize,
     },
     #[error("triangle {triangle} refers to vertex {index}, but there are only {vertex_count}")]
+    /// A triangle names a vertex that does not exist.
     IndexOutOfRange {
+        /// The triangle.
         triangle: usize,
+        /// The vertex index it names.
         index: u32,
+        /// How many vertices there are.
         vertex_count: usize,
     },
     #[error(
         "vertex {vertex} at keyframe {keyframe} has a non-finite or huge coordinate (NaN, infinite or beyond f32)"
     )]
-    NonFinitePosition { keyframe: usize, vertex: usize },
+    /// A position is NaN, infinite or beyond `f32`.
+    NonFinitePosition {
+        /// The keyframe.
+        keyframe: usize,
+        /// The vertex.
+        vertex: usize,
+    },
     #[error("the UV of vertex {vertex} is not finite")]
-    NonFiniteUv { vertex: usize },
+    /// A UV is NaN or infinite.
+    NonFiniteUv {
+        /// The vertex.
+        vertex: usize,
+    },
     #[error("its base colour {color:?} is not four numbers in [0, 1]")]
-    BaseColor { color: [f32; 4] },
+    /// The base colour is outside `[0, 1]`.
+    BaseColor {
+        /// The colour given.
+        color: [f32; 4],
+    },
     #[error("its base-colour texture is not a PNG file")]
+    /// The base-colour texture is not a PNG.
     TextureNotPng,
 }

@@ -48,6 +48,8 @@
 //! See [`Encoding`] for the three storage modes and [`glb_size_report`] for
 //! the file size in each.
 
+#![warn(missing_docs)]
+
 mod between;
 mod error;
 mod glb;
@@ -138,6 +140,7 @@ pub enum Encoding {
 }
 
 impl Encoding {
+    /// Every encoding, in the order the documentation lists them.
     pub const ALL: [Encoding; 4] = [
         Encoding::Dense,
         Encoding::Sparse,
@@ -160,6 +163,7 @@ impl std::fmt::Display for Encoding {
 /// Options of the .glb export.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GlbOptions {
+    /// How keyframes map to seconds.
     pub timing: Timing,
     /// At most this many morph targets per mesh (default 250, see the crate
     /// documentation); longer keyframe sequences are resampled.
@@ -168,6 +172,7 @@ pub struct GlbOptions {
     /// them clients compute flat or smooth normals themselves and the file is
     /// about half as large.
     pub normals: bool,
+    /// How the morph targets are stored.
     pub encoding: Encoding,
 }
 

@@ -8,8 +8,11 @@ use crate::{Encoding, ExportError, GlbOptions, Track, glb_bytes};
 /// Size of one .glb variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GlbSize {
+    /// How the animation is stored.
     pub encoding: Encoding,
+    /// Whether normals are stored.
     pub normals: bool,
+    /// The file's size.
     pub bytes: usize,
 }
 
@@ -17,10 +20,15 @@ pub struct GlbSize {
 /// normals. `Display` prints a Markdown table.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct GlbSizeReport {
+    /// Tracks exported.
     pub tracks: usize,
+    /// Vertices over all tracks.
     pub vertices: usize,
+    /// Keyframes of the run.
     pub keyframes: usize,
+    /// Morph targets per mesh after resampling.
     pub morph_targets: usize,
+    /// One entry per variant.
     pub sizes: Vec<GlbSize>,
 }
 

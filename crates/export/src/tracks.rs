@@ -13,13 +13,18 @@ use crate::Track;
 /// the UV layout and the colour of one organ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrackLook<'a> {
+    /// The organ's name.
     pub name: &'a str,
+    /// Vertex indices, three per triangle.
     pub triangles: &'a [[u32; 3]],
+    /// One UV per vertex.
     pub uvs: &'a [DVec2],
+    /// Linear RGBA in `[0, 1]`.
     pub base_color: [f32; 4],
 }
 
 impl<'a> TrackLook<'a> {
+    /// The look of one organ.
     pub fn new(
         name: &'a str,
         triangles: &'a [[u32; 3]],
