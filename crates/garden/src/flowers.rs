@@ -541,11 +541,12 @@ pub fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
         // not significantly): the base opens wide. No inner excess across
         // (the petal stays cupped) and in the upper region the outer side
         // grows a little more (a difference well within "not significant"),
-        // so the cupped tips keep turning in and up: a shallow dish of
-        // spoon-shaped petals rather than a flat saucer.
+        // so the cupped tips keep turning in and up: a shallow bowl of
+        // spoon-shaped petals (base about 69° from the axis, tips back to
+        // upright) rather than a flat saucer.
         Cultivar::Pinocchio => EustomaGrowth {
             e: [[0.5, 0.5, 0.5], [0.5, 0.5, 0.5]],
-            e_in_excess: [[0.08, 0.0, -0.04], [0.03, 0.0, -0.04]],
+            e_in_excess: [[0.06, 0.0, -0.04], [0.02, 0.0, -0.04]],
             w: [[0.8; 3], [0.8; 3]],
             w_in_excess: [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
             fan: 0.0,
