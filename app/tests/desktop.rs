@@ -587,6 +587,53 @@ fn dropped_maps_meshes_and_projects_are_used_or_refused_with_a_message() {
     assert_eq!(harness.state().project().name, "Dropped flower");
 }
 
+#[test]
+fn a_dropped_mesh_in_another_unit_is_offered_converted_kept_or_used_as_it_is() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut harness = harness(small_flower());
+    harness.run();
+    let before = harness.state().project().clone();
+    let original = before.flower.templates[0].mesh.clone();
+    // The same petal from a tool working in millimetres: ten times larger.
+    let mut in_millimetres = original.clone();
+    for p in &mut in_millimetres.positions {
+        *p *= 10.0;
+    }
+    let obj = dir.path().join("petal-mm.obj");
+    std::fs::write(&obj, anthesis_mesh::obj_string(&in_millimetres)).expect("write obj");
+    let length = |mesh: &anthesis_mesh::Mesh| anthesis_flower::scale::organ_length(mesh);
+
+    // Asked first; nothing changes until answered.
+    drop(&mut harness, &obj);
+    assert!(harness.state().unit_offer().is_some());
+    assert_eq!(harness.state().project(), &before);
+    harness.get_by_label_contains("10 times too large");
+
+    // Keep the old mesh: nothing changes.
+    harness.get_by_label("Keep the old mesh").click();
+    harness.run();
+    assert!(harness.state().unit_offer().is_none());
+    assert_eq!(harness.state().project(), &before);
+
+    // Convert: the petal comes back at its own size, as one undo step.
+    drop(&mut harness, &obj);
+    harness.get_by_label("Convert (scale by 0.1)").click();
+    harness.run();
+    let converted = &harness.state().project().flower.templates[0].mesh;
+    assert!((length(converted) - length(&original)).abs() < 1e-9 * length(&original));
+    assert_eq!(
+        harness.state().document().undo_label(),
+        Some("mesh of petal")
+    );
+
+    // Use as it is: the user knows best.
+    drop(&mut harness, &obj);
+    harness.get_by_label("Use as it is").click();
+    harness.run();
+    let used = &harness.state().project().flower.templates[0].mesh;
+    assert!((length(used) - 10.0 * length(&original)).abs() < 1e-9 * length(used));
+}
+
 /// eframe's key-value store, in memory.
 #[derive(Default)]
 struct MemoryStorage(std::collections::HashMap<String, String>);

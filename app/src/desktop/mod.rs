@@ -155,6 +155,9 @@ pub struct AnthesisApp {
     paint: PaintState,
     /// An action waiting for "save changes?".
     pending: Option<Pending>,
+    /// A dropped mesh that looks made in another unit, waiting for the
+    /// user's choice.
+    unit_offer: Option<prompts::UnitOffer>,
     /// Closing was confirmed; let the window close.
     may_close: bool,
     /// The project changed since the last run started.
@@ -244,6 +247,7 @@ impl AnthesisApp {
             export: ExportDialog::default(),
             paint: PaintState::default(),
             pending: None,
+            unit_offer: None,
             may_close: false,
             needs_run: true,
             has_gpu,
@@ -451,6 +455,7 @@ impl eframe::App for AnthesisApp {
         self.export_window(&ctx);
         self.apply_queued();
         self.unsaved_prompt(&ctx);
+        self.unit_prompt(&ctx);
         self.recovery_prompt(&ctx);
         self.autosave_tick(&ctx);
 

@@ -11,7 +11,7 @@ use super::command::{LoadedMap, ProjectEdit};
 use super::document::Document;
 use super::export;
 use super::files::DialogPurpose;
-use super::prompts::Pending;
+use super::prompts::{Pending, UnitOffer};
 use anthesis_maps::brush::PaintTarget;
 
 impl AnthesisApp {
@@ -60,22 +60,40 @@ impl AnthesisApp {
         let template = self.selected_template();
         match anthesis_mesh::load_obj(path) {
             Ok(mesh) => {
-                let name = self.project().flower.templates[template].name.clone();
-                self.edit(
-                    &format!("mesh of {name}"),
-                    ProjectEdit::Mesh {
-                        template,
-                        mesh: Box::new(mesh),
-                    },
-                );
-                self.doc.seal();
-                self.log
-                    .info(format!("{name} now uses the mesh of {}", path.display()));
+                let current = &self.project().flower.templates[template];
+                match anthesis_flower::scale::check_replacement(current, &mesh) {
+                    // Looks made in another unit: ask before using it.
+                    Some(mismatch) => {
+                        self.unit_offer = Some(UnitOffer {
+                            template,
+                            path: path.to_path_buf(),
+                            mesh: Box::new(mesh),
+                            mismatch,
+                        });
+                    }
+                    None => self.use_mesh(template, mesh, path),
+                }
             }
             Err(e) => self
                 .log
                 .error(format!("cannot use {} as a mesh: {e}", path.display())),
         }
+    }
+
+    /// Puts `mesh` (read from `path`) in place of `template`'s mesh, as one
+    /// undoable edit.
+    pub(super) fn use_mesh(&mut self, template: usize, mesh: anthesis_mesh::Mesh, path: &Path) {
+        let name = self.project().flower.templates[template].name.clone();
+        self.edit(
+            &format!("mesh of {name}"),
+            ProjectEdit::Mesh {
+                template,
+                mesh: Box::new(mesh),
+            },
+        );
+        self.doc.seal();
+        self.log
+            .info(format!("{name} now uses the mesh of {}", path.display()));
     }
 
     fn load_map(&mut self, path: &Path) {

@@ -1,5 +1,6 @@
 //! Questions before an action that would lose work: the "save changes?"
-//! prompt and the window's close request.
+//! prompt and the window's close request; and the offer to convert a
+//! dropped mesh that looks made in another unit.
 
 use eframe::egui;
 
@@ -106,6 +107,71 @@ impl AnthesisApp {
             self.pending = Some(Pending::Quit);
         }
     }
+}
+
+/// A dropped mesh whose size does not fit the project (see
+/// `anthesis_flower::scale::check_replacement`), waiting for the user to
+/// convert it, use it as it is, or keep the old one.
+#[derive(Debug, Clone)]
+pub struct UnitOffer {
+    pub template: usize,
+    pub path: std::path::PathBuf,
+    pub mesh: Box<anthesis_mesh::Mesh>,
+    pub mismatch: anthesis_flower::scale::ScaleMismatch,
+}
+
+impl AnthesisApp {
+    /// The offer to convert a dropped mesh made in another unit.
+    pub(super) fn unit_prompt(&mut self, ctx: &egui::Context) {
+        let Some(offer) = &self.unit_offer else {
+            return;
+        };
+        let scale = anthesis_files::short_number(1.0 / offer.mismatch.factor);
+        let mut answer = None;
+        egui::Modal::new(egui::Id::unique("mesh in another unit")).show(ctx, |ui| {
+            ui.heading("A mesh in another unit?");
+            ui.label(offer.mismatch.to_string());
+            ui.horizontal(|ui| {
+                if ui.button(format!("Convert (scale by {scale})")).clicked() {
+                    answer = Some(UnitAnswer::Convert);
+                }
+                if ui.button("Use as it is").clicked() {
+                    answer = Some(UnitAnswer::AsItIs);
+                }
+                if ui.button("Keep the old mesh").clicked() {
+                    answer = Some(UnitAnswer::Keep);
+                }
+            });
+        });
+        let Some(answer) = answer else {
+            return;
+        };
+        let Some(offer) = self.unit_offer.take() else {
+            return;
+        };
+        match answer {
+            UnitAnswer::Convert => {
+                let mesh = offer.mismatch.rescaled(&offer.mesh);
+                self.use_mesh(offer.template, mesh, &offer.path);
+            }
+            UnitAnswer::AsItIs => self.use_mesh(offer.template, *offer.mesh, &offer.path),
+            UnitAnswer::Keep => self
+                .log
+                .info(format!("kept the mesh; {} not used", offer.path.display())),
+        }
+    }
+
+    /// The dropped mesh waiting for the unit question, if any.
+    pub fn unit_offer(&self) -> Option<&UnitOffer> {
+        self.unit_offer.as_ref()
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+enum UnitAnswer {
+    Convert,
+    AsItIs,
+    Keep,
 }
 
 /// The user's answer to the prompt.

@@ -44,6 +44,10 @@ pub struct ScaleMismatch {
     /// millimetres in a project in centimetres, 0.001 for one made in
     /// metres in a project in millimetres.
     pub factor: f64,
+    /// When the mesh is to replace another: that mesh's length. The
+    /// mismatch is then against it (a mesh ten times the one it replaces,
+    /// though still a plausible number of thicknesses long).
+    pub replaced_length: Option<f64>,
 }
 
 impl ScaleMismatch {
@@ -67,6 +71,19 @@ impl fmt::Display for ScaleMismatch {
         } else {
             1.0 / self.factor
         };
+        if let Some(replaced) = self.replaced_length {
+            return write!(
+                f,
+                "template \"{}\": the new mesh is {} long, {} times the {} of the mesh it \
+                 replaces. It looks {times:.0} times too {size}, perhaps {}. Scale it by {}",
+                self.template,
+                significant(self.length),
+                significant(self.length / replaced),
+                significant(replaced),
+                unit_guess(self.factor),
+                anthesis_files::short_number(1.0 / self.factor),
+            );
+        }
         write!(
             f,
             "template \"{}\": its mesh is {} long, {} times its thickness {}, but organs are \
@@ -128,8 +145,16 @@ pub fn organ_length(mesh: &Mesh) -> f64 {
 
 /// The mismatch of one template, if its mesh does not fit its thickness.
 pub fn check_template(template: &Template) -> Option<ScaleMismatch> {
-    let length = organ_length(&template.mesh);
-    let thickness = template.thickness;
+    check_length(
+        &template.name,
+        organ_length(&template.mesh),
+        template.thickness,
+    )
+}
+
+/// The mismatch of an organ `length` long and `thickness` thick, if that
+/// is not a plausible organ.
+fn check_length(template: &str, length: f64, thickness: f64) -> Option<ScaleMismatch> {
     let in_thicknesses = length / thickness;
     if !in_thicknesses.is_finite()
         || in_thicknesses <= 0.0
@@ -143,10 +168,43 @@ pub fn check_template(template: &Template) -> Option<ScaleMismatch> {
         .log10()
         .round();
     Some(ScaleMismatch {
-        template: template.name.clone(),
+        template: template.to_string(),
         length,
         thickness,
         factor: 10f64.powf(exponent),
+        replaced_length: None,
+    })
+}
+
+/// A mesh that is off from the one it replaces by this close to a power of
+/// ten (a factor within 10^±0.2, about ×0.63 to ×1.58 of it) counts as made
+/// in another unit; a new petal half or twice as long is a design change.
+const UNIT_STEP_TOLERANCE_LOG10: f64 = 0.2;
+
+/// The mismatch of `mesh` put in place of `template`'s mesh: against the
+/// mesh it replaces, when the new one is a power of ten (×10, ×100,
+/// ×0.001, …) longer or shorter, or else against the template's thickness
+/// (as [`check_template`]). A tool working in millimetres for a project in
+/// centimetres makes a petal ten times too long that may still be a
+/// plausible number of thicknesses long; the mesh it replaces tells.
+pub fn check_replacement(template: &Template, mesh: &Mesh) -> Option<ScaleMismatch> {
+    let (length, replaced) = (organ_length(mesh), organ_length(&template.mesh));
+    let ratio_log10 = (length / replaced).log10();
+    let exponent = ratio_log10.round();
+    // The mesh it replaces gives the factor exactly (the thickness only to
+    // the nearest power of ten of a typical organ).
+    if !ratio_log10.is_finite()
+        || exponent == 0.0
+        || (ratio_log10 - exponent).abs() > UNIT_STEP_TOLERANCE_LOG10
+    {
+        return check_length(&template.name, length, template.thickness);
+    }
+    Some(ScaleMismatch {
+        template: template.name.clone(),
+        length,
+        thickness: template.thickness,
+        factor: 10f64.powf(exponent),
+        replaced_length: Some(replaced),
     })
 }
 
@@ -159,6 +217,48 @@ pub fn check_flower(flower: &Flower) -> Vec<ScaleMismatch> {
 mod tests {
     use super::*;
     use anthesis_maps::{GrowthMaps, KeyedMaps};
+
+    #[test]
+    fn a_mesh_a_power_of_ten_off_the_one_it_replaces_is_caught_and_converted_back() {
+        // 88 thicknesses long: ×10 (880) stays within 10–2000 thicknesses,
+        // so only the mesh it replaces tells; ×100, ×0.001 and ×0.1 (8.8)
+        // fail the thickness test too.
+        let template = petal(1.0, 0.5);
+        for scale in [10.0, 100.0, 0.001, 0.1] {
+            let mesh = petal(scale, 0.5).mesh;
+            let mismatch = check_replacement(&template, &mesh).expect("caught");
+            assert!(
+                (mismatch.factor - scale).abs() < 1e-9 * scale,
+                "{mismatch:?}"
+            );
+            let back = mismatch.rescaled(&mesh);
+            assert!((organ_length(&back) - organ_length(&template.mesh)).abs() < 1e-9);
+            let text = mismatch.to_string();
+            assert!(text.contains("petal"), "{text}");
+        }
+        let ten = check_replacement(&template, &petal(10.0, 0.5).mesh).expect("caught");
+        assert_eq!(
+            check_template(&Template {
+                mesh: petal(10.0, 0.5).mesh,
+                ..template.clone()
+            }),
+            None
+        );
+        assert!(ten.replaced_length.is_some());
+        let text = ten.to_string();
+        assert!(
+            text.contains("10 times too large") && text.contains("millimetres"),
+            "{text}"
+        );
+        // A redesign is not a unit: half, one and a half or twice as long.
+        for scale in [0.5, 1.0, 1.5, 2.0] {
+            assert_eq!(
+                check_replacement(&template, &petal(scale, 0.5).mesh),
+                None,
+                "×{scale}"
+            );
+        }
+    }
 
     /// A template like the lily petal: a 13 x 44 sheet, thickness 0.2.
     fn petal(scale: f64, thickness: f64) -> Template {
