@@ -143,17 +143,17 @@ impl KeyedMaps {
     }
 
     /// The one size all raster maps of these keys have (a project keeps one
-    /// size per template; 1x1 maps are constants and fit any size): the
-    /// first raster's, `None` when every map is a constant.
+    /// size per template; 1x1 maps are constants and fit any size), by the
+    /// rule the project loader checks ([`common_raster_size`]): `None` when
+    /// every map is a constant.
     pub fn raster_size(&self) -> Option<(u32, u32)> {
-        self.keys.iter().find_map(|key| {
+        common_raster_size(self.keys.iter().flat_map(|key| {
             let maps = &key.maps;
             MapKind::ALL
                 .iter()
                 .map(|&kind| maps.scalar(kind).size())
                 .chain(std::iter::once(maps.direction.size()))
-                .find(|&size| size != (1, 1))
-        })
+        }))
     }
 
     /// The keys, for editing their maps. Changing a key's `step` here must
@@ -280,4 +280,26 @@ fn blend_weights<K>(
     let end = f64::from(step_of(&keys[later]));
     let weight = blend.apply((step - start) / (end - start));
     [(earlier, 1.0 - weight), (later, weight)]
+}
+
+/// The size the raster maps of one template share, from their `sizes` in
+/// reading order: the size most maps have (the first one read wins a tie),
+/// 1x1 maps left out (they are constants and fit any size); `None` when
+/// every map is a constant. The project loader names the maps that differ
+/// from it; the app paints and loads maps at it.
+pub fn common_raster_size(sizes: impl IntoIterator<Item = (u32, u32)>) -> Option<(u32, u32)> {
+    let mut counts: Vec<((u32, u32), usize)> = Vec::new();
+    for size in sizes.into_iter().filter(|&size| size != (1, 1)) {
+        match counts.iter_mut().find(|(s, _)| *s == size) {
+            Some((_, n)) => *n += 1,
+            None => counts.push((size, 1)),
+        }
+    }
+    // The first of the most common sizes: `max_by_key` keeps the last of
+    // equals, so look from the end.
+    counts
+        .iter()
+        .rev()
+        .max_by_key(|(_, n)| *n)
+        .map(|(size, _)| *size)
 }

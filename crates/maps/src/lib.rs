@@ -42,7 +42,7 @@ mod raster;
 
 pub use error::MapError;
 pub use growth::{DIRECTION_MAP_NAME, GrowthMaps, MapKind};
-pub use keys::{Blend, KeySchedule, KeyedMaps, MapKey};
+pub use keys::{Blend, KeySchedule, KeyedMaps, MapKey, common_raster_size};
 pub use png_io::{BitDepth, MAX_MAP_SIDE, MAX_PNG_BYTES};
 pub use raster::{DirectionMap, Raster, ScalarMap};
 

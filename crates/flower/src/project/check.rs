@@ -11,7 +11,8 @@ use crate::{MAX_KEYFRAMES, Project, Template};
 
 /// All raster maps of a template must share one size. 1x1 maps are
 /// constants and fit any size. The size most maps have is the right one
-/// (the first read wins a tie), so the error names the map that differs.
+/// (the first read wins a tie: `anthesis_maps::common_raster_size`), so the
+/// error names the map that differs.
 #[derive(Default)]
 pub(super) struct SizeCheck {
     maps: Vec<(PathBuf, (u32, u32))>,
@@ -25,20 +26,11 @@ impl SizeCheck {
         }
     }
 
-    /// Fails on the first map whose size is not the one most maps have.
+    /// Fails on the first map whose size is not the one most maps have
+    /// (`anthesis_maps::common_raster_size`, the rule the app uses too).
     pub(super) fn finish(&self) -> Result<(), ProjectError> {
-        let count = |size: (u32, u32)| self.maps.iter().filter(|(_, s)| *s == size).count();
-        let Some(expected) = self
-            .maps
-            .iter()
-            .map(|(_, size)| *size)
-            .reduce(|best, size| {
-                if count(size) > count(best) {
-                    size
-                } else {
-                    best
-                }
-            })
+        let Some(expected) =
+            anthesis_maps::common_raster_size(self.maps.iter().map(|(_, size)| *size))
         else {
             return Ok(());
         };

@@ -303,3 +303,19 @@ fn the_raster_size_is_the_first_rasters_and_constants_have_none() {
     maps.keys_mut()[1].maps.bend = ScalarMap::from_fn(8, 4, |_| 0.5);
     assert_eq!(maps.raster_size(), Some((8, 4)));
 }
+
+#[test]
+fn the_common_raster_size_is_the_most_frequent_first_read_wins_a_tie_constants_left_out() {
+    use crate::common_raster_size;
+    assert_eq!(common_raster_size([(1, 1), (1, 1)]), None);
+    assert_eq!(
+        common_raster_size([(1, 1), (8, 8), (4, 4), (4, 4)]),
+        Some((4, 4))
+    );
+    assert_eq!(common_raster_size([(8, 8), (4, 4), (1, 1)]), Some((8, 8)));
+    assert_eq!(
+        common_raster_size([(4, 4), (8, 8), (8, 8), (4, 4)]),
+        Some((4, 4))
+    );
+    assert_eq!(common_raster_size([]), None);
+}
