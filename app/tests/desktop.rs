@@ -130,6 +130,15 @@ fn feed(harness: &mut Harness<'_, AnthesisApp>, up_to: Option<u32>) {
     assert!(failures.is_empty());
 }
 
+/// The small flower launched with its whole recorded opening received.
+fn opened_small_flower() -> Harness<'static, AnthesisApp> {
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    harness
+}
+
 #[test]
 fn first_frame_shows_the_flower_opening_and_the_timeline() {
     let mut harness = harness(small_flower());
@@ -154,10 +163,7 @@ fn first_frame_shows_the_flower_opening_and_the_timeline() {
 
 #[test]
 fn timeline_buttons_and_shortcuts_scrub_step_and_play() {
-    let mut harness = harness(small_flower());
-    harness.run();
-    feed(&mut harness, None);
-    harness.run();
+    let mut harness = opened_small_flower();
 
     harness.get_by_label("Start").click();
     harness.run();
@@ -203,10 +209,7 @@ fn timeline_buttons_and_shortcuts_scrub_step_and_play() {
 
 #[test]
 fn parameter_edits_restart_the_run_and_undo_redo_with_shortcuts() {
-    let mut harness = harness(small_flower());
-    harness.run();
-    feed(&mut harness, None);
-    harness.run();
+    let mut harness = opened_small_flower();
     let first_run = harness.state().session().run();
     let ramps = harness.state().project().flower.templates[0]
         .joint_schedule
@@ -269,10 +272,7 @@ fn selecting_an_organ_and_single_organ_preview_simulate_only_that_organ() {
 
 #[test]
 fn view_menu_turns_on_the_wireframe_and_a_map_overlay() {
-    let mut harness = harness(small_flower());
-    harness.run();
-    feed(&mut harness, None);
-    harness.run();
+    let mut harness = opened_small_flower();
     harness.get_by_label("View").click();
     harness.run();
     harness.get_by_label("Wireframe  (W)").click();
@@ -377,10 +377,7 @@ fn a_failed_run_is_shown_and_the_app_keeps_going() {
 fn the_export_dialog_writes_a_glb_and_reports_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("flower.glb");
-    let mut harness = harness(small_flower());
-    harness.run();
-    feed(&mut harness, None);
-    harness.run();
+    let mut harness = opened_small_flower();
     harness.get_by_label("File").click();
     harness.run();
     harness.get_by_label("Export animation…  (Ctrl+E)").click();
@@ -442,10 +439,7 @@ fn stroke_on_canvas(harness: &mut Harness<'_, AnthesisApp>, from: egui::Vec2, to
 
 #[test]
 fn a_stroke_on_the_uv_canvas_paints_the_map_restarts_and_undoes_in_one_step() {
-    let mut harness = harness(small_flower());
-    harness.run();
-    feed(&mut harness, None);
-    harness.run();
+    let mut harness = opened_small_flower();
     let before = harness.state().project().clone();
     let run = harness.state().session().run();
     harness.get_by_label("subtract").click();
@@ -694,10 +688,7 @@ fn the_last_project_and_view_are_remembered_between_launches() {
 
 #[test]
 fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
-    let mut harness = harness(small_flower());
-    harness.run();
-    feed(&mut harness, None);
-    harness.run();
+    let mut harness = opened_small_flower();
     // Aim the camera at the middle of petal-1 as it is shown now.
     let app = harness.state_mut();
     let template = &app.project().flower.templates[0];
@@ -1044,10 +1035,7 @@ fn preview_and_selection_commands_choose_what_the_next_run_simulates() {
 #[test]
 fn orbiting_the_camera_keeps_the_scene_and_a_new_keyframe_or_edit_rebuilds_it() {
     use anthesis_app::desktop::Command;
-    let mut harness = harness(small_flower());
-    harness.run();
-    feed(&mut harness, None);
-    harness.run();
+    let mut harness = opened_small_flower();
     let built = harness.state().scene_rebuilds();
     let camera = *harness.state_mut().camera_mut();
     // Orbit: drag across the viewport over many frames.

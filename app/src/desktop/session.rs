@@ -325,11 +325,7 @@ mod tests {
             let event = worker
                 .wait_event(Duration::from_secs(60))
                 .expect("the worker answers");
-            let end = event.run() == run
-                && matches!(
-                    event,
-                    Event::Finished { .. } | Event::Failed { .. } | Event::Cancelled { .. }
-                );
+            let end = event.ends(run);
             session.accept(event, &mut failures);
             if end {
                 return failures;

@@ -643,33 +643,18 @@ mod tests {
                 .collect()
         };
         let skip = vec![false; mesh.vertex_count()];
-        let inside = side_check(
-            &shifted(-0.2),
-            &skip,
-            &mesh.positions,
-            &mesh,
-            1.0,
-            1.0,
-            0.01,
-        )
-        .expect("measurable");
+        let check = |dz: f64| {
+            side_check(&shifted(dz), &skip, &mesh.positions, &mesh, 1.0, 1.0, 0.01)
+                .expect("measurable")
+        };
+        let inside = check(-0.2);
         assert!(inside.over > 0 && inside.wrong == 0, "{inside:?}");
         assert!((inside.closest - 0.2).abs() < 1e-9, "{inside:?}");
-        let outside = side_check(&shifted(0.2), &skip, &mesh.positions, &mesh, 1.0, 1.0, 0.01)
-            .expect("measurable");
+        let outside = check(0.2);
         assert_eq!(outside.wrong, outside.over, "{outside:?}");
         assert!(outside.over > 0 && (outside.closest + 0.2).abs() < 1e-9);
         // Beyond `reach`, nothing is over.
-        let far = side_check(
-            &shifted(-2.0),
-            &skip,
-            &mesh.positions,
-            &mesh,
-            1.0,
-            1.0,
-            0.01,
-        )
-        .expect("measurable");
+        let far = check(-2.0);
         assert_eq!(far.over, 0);
     }
 }

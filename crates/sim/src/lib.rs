@@ -354,7 +354,7 @@ impl Simulation {
             push_back(&mut organ.positions, c, &mut moved);
         }
         let mut round = 1;
-        let mut pressed: Vec<Vec<bool>>;
+        let mut pressed = Vec::new();
         let pushed = loop {
             let mut round_iterations = 0;
             let mut converged = false;
@@ -403,23 +403,10 @@ impl Simulation {
             for organ in &mut self.organs {
                 organ.attach(step);
             }
-            // Particles the settled organs lean on a neighbour with.
-            pressed = self
-                .organs
-                .iter()
-                .zip(&contacts)
-                .map(|(o, c)| {
-                    let mut held = vec![false; o.positions.len()];
-                    for contact in c {
-                        let p = contact.particle as usize;
-                        held[p] |= contact.violation(o.positions[p]) > 0.0;
-                    }
-                    held
-                })
-                .collect();
             if self.overlaps.is_empty() {
                 break 0;
             }
+            pressed = self.pressed(&contacts);
             // Each organ kept off where its neighbours were when the
             // contacts were found, but the neighbours moved too: where
             // organs press on each other they now overlap. Pushed back from
@@ -475,6 +462,24 @@ impl Simulation {
                 contact_particles: self.particles_in_contact(&pressed),
             },
         })
+    }
+
+    /// Per organ, which particles the organs lean on a neighbour with: a
+    /// contact of `contacts` (those held while they settled) is violated,
+    /// so its force holds them off.
+    fn pressed(&self, contacts: &[Vec<Contact>]) -> Vec<Vec<bool>> {
+        self.organs
+            .iter()
+            .zip(contacts)
+            .map(|(o, c)| {
+                let mut held = vec![false; o.positions.len()];
+                for contact in c {
+                    let p = contact.particle as usize;
+                    held[p] |= contact.violation(o.positions[p]) > 0.0;
+                }
+                held
+            })
+            .collect()
     }
 
     /// How many particles touch a neighbouring organ: `pressed` (held off

@@ -107,7 +107,7 @@ pub(crate) struct OrganSim {
     pub is_base: Vec<bool>,
     /// The triangles around each particle, where collisions look for the
     /// nearest point of this organ's surface.
-    pub triangles_around: Vec<Vec<u32>>,
+    triangles_around: Vec<Vec<u32>>,
     /// Whether each particle is on the organ's rim.
     rim: Vec<bool>,
     placement: Placement,

@@ -70,6 +70,16 @@ impl Event {
             | Event::Cancelled { run } => *run,
         }
     }
+
+    /// Whether this is the last event of run `run` (it finished, failed or
+    /// was cancelled).
+    pub fn ends(&self, run: RunId) -> bool {
+        self.run() == run
+            && matches!(
+                self,
+                Event::Finished { .. } | Event::Failed { .. } | Event::Cancelled { .. }
+            )
+    }
 }
 
 /// A run asked for and not yet started.
@@ -348,11 +358,7 @@ mod tests {
             let event = worker
                 .wait_event(Duration::from_secs(60))
                 .expect("the worker answers");
-            let end = event.run() == run
-                && matches!(
-                    event,
-                    Event::Finished { .. } | Event::Failed { .. } | Event::Cancelled { .. }
-                );
+            let end = event.ends(run);
             seen.push(event);
             if end {
                 return seen;
