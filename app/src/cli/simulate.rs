@@ -214,8 +214,9 @@ pub(super) fn run_keyframes(
     }
     if failure.is_none() {
         eprintln!(
-            "simulated {done} keyframes of {} organ(s) in {seconds:.2} s",
-            sim.organs().len()
+            "simulated {done} keyframes of {} organ(s) in {seconds:.2} s ({} Hessian factorisations)",
+            sim.organs().len(),
+            sim.factorisations()
         );
     }
     Run {
