@@ -357,7 +357,7 @@ impl AnthesisApp {
         if let Err(e) = anthesis_sim::memory::check_run(
             self.doc.project(),
             &selection,
-            anthesis_sim::memory::KeyframeCost::Kept,
+            anthesis_sim::memory::KeyframeCost::Editable,
         ) {
             self.log.error(format!("the simulation did not start: {e}"));
             self.needs_run = false;

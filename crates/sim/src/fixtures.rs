@@ -177,3 +177,16 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
         },
     }
 }
+
+/// A stroke on time key `key` of `template`: inner growth along the organ
+/// raised by 0.3 within 0.15 (in UV) of the point (0.5, 0.8), near the tip,
+/// the reflex a user paints on the lily's late key. The map keeps its size.
+pub fn stroke_near_tip(project: &mut Project, template: usize, key: usize) {
+    let maps = &mut project.flower.templates[template].maps.keys_mut()[key].maps;
+    let old = maps.e_growth_in.clone();
+    let (width, height) = (old.width(), old.height());
+    maps.e_growth_in = ScalarMap::from_fn(width, height, |uv| {
+        let near_tip = (uv - glam::DVec2::new(0.5, 0.8)).length() < 0.15;
+        (old.sample(uv) + if near_tip { 0.3 } else { 0.0 }) as f32
+    });
+}

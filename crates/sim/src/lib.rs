@@ -14,6 +14,7 @@ pub mod fault;
 pub mod fixtures;
 pub mod memory;
 mod organ;
+pub mod resume;
 pub mod worker;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -26,7 +27,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::collide::{Surface, Tracker, Violated, contacts_against, max_violation, push_back};
-use crate::organ::OrganSim;
+use crate::organ::{OrganSim, OrganState};
+use crate::resume::{Edit, edit_between};
 
 /// Which organs to simulate.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -172,9 +174,23 @@ const RESETTLE_DEPTH: f64 = 0.01;
 /// Passes of the final push-back at most.
 const PUSH_BACK_PASSES: u32 = 3;
 
+/// The state of every organ at the end of one keyframe, and what the
+/// blow-up check compares the next keyframe with.
+struct Checkpoint {
+    organs: Vec<OrganState>,
+    previous_energy: Vec<f64>,
+}
+
 /// A running simulation of a project (or of one organ of it).
 pub struct Simulation {
     organs: Vec<OrganSim>,
+    /// The simulated organs, and their indices in the project.
+    selection: Selection,
+    chosen: Vec<usize>,
+    /// When kept (see [`Simulation::keep_checkpoints`]), entry `k` is the
+    /// state at the end of keyframe `k` (0: the bud), for every keyframe
+    /// computed so far.
+    checkpoints: Option<Vec<Checkpoint>>,
     /// Overlaps between simulated organs, as indices into `organs`.
     overlaps: Vec<(usize, usize)>,
     settings: anthesis_flower::SimulationSettings,
@@ -213,6 +229,9 @@ impl Simulation {
         let previous_energy = vec![0.0; organs.len()];
         Ok(Simulation {
             organs,
+            selection: selection.clone(),
+            chosen,
+            checkpoints: None,
             overlaps,
             settings: project.settings,
             next_step: 1,
@@ -223,6 +242,93 @@ impl Simulation {
             #[cfg(test)]
             fault: None,
         })
+    }
+
+    /// Keeps the state at the end of every keyframe from now on, so that
+    /// [`Simulation::edit`] can go on from the first keyframe an edit
+    /// changes instead of from the bud. Costs, per keyframe and organ, the
+    /// positions and two numbers per edge (see
+    /// [`Simulation::checkpoint_bytes`]); a batch run that is never edited
+    /// does without.
+    pub fn keep_checkpoints(&mut self) {
+        if self.checkpoints.is_none() && self.next_step == 1 {
+            let bud = self.checkpoint();
+            self.checkpoints = Some(vec![bud]);
+        }
+    }
+
+    /// Memory the kept checkpoints hold, in bytes.
+    pub fn checkpoint_bytes(&self) -> usize {
+        self.checkpoints
+            .iter()
+            .flatten()
+            .map(|c| c.organs.iter().map(OrganState::bytes).sum::<usize>())
+            .sum()
+    }
+
+    fn checkpoint(&mut self) -> Checkpoint {
+        Checkpoint {
+            organs: self.organs.iter_mut().map(OrganSim::save).collect(),
+            previous_energy: self.previous_energy.clone(),
+        }
+    }
+
+    /// Makes this simulation run `after` instead of `before` (the project
+    /// it was made from or last edited to), keeping every computed keyframe
+    /// the edit cannot change (see [`resume`]). Returns the first keyframe
+    /// the next [`Simulation::step`] computes: keyframes before it are those
+    /// computed already and still valid; 1 means the run starts over (when
+    /// the edit reaches the bud, or no checkpoints were kept).
+    ///
+    /// The keyframes computed from there are the same, bit for bit, as a
+    /// run of `after` from the bud.
+    pub fn edit(&mut self, before: &Project, after: &Project) -> Result<u32, SimError> {
+        let edit = if self.panicked_at.is_some() {
+            Edit::Everything
+        } else {
+            edit_between(before, after, &self.chosen)
+        };
+        let first = match edit {
+            Edit::Nothing => self.next_step,
+            Edit::From(step) => step.min(self.next_step),
+            Edit::Everything => 1,
+        };
+        let rewound = first > 1 && self.rewind(first);
+        if !rewound {
+            let keep = self.checkpoints.is_some();
+            let selection = self.selection.clone();
+            *self = Simulation::new(after, &selection)?;
+            if keep {
+                self.keep_checkpoints();
+            }
+            return Ok(1);
+        }
+        for (organ, &index) in self.organs.iter_mut().zip(&self.chosen) {
+            organ.take_maps(
+                before.flower.template_of(index),
+                after.flower.template_of(index),
+            );
+        }
+        self.settings.keyframes = after.settings.keyframes;
+        Ok(self.next_step)
+    }
+
+    /// Puts every organ back at the end of keyframe `step - 1`, if that
+    /// state was kept, so the next step computes keyframe `step`.
+    fn rewind(&mut self, step: u32) -> bool {
+        let Some(checkpoints) = &mut self.checkpoints else {
+            return false;
+        };
+        let Some(state) = checkpoints.get(step as usize - 1) else {
+            return false;
+        };
+        for (organ, saved) in self.organs.iter_mut().zip(&state.organs) {
+            organ.restore(saved);
+        }
+        self.previous_energy.clone_from(&state.previous_energy);
+        checkpoints.truncate(step as usize);
+        self.next_step = step;
+        true
     }
 
     /// Forces `fault` on this simulation (tests only).
@@ -449,6 +555,10 @@ impl Simulation {
             energy += e;
         }
         self.next_step += 1;
+        if self.checkpoints.is_some() {
+            let state = self.checkpoint();
+            self.checkpoints.get_or_insert_default().push(state);
+        }
         Ok(Keyframe {
             index: step,
             positions_in_world: self.organs.iter().map(|o| o.positions.clone()).collect(),

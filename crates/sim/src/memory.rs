@@ -53,8 +53,12 @@ const BASE_BYTES: f64 = 4.5 * 1024.0 * 1024.0;
 /// OBJ files 48, a .usda 356. Rounded up here.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum KeyframeCost {
-    /// Kept as positions (statistics only, the app's timeline).
+    /// Kept as positions (statistics only).
     Kept,
+    /// Kept as positions with the state each keyframe ends in, so an edit
+    /// goes on from the first keyframe it changes (the app's runs; see
+    /// [`crate::Simulation::keep_checkpoints`]).
+    Editable,
     /// Written to a .glb.
     Glb,
     /// Written as OBJ files.
@@ -67,6 +71,10 @@ impl KeyframeCost {
     fn bytes_per_particle(self) -> u64 {
         match self {
             KeyframeCost::Kept => 32,
+            // The checkpoint holds the positions (24 bytes) and two
+            // numbers per edge, about three edges per particle (48 bytes);
+            // tested against what a run keeps.
+            KeyframeCost::Editable => 32 + 80,
             KeyframeCost::Glb => 128,
             KeyframeCost::Obj => 64,
             KeyframeCost::Usd => 384,
@@ -254,6 +262,26 @@ mod tests {
             let error = (model - measured) / measured;
             assert!(error.abs() < 0.05, "{triangles} triangles: {error:+.3}");
         }
+    }
+
+    #[test]
+    fn the_editable_cost_covers_what_checkpoints_hold() {
+        let project = whorl(2, 12, 20, 6);
+        let mut sim = crate::Simulation::new(&project, &Selection::All).expect("valid");
+        sim.keep_checkpoints();
+        while !sim.finished() {
+            sim.step(&|| false, &mut |_| {}).expect("steps");
+        }
+        let particles: usize = (0..2)
+            .map(|i| project.flower.template_of(i).mesh.vertex_count())
+            .sum();
+        let per_particle = sim.checkpoint_bytes() as f64 / (particles as f64 * 7.0);
+        let allowed = (KeyframeCost::Editable.bytes_per_particle()
+            - KeyframeCost::Kept.bytes_per_particle()) as f64;
+        assert!(
+            per_particle <= allowed && per_particle > 0.75 * allowed,
+            "checkpoints hold {per_particle:.1} bytes per particle and keyframe, the estimate {allowed}"
+        );
     }
 
     #[test]

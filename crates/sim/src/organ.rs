@@ -13,6 +13,7 @@ use anthesis_physics::{
     SolverSettings, StepReport,
 };
 use std::collections::VecDeque;
+use std::sync::Arc;
 
 use glam::{DQuat, DVec2, DVec3};
 
@@ -132,8 +133,32 @@ pub(crate) struct OrganSim {
     base_current: Vec<DVec3>,
     base_target: Vec<DVec3>,
     /// Positions at the end of the last (up to) three keyframes, oldest
-    /// first, for [`OrganSim::predict`].
-    history: VecDeque<Vec<DVec3>>,
+    /// first, for [`OrganSim::predict`]; shared with the saved states.
+    history: VecDeque<Arc<Vec<DVec3>>>,
+    /// The current positions as [`OrganSim::save`] stored them, so the next
+    /// keyframe's history shares them instead of copying.
+    saved: Option<Arc<Vec<DVec3>>>,
+}
+
+/// What an organ carries from the end of one keyframe into the next: with
+/// the project's inputs for the later steps, all a run needs to go on from
+/// there (the solver keeps nothing across keyframes, and growth recomputes
+/// stiffness, rates and the membrane from these).
+#[derive(Clone)]
+pub(crate) struct OrganState {
+    positions: Arc<Vec<DVec3>>,
+    rest_lengths: Vec<f64>,
+    rest_angles: Vec<f64>,
+    rotation_guess: DQuat,
+    history: VecDeque<Arc<Vec<DVec3>>>,
+}
+
+impl OrganState {
+    /// Bytes this state holds beyond what earlier states share with it.
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<DVec3>() * self.positions.len()
+            + std::mem::size_of::<f64>() * (self.rest_lengths.len() + self.rest_angles.len())
+    }
 }
 
 impl OrganSim {
@@ -217,6 +242,7 @@ impl OrganSim {
             rates: Vec::new(),
             rotation_guess: DQuat::IDENTITY,
             history: VecDeque::with_capacity(3),
+            saved: None,
             topology,
         };
         sim.update_stiffness(0);
@@ -274,12 +300,13 @@ impl OrganSim {
     /// A prediction that has more energy than the last keyframe's shape (a
     /// snap-through extrapolated too far, a collapsed triangle) is dropped.
     fn predict(&mut self) {
-        let mut latest = if self.history.len() == 3 {
-            self.history.pop_front().unwrap_or_default()
-        } else {
-            Vec::new()
-        };
-        latest.clone_from(&self.positions);
+        let latest = self
+            .saved
+            .take()
+            .unwrap_or_else(|| Arc::new(self.positions.clone()));
+        if self.history.len() == 3 {
+            self.history.pop_front();
+        }
         self.history.push_back(latest);
         let h = &self.history;
         let predicted: Vec<DVec3> = match h.len() {
@@ -391,6 +418,56 @@ impl OrganSim {
 
     pub fn factorisations(&self) -> u64 {
         self.solver.factorisations()
+    }
+
+    /// Takes the time keys, joint schedule and colour of `new`, an edit of
+    /// `old` (the template this organ was made from or last took) with the
+    /// same mesh. Keys whose maps are unchanged keep their samples.
+    pub fn take_maps(&mut self, old: &Template, new: &Template) {
+        let mut kept: Vec<Option<SampledKey>> = std::mem::take(&mut self.keys)
+            .into_iter()
+            .map(Some)
+            .collect();
+        let old_keys = old.maps.keys();
+        self.keys = new
+            .maps
+            .keys()
+            .iter()
+            .map(|key| {
+                old_keys
+                    .iter()
+                    .position(|o| o.maps == key.maps)
+                    .and_then(|i| kept.get_mut(i).and_then(Option::take))
+                    .unwrap_or_else(|| SampledKey::new(&key.maps, &self.mesh, &self.topology))
+            })
+            .collect();
+        self.key_schedule = new.maps.schedule();
+        self.schedule.clone_from(&new.joint_schedule);
+        self.color = new.color;
+    }
+
+    /// The state a later run can go on from (see [`OrganState`]).
+    pub fn save(&mut self) -> OrganState {
+        let positions = Arc::new(self.positions.clone());
+        self.saved = Some(Arc::clone(&positions));
+        OrganState {
+            positions,
+            rest_lengths: self.elastic.rest_lengths.clone(),
+            rest_angles: self.elastic.rest_angles.clone(),
+            rotation_guess: self.rotation_guess,
+            history: self.history.clone(),
+        }
+    }
+
+    /// Puts this organ back in `state`, saved by [`OrganSim::save`] from an
+    /// organ of the same mesh.
+    pub fn restore(&mut self, state: &OrganState) {
+        self.positions.clone_from(&state.positions);
+        self.saved = Some(Arc::clone(&state.positions));
+        self.elastic.rest_lengths.clone_from(&state.rest_lengths);
+        self.elastic.rest_angles.clone_from(&state.rest_angles);
+        self.rotation_guess = state.rotation_guess;
+        self.history.clone_from(&state.history);
     }
 
     pub fn energy(&self) -> f64 {

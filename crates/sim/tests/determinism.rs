@@ -4,30 +4,9 @@
 mod common;
 
 use anthesis_flower::Project;
+use anthesis_sim::Selection;
 use anthesis_sim::fixtures::whorl;
-use anthesis_sim::{Keyframe, Selection};
-
-/// Every number of every keyframe as bits (wall time excluded).
-fn fingerprint(keyframes: &[Keyframe]) -> Vec<u64> {
-    let mut bits = Vec::new();
-    for k in keyframes {
-        bits.push(u64::from(k.index));
-        for organ in &k.positions_in_world {
-            bits.push(organ.len() as u64);
-            for p in organ {
-                bits.extend([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]);
-            }
-        }
-        bits.extend([
-            u64::from(k.stats.index),
-            k.stats.energy.to_bits(),
-            u64::from(k.stats.iterations),
-            k.stats.relative_gradient.to_bits(),
-            u64::from(k.stats.pushed_particles),
-        ]);
-    }
-    bits
-}
+use common::fingerprint;
 
 fn run_on(threads: usize, project: &Project) -> Vec<u64> {
     let pool = rayon::ThreadPoolBuilder::new()
