@@ -251,46 +251,86 @@ fn serve(mailbox: &Mailbox, events: Sender<Event>, current: Arc<AtomicU64>, wake
         let send = send.lock().unwrap_or_else(PoisonError::into_inner);
         send(event);
     };
+    // The last run's simulation, kept so that an edit goes on from the
+    // first keyframe it changes. Taken out while a job runs: a job that
+    // panics outside the simulation's own guard leaves nothing behind.
+    let mut last: Option<LastRun> = None;
     while let Some(request) = mailbox.next() {
         let run = request.run;
         if current.load(Ordering::SeqCst) != run {
             // Cancelled before it started.
             continue;
         }
+        let previous = last.take();
         // Unwind safety: the job owns its simulation and reads an
         // immutable project; nothing it leaves half done outlives it.
-        let job = catch_unwind(AssertUnwindSafe(|| run_job(&request, &current, &emit)));
-        if let Err(payload) = job {
-            emit(Event::Failed {
+        let job = catch_unwind(AssertUnwindSafe(|| {
+            run_job(&request, previous, &current, &emit)
+        }));
+        match job {
+            Ok(kept) => last = kept,
+            Err(payload) => emit(Event::Failed {
                 run,
                 error: SimError::Panicked {
                     run: Some(run),
                     keyframe: None,
                     message: panic_message(payload.as_ref()),
                 },
-            });
+            }),
         }
     }
 }
 
-fn run_job(request: &RunRequest, current: &AtomicU64, emit: &dyn Fn(Event)) {
-    let RunRequest {
-        run,
-        ref project,
-        ref selection,
-        ..
-    } = *request;
+/// What the worker keeps of its last run: the project and selection it
+/// ran, its simulation (with checkpoints) and the keyframes it computed.
+struct LastRun {
+    project: Arc<Project>,
+    selection: Selection,
+    sim: Simulation,
+    keyframes: Vec<Arc<Keyframe>>,
+}
+
+/// The simulation for `request`: the last run's, edited, when it ran the
+/// same organs (keeping the keyframes the edit cannot change), else a new
+/// one. Returns it with the keyframes kept.
+fn simulation_for(
+    request: &RunRequest,
+    last: Option<LastRun>,
+) -> Result<(Simulation, Vec<Arc<Keyframe>>), SimError> {
+    #[cfg(any(test, feature = "fault-hook"))]
+    let last = last.filter(|_| request.fault.is_none());
+    if let Some(mut last) = last.filter(|l| l.selection == request.selection) {
+        let first = last.sim.edit(&last.project, &request.project)?;
+        // Starting over may start from another bud (a new mesh).
+        last.keyframes
+            .truncate(if first == 1 { 0 } else { first as usize });
+        return Ok((last.sim, last.keyframes));
+    }
+    let mut sim = Simulation::new(&request.project, &request.selection)?;
+    sim.keep_checkpoints();
+    Ok((sim, Vec::new()))
+}
+
+/// Runs one job. Returns what a later edit can go on from (nothing when the
+/// simulation could not be made).
+fn run_job(
+    request: &RunRequest,
+    last: Option<LastRun>,
+    current: &AtomicU64,
+    emit: &dyn Fn(Event),
+) -> Option<LastRun> {
+    let run = request.run;
     let started = Instant::now();
     let stale = || current.load(Ordering::SeqCst) != run;
     #[cfg(any(test, feature = "fault-hook"))]
     if request.fault == Some(Fault::PanicBeforeStart) {
         panic!("forced fault before run {run} started (test hook)");
     }
-    let mut sim = match Simulation::new(project, selection) {
-        Ok(sim) => sim,
+    let (mut sim, mut keyframes) = match simulation_for(request, last) {
+        Ok(made) => made,
         Err(error) => {
             emit(Event::Failed { run, error });
-            return;
+            return None;
         }
     };
     #[cfg(any(test, feature = "fault-hook"))]
@@ -302,22 +342,29 @@ fn run_job(request: &RunRequest, current: &AtomicU64, emit: &dyn Fn(Event)) {
         organs: sim.organs().iter().map(|s| s.to_string()).collect(),
         keyframes: sim.keyframe_count(),
     });
-    emit(Event::Keyframe {
-        run,
-        keyframe: Arc::new(sim.bud()),
-    });
+    if keyframes.is_empty() {
+        keyframes.push(Arc::new(sim.bud()));
+    }
+    // The keyframes the edit left as they were, at once.
+    for keyframe in &keyframes {
+        emit(Event::Keyframe {
+            run,
+            keyframe: Arc::clone(keyframe),
+        });
+    }
     while !sim.finished() {
         let result = sim.step(&stale, &mut |progress| {
             emit(Event::Progress { run, progress })
         });
         match result {
-            Ok(keyframe) => emit(Event::Keyframe {
-                run,
-                keyframe: Arc::new(keyframe),
-            }),
+            Ok(keyframe) => {
+                let keyframe = Arc::new(keyframe);
+                keyframes.push(Arc::clone(&keyframe));
+                emit(Event::Keyframe { run, keyframe });
+            }
             Err(SimError::Cancelled) => {
                 emit(Event::Cancelled { run });
-                return;
+                break;
             }
             Err(SimError::Panicked {
                 keyframe, message, ..
@@ -330,19 +377,27 @@ fn run_job(request: &RunRequest, current: &AtomicU64, emit: &dyn Fn(Event)) {
                         message,
                     },
                 });
-                return;
+                break;
             }
             Err(error) => {
                 emit(Event::Failed { run, error });
-                return;
+                break;
             }
         }
     }
-    emit(Event::Finished {
-        run,
-        keyframes: sim.keyframe_count(),
-        seconds: started.elapsed().as_secs_f64(),
-    });
+    if sim.finished() {
+        emit(Event::Finished {
+            run,
+            keyframes: sim.keyframe_count(),
+            seconds: started.elapsed().as_secs_f64(),
+        });
+    }
+    Some(LastRun {
+        project: Arc::clone(&request.project),
+        selection: request.selection.clone(),
+        sim,
+        keyframes,
+    })
 }
 
 #[cfg(test)]
@@ -400,6 +455,57 @@ mod tests {
             std::thread::sleep(Duration::from_millis(1));
         }
         assert_eq!(wakes.load(Ordering::SeqCst), events.len());
+    }
+
+    /// The keyframes of `events`, in the order they came.
+    fn keyframes_of(events: &[Event]) -> Vec<Arc<Keyframe>> {
+        events
+            .iter()
+            .filter_map(|e| match e {
+                Event::Keyframe { keyframe, .. } => Some(Arc::clone(keyframe)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn an_edit_resends_the_keyframes_it_cannot_change_and_computes_the_rest() {
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let before = whorl(2, 6, 10, 44);
+        let first = worker.start(Arc::new(before.clone()), Selection::All);
+        let old = keyframes_of(&collect_until_end(&worker, first));
+        let mut after = before.clone();
+        crate::fixtures::stroke_near_tip(&mut after, 0, 1);
+        let second = worker.start(Arc::new(after.clone()), Selection::All);
+        let events = collect_until_end(&worker, second);
+        let new = keyframes_of(&events);
+        let indices: Vec<u32> = new.iter().map(|k| k.index).collect();
+        assert_eq!(indices, (0..=44).collect::<Vec<_>>());
+        // Keyframes before 40 (where the stroked step-50 key is first
+        // read) are the same ones, sent before any work.
+        assert!((0..40).all(|i| Arc::ptr_eq(&new[i], &old[i])));
+        assert!((40..=44).all(|i| !Arc::ptr_eq(&new[i], &old[i])));
+        let first_progress = events.iter().find_map(|e| match e {
+            Event::Progress { progress, .. } => Some(progress.keyframe),
+            _ => None,
+        });
+        assert_eq!(first_progress, Some(40));
+        // And they are what a run of the edited project gives.
+        let mut fresh = Vec::new();
+        crate::run(&after, &Selection::All, &mut |_, k| fresh.push(k.clone()))
+            .expect("the edited project runs");
+        for (k, f) in new.iter().zip(&fresh) {
+            assert_eq!(
+                k.positions_in_world, f.positions_in_world,
+                "keyframe {}",
+                k.index
+            );
+        }
+        // Another selection starts over.
+        let one = worker.start(Arc::new(after), Selection::Only(0));
+        let alone = keyframes_of(&collect_until_end(&worker, one));
+        assert_eq!(alone.len(), 45);
+        assert!(!Arc::ptr_eq(&alone[0], &new[0]));
     }
 
     #[test]
