@@ -1,13 +1,20 @@
 //! The built-in Asiatic lily, 100 keyframes (DESIGN.md §6: a single lily
 //! petal and the whole lily, next to the paper's 2.5 and 11.5 minutes).
-//! Each iteration runs from the bud to the last keyframe.
+//! The `*_keyframes` benchmarks run from the bud to the last keyframe; the
+//! `stroke_*` ones measure what a user waits for after a stroke on the
+//! petals' late (step-50) key: the edit, then every keyframe from the first
+//! one it changes (40) to the last (issue 11's targets: 0.4 s for the whole
+//! lily, 0.1 s for one petal in preview). Each is measured at the default
+//! resolution and at Table 1's (painting) resolution.
 //!
 //! `cargo bench -p anthesis-garden --bench lily`
 
 use std::hint::black_box;
 
 use anthesis_flower::Project;
-use anthesis_sim::{Selection, run};
+use anthesis_garden::flowers::flower_at_resolution;
+use anthesis_sim::fixtures::stroke_near_tip;
+use anthesis_sim::{Selection, Simulation, run};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 /// Runs `selection` of `project` to the end and returns the last keyframe's
@@ -23,17 +30,22 @@ fn simulate(project: &Project, selection: &Selection) -> f64 {
     energy
 }
 
+/// The index of the lily's first petal.
+fn first_petal(project: &Project) -> usize {
+    project
+        .flower
+        .organs
+        .iter()
+        .position(|o| project.flower.templates[o.template].name.contains("petal"))
+        .unwrap_or_else(|| panic!("the lily has no petal"))
+}
+
 fn lily(c: &mut Criterion) {
     let project = match anthesis_garden::builtin_lily() {
         Ok(project) => project,
         Err(error) => panic!("the built-in lily does not load: {error}"),
     };
-    let petal = project
-        .flower
-        .organs
-        .iter()
-        .position(|o| project.flower.templates[o.template].name.contains("petal"))
-        .unwrap_or_else(|| panic!("the lily has no petal"));
+    let petal = first_petal(&project);
     let keyframes = project.settings.keyframes;
     c.bench_function(&format!("lily_petal_{keyframes}_keyframes"), |b| {
         b.iter(|| simulate(black_box(&project), &Selection::Only(petal)))
@@ -43,9 +55,75 @@ fn lily(c: &mut Criterion) {
     });
 }
 
+/// Steps `sim` to its last keyframe.
+fn finish(sim: &mut Simulation) {
+    while !sim.finished() {
+        if let Err(error) = sim.step(&|| false, &mut |_| {}) {
+            panic!("a stroke's run failed: {error}");
+        }
+    }
+}
+
+/// A stroke on the petals' late key, then every keyframe it changes.
+/// Iterations alternate between painting the stroke and taking it back
+/// (undo), each an edit of the late key.
+fn stroke(c: &mut Criterion, name: &str, project: &Project, selection: Selection) {
+    let petal_template = project.flower.organs[first_petal(project)].template;
+    let late_key = project.flower.templates[petal_template].maps.keys().len() - 1;
+    let mut painted = project.clone();
+    stroke_near_tip(&mut painted, petal_template, late_key);
+    let mut sim = match Simulation::new(project, &selection) {
+        Ok(sim) => sim,
+        Err(error) => panic!("{name}: {error}"),
+    };
+    sim.keep_checkpoints();
+    finish(&mut sim);
+    let mut states = [project, &painted];
+    c.bench_function(name, |b| {
+        b.iter(|| {
+            let first = match sim.edit(states[0], states[1]) {
+                Ok(first) => first,
+                Err(error) => panic!("{name}: {error}"),
+            };
+            assert!(first > 1, "{name}: a late stroke started the run over");
+            finish(&mut sim);
+            states.swap(0, 1);
+        })
+    });
+}
+
+fn strokes(c: &mut Criterion) {
+    for (resolution, edge_scale) in [("default", None), ("table1", Some(1.0))] {
+        let project = match edge_scale {
+            None => anthesis_garden::builtin_lily().map_err(|e| e.to_string()),
+            Some(scale) => match flower_at_resolution("lily", scale) {
+                Some(built) => built.map_err(|e| e.to_string()),
+                None => Err("no lily builder".to_string()),
+            },
+        };
+        let project = match project {
+            Ok(project) => project,
+            Err(error) => panic!("the lily does not build: {error}"),
+        };
+        let petal = first_petal(&project);
+        stroke(
+            c,
+            &format!("stroke_late_key_whole_lily_{resolution}"),
+            &project,
+            Selection::All,
+        );
+        stroke(
+            c,
+            &format!("stroke_late_key_petal_preview_{resolution}"),
+            &project,
+            Selection::Only(petal),
+        );
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10);
-    targets = lily
+    targets = lily, strokes
 }
 criterion_main!(benches);
