@@ -178,15 +178,23 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
     }
 }
 
-/// A stroke on time key `key` of `template`: inner growth along the organ
-/// raised by 0.3 within 0.15 (in UV) of the point (0.5, 0.8), near the tip,
-/// the reflex a user paints on the lily's late key. The map keeps its size.
+/// A stroke on time key `key` of `template` with the app's default brush
+/// (set towards 0.8 at half strength, radius 0.08, mirrored about the
+/// midrib): inner growth along the midrib from v = 0.7 to 0.9, near the tip,
+/// the reflex a user paints on the lily's late key. Dabs are a quarter of
+/// the radius apart; a uniform map becomes a 64 x 64 raster first.
 pub fn stroke_near_tip(project: &mut Project, template: usize, key: usize) {
-    let maps = &mut project.flower.templates[template].maps.keys_mut()[key].maps;
-    let old = maps.e_growth_in.clone();
-    let (width, height) = (old.width(), old.height());
-    maps.e_growth_in = ScalarMap::from_fn(width, height, |uv| {
-        let near_tip = (uv - glam::DVec2::new(0.5, 0.8)).length() < 0.15;
-        (old.sample(uv) + if near_tip { 0.3 } else { 0.0 }) as f32
-    });
+    use anthesis_maps::brush::{Brush, dab_scalar, ensure_scalar_raster};
+    let map = &mut project.flower.templates[template].maps.keys_mut()[key]
+        .maps
+        .e_growth_in;
+    if map.size() == (1, 1) {
+        ensure_scalar_raster(map, (64, 64));
+    }
+    let brush = Brush::default();
+    let dabs = (0.2 / (0.25 * brush.radius_in_uv)).ceil() as u32;
+    for i in 0..=dabs {
+        let v = 0.7 + 0.2 * f64::from(i) / f64::from(dabs);
+        dab_scalar(map, &brush, glam::DVec2::new(0.5, v), 0.0);
+    }
 }
