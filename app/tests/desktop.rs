@@ -105,6 +105,7 @@ fn feed(harness: &mut Harness<'_, AnthesisApp>, up_to: Option<u32>) {
             run,
             organs: Vec::new(),
             keyframes: total,
+            first_computed: 1,
         },
         &mut failures,
     );
@@ -911,6 +912,7 @@ fn the_window_and_anthesis_render_show_an_organ_in_the_same_colour() {
             run,
             organs: Vec::new(),
             keyframes: 4,
+            first_computed: 1,
         },
         &mut failures,
     );

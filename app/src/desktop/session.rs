@@ -29,6 +29,8 @@ pub enum RunStatus {
     Running,
     Finished {
         seconds: f64,
+        /// The first keyframe the run computed (see `Event::Started`).
+        first_computed: u32,
     },
     Failed {
         message: String,
@@ -50,6 +52,8 @@ pub struct SimSession {
     started_at: Option<Instant>,
     /// Newton iteration inside the keyframe being computed.
     iteration: Option<(u32, u32)>,
+    /// The first keyframe the current run computes (see `Event::Started`).
+    first_computed: u32,
 }
 
 /// Longest time one frame spends taking events from the worker.
@@ -78,6 +82,7 @@ impl SimSession {
             status: RunStatus::Idle,
             started_at: None,
             iteration: None,
+            first_computed: 1,
         }
     }
 
@@ -145,8 +150,13 @@ impl SimSession {
             return false;
         }
         match event {
-            Event::Started { keyframes, .. } => {
+            Event::Started {
+                keyframes,
+                first_computed,
+                ..
+            } => {
                 self.total = keyframes;
+                self.first_computed = first_computed;
                 self.status = RunStatus::Running;
             }
             Event::Keyframe { keyframe, .. } => {
@@ -162,7 +172,10 @@ impl SimSession {
                 self.iteration = Some((progress.keyframe, progress.iteration));
             }
             Event::Finished { seconds, .. } => {
-                self.status = RunStatus::Finished { seconds };
+                self.status = RunStatus::Finished {
+                    seconds,
+                    first_computed: self.first_computed,
+                };
                 self.iteration = None;
             }
             Event::Failed { error, .. } => {
@@ -367,5 +380,34 @@ mod tests {
         assert!(follow(&worker, &mut session, next).is_empty());
         assert!(matches!(session.status(), RunStatus::Finished { .. }));
         assert_eq!(session.last_index(), Some(4));
+    }
+
+    #[test]
+    fn a_stroke_on_the_late_key_keeps_the_frames_before_it_and_says_so() {
+        let before = anthesis_sim::fixtures::whorl(2, 6, 10, 44);
+        let mut after = before.clone();
+        anthesis_sim::fixtures::stroke_near_tip(&mut after, 0, 1);
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let mut session = SimSession::recorded();
+        for project in [before, after] {
+            let project = Arc::new(project);
+            let run = session.start(Arc::clone(&project), Selection::All);
+            assert_eq!(worker.start(project, Selection::All), run);
+            assert!(follow(&worker, &mut session, run).is_empty());
+        }
+        assert_eq!(session.last_index(), Some(44));
+        assert!(matches!(
+            session.status(),
+            RunStatus::Finished {
+                first_computed: 40,
+                ..
+            }
+        ));
+        let line = crate::desktop::timeline::status_line(&session);
+        assert!(
+            line.starts_with("keyframes 40–44 in ")
+                && line.ends_with("(39 kept: the edit cannot change them)"),
+            "{line}"
+        );
     }
 }

@@ -139,7 +139,15 @@ pub fn status_line(session: &SimSession) -> String {
             }
             line
         }
-        RunStatus::Finished { seconds } => {
+        RunStatus::Finished {
+            seconds,
+            first_computed,
+        } if *first_computed > 1 => format!(
+            "keyframes {first_computed}–{total} in {} ({} kept: the edit cannot change them)",
+            format_seconds(*seconds),
+            first_computed - 1
+        ),
+        RunStatus::Finished { seconds, .. } => {
             format!("{total} keyframes in {}", format_seconds(*seconds))
         }
         RunStatus::Failed { message } => format!("stopped at keyframe {done}: {message}"),

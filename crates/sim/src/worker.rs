@@ -36,6 +36,10 @@ pub enum Event {
         run: RunId,
         organs: Vec<String>,
         keyframes: u32,
+        /// The first keyframe this run computes; those before it are the
+        /// last run's, which the edit could not change, and are sent again
+        /// at once (1 when the run starts from the bud).
+        first_computed: u32,
     },
     Keyframe {
         run: RunId,
@@ -341,6 +345,7 @@ fn run_job(
         run,
         organs: sim.organs().iter().map(|s| s.to_string()).collect(),
         keyframes: sim.keyframe_count(),
+        first_computed: keyframes.len().max(1) as u32,
     });
     if keyframes.is_empty() {
         keyframes.push(Arc::new(sim.bud()));
@@ -490,6 +495,13 @@ mod tests {
             _ => None,
         });
         assert_eq!(first_progress, Some(40));
+        assert!(matches!(
+            events.first(),
+            Some(Event::Started {
+                first_computed: 40,
+                ..
+            })
+        ));
         // And they are what a run of the edited project gives.
         let mut fresh = Vec::new();
         crate::run(&after, &Selection::All, &mut |_, k| fresh.push(k.clone()))
