@@ -107,6 +107,15 @@ pub enum MeshError {
         /// The error with the OBJ's numbers (from 1).
         error: Box<MeshError>,
     },
+    #[error(
+        "subdividing {level} times would make {vertices} vertices, more than the limit of {limit}: \
+         choose a lower level"
+    )]
+    SubdivisionTooLarge {
+        level: u32,
+        vertices: u64,
+        limit: u64,
+    },
     #[error("cannot read mesh: {0}")]
     Io(String),
 }

@@ -1,5 +1,6 @@
-//! Triangle meshes with one UV layout, their edge topology, OBJ import and
-//! validation.
+//! Triangle meshes with one UV layout, their edge topology, OBJ import,
+//! validation and Loop subdivision (render meshes finer than the simulated
+//! ones, [`Subdivision`]).
 //!
 //! Conventions used across Anthesis:
 //! - positions are `f64` (`glam::DVec3`); UVs are `glam::DVec2`;
@@ -13,6 +14,7 @@ pub mod generate;
 pub mod nearest;
 pub mod obj;
 pub mod ray;
+pub mod subdivide;
 mod topology;
 pub mod validate;
 
@@ -21,6 +23,7 @@ pub use obj::{
     ObjFile, ObjWarning, load_obj, load_obj_file, obj_string, parse_obj, parse_obj_file,
     parse_obj_unvalidated, write_obj,
 };
+pub use subdivide::Subdivision;
 pub use topology::{Edge, EdgeSide, Topology};
 pub use validate::validate;
 

@@ -55,12 +55,17 @@ impl Topology {
     /// two triangles that traverse a shared edge in the same direction
     /// (inconsistent orientation).
     pub fn build(mesh: &Mesh) -> Result<Topology, MeshError> {
+        Topology::from_triangles(&mesh.triangles)
+    }
+
+    /// [`Topology::build`] from the triangles alone.
+    pub fn from_triangles(triangles: &[[u32; 3]]) -> Result<Topology, MeshError> {
         let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
         let mut edges: Vec<Edge> = Vec::new();
         let mut index_of: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut triangle_edges = Vec::with_capacity(mesh.triangles.len());
+        let mut triangle_edges = Vec::with_capacity(triangles.len());
         let mut faces_on_edge: HashMap<(u32, u32), usize> = HashMap::new();
-        for (t, tri) in mesh.triangles.iter().enumerate() {
+        for (t, tri) in triangles.iter().enumerate() {
             let mut te = [0u32; 3];
             for k in 0..3 {
                 let (a, b, c) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
