@@ -71,6 +71,11 @@ pub enum Command {
         /// How the .glb stores its data.
         #[arg(long, value_enum, default_value_t = EncodingArg::Dense)]
         encoding: EncodingArg,
+        /// Export each organ as a smooth render mesh: N levels of Loop
+        /// subdivision of the simulated mesh, about 4^N times the vertices
+        /// (0 = the simulated mesh).
+        #[arg(long, value_name = "N", default_value_t = 0)]
+        subdivide: u32,
     },
     /// Simulate a project and render chosen keyframes to PNG pictures, all
     /// seen by one camera.
@@ -185,6 +190,7 @@ pub fn run(cli: Cli) -> Result<()> {
             max_targets,
             no_normals,
             encoding,
+            subdivide,
         }) => {
             let timing = match (fps, duration) {
                 (_, Some(d)) if d > 0.0 && d.is_finite() => Timing::Duration(d),
@@ -206,6 +212,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 stats.as_deref(),
                 out.as_deref(),
                 &glb,
+                subdivide,
             )
         }
         Some(Command::Render(args)) => render::render(&args),

@@ -712,6 +712,14 @@ fn the_readme_lists_the_limits_the_code_enforces() {
             grouped(u64::from(anthesis_flower::MAX_KEYFRAMES))
         ),
         format!(
+            "| Render vertices per subdivided organ (`--subdivide`) | {} |",
+            grouped(anthesis_mesh::subdivide::MAX_SUBDIVIDED_VERTICES)
+        ),
+        format!(
+            "| Render positions of an export (render vertices × keyframes) | {} |",
+            grouped(anthesis_export::MAX_RENDER_POSITIONS)
+        ),
+        format!(
             "| Template and organ names | {} characters |",
             anthesis_flower::project::MAX_NAME_CHARS
         ),

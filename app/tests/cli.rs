@@ -403,3 +403,108 @@ fn a_step_that_fails_part_way_keeps_the_keyframes_before_it() {
         7
     );
 }
+
+/// The Khronos validator's report on `glb`, asserting no errors and no
+/// warnings.
+fn validated(glb: &Path) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/gltf-validator/validate.mjs");
+    let report = Command::new("node").arg(&script).arg(glb).output().expect(
+        "node runs the glTF validator (install node and run `npm ci --prefix tests/gltf-validator`)",
+    );
+    assert!(
+        report.status.success(),
+        "validator failed: {}",
+        text(&report.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&report.stdout).expect("validator JSON");
+    assert_eq!(report["issues"]["numErrors"], 0, "{report:#}");
+    assert_eq!(report["issues"]["numWarnings"], 0, "{report:#}");
+    report
+}
+
+#[test]
+fn simulate_subdivide_exports_smooth_render_meshes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 3);
+    let receptacle =
+        anthesis_flower::receptacle_for(&anthesis_sim::fixtures::whorl(2, 8, 14, 3).flower)
+            .vertex_count();
+    // Each organ: 112 particles, 293 edges, 182 triangles; one level adds a
+    // vertex per edge (405), the second 2·293 + 3·182 more (1,537).
+    for (level, per_organ) in [("0", 112), ("1", 405), ("2", 1537)] {
+        for encoding in ["dense", "meshopt"] {
+            let glb = dir.path().join(format!("level-{level}-{encoding}.glb"));
+            let out = anthesis(&[
+                "simulate",
+                path.to_str().expect("utf-8"),
+                "--subdivide",
+                level,
+                "--encoding",
+                encoding,
+                "--out",
+                glb.to_str().expect("utf-8"),
+            ]);
+            assert!(out.status.success(), "{}", text(&out.stderr));
+            let report = validated(&glb);
+            assert_eq!(
+                report["info"]["totalVertexCount"],
+                2 * per_organ + receptacle,
+                "level {level}, {encoding}"
+            );
+        }
+    }
+    // OBJ per keyframe: the same render meshes.
+    let objs = dir.path().join("objs");
+    let out = anthesis(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--subdivide",
+        "2",
+        "--out",
+        objs.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&objs)
+        .expect("folder")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 4, "the bud and three keyframes");
+    let obj = std::fs::read_to_string(&files[3]).expect("obj");
+    let vertices = obj.lines().filter(|l| l.starts_with("v ")).count();
+    assert_eq!(vertices, 2 * 1537 + receptacle);
+    let triangles = obj.lines().filter(|l| l.starts_with("f ")).count();
+    assert_eq!(
+        triangles,
+        2 * 16 * 182
+            + anthesis_flower::receptacle_for(&anthesis_sim::fixtures::whorl(2, 8, 14, 3).flower)
+                .triangle_count()
+    );
+}
+
+#[test]
+fn a_render_level_too_fine_is_refused_with_the_vertex_count_before_the_run() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 3);
+    let glb = dir.path().join("fine.glb");
+    let stats = dir.path().join("stats.json");
+    let out = one_line_error(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--subdivide",
+        "9",
+        "--stats",
+        stats.to_str().expect("utf-8"),
+        "--out",
+        glb.to_str().expect("utf-8"),
+    ]);
+    let stderr = text(&out.stderr);
+    // 2 organs at level 9 and 4 keyframes: the count and the finest level
+    // that fits are named.
+    assert!(stderr.contains("render subdivision level 9"), "{stderr}");
+    assert!(stderr.contains("render vertices per keyframe"), "{stderr}");
+    assert!(stderr.contains("the finest that fits"), "{stderr}");
+    // Refused from the counts before the run: no statistics, no file.
+    assert!(!glb.exists());
+    assert!(!stats.exists());
+}

@@ -305,3 +305,42 @@ fn render_without_a_graphics_adapter_says_so_in_one_line() {
     assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
     assert!(stderr.contains("no graphics adapter"), "{stderr}");
 }
+
+#[test]
+fn render_subdivide_draws_the_smooth_render_meshes_in_the_same_place() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let project = saved_whorl(dir.path());
+    let picture_at = |level: &str| {
+        let pictures = dir.path().join(format!("level-{level}"));
+        let out = anthesis(&[
+            "render",
+            utf8(&project),
+            "--frames",
+            "4",
+            "--out",
+            utf8(&pictures),
+            "--size",
+            "200x150",
+            "--subdivide",
+            level,
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        load_png(&pictures.join("frame-004.png"))
+    };
+    let (coarse, smooth) = (picture_at("0"), picture_at("2"));
+    // The smooth surface follows the simulated one: nearly the same
+    // silhouette (it rounds off the simulated mesh's facets and rim
+    // corners), but not the same picture (its shading is smoother).
+    let inside = |picture: &RgbaImage| -> std::collections::HashSet<(u32, u32)> {
+        organ_pixels(picture).into_iter().collect()
+    };
+    let (a, b) = (inside(&coarse), inside(&smooth));
+    let overlap = a.intersection(&b).count() as f64 / a.union(&b).count() as f64;
+    assert!(overlap > 0.9, "silhouettes overlap by {overlap:.3}");
+    let changed = coarse
+        .pixels()
+        .zip(smooth.pixels())
+        .filter(|(p, q)| differs(p, q))
+        .count();
+    assert!(changed > 20, "only {changed} pixels changed");
+}

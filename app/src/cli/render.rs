@@ -6,6 +6,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anthesis_flower::Project;
+use anthesis_mesh::Subdivision;
 use anthesis_render::{Background, Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
 use anthesis_sim::memory::KeyframeCost;
 use anthesis_sim::{Selection, Simulation};
@@ -84,6 +85,11 @@ pub struct RenderArgs {
     /// white (default: a soft blue-grey gradient).
     #[arg(long, value_name = "RRGGBB")]
     pub background: Option<String>,
+    /// Draw each organ as a smooth render mesh: N levels of Loop
+    /// subdivision of the simulated mesh, about 4^N times the vertices
+    /// (0 = the simulated mesh), as `simulate --subdivide` exports it.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub subdivide: u32,
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
@@ -136,6 +142,12 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         _ => None,
     };
     let background = args.background.as_deref().map(parse_color).transpose()?;
+    anthesis_export::check_render_level(
+        &project.flower,
+        &selection.organs(project.flower.organs.len()),
+        frames.len(),
+        args.subdivide,
+    )?;
     // Before the simulation, so that a machine without a GPU driver fails
     // at once.
     let mut renderer = OffscreenRenderer::new().context("cannot render")?;
@@ -149,7 +161,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         );
     }
 
-    let scenes = simulate_scenes(&project, &selection, &frames)?;
+    let scenes = simulate_scenes(&project, &selection, &frames, args.subdivide)?;
     if let Some((target, options)) = &animation {
         let count = scenes.len();
         let organs: Vec<Vec<OrganMesh>> = scenes.into_iter().map(|(_, organs)| organs).collect();
@@ -251,29 +263,50 @@ fn parse_color(hex: &str) -> Result<[f32; 3]> {
 }
 
 /// Simulates through the last of `frames` (sorted keyframe numbers, 0 the
-/// bud) and returns each of those keyframes' organs, ready to draw.
+/// bud) and returns each of those keyframes' organs, ready to draw, as
+/// render meshes of `render_level` levels of subdivision (0: as simulated).
 fn simulate_scenes(
     project: &Project,
     selection: &Selection,
     frames: &[u32],
+    render_level: u32,
 ) -> Result<Vec<(u32, Vec<OrganMesh>)>> {
     anthesis_sim::memory::check_run(project, selection, KeyframeCost::Kept)?;
     let mut sim = Simulation::new(project, selection)?;
     let colors: Vec<[f32; 4]> = (0..sim.organs().len()).map(|i| sim.color(i)).collect();
-    let triangles: Vec<Vec<[u32; 3]>> = (0..colors.len())
-        .map(|i| sim.triangles(i).to_vec())
-        .collect();
+    // The same render meshes as `simulate --subdivide` exports
+    // (`anthesis_export::Track::subdivided`): each organ's subdivision built
+    // once, its corners found in the bud.
+    let bud = sim.bud();
+    let subdivisions: Vec<Subdivision> = selection
+        .organs(project.flower.organs.len())
+        .iter()
+        .zip(&bud.positions_in_world)
+        .map(|(&organ, positions)| {
+            let template = &project.flower.template_of(organ).mesh;
+            let in_bud = anthesis_mesh::Mesh {
+                positions: positions.clone(),
+                ..template.clone()
+            };
+            Subdivision::new(&in_bud, render_level).with_context(|| {
+                format!(
+                    "cannot subdivide organ `{}`",
+                    project.flower.organs[organ].name
+                )
+            })
+        })
+        .collect::<Result<_>>()?;
     let organs_at = |positions: &[Vec<glam::DVec3>]| -> Vec<OrganMesh> {
         positions
             .iter()
-            .zip(&triangles)
+            .zip(&subdivisions)
             .zip(&colors)
-            .map(|((p, t), c)| OrganMesh::from_positions(p, t, *c))
+            .map(|((p, s), c)| OrganMesh::from_positions(&s.apply(p), s.triangles(), *c))
             .collect()
     };
     let mut scenes: Vec<(u32, Vec<OrganMesh>)> = Vec::with_capacity(frames.len());
     if frames.first() == Some(&0) {
-        scenes.push((0, organs_at(&sim.bud().positions_in_world)));
+        scenes.push((0, organs_at(&bud.positions_in_world)));
     }
     let last_wanted = frames.last().copied().unwrap_or(0);
     run_keyframes(&mut sim, last_wanted, &mut |keyframe| {

@@ -51,6 +51,7 @@ pub(super) fn simulate(
     stats_path: Option<&Path>,
     out: Option<&Path>,
     glb: &GlbOptions,
+    render_level: u32,
 ) -> Result<()> {
     let mut project = load(path)?;
     set_keyframes(&mut project, keyframes)?;
@@ -62,6 +63,13 @@ pub(super) fn simulate(
     }
     if let Some(out) = out {
         check_output(out, glb, project.settings.keyframes)?;
+        // The bud and every keyframe, at the render level asked for.
+        anthesis_export::check_render_level(
+            &project.flower,
+            &selection.organs(project.flower.organs.len()),
+            project.settings.keyframes as usize + 1,
+            render_level,
+        )?;
     }
     let cost = match out.map(OutputKind::of) {
         None => KeyframeCost::Kept,
@@ -103,7 +111,8 @@ pub(super) fn simulate(
             &project.flower,
             &selection.organs(project.flower.organs.len()),
             frames.iter().map(Vec::as_slice),
-        );
+            render_level,
+        )?;
         let kind = OutputKind::of(out);
         match kind {
             OutputKind::Glb => anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})

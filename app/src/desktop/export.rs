@@ -46,6 +46,9 @@ pub struct ExportDialog {
     pub max_morph_targets: usize,
     pub normals: bool,
     pub encoding: Encoding,
+    /// Levels of Loop subdivision of every organ in the export (0 = the
+    /// simulated mesh; each level about four times the vertices).
+    pub render_level: u32,
     /// How a .gif export looks (size, camera, turn, speed).
     pub animation: AnimationOptions,
     /// A .gif shows every `animation_step`-th keyframe (and the last).
@@ -66,6 +69,7 @@ impl Default for ExportDialog {
             max_morph_targets: defaults.max_morph_targets,
             normals: defaults.normals,
             encoding: defaults.encoding,
+            render_level: 0,
             animation: AnimationOptions::default(),
             animation_step: 1,
             state: ExportState::Idle,
@@ -73,6 +77,10 @@ impl Default for ExportDialog {
         }
     }
 }
+
+/// The most subdivision levels the dialog offers (the default lily at 3 is
+/// about 380,000 render vertices per keyframe).
+pub const MAX_DIALOG_RENDER_LEVEL: u32 = 3;
 
 /// A labelled row editing an angle in degrees within `[-limit, limit]`;
 /// returns the editor's response.
@@ -144,13 +152,20 @@ pub struct ExportRequests {
 }
 
 /// The animation tracks of the computed keyframes: one per simulated organ
-/// and the receptacle, as every export of a flower has them
-/// ([`anthesis_export::flower_tracks`]).
-pub fn tracks(project: &Project, organs: &[usize], keyframes: &[Arc<Keyframe>]) -> Vec<Track> {
+/// (as render meshes of `render_level` levels of subdivision, 0 for the
+/// simulated meshes) and the receptacle, as every export of a flower has
+/// them ([`anthesis_export::flower_tracks`]).
+pub fn tracks(
+    project: &Project,
+    organs: &[usize],
+    keyframes: &[Arc<Keyframe>],
+    render_level: u32,
+) -> Result<Vec<Track>, anthesis_export::ExportError> {
     anthesis_export::flower_tracks(
         &project.flower,
         organs,
         keyframes.iter().map(|k| k.positions_in_world.as_slice()),
+        render_level,
     )
 }
 
@@ -207,6 +222,12 @@ impl ExportDialog {
             normals: self.normals,
             encoding: self.encoding,
         }
+    }
+
+    /// Shows an export that could not start (its tracks could not be
+    /// built) as failed, with `message`.
+    pub fn fail(&mut self, message: String) {
+        self.state = ExportState::Failed { message };
     }
 
     /// Starts writing `tracks` to the dialog's path on a thread; `wake` is
@@ -360,6 +381,22 @@ impl ExportDialog {
                 egui::Grid::new("export options")
                     .num_columns(2)
                     .show(ui, |ui| {
+                        let label = ui
+                            .label("Smooth mesh")
+                            .on_hover_text(
+                                "Levels of Loop subdivision of every organ: a finer render mesh \
+                                 driven by the simulated one, about four times the vertices per \
+                                 level (0 = the simulated mesh as it is)",
+                            )
+                            .id;
+                        ui.add(
+                            egui::DragValue::new(&mut self.render_level)
+                                .range(0..=MAX_DIALOG_RENDER_LEVEL)
+                                .prefix("subdivide ")
+                                .suffix(" ×"),
+                        )
+                        .labelled_by(label);
+                        ui.end_row();
                         if gif {
                             self.gif_options_ui(ui);
                             return;
@@ -510,7 +547,10 @@ mod tests {
             path: dir.path().join("out.glb").display().to_string(),
             ..ExportDialog::default()
         };
-        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        dialog.start(
+            tracks(&project, &[0, 1], &frames, 0).expect("tracks"),
+            || {},
+        );
         let end = wait_for_the_end(&mut dialog);
         let ExportState::Done { bytes, .. } = end else {
             panic!("export failed: {end:?}");
@@ -526,7 +566,7 @@ mod tests {
         let bud = anthesis_sim::Simulation::new(&project, &anthesis_sim::Selection::Only(1))
             .expect("sim")
             .bud();
-        let tracks = tracks(&project, &[1], &[Arc::new(bud.clone())]);
+        let tracks = tracks(&project, &[1], &[Arc::new(bud.clone())], 0).expect("tracks");
         assert_eq!(tracks.len(), 2, "the organ and the receptacle");
         let template = project.flower.template_of(1);
         assert_eq!(tracks[0].name, project.flower.organs[1].name);
@@ -540,7 +580,11 @@ mod tests {
         assert_eq!(tracks[1].keyframes, vec![receptacle.positions]);
         assert_eq!(tracks[1].base_color, anthesis_flower::RECEPTACLE_COLOR);
         // Before the first keyframe there is nothing to export.
-        assert!(super::tracks(&project, &[1], &[]).is_empty());
+        assert!(
+            super::tracks(&project, &[1], &[], 0)
+                .expect("tracks")
+                .is_empty()
+        );
     }
 
     #[test]
@@ -553,7 +597,10 @@ mod tests {
             path: "/no/such/folder/out.glb".to_string(),
             ..ExportDialog::default()
         };
-        dialog.start(tracks(&project, &[0], &[Arc::new(bud)]), || {});
+        dialog.start(
+            tracks(&project, &[0], &[Arc::new(bud)], 0).expect("tracks"),
+            || {},
+        );
         let end = wait_for_the_end(&mut dialog);
         assert!(
             matches!(&end, ExportState::Failed { message } if message.contains("/no/such/folder")),
@@ -575,7 +622,10 @@ mod tests {
             path: usda.display().to_string(),
             ..ExportDialog::default()
         };
-        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        dialog.start(
+            tracks(&project, &[0, 1], &frames, 0).expect("tracks"),
+            || {},
+        );
         let end = wait_for_the_end(&mut dialog);
         let ExportState::Done { bytes, .. } = end else {
             panic!("export failed: {end:?}");
@@ -593,7 +643,10 @@ mod tests {
 
         let usdc = dir.path().join("out.usdc");
         dialog.path = usdc.display().to_string();
-        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        dialog.start(
+            tracks(&project, &[0, 1], &frames, 0).expect("tracks"),
+            || {},
+        );
         let end = wait_for_the_end(&mut dialog);
         assert!(
             matches!(&end, ExportState::Failed { message } if message.contains("usdcat")),
@@ -625,7 +678,10 @@ mod tests {
         };
         dialog.animation.width = 80;
         dialog.animation.height = 60;
-        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        dialog.start(
+            tracks(&project, &[0, 1], &frames, 0).expect("tracks"),
+            || {},
+        );
         let end = wait_for_the_end(&mut dialog);
         let ExportState::Done { bytes, .. } = end else {
             panic!("export failed: {end:?}");
@@ -648,12 +704,60 @@ mod tests {
         let wide = dir.path().join("wide.gif");
         dialog.path = wide.display().to_string();
         dialog.animation.width = 70_000;
-        dialog.start(tracks(&project, &[0, 1], &frames), || {});
+        dialog.start(
+            tracks(&project, &[0, 1], &frames, 0).expect("tracks"),
+            || {},
+        );
         let end = wait_for_the_end(&mut dialog);
         assert!(
             matches!(&end, ExportState::Failed { message } if message.contains("65535")),
             "{end:?}"
         );
         assert!(!wide.exists());
+    }
+
+    #[test]
+    fn the_smooth_mesh_option_subdivides_the_organs_and_refuses_too_fine_levels() {
+        let project = anthesis_sim::fixtures::whorl(2, 4, 6, 2);
+        let mut frames = Vec::new();
+        anthesis_sim::run(&project, &anthesis_sim::Selection::All, &mut |_, k| {
+            frames.push(Arc::new(k.clone()))
+        })
+        .expect("simulates");
+        let coarse = tracks(&project, &[0, 1], &frames, 0).expect("tracks");
+        let smooth = tracks(&project, &[0, 1], &frames, 1).expect("tracks");
+        let mesh = &project.flower.template_of(0).mesh;
+        let edges = anthesis_mesh::Topology::build(mesh)
+            .expect("manifold")
+            .edges
+            .len();
+        assert_eq!(smooth[0].uvs.len(), mesh.vertex_count() + edges);
+        assert_eq!(smooth[0].triangles.len(), 4 * mesh.triangle_count());
+        assert_eq!(smooth[0].keyframes.len(), coarse[0].keyframes.len());
+        assert_eq!(smooth[2], coarse[2], "the receptacle is exported as it is");
+
+        // Through the dialog: a file of the render meshes, or the reason
+        // when the level asks for too much.
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut dialog = ExportDialog {
+            path: dir.path().join("smooth.glb").display().to_string(),
+            render_level: 1,
+            ..ExportDialog::default()
+        };
+        dialog.start(
+            tracks(&project, &[0, 1], &frames, dialog.render_level).expect("tracks"),
+            || {},
+        );
+        let end = wait_for_the_end(&mut dialog);
+        assert!(matches!(end, ExportState::Done { .. }), "{end:?}");
+        let error = tracks(&project, &[0, 1], &frames, 12).expect_err("too fine");
+        dialog.fail(error.to_string());
+        assert!(
+            matches!(dialog.state(), ExportState::Failed { message }
+                if message.contains("render subdivision level 12")
+                    && message.contains("the finest that fits")),
+            "{:?}",
+            dialog.state()
+        );
     }
 }

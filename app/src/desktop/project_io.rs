@@ -257,8 +257,12 @@ impl AnthesisApp {
             self.doc.project(),
             self.session.organs(),
             self.session.keyframes(),
+            self.export.render_level,
         );
         let wake = self.ctx.clone();
-        self.export.start(tracks, move || wake.request_repaint());
+        match tracks {
+            Ok(tracks) => self.export.start(tracks, move || wake.request_repaint()),
+            Err(error) => self.export.fail(error.to_string()),
+        }
     }
 }

@@ -48,9 +48,46 @@ pub enum ExportError {
         /// The size it would have.
         bytes: u64,
     },
+    #[error(
+        "render subdivision level {level} would make {vertices} render vertices per keyframe, \
+         {positions} positions over {keyframes} keyframes, more than the {limit} an export may \
+         hold{}",
+        finest_hint(*finest)
+    )]
+    /// The render subdivision level asks for more vertices than an export
+    /// may hold (see [`crate::MAX_RENDER_POSITIONS`]).
+    TooFine {
+        /// The level asked for.
+        level: u32,
+        /// Render vertices per keyframe over every subdivided organ.
+        vertices: u64,
+        /// `vertices` times the keyframes.
+        positions: u64,
+        /// The keyframes (the bud included).
+        keyframes: usize,
+        /// [`crate::MAX_RENDER_POSITIONS`].
+        limit: u64,
+        /// The finest level that fits, if any above 0 does.
+        finest: Option<u32>,
+    },
+    #[error("cannot subdivide organ {organ:?}: {error}")]
+    /// An organ's mesh cannot be subdivided.
+    Subdivision {
+        /// The organ's name.
+        organ: String,
+        /// What is wrong with its mesh.
+        error: anthesis_mesh::MeshError,
+    },
     #[error("cannot build the USD layer: {0}")]
     /// The USD layer could not be built.
     Usd(String),
+}
+
+fn finest_hint(finest: Option<u32>) -> String {
+    match finest {
+        Some(level) => format!("; level {level} is the finest that fits"),
+        None => "; export without subdivision (level 0)".to_string(),
+    }
 }
 
 /// What is wrong with one track's data.

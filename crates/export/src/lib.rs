@@ -68,7 +68,9 @@ pub use error::{ExportError, TrackProblem};
 pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
 pub use report::{GlbSize, GlbSizeReport, glb_size_report};
-pub use tracks::{TrackLook, flower_tracks, organ_tracks};
+pub use tracks::{
+    MAX_RENDER_POSITIONS, TrackLook, check_render_level, flower_tracks, organ_tracks,
+};
 pub use usd::{
     USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, write_usd,
 };

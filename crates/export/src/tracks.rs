@@ -1,13 +1,17 @@
 //! Building [`Track`]s: from the keyframes of a simulation, which hands out
 //! the positions of every organ keyframe by keyframe, and from a mesh that
 //! does not move; [`flower_tracks`] is the one rule every export of a
-//! flower follows (the desktop's and the command line's).
+//! flower follows (the desktop's and the command line's), with its organs
+//! at the simulated resolution or as finer render meshes driven by the
+//! simulated ones (Loop subdivision, [`check_render_level`]).
 
 use anthesis_flower::{Flower, RECEPTACLE_COLOR, receptacle_for};
 use anthesis_mesh::Mesh;
+use anthesis_mesh::Subdivision;
+use anthesis_mesh::subdivide::subdivided_counts;
 use glam::{DVec2, DVec3};
 
-use crate::Track;
+use crate::{ExportError, Track, TrackProblem};
 
 /// What a [`Track`] keeps through a whole run: the name, the triangulation,
 /// the UV layout and the colour of one organ.
@@ -83,6 +87,69 @@ pub fn organ_tracks<'a, 'k>(
     tracks
 }
 
+/// The most render positions (render vertices per keyframe times the
+/// keyframes, over every subdivided organ) an export may build: about
+/// 1.2 GB of positions in memory and as much again in a dense .glb. A finer
+/// render level is refused with [`ExportError::TooFine`] before anything is
+/// built.
+pub const MAX_RENDER_POSITIONS: u64 = 50_000_000;
+
+/// The render vertices per keyframe of `flower`'s `organs` at render
+/// subdivision `level` (see [`anthesis_mesh::subdivide`]), checked against
+/// [`MAX_RENDER_POSITIONS`] for `keyframe_count` keyframes (the bud
+/// included). For checking a command line before a long simulation; level
+/// 0 (the simulated meshes) always passes.
+pub fn check_render_level(
+    flower: &Flower,
+    organs: &[usize],
+    keyframe_count: usize,
+    level: u32,
+) -> Result<u64, ExportError> {
+    let per_keyframe = |level: u32| -> u64 {
+        organs
+            .iter()
+            .map(|&organ| {
+                let mesh = &flower.template_of(organ).mesh;
+                let edges = edge_count(&mesh.triangles);
+                subdivided_counts(
+                    mesh.vertex_count() as u64,
+                    edges,
+                    mesh.triangle_count() as u64,
+                    level,
+                )
+                .0
+            })
+            .fold(0, u64::saturating_add)
+    };
+    let vertices = per_keyframe(level);
+    let positions = vertices.saturating_mul(keyframe_count as u64);
+    if level == 0 || positions <= MAX_RENDER_POSITIONS {
+        return Ok(vertices);
+    }
+    let finest = (1..level)
+        .rev()
+        .find(|&l| per_keyframe(l).saturating_mul(keyframe_count as u64) <= MAX_RENDER_POSITIONS);
+    Err(ExportError::TooFine {
+        level,
+        vertices,
+        positions,
+        keyframes: keyframe_count,
+        limit: MAX_RENDER_POSITIONS,
+        finest,
+    })
+}
+
+/// The number of distinct edges of `triangles`.
+fn edge_count(triangles: &[[u32; 3]]) -> u64 {
+    let mut edges: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges.len() as u64
+}
+
 /// What an export of `flower` holds: one track per simulated organ (`organs`
 /// are indices into `flower.organs`, in the order the keyframes hold their
 /// positions), named after the organ and drawn with its template's mesh,
@@ -91,15 +158,25 @@ pub fn organ_tracks<'a, 'k>(
 ///
 /// `keyframes` are as [`organ_tracks`] takes them: keyframe 0 (the bud)
 /// first. Without keyframes there is nothing to export: no tracks.
+///
+/// `render_level` above 0 exports each organ as its render mesh
+/// ([`Track::subdivided`]): the simulated mesh after that many levels of
+/// Loop subdivision, built once per organ and applied to every keyframe,
+/// about four times the vertices per level, with the template's UVs
+/// interpolated linearly so the painted maps land as on the simulated mesh. The receptacle, which is not simulated, is exported as
+/// it is. Fails when the level is too fine ([`check_render_level`]) or an
+/// organ's mesh cannot be subdivided.
 pub fn flower_tracks<'k>(
     flower: &Flower,
     organs: &[usize],
     keyframes: impl IntoIterator<Item = &'k [Vec<DVec3>]>,
-) -> Vec<Track> {
-    let mut keyframes = keyframes.into_iter().peekable();
-    if keyframes.peek().is_none() {
-        return Vec::new();
+    render_level: u32,
+) -> Result<Vec<Track>, ExportError> {
+    let keyframes: Vec<&[Vec<DVec3>]> = keyframes.into_iter().collect();
+    if keyframes.is_empty() {
+        return Ok(Vec::new());
     }
+    check_render_level(flower, organs, keyframes.len(), render_level)?;
     let looks = organs.iter().map(|&organ| {
         let template = flower.template_of(organ);
         TrackLook::new(
@@ -110,12 +187,78 @@ pub fn flower_tracks<'k>(
         )
     });
     let mut tracks = organ_tracks(looks, keyframes);
+    if render_level > 0 {
+        tracks = tracks
+            .iter()
+            .enumerate()
+            .map(|(i, track)| {
+                track.subdivided(render_level).map_err(|error| match error {
+                    ExportError::InvalidTrack { name, problem, .. } => ExportError::InvalidTrack {
+                        track: i,
+                        name,
+                        problem,
+                    },
+                    other => other,
+                })
+            })
+            .collect::<Result<_, _>>()?;
+    }
     tracks.push(Track::still(
         "receptacle",
         receptacle_for(flower),
         RECEPTACLE_COLOR,
     ));
-    tracks
+    Ok(tracks)
+}
+
+impl Track {
+    /// The track's render mesh: its mesh after `level` levels of Loop
+    /// subdivision ([`Subdivision`]: the rim a crease, rim corners sharper
+    /// than [`anthesis_mesh::subdivide::CORNER_ANGLE`] in keyframe 0 kept,
+    /// UVs interpolated linearly), built once and applied to every
+    /// keyframe. Fails on a mesh that is not a manifold, consistently
+    /// oriented surface, one whose render mesh would have more than
+    /// [`anthesis_mesh::subdivide::MAX_SUBDIVIDED_VERTICES`], or a keyframe
+    /// with another vertex count than keyframe 0 (reported as track 0: the
+    /// caller knows the track's index).
+    pub fn subdivided(&self, level: u32) -> Result<Track, ExportError> {
+        let Some(first) = self.keyframes.first() else {
+            return Ok(self.clone());
+        };
+        let mesh = Mesh {
+            positions: first.clone(),
+            uvs: self.uvs.clone(),
+            triangles: self.triangles.clone(),
+        };
+        let subdivision =
+            Subdivision::new(&mesh, level).map_err(|error| ExportError::Subdivision {
+                organ: self.name.clone(),
+                error,
+            })?;
+        let mut keyframes = Vec::with_capacity(self.keyframes.len());
+        for (keyframe, coarse) in self.keyframes.iter().enumerate() {
+            if coarse.len() != first.len() {
+                return Err(ExportError::InvalidTrack {
+                    track: 0,
+                    name: self.name.clone(),
+                    problem: TrackProblem::KeyframeVertexCount {
+                        keyframe,
+                        expected: first.len(),
+                        found: coarse.len(),
+                    },
+                });
+            }
+            keyframes.push(subdivision.apply(coarse));
+        }
+        Ok(Track {
+            name: self.name.clone(),
+            triangles: subdivision.triangles().to_vec(),
+            uvs: subdivision.uvs().to_vec(),
+            base_color: self.base_color,
+            keyframes,
+            base_color_png: self.base_color_png.clone(),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -155,5 +298,78 @@ mod tests {
         assert_eq!(track.uvs, mesh.uvs);
         assert_eq!(track.keyframes, vec![mesh.positions]);
         assert_eq!(track.base_color, [0.5; 4]);
+    }
+
+    /// A petal bending outwards over three keyframes.
+    fn bending_petal() -> Track {
+        let petal = anthesis_mesh::generate::test_petal(10.0, 4.0, 9, 17);
+        let keyframes = (0..3)
+            .map(|k| {
+                let bend = 0.02 * f64::from(k);
+                petal
+                    .positions
+                    .iter()
+                    .map(|p| DVec3::new(p.x, p.y, p.z + bend * p.y * p.y))
+                    .collect()
+            })
+            .collect();
+        Track {
+            name: "petal".into(),
+            triangles: petal.triangles,
+            uvs: petal.uvs,
+            base_color: [0.9, 0.8, 0.9, 1.0],
+            keyframes,
+            base_color_png: None,
+        }
+    }
+
+    #[test]
+    fn a_subdivided_track_is_every_keyframe_through_one_subdivision() {
+        let track = bending_petal();
+        assert_eq!(track.subdivided(0).expect("level 0"), track);
+        let fine = track.subdivided(2).expect("subdivides");
+        let bud = Mesh {
+            positions: track.keyframes[0].clone(),
+            uvs: track.uvs.clone(),
+            triangles: track.triangles.clone(),
+        };
+        let subdivision = Subdivision::new(&bud, 2).expect("subdivides");
+        assert_eq!(fine.name, track.name);
+        assert_eq!(fine.base_color, track.base_color);
+        assert_eq!(fine.triangles, subdivision.triangles());
+        assert_eq!(fine.uvs, subdivision.uvs());
+        assert_eq!(fine.triangles.len(), 16 * track.triangles.len());
+        assert_eq!(fine.keyframes.len(), 3);
+        for (coarse, fine) in track.keyframes.iter().zip(&fine.keyframes) {
+            assert_eq!(*fine, subdivision.apply(coarse));
+        }
+        // The simulated particles keep their indices.
+        assert_eq!(fine.keyframes[2].len(), subdivision.vertex_count());
+    }
+
+    #[test]
+    fn bad_tracks_are_refused_with_the_reason() {
+        let mut track = bending_petal();
+        track.keyframes[2].pop();
+        let error = track.subdivided(1).expect_err("a short keyframe");
+        assert!(
+            matches!(
+                &error,
+                ExportError::InvalidTrack {
+                    problem: TrackProblem::KeyframeVertexCount { keyframe: 2, .. },
+                    ..
+                }
+            ),
+            "{error}"
+        );
+        let mut track = bending_petal();
+        track.triangles.push(track.triangles[0]);
+        let error = track.subdivided(1).expect_err("a repeated triangle");
+        assert!(error.to_string().contains("petal"), "{error}");
+        let error = bending_petal().subdivided(9).expect_err("too fine");
+        assert!(
+            error.to_string().contains("choose a lower level"),
+            "{error}"
+        );
     }
 }

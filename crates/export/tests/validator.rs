@@ -168,3 +168,21 @@ fn a_broken_accessor_makes_the_validator_fail() {
         "assert_valid_glb must reject a broken file"
     );
 }
+
+#[test]
+fn smooth_render_meshes_pass_the_validator_in_every_encoding() {
+    // The organs subdivided twice (the receptacle as it is), as
+    // `anthesis simulate --subdivide 2` exports them.
+    let mut tracks = fixture(11);
+    let coarse: usize = tracks.iter().map(|t| t.uvs.len()).sum();
+    for track in tracks.iter_mut().take(2) {
+        *track = track.subdivided(2).expect("subdivides");
+    }
+    let fine: usize = tracks.iter().map(|t| t.uvs.len()).sum();
+    assert!(fine > 10 * (coarse - 36), "{coarse} -> {fine} vertices");
+    for encoding in Encoding::ALL {
+        let bytes = glb_bytes(&tracks, &options(encoding, true), &mut |_| {}).expect("export");
+        let report = assert_valid_glb(&bytes, &format!("subdivided-{encoding}"));
+        assert_eq!(report["info"]["totalVertexCount"], fine, "{encoding}");
+    }
+}

@@ -13,7 +13,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         frames.push(k.positions_in_world.clone())
     })?;
     let organs = Selection::All.organs(sim.organs().len());
-    let tracks = flower_tracks(&project.flower, &organs, frames.iter().map(Vec::as_slice));
+    let tracks = flower_tracks(
+        &project.flower,
+        &organs,
+        frames.iter().map(Vec::as_slice),
+        0,
+    )?;
     let report = glb_size_report(&tracks, &GlbOptions::default())?;
     println!("{report}");
     // With a path argument, also write the default (dense) file there.
