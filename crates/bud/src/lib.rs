@@ -28,11 +28,13 @@
 #![warn(missing_docs)]
 
 mod examples;
+mod from_mesh;
 mod quality;
 mod remesh;
 mod surface;
 
 pub use examples::{eustoma_petal_surface, lily_petal_surface};
+pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use quality::{MeshQuality, find_self_intersection, quality};
 pub use surface::{BezierCurve, BezierPatch, MAX_STRETCH_TO_BEND, PdeSweep, Surface, bernstein3};
 
@@ -175,6 +177,30 @@ pub enum BudError {
         /// Roughly where, in the template frame.
         near_in_template: glam::DVec3,
     },
+    #[error(
+        "the UV layout is not one span across at v = {v:.4}: a line of constant v crosses its outline {crossings} times, not twice (the remesher needs u across and v from base to tip, without holes or bays that turn back)"
+    )]
+    /// A line of constant `v` crosses the UV outline other than twice.
+    UvNotMonotone {
+        /// The line, in the mesh's UVs.
+        v: f64,
+        /// How often it crosses the outline.
+        crossings: usize,
+    },
+    #[error(
+        "the UV layout overlaps or folds over itself: its triangles cover {covered_area:.4} of UV area, its outline holds {outline_area:.4}"
+    )]
+    /// The UV triangles overlap (cover more area than the outline holds) or
+    /// wind both ways.
+    UvOverlap {
+        /// The UV triangles' areas added up.
+        covered_area: f64,
+        /// The area inside the UV outline.
+        outline_area: f64,
+    },
+    #[error("the mesh has no UV layout to remesh in: its UVs all lie on one line or point")]
+    /// The UVs span no area.
+    NoUvArea,
     /// The finished mesh failed validation.
     #[error("the remeshed organ is not a valid mesh: {0}")]
     InvalidMesh(#[from] MeshError),
@@ -184,8 +210,14 @@ pub enum BudError {
 /// close to `options.target_edge`, UVs equal to the surface parameters and
 /// the winding chosen by `options.inner_side`; reports its quality.
 pub fn build_organ(surface: &dyn Surface, options: &RemeshOptions) -> Result<Bud, BudError> {
-    let mut mesh = remesh::remesh(surface, options)?;
+    let mut mesh = remesh::remesh(surface, options, remesh::PointedEnds::TipOnly)?;
     orient(&mut mesh, options.inner_side);
+    checked(mesh, options)
+}
+
+/// Validates a finished mesh and measures it; refuses it below the quality
+/// floor or, if asked, when it crosses itself.
+fn checked(mesh: Mesh, options: &RemeshOptions) -> Result<Bud, BudError> {
     anthesis_mesh::validate::validate(&mesh)?;
     let quality = quality(&mesh);
     if quality.min_angle_deg < options.min_angle_floor_deg {

@@ -13,6 +13,14 @@ use glam::{DVec2, DVec3};
 pub trait Surface {
     /// The point at parameters `point_in_uv`, in the organ template frame.
     fn point(&self, point_in_uv: DVec2) -> DVec3;
+
+    /// The UV a mesh vertex at parameters `point_in_uv` gets: the
+    /// parameters themselves for a bud surface; a template mesh seen as a
+    /// surface ([`crate::MeshSurface`]) maps them to its own UV layout. The
+    /// remesher keeps triangles counter-clockwise in both.
+    fn layout_uv(&self, point_in_uv: DVec2) -> DVec2 {
+        point_in_uv
+    }
 }
 
 /// Any closure `Fn(DVec2) -> DVec3` is a surface.

@@ -55,14 +55,22 @@ impl Adjacency {
 }
 
 impl Work<'_> {
-    /// Signed area of a triangle in UV (positive when counter-clockwise).
+    /// Signed area of a triangle in the parameters (positive when
+    /// counter-clockwise).
     fn uv_area(&self, t: [u32; 3]) -> f64 {
         let [a, b, c] = t.map(|i| self.uvs[i as usize]);
         0.5 * (b - a).perp_dot(c - a)
     }
 
-    /// Whether a triangle is acceptable: counter-clockwise in UV and with a
-    /// 3D area that is not negligible.
+    /// Signed area of a triangle in the layout's UVs
+    /// ([`crate::Surface::layout_uv`]).
+    fn layout_area(&self, t: [u32; 3]) -> f64 {
+        let [a, b, c] = t.map(|i| self.surface.layout_uv(self.uvs[i as usize]));
+        0.5 * (b - a).perp_dot(c - a)
+    }
+
+    /// Whether a triangle is acceptable: counter-clockwise in the parameters
+    /// and in the layout's UVs, with a 3D area that is not negligible.
     fn is_valid(&self, t: [u32; 3]) -> bool {
         let [a, b, c] = t.map(|i| self.positions[i as usize]);
         let area = 0.5 * (b - a).cross(c - a).length();
@@ -70,7 +78,7 @@ impl Work<'_> {
             .length_squared()
             .max((c - b).length_squared())
             .max((a - c).length_squared());
-        self.uv_area(t) > 1e-12 && area > 1e-9 * longest
+        self.uv_area(t) > 1e-12 && area > 1e-9 * longest && self.layout_area(t) > 0.0
     }
 
     /// The cosine of the smallest interior angle of a triangle in 3D (the
@@ -88,7 +96,8 @@ impl Work<'_> {
 
     /// One pass of edge flips over the interior edges: an edge is flipped
     /// when that raises the smallest angle of its two triangles (in the plane
-    /// this is the Delaunay flip). Returns the number of flips.
+    /// this is the Delaunay flip), or when one of them is folded and the
+    /// flip unfolds both. Returns the number of flips.
     pub(super) fn flip_pass(&mut self) -> usize {
         let adjacency = Adjacency::new(self.uvs.len(), &self.triangles);
         // A triangle changed in this pass is not looked at again until the
@@ -122,9 +131,13 @@ impl Work<'_> {
                 if !self.is_valid(n1) || !self.is_valid(n2) {
                     continue;
                 }
+                // A pair with a folded triangle (the strips can fold one in
+                // the layout's UVs near a pointed end) is flipped whenever
+                // that unfolds it.
+                let repairs = !self.is_valid(tri) || !self.is_valid(other);
                 let before = self.min_angle_cos(tri).max(self.min_angle_cos(other));
                 let after = self.min_angle_cos(n1).max(self.min_angle_cos(n2));
-                if after < before - 1e-9 {
+                if repairs || after < before - 1e-9 {
                     self.triangles[t1] = n1;
                     self.triangles[t2] = n2;
                     touched[t1] = true;

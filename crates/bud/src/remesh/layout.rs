@@ -4,18 +4,23 @@
 use glam::{DVec2, DVec3};
 
 use super::{
-    Layout, NEAR_BOUNDARY, Pin, SAMPLES_ACROSS, SAMPLES_ALONG_V, Work, ZERO_WIDTH,
+    Layout, NEAR_BOUNDARY, Pin, PointedEnds, SAMPLES_ACROSS, SAMPLES_ALONG_V, Work, ZERO_WIDTH,
     cumulative_length, invert_length, point,
 };
 use crate::{BudError, RemeshOptions};
 
 impl Work<'_> {
     /// Step 1: places the vertices. Returns the rows (each in increasing
-    /// `u`): the full base row first, then the interior points of each inner
+    /// `u`): the full base row (or, when `ends` allows it, a single base
+    /// vertex where the base has no width) first, then the interior points of each inner
     /// row (rows without any are left out), then the full top row or the
     /// single tip vertex; and the two margins (`u = 0` and `u = 1`, each from
     /// its base corner to its top corner or the tip).
-    pub(super) fn lay_out(&mut self, options: &RemeshOptions) -> Result<Layout, BudError> {
+    pub(super) fn lay_out(
+        &mut self,
+        options: &RemeshOptions,
+        ends: PointedEnds,
+    ) -> Result<Layout, BudError> {
         let h = options.target_edge;
         let surface = self.surface;
         // Length along v: the mean of five lines of constant u.
@@ -45,13 +50,18 @@ impl Work<'_> {
         if length <= ZERO_WIDTH * size {
             return Err(BudError::ZeroLength);
         }
-        // Everything but the last sample (the tip) must have a width.
-        if let Some(k) = widths[..SAMPLES_ALONG_V]
+        // Everything but the last sample (the tip), and the first (the
+        // base) where a pointed base is allowed, must have a width.
+        let first = match ends {
+            PointedEnds::TipOnly => 0,
+            PointedEnds::BaseAndTip => 1,
+        };
+        if let Some(k) = widths[first..SAMPLES_ALONG_V]
             .iter()
             .position(|&w| w <= ZERO_WIDTH * size)
         {
             return Err(BudError::ZeroWidth {
-                v: k as f64 / SAMPLES_ALONG_V as f64,
+                v: (k + first) as f64 / SAMPLES_ALONG_V as f64,
             });
         }
         let spacing = h * 3f64.sqrt() / 2.0;
@@ -89,6 +99,11 @@ impl Work<'_> {
             if j == gaps && coarse[SAMPLES_ACROSS] < 0.5 * h {
                 // A pointed (or nearly pointed) tip: one vertex.
                 rows.push(vec![(DVec2::new(0.5, 1.0), Pin::Fixed)]);
+                continue;
+            }
+            if j == 0 && ends == PointedEnds::BaseAndTip && coarse[SAMPLES_ACROSS] < 0.5 * h {
+                // A pointed base, where allowed: one vertex, as the tip.
+                rows.push(vec![(DVec2::new(0.5, 0.0), Pin::Fixed)]);
                 continue;
             }
             let segments = ((coarse[SAMPLES_ACROSS] / h).round() as usize).max(1);
@@ -146,15 +161,21 @@ impl Work<'_> {
             }
         }
         let tip = point(surface, DVec2::new(0.5, 1.0))?;
+        let pointed_base = match rows[0].as_slice() {
+            [(uv, _)] => Some(point(surface, *uv)?),
+            _ => None,
+        };
 
-        // Inner-row points too close to a margin point or the tip are left
-        // out (only the two outermost points of a row on each side can be).
+        // Inner-row points too close to a margin point, the tip or a pointed
+        // base are left out (only the two outermost points of a row on each
+        // side can be).
         let too_close = |p: DVec3| {
             margin_points
                 .iter()
                 .flatten()
                 .map(|(_, m)| m)
                 .chain(std::iter::once(&tip))
+                .chain(pointed_base.as_ref())
                 .any(|m| m.distance(p) < NEAR_BOUNDARY * h)
         };
         let last = rows.len() - 1;

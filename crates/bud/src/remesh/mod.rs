@@ -24,7 +24,10 @@
 //!    `u`, corners and the tip stay, and a move that would fold a triangle in
 //!    the parameter domain is shortened or skipped.
 //!
-//! The mesh winds counter-clockwise in UV (around `dS/du × dS/dv`).
+//! The mesh winds counter-clockwise in UV (around `dS/du × dS/dv`). Its UVs
+//! are the parameters, or where the surface maps them
+//! ([`crate::Surface::layout_uv`]; triangles are kept counter-clockwise
+//! there too).
 
 mod improve;
 mod layout;
@@ -72,7 +75,21 @@ struct Work<'a> {
     boundary_neighbours: Vec<Vec<u32>>,
 }
 
-pub(crate) fn remesh(surface: &dyn Surface, options: &RemeshOptions) -> Result<Mesh, BudError> {
+/// Which ends of the organ may come to a point. A bud surface may end in a
+/// pointed tip only (its base attaches to the receptacle); a template mesh
+/// remeshed through its UVs ([`crate::remesh_mesh`]) may also have a
+/// pointed base (e.g. a disc-shaped UV layout).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum PointedEnds {
+    TipOnly,
+    BaseAndTip,
+}
+
+pub(crate) fn remesh(
+    surface: &dyn Surface,
+    options: &RemeshOptions,
+    ends: PointedEnds,
+) -> Result<Mesh, BudError> {
     let h = options.target_edge;
     if !(h.is_finite() && h > 0.0) {
         return Err(BudError::InvalidTargetEdge(h));
@@ -85,7 +102,7 @@ pub(crate) fn remesh(surface: &dyn Surface, options: &RemeshOptions) -> Result<M
         triangles: Vec::new(),
         boundary_neighbours: Vec::new(),
     };
-    let layout = work.lay_out(options)?;
+    let layout = work.lay_out(options, ends)?;
     work.triangulate(&layout);
     for _ in 0..options.smoothing_iterations {
         for _ in 0..4 {
@@ -102,7 +119,7 @@ pub(crate) fn remesh(surface: &dyn Surface, options: &RemeshOptions) -> Result<M
     }
     Ok(Mesh {
         positions: work.positions,
-        uvs: work.uvs,
+        uvs: work.uvs.iter().map(|&p| surface.layout_uv(p)).collect(),
         triangles: work.triangles,
     })
 }
