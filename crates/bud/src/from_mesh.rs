@@ -22,7 +22,7 @@
 use anthesis_mesh::{Mesh, Topology};
 use glam::{DVec2, DVec3};
 
-use crate::remesh::{self, PointedEnds};
+use crate::remesh::{self, SurfaceKind};
 use crate::{Bud, BudError, RemeshOptions, Surface};
 
 /// Lines of constant `v` at which the outline is checked (crossings, area).
@@ -200,7 +200,7 @@ impl Surface for MeshSurface<'_> {
 /// UV). `options.inner_side` is not used: the old winding decides.
 pub fn remesh_mesh(mesh: &Mesh, options: &RemeshOptions) -> Result<Bud, BudError> {
     let surface = MeshSurface::new(mesh)?;
-    let mut remeshed = remesh::remesh(&surface, options, PointedEnds::BaseAndTip)?;
+    let mut remeshed = remesh::remesh(&surface, options, SurfaceKind::TemplateMesh)?;
     // The remesher winds counter-clockwise in its parameters, which is
     // counter-clockwise in UV (s grows with u, t with v).
     if surface.clockwise_in_uv {

@@ -210,7 +210,7 @@ pub enum BudError {
 /// close to `options.target_edge`, UVs equal to the surface parameters and
 /// the winding chosen by `options.inner_side`; reports its quality.
 pub fn build_organ(surface: &dyn Surface, options: &RemeshOptions) -> Result<Bud, BudError> {
-    let mut mesh = remesh::remesh(surface, options, remesh::PointedEnds::TipOnly)?;
+    let mut mesh = remesh::remesh(surface, options, remesh::SurfaceKind::Bud)?;
     orient(&mut mesh, options.inner_side);
     checked(mesh, options)
 }

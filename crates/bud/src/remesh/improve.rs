@@ -6,6 +6,10 @@ use glam::{DVec2, DVec3};
 
 use super::{Pin, Work};
 
+/// The cosine of 20° (the default quality floor): guarded smoothing may
+/// lower an angle to this.
+const GUARD_COS: f64 = 0.939_692_620_785_908_4;
+
 /// The directed edges leaving each vertex, with their triangles: a compact
 /// adjacency rebuilt before each pass.
 struct Adjacency {
@@ -186,8 +190,10 @@ impl Work<'_> {
         (weight > 0.0).then(|| sum / weight)
     }
 
-    /// One Gauss–Seidel sweep of tangential smoothing.
-    pub(super) fn smooth_pass(&mut self) {
+    /// One Gauss–Seidel sweep of tangential smoothing. With
+    /// `guard_angles`, a move that makes the smallest angle around the
+    /// vertex worse, and below 20°, is not taken.
+    pub(super) fn smooth_pass(&mut self, guard_angles: bool) {
         let n = self.uvs.len();
         let adjacency = Adjacency::new(n, &self.triangles);
         let mut around = Vec::new();
@@ -234,7 +240,19 @@ impl Work<'_> {
             if !step.is_finite() {
                 continue;
             }
-            // Take the step, or half of it, ... as long as no triangle folds.
+            // Take the step, or half of it, ... as long as no triangle folds
+            // (and, guarded, the worst angle around does not get worse).
+            let worst_cos = |work: &Self| {
+                around
+                    .iter()
+                    .map(|&t| work.min_angle_cos(work.triangles[t]))
+                    .fold(f64::NEG_INFINITY, f64::max)
+            };
+            let allowed_cos = if guard_angles {
+                worst_cos(self).max(GUARD_COS)
+            } else {
+                f64::INFINITY
+            };
             let (old_uv, old_position) = (uv, self.positions[i]);
             let mut scale = 1.0;
             for _ in 0..4 {
@@ -243,7 +261,9 @@ impl Work<'_> {
                 if p.is_finite() {
                     self.uvs[i] = new_uv;
                     self.positions[i] = p;
-                    if around.iter().all(|&t| self.is_valid(self.triangles[t])) {
+                    if around.iter().all(|&t| self.is_valid(self.triangles[t]))
+                        && worst_cos(self) <= allowed_cos
+                    {
                         break;
                     }
                 }

@@ -4,14 +4,14 @@
 use glam::{DVec2, DVec3};
 
 use super::{
-    Layout, NEAR_BOUNDARY, Pin, PointedEnds, SAMPLES_ACROSS, SAMPLES_ALONG_V, Work, ZERO_WIDTH,
+    Layout, NEAR_BOUNDARY, Pin, SAMPLES_ACROSS, SAMPLES_ALONG_V, SurfaceKind, Work, ZERO_WIDTH,
     cumulative_length, invert_length, point,
 };
 use crate::{BudError, RemeshOptions};
 
 impl Work<'_> {
     /// Step 1: places the vertices. Returns the rows (each in increasing
-    /// `u`): the full base row (or, when `ends` allows it, a single base
+    /// `u`): the full base row (or, for a template mesh, a single base
     /// vertex where the base has no width) first, then the interior points of each inner
     /// row (rows without any are left out), then the full top row or the
     /// single tip vertex; and the two margins (`u = 0` and `u = 1`, each from
@@ -19,7 +19,7 @@ impl Work<'_> {
     pub(super) fn lay_out(
         &mut self,
         options: &RemeshOptions,
-        ends: PointedEnds,
+        kind: SurfaceKind,
     ) -> Result<Layout, BudError> {
         let h = options.target_edge;
         let surface = self.surface;
@@ -52,9 +52,9 @@ impl Work<'_> {
         }
         // Everything but the last sample (the tip), and the first (the
         // base) where a pointed base is allowed, must have a width.
-        let first = match ends {
-            PointedEnds::TipOnly => 0,
-            PointedEnds::BaseAndTip => 1,
+        let first = match kind {
+            SurfaceKind::Bud => 0,
+            SurfaceKind::TemplateMesh => 1,
         };
         if let Some(k) = widths[first..SAMPLES_ALONG_V]
             .iter()
@@ -101,7 +101,7 @@ impl Work<'_> {
                 rows.push(vec![(DVec2::new(0.5, 1.0), Pin::Fixed)]);
                 continue;
             }
-            if j == 0 && ends == PointedEnds::BaseAndTip && coarse[SAMPLES_ACROSS] < 0.5 * h {
+            if j == 0 && kind == SurfaceKind::TemplateMesh && coarse[SAMPLES_ACROSS] < 0.5 * h {
                 // A pointed base, where allowed: one vertex, as the tip.
                 rows.push(vec![(DVec2::new(0.5, 0.0), Pin::Fixed)]);
                 continue;

@@ -75,20 +75,27 @@ struct Work<'a> {
     boundary_neighbours: Vec<Vec<u32>>,
 }
 
-/// Which ends of the organ may come to a point. A bud surface may end in a
-/// pointed tip only (its base attaches to the receptacle); a template mesh
-/// remeshed through its UVs ([`crate::remesh_mesh`]) may also have a
-/// pointed base (e.g. a disc-shaped UV layout).
+/// What is remeshed.
+///
+/// A bud surface may end in a pointed tip only (its base attaches to the
+/// receptacle). A template mesh remeshed through its UVs
+/// ([`crate::remesh_mesh`]) may also have a pointed base (e.g. a
+/// disc-shaped UV layout), and, being piecewise flat with the kinks of its
+/// old triangles, its smoothing keeps a move only if it does not make the
+/// smallest angle around the vertex worse (below 20°): on the shipped
+/// Eustoma petal, unguarded smoothing pushed a vertex next to the blunt
+/// tip's edge (a 6.4° triangle). Bud surfaces keep the unguarded rule, so
+/// the committed buds are built as before.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum PointedEnds {
-    TipOnly,
-    BaseAndTip,
+pub(crate) enum SurfaceKind {
+    Bud,
+    TemplateMesh,
 }
 
 pub(crate) fn remesh(
     surface: &dyn Surface,
     options: &RemeshOptions,
-    ends: PointedEnds,
+    kind: SurfaceKind,
 ) -> Result<Mesh, BudError> {
     let h = options.target_edge;
     if !(h.is_finite() && h > 0.0) {
@@ -102,7 +109,7 @@ pub(crate) fn remesh(
         triangles: Vec::new(),
         boundary_neighbours: Vec::new(),
     };
-    let layout = work.lay_out(options, ends)?;
+    let layout = work.lay_out(options, kind)?;
     work.triangulate(&layout);
     for _ in 0..options.smoothing_iterations {
         for _ in 0..4 {
@@ -110,7 +117,7 @@ pub(crate) fn remesh(
                 break;
             }
         }
-        work.smooth_pass();
+        work.smooth_pass(kind == SurfaceKind::TemplateMesh);
     }
     for _ in 0..8 {
         if work.flip_pass() == 0 {
