@@ -4,9 +4,11 @@
 
 pub mod project;
 mod receptacle;
+pub mod resolution;
 pub mod scale;
 
 pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
+pub use resolution::Resolution;
 
 use anthesis_maps::KeyedMaps;
 use anthesis_mesh::Mesh;
@@ -177,6 +179,9 @@ pub struct SimulationSettings {
     pub model: Model,
     /// Which angle a hinge's growth starts from.
     pub bend_base: BendBase,
+    /// The meshes as built, or every template remeshed at one mean edge
+    /// ([`resolution`]; the project keeps the meshes as built).
+    pub resolution: Resolution,
 }
 
 impl Default for SimulationSettings {
@@ -187,6 +192,7 @@ impl Default for SimulationSettings {
             collision_offset: 0.01,
             model: Model::default(),
             bend_base: BendBase::default(),
+            resolution: Resolution::AsBuilt,
         }
     }
 }

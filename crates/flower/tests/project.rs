@@ -11,7 +11,8 @@ use anthesis_flower::project::{
     save_project,
 };
 use anthesis_flower::{
-    BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings, Template,
+    BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, Resolution,
+    SimulationSettings, Template,
 };
 use anthesis_maps::{
     BitDepth, Blend, DirectionMap, GrowthMaps, KeyedMaps, MapError, MapKey, MapKind, ScalarMap,
@@ -424,21 +425,21 @@ fn a_newer_version_says_so() {
     // A newer version may have fields this build does not know: the version
     // error must win over the unknown field.
     edit(&path, |text| {
-        replace_once(text, "version = 2", "version = 3\nwind = \"strong\"")
+        replace_once(text, "version = 2", "version = 4\nwind = \"strong\"")
     });
     let error = load_project(&path).expect_err("newer");
     assert_eq!(
         error,
         ProjectError::NewerVersion {
             path: path.clone(),
-            found: 3,
+            found: 4,
             supported: FORMAT_VERSION,
         }
     );
     assert_eq!(
         error.to_string(),
         format!(
-            "{} was written by a newer Anthesis (format version 3; this build reads up to 2)",
+            "{} was written by a newer Anthesis (format version 4; this build reads up to 3)",
             path.display()
         )
     );
@@ -1267,4 +1268,61 @@ fn a_version_1_project_from_the_previous_release_opens() {
         project.settings.bend_base,
         anthesis_physics::BendBase::Dihedral
     );
+}
+
+#[test]
+fn the_resolution_is_saved_and_read_and_the_mesh_as_built_is_kept() {
+    let (_folder, path) = saved_lily();
+    let as_built = fs::read_to_string(&path).expect("read");
+    // No setting: the file is the version 2 file it always was.
+    assert!(as_built.contains("version = 2\n"), "{as_built}");
+    assert!(!as_built.contains("mean_edge"));
+    let loaded = load_project(&path).expect("loads");
+    assert_eq!(loaded.settings.resolution, Resolution::AsBuilt);
+
+    let mut fine = loaded.clone();
+    fine.settings.resolution = Resolution::MeanEdge(0.75);
+    let folder = tempfile::tempdir().expect("temp dir");
+    let fine_path = folder.path().join("fine").join("lily.anthesis.toml");
+    save_project(&fine, &fine_path).expect("saves");
+    let text = fs::read_to_string(&fine_path).expect("read");
+    assert!(text.contains("version = 3\n"), "{text}");
+    assert!(text.contains("mean_edge = 0.75\n"), "{text}");
+    let read = load_project(&fine_path).expect("loads");
+    assert_eq!(read.settings.resolution, Resolution::MeanEdge(0.75));
+    // The mesh saved is the one built, not the remeshed one.
+    assert_eq!(
+        read.flower.templates[0].mesh,
+        loaded.flower.templates[0].mesh
+    );
+    let mesh_file = |p: &Path| fs::read(p.parent().expect("folder").join("meshes/petal.obj"));
+    assert_eq!(
+        mesh_file(&fine_path).expect("mesh"),
+        mesh_file(&path).expect("mesh")
+    );
+    // Back to as built: the same bytes as the first save.
+    let mut back = read;
+    back.settings.resolution = Resolution::AsBuilt;
+    let back_path = folder.path().join("back").join("lily.anthesis.toml");
+    save_project(&back, &back_path).expect("saves");
+    assert_eq!(fs::read_to_string(&back_path).expect("read"), as_built);
+}
+
+#[test]
+fn a_mean_edge_that_is_not_a_length_is_refused() {
+    for bad in ["0.0", "-1.0", "nan"] {
+        let (_folder, path) = saved_lily();
+        edit(&path, |text| {
+            replace_once(
+                text,
+                "[simulation]\n",
+                &format!("[simulation]\nmean_edge = {bad}\n"),
+            )
+        });
+        let message = load_project(&path).expect_err("bad").to_string();
+        assert!(
+            message.contains("mean_edge must be a positive length"),
+            "{bad}: {message}"
+        );
+    }
 }

@@ -111,7 +111,9 @@ impl fmt::Display for MemoryEstimate {
 }
 
 /// The memory a run of the organs of `project` in `selection` needs, with
-/// its keyframes kept as `cost` says.
+/// its keyframes kept as `cost` says; at the project's resolution (the
+/// remeshed meshes' sizes predicted from their areas when the project sets
+/// a mean edge and has not been resolved yet).
 pub fn estimate(project: &Project, selection: &Selection, cost: KeyframeCost) -> MemoryEstimate {
     let flower = &project.flower;
     let mut solver_bytes = 0u64;
@@ -121,10 +123,17 @@ pub fn estimate(project: &Project, selection: &Selection, cost: KeyframeCost) ->
         if organ >= flower.organs.len() {
             continue;
         }
+        // A project not yet resolved to its resolution counts the meshes it
+        // will be remeshed into (`anthesis_flower::resolution`), so that a
+        // too-fine edge is refused before anything is remeshed.
         let mesh = &flower.template_of(organ).mesh;
-        solver_bytes = solver_bytes.saturating_add(organ_solver_bytes(mesh.triangle_count()));
-        triangles += mesh.triangle_count() as u64;
-        particles += mesh.vertex_count() as u64;
+        let (organ_particles, organ_triangles) = match project.settings.resolution.mean_edge() {
+            Some(edge) => anthesis_flower::resolution::predicted_size(mesh, edge),
+            None => (mesh.vertex_count(), mesh.triangle_count()),
+        };
+        solver_bytes = solver_bytes.saturating_add(organ_solver_bytes(organ_triangles));
+        triangles += organ_triangles as u64;
+        particles += organ_particles as u64;
     }
     let keyframes = u64::from(project.settings.keyframes) + 1;
     let keyframe_bytes = keyframes
@@ -318,6 +327,38 @@ mod tests {
         );
         assert!(message.contains("for 11 keyframes"), "{message}");
         assert!(message.contains("of memory is available"), "{message}");
+    }
+
+    #[test]
+    fn a_mean_edge_counts_the_meshes_it_will_make() {
+        use anthesis_flower::Resolution;
+        let mut project = whorl(1, 28, 14, 10);
+        let built = estimate(&project, &Selection::All, KeyframeCost::Kept);
+        let edge = anthesis_bud::quality(&project.flower.templates[0].mesh).mean_edge / 2.0;
+        project.settings.resolution = Resolution::MeanEdge(edge);
+        let predicted = estimate(&project, &Selection::All, KeyframeCost::Kept);
+        let resolved = anthesis_flower::resolution::resolve(&project).expect("remeshes");
+        let actual = estimate(&resolved, &Selection::All, KeyframeCost::Kept);
+        // The prediction is what the remesh makes, and half the edge
+        // predicts four times the triangles.
+        assert_ne!(predicted.triangles, built.triangles);
+        project.settings.resolution = Resolution::MeanEdge(edge / 2.0);
+        let finer = estimate(&project, &Selection::All, KeyframeCost::Kept);
+        let ratio = finer.triangles as f64 / predicted.triangles as f64;
+        assert!((ratio - 4.0).abs() < 0.2, "{ratio}");
+        let off = predicted.triangles.abs_diff(actual.triangles) as f64 / actual.triangles as f64;
+        // Within 30 % (the remeshed mean edge is within 10 % of the one
+        // asked for, and triangles go as its inverse square; this small
+        // petal has much outline); the run is checked again on the
+        // remeshed meshes before it starts, so the prediction only has to
+        // stop an edge that is far too fine before it is remeshed.
+        assert!(off < 0.3, "predicted {predicted}, remeshed {actual}");
+        // An edge that would make millions of particles is refused by the
+        // estimate alone, before anything is remeshed.
+        project.settings.resolution = Resolution::MeanEdge(edge / 200.0);
+        let huge = estimate(&project, &Selection::All, KeyframeCost::Kept);
+        assert!(huge.triangles > 10_000_000, "{huge}");
+        assert!(check(huge, 8 << 30).is_err());
     }
 
     #[test]

@@ -153,6 +153,14 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
             short_number(settings.collision_offset)
         ));
     }
+    if let Some(edge) = settings.resolution.mean_edge()
+        && !(edge > 0.0 && edge.is_finite())
+    {
+        return invalid(format!(
+            "simulation: mean_edge must be a positive length, found {}",
+            short_number(edge)
+        ));
+    }
 
     for template in &flower.templates {
         if let Some(message) = template.problem() {

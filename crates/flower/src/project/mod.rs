@@ -4,7 +4,7 @@
 //!
 //! ```toml
 //! format = "anthesis-project"
-//! version = 2
+//! version = 3
 //! name = "Asiatic lily"
 //!
 //! [simulation]                 # optional; each field defaults as shown
@@ -17,6 +17,11 @@
 //!                              # read as "paper", the model they were made with
 //! bend_from = "dihedral"       # or "rest_angle": what a hinge's growth adds
 //!                              # to, its current dihedral or its rest angle
+//! mean_edge = 0.8              # absent: the meshes as built; a length:
+//!                              # every template simulated remeshed at this
+//!                              # mean edge (crate::resolution; the meshes
+//!                              # saved stay as built). Version 3; files
+//!                              # without it are written as version 2
 //!
 //! [[templates]]
 //! name = "petal"
@@ -118,7 +123,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// Where saved meshes go, relative to the project file.
 pub const MESH_FOLDER: &str = "meshes";

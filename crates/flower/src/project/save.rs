@@ -12,7 +12,7 @@ use super::schema::{
     ProjectFile, ScalarEntry, SimulationFile, TemplateFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
-use crate::{Project, Template};
+use crate::{Project, Resolution, Template};
 
 /// The files of a saved project: the TOML text and the meshes and maps, by
 /// path relative to the project file.
@@ -57,7 +57,7 @@ pub(super) fn plan_save(
         .collect();
     let file = ProjectFile {
         format: FORMAT_NAME.to_string(),
-        version: FORMAT_VERSION,
+        version: file_version(project),
         name: project.name.clone(),
         simulation: SimulationFile::from(&project.settings),
         templates,
@@ -73,6 +73,17 @@ pub(super) fn plan_save(
          files in {MAP_FOLDER}/.\n{body}"
     );
     Ok(SavePlan { toml, files })
+}
+
+/// The format version a file of `project` needs: the oldest that holds
+/// everything it sets, so a project that sets nothing new stays readable by
+/// older builds and saves byte for byte as before (version 3 added
+/// `mean_edge`).
+fn file_version(project: &Project) -> u32 {
+    match project.settings.resolution {
+        Resolution::AsBuilt => 2,
+        Resolution::MeanEdge(_) => FORMAT_VERSION,
+    }
 }
 
 /// The file entry of one template; adds its mesh and raster maps to `files`.

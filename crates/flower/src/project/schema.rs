@@ -8,7 +8,7 @@ use anthesis_physics::{BendBase, Model, SolverSettings};
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 
-use crate::{BaseRegion, JointRamp, SimulationSettings};
+use crate::{BaseRegion, JointRamp, Resolution, SimulationSettings};
 
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -37,6 +37,9 @@ pub(super) struct SimulationFile {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(super) model: Option<ModelFile>,
     pub(super) bend_from: BendFromFile,
+    /// Absent: the meshes as built (every file before version 3).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(super) mean_edge: Option<f64>,
 }
 
 /// [`Model`] in the file.
@@ -301,6 +304,7 @@ impl From<&SimulationSettings> for SimulationFile {
                 BendBase::Dihedral => BendFromFile::Dihedral,
                 BendBase::RestAngle => BendFromFile::RestAngle,
             },
+            mean_edge: settings.resolution.mean_edge(),
         }
     }
 }
@@ -334,6 +338,10 @@ impl From<&SimulationFile> for SimulationSettings {
                 max_iterations: file.max_iterations,
             },
             collision_offset: file.collision_offset,
+            resolution: match file.mean_edge {
+                Some(edge) => Resolution::MeanEdge(edge),
+                None => Resolution::AsBuilt,
+            },
             ..SimulationSettings::default()
         }
     }

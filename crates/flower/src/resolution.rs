@@ -1,0 +1,280 @@
+//! The resolution a flower is simulated at: every template remeshed at one
+//! mean edge length (project units), or the meshes as built.
+//!
+//! The remeshed meshes are derived: a [`Project`] keeps the meshes the user
+//! made and the setting ([`SimulationSettings::resolution`]); [`resolve`]
+//! gives the project to simulate, each template's mesh remeshed by
+//! [`anthesis_bud::remesh_mesh`] (the bud remesher, through the mesh's UV
+//! layout), so the painted maps, which are rasters over the UVs, apply
+//! unchanged. The same flower can be simulated coarse while painting and
+//! fine for the final export.
+//!
+//! Why one edge length in project units and not a factor of each
+//! template's own edge: organs touch and are pushed apart particle by
+//! particle, so organs meshed alike behave alike; a length is what the
+//! paper reports (Table 1: 1.3 for a lily petal) and what the window shows
+//! beside the particle counts it gives; and a factor would mean something
+//! different for every imported mesh.
+//!
+//! [`SimulationSettings::resolution`]: crate::SimulationSettings::resolution
+
+use anthesis_bud::{BudError, RemeshOptions, remesh_mesh};
+use anthesis_mesh::Mesh;
+use thiserror::Error;
+
+use crate::{Project, Template};
+
+/// How finely the templates are simulated.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Resolution {
+    /// The meshes as they were built or imported.
+    #[default]
+    AsBuilt,
+    /// Every template remeshed at this mean edge length (project units).
+    MeanEdge(f64),
+}
+
+impl Resolution {
+    /// The mean edge asked for, if any.
+    pub fn mean_edge(self) -> Option<f64> {
+        match self {
+            Resolution::AsBuilt => None,
+            Resolution::MeanEdge(edge) => Some(edge),
+        }
+    }
+}
+
+/// The most particles one remeshed template may have. Far more than a
+/// film-resolution petal (4,000 to 10,000); the memory check of a run
+/// (`anthesis_sim::memory`) usually refuses well before this.
+pub const MAX_PARTICLES_PER_TEMPLATE: usize = 200_000;
+
+/// Why a template could not be remeshed.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("template \"{template}\" cannot be remeshed at mean edge {mean_edge}: {problem}")]
+pub struct ResolutionError {
+    /// The template's name.
+    pub template: String,
+    /// The edge asked for.
+    pub mean_edge: f64,
+    pub problem: ResolutionProblem,
+}
+
+/// What went wrong remeshing a template.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ResolutionProblem {
+    #[error(transparent)]
+    Remesh(#[from] BudError),
+    #[error(
+        "no particle of the new mesh lies in the base region (v ≤ {v_max}, {u_min} ≤ u ≤ {u_max}), so nothing would attach it; widen base_region or use a finer edge"
+    )]
+    NoBase { v_max: f64, u_min: f64, u_max: f64 },
+    #[error(
+        "the new mesh has {particles} base particles where the old had {old}; at least two are needed to hold the organ"
+    )]
+    TooFewBaseParticles { particles: usize, old: usize },
+}
+
+/// The options the remesh uses at `mean_edge`.
+fn options(mean_edge: f64) -> RemeshOptions {
+    RemeshOptions {
+        max_vertices: MAX_PARTICLES_PER_TEMPLATE,
+        ..RemeshOptions::new(mean_edge)
+    }
+}
+
+/// `template`'s mesh remeshed at `mean_edge` (see the module
+/// documentation); its base region must still hold at least two particles
+/// (or as many as the old mesh had, if fewer).
+pub fn remesh_template(template: &Template, mean_edge: f64) -> Result<Mesh, ResolutionError> {
+    let error = |problem: ResolutionProblem| ResolutionError {
+        template: template.name.clone(),
+        mean_edge,
+        problem,
+    };
+    let bud = remesh_mesh(&template.mesh, &options(mean_edge))
+        .map_err(|e| error(ResolutionProblem::Remesh(e)))?;
+    let region = template.base_region;
+    let base = region.particles(&bud.mesh).len();
+    let old = region.particles(&template.mesh).len();
+    if base == 0 && old > 0 {
+        return Err(error(ResolutionProblem::NoBase {
+            v_max: region.v_max,
+            u_min: region.u_min,
+            u_max: region.u_max,
+        }));
+    }
+    if base < old.min(2) {
+        return Err(error(ResolutionProblem::TooFewBaseParticles {
+            particles: base,
+            old,
+        }));
+    }
+    Ok(bud.mesh)
+}
+
+/// The project to simulate: `project` with every template remeshed as its
+/// resolution says (unchanged, but for the setting, when it is
+/// [`Resolution::AsBuilt`]). The result's resolution is `AsBuilt`: its
+/// meshes are the resolution. The first template that cannot be remeshed is
+/// an error naming it.
+pub fn resolve(project: &Project) -> Result<Project, ResolutionError> {
+    let mut resolved = project.clone();
+    resolved.settings.resolution = Resolution::AsBuilt;
+    if let Resolution::MeanEdge(edge) = project.settings.resolution {
+        for template in &mut resolved.flower.templates {
+            template.mesh = remesh_template(template, edge)?;
+        }
+    }
+    Ok(resolved)
+}
+
+/// About how many particles and triangles `mesh` gets remeshed at
+/// `mean_edge`, from its area and outline, without remeshing it (for memory
+/// estimates before a run). An equilateral mesh of edge `h` has a triangle
+/// per `√3/4 · h²` of area; a vertex on the outline, every `h` along it,
+/// counts half in that area.
+pub fn predicted_size(mesh: &Mesh, mean_edge: f64) -> (usize, usize) {
+    if !(mean_edge > 0.0 && mean_edge.is_finite()) {
+        return (mesh.vertex_count(), mesh.triangle_count());
+    }
+    let per_triangle = 3f64.sqrt() / 4.0 * mean_edge * mean_edge;
+    let triangles = (mesh.area() / per_triangle).min(1e15);
+    let outline: f64 = anthesis_mesh::Topology::build(mesh)
+        .map(|topology| {
+            topology
+                .boundary_edges()
+                .map(|[a, b]| mesh.positions[a as usize].distance(mesh.positions[b as usize]))
+                .sum()
+        })
+        .unwrap_or(0.0);
+    let particles = triangles / 2.0 + (outline / mean_edge).min(1e15) / 2.0 + 1.0;
+    (particles as usize, triangles as usize)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{BaseRegion, Flower, Organ, Placement, SimulationSettings};
+    use anthesis_maps::KeyedMaps;
+    use anthesis_mesh::generate::test_petal;
+
+    fn template(mesh: Mesh) -> Template {
+        Template {
+            name: "petal".to_string(),
+            mesh,
+            maps: KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
+            dg: 0.01,
+            thickness: 0.2,
+            stretch_stiffness: 20.0,
+            bend_stiffness: 20.0,
+            base_region: BaseRegion::default(),
+            joint_schedule: Vec::new(),
+            color: [1.0; 4],
+        }
+    }
+
+    fn project(mesh: Mesh, resolution: Resolution) -> Project {
+        Project {
+            name: "test".to_string(),
+            flower: Flower {
+                templates: vec![template(mesh)],
+                organs: vec![Organ {
+                    name: "petal-1".to_string(),
+                    template: 0,
+                    placement: Placement {
+                        position: glam::DVec3::ZERO,
+                        azimuth_deg: 0.0,
+                        joint_angle_deg: 0.0,
+                    },
+                }],
+                overlaps: Vec::new(),
+            },
+            settings: SimulationSettings {
+                resolution,
+                ..SimulationSettings::default()
+            },
+        }
+    }
+
+    #[test]
+    fn as_built_changes_nothing_and_an_edge_remeshes_every_template() {
+        let mesh = test_petal(10.0, 5.0, 9, 17);
+        let same = resolve(&project(mesh.clone(), Resolution::AsBuilt)).expect("resolves");
+        assert_eq!(same, project(mesh.clone(), Resolution::AsBuilt));
+        let fine = resolve(&project(mesh.clone(), Resolution::MeanEdge(0.4))).expect("resolves");
+        let remeshed = &fine.flower.templates[0].mesh;
+        assert!(remeshed.vertex_count() > 2 * mesh.vertex_count());
+        assert_eq!(fine.settings.resolution, Resolution::AsBuilt);
+        // The prediction is close to what the remesh gives.
+        let (predicted, _) = predicted_size(&mesh, 0.4);
+        let actual = remeshed.vertex_count() as f64;
+        assert!(
+            (predicted as f64 - actual).abs() < 0.1 * actual,
+            "{predicted} vs {actual}"
+        );
+        // The base region still picks the base row, across the whole base.
+        let base = fine.flower.templates[0].base_region.particles(remeshed);
+        let xs: Vec<f64> = base
+            .iter()
+            .map(|&i| remeshed.positions[i as usize].x)
+            .collect();
+        let width = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - xs.iter().copied().fold(f64::INFINITY, f64::min);
+        let old_base = BaseRegion::default().particles(&mesh);
+        let old_xs: Vec<f64> = old_base
+            .iter()
+            .map(|&i| mesh.positions[i as usize].x)
+            .collect();
+        let old_width = old_xs.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            - old_xs.iter().copied().fold(f64::INFINITY, f64::min);
+        // The old base row's corners are base particles again (a finer mesh
+        // has more particles below v_max: margin particles too).
+        assert!(width >= old_width - 1e-9, "{width} vs {old_width}");
+        for corner in [glam::DVec2::new(0.0, 0.0), glam::DVec2::new(1.0, 0.0)] {
+            let at = mesh
+                .uvs
+                .iter()
+                .position(|uv| *uv == corner)
+                .expect("corner");
+            assert!(
+                base.iter()
+                    .any(|&i| remeshed.positions[i as usize].distance(mesh.positions[at]) < 1e-9),
+                "base corner {corner} is not a base particle"
+            );
+        }
+    }
+
+    #[test]
+    fn a_failure_names_the_template_and_why() {
+        let mesh = test_petal(10.0, 5.0, 9, 17);
+        let error = resolve(&project(mesh, Resolution::MeanEdge(1e-4))).expect_err("too fine");
+        let text = error.to_string();
+        assert!(
+            text.starts_with("template \"petal\" cannot be remeshed at mean edge 0.0001"),
+            "{text}"
+        );
+        assert!(text.contains("more than the limit of 200000"), "{text}");
+    }
+
+    #[test]
+    fn a_base_region_the_new_mesh_misses_is_refused() {
+        let mesh = test_petal(10.0, 5.0, 9, 17);
+        let mut template = template(mesh);
+        // The old mesh has a row at v = 1/16; a coarse mesh has none there.
+        template.base_region = BaseRegion {
+            v_max: 0.07,
+            u_min: 0.4,
+            u_max: 0.6,
+        };
+        assert!(!template.base_region.particles(&template.mesh).is_empty());
+        match remesh_template(&template, 2.5) {
+            Err(ResolutionError {
+                problem:
+                    ResolutionProblem::NoBase { .. } | ResolutionProblem::TooFewBaseParticles { .. },
+                ..
+            }) => {}
+            other => panic!("{other:?}"),
+        }
+    }
+}
