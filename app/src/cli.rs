@@ -10,9 +10,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anthesis_export::{Encoding, GlbOptions, Timing};
-use anthesis_flower::Project;
 use anthesis_flower::project::load_project;
+use anthesis_flower::{Project, Resolution};
 use anthesis_sim::Selection;
+use anthesis_sim::memory::KeyframeCost;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -36,6 +37,9 @@ pub enum Command {
     Info {
         /// A project file (*.anthesis.toml).
         project: PathBuf,
+        /// Count the particles at this resolution (see `simulate --edge`).
+        #[arg(long, value_name = "LENGTH|as-built", value_parser = parse_edge)]
+        edge: Option<Resolution>,
     },
     /// Simulate a project and write statistics and the animation.
     Simulate {
@@ -47,6 +51,12 @@ pub enum Command {
         /// Number of keyframes (default: the project's).
         #[arg(long)]
         keyframes: Option<u32>,
+        /// Simulate every template remeshed at this mean edge length, in
+        /// project units (the painted maps apply unchanged), or `as-built`
+        /// for the meshes as they are (default: the project's
+        /// `[simulation] mean_edge`, else as built).
+        #[arg(long, value_name = "LENGTH|as-built", value_parser = parse_edge)]
+        edge: Option<Resolution>,
         /// Write per-keyframe statistics as JSON.
         #[arg(long, value_name = "FILE.json")]
         stats: Option<PathBuf>,
@@ -178,11 +188,12 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         // No subcommand: the desktop window.
         None => crate::desktop::run(),
-        Some(Command::Info { project }) => simulate::info(&project),
+        Some(Command::Info { project, edge }) => simulate::info(&project, edge),
         Some(Command::Simulate {
             project,
             organ,
             keyframes,
+            edge,
             stats,
             out,
             fps,
@@ -209,6 +220,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 &project,
                 organ.as_deref(),
                 keyframes,
+                edge,
                 stats.as_deref(),
                 out.as_deref(),
                 &glb,
@@ -236,6 +248,39 @@ fn load(path: &Path) -> Result<Project> {
     let project = load_project(path).context("cannot open project")?;
     check_units(&project)?;
     Ok(project)
+}
+
+/// `--edge`: a positive length, or `as-built`.
+fn parse_edge(text: &str) -> Result<Resolution, String> {
+    if text.trim() == "as-built" {
+        return Ok(Resolution::AsBuilt);
+    }
+    match text.trim().parse::<f64>() {
+        Ok(edge) if edge > 0.0 && edge.is_finite() => Ok(Resolution::MeanEdge(edge)),
+        _ => Err(format!(
+            "`{text}` is not a mean edge length: give a positive number in project units, or \
+             as-built"
+        )),
+    }
+}
+
+/// The project to simulate: every template remeshed at the project's
+/// resolution, or at `edge` when given (`anthesis_flower::resolution`).
+/// With `memory`, the run of `selection` is checked against the memory
+/// first, on the sizes the remeshed meshes will have, so that a too-fine
+/// edge is refused before anything is remeshed.
+fn at_resolution(
+    mut project: Project,
+    edge: Option<Resolution>,
+    memory: Option<(&Selection, KeyframeCost)>,
+) -> Result<Project> {
+    if let Some(edge) = edge {
+        project.settings.resolution = edge;
+    }
+    if let Some((selection, cost)) = memory {
+        anthesis_sim::memory::check_run(&project, selection, cost)?;
+    }
+    Ok(anthesis_flower::resolution::resolve(&project)?)
 }
 
 /// Refuses a project with a mesh in another unit than the project (see

@@ -414,7 +414,7 @@ fn catalogue() -> Vec<Case> {
                 replace(d, PROJECT, "version = 2", "version = 99");
                 info(d)
             },
-            "was written by a newer Anthesis (format version 99; this build reads up to 2)"
+            "was written by a newer Anthesis (format version 99; this build reads up to 3)"
         ),
         case!(
             "NaN parameter",
@@ -571,6 +571,31 @@ fn catalogue() -> Vec<Case> {
             |d| simulate(d, &[]),
             "ANTHESIS_MEMORY_LIMIT_MIB must be a whole number of MiB above 0, found lots",
             &[("ANTHESIS_MEMORY_LIMIT_MIB", "lots")]
+        ),
+        // -------------------------------------------------------- resolution
+        case!(
+            "a mean edge that would make millions of particles",
+            |d| simulate(d, &["--edge", "0.0001"]),
+            "of memory is available; simulate fewer organs (one organ alone) or keyframes, or use a coarser mesh",
+            &[("ANTHESIS_MEMORY_LIMIT_MIB", "4096")]
+        ),
+        case!(
+            "a mean edge too long for a template",
+            |d| simulate(d, &["--edge", "50"]),
+            "template \"petal\" cannot be remeshed at mean edge 50: target edge 50 is too large for this organ"
+        ),
+        case!(
+            "a mean edge in the file that is not a length",
+            |d| {
+                replace(
+                    d,
+                    PROJECT,
+                    "[simulation]\n",
+                    "[simulation]\nmean_edge = -1.0\n",
+                );
+                info(d)
+            },
+            "simulation: mean_edge must be a positive length, found -1"
         ),
         // ------------------------------------------------------------ solver
         case!(

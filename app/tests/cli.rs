@@ -30,6 +30,65 @@ fn info_prints_one_line_per_organ_with_counts() {
 }
 
 #[test]
+fn edge_remeshes_what_info_counts_and_what_simulate_runs() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 2);
+    let p = path.to_str().expect("utf-8");
+    let particles = |args: &[&str]| -> Vec<usize> {
+        let out = anthesis(args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+            .lines()
+            .map(|l| {
+                l.split(' ')
+                    .nth(2)
+                    .expect("particles")
+                    .parse()
+                    .expect("a count")
+            })
+            .collect()
+    };
+    let built = particles(&["info", p]);
+    assert_eq!(particles(&["info", p, "--edge", "as-built"]), built);
+    let project = anthesis_flower::project::load_project(&path).expect("loads");
+    let edge = anthesis_bud::quality(&project.flower.templates[0].mesh).mean_edge;
+    let fine = particles(&["info", p, "--edge", &format!("{}", edge / 2.0)]);
+    // Half the edge, about four times the particles.
+    for (f, b) in fine.iter().zip(&built) {
+        assert!(*f > 3 * b && *f < 5 * b, "{fine:?} vs {built:?}");
+    }
+    // The project's own setting, and --edge over it.
+    let text_file = std::fs::read_to_string(&path).expect("read");
+    let set = text_file.replacen(
+        "[simulation]\n",
+        &format!("[simulation]\nmean_edge = {}\n", edge / 2.0),
+        1,
+    );
+    std::fs::write(&path, set).expect("write");
+    assert_eq!(particles(&["info", p]), fine);
+    assert_eq!(particles(&["info", p, "--edge", "as-built"]), built);
+    // A run at that resolution writes keyframes of the remeshed size.
+    let stats = dir.path().join("stats.json");
+    let out = anthesis(&[
+        "simulate",
+        p,
+        "--organ",
+        "petal-1",
+        "--stats",
+        stats.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // Not a length: a usage error that says what --edge takes.
+    let out = anthesis(&["info", p, "--edge", "0"]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("`0` is not a mean edge length"),
+        "{}",
+        text(&out.stderr)
+    );
+}
+
+#[test]
 fn simulate_writes_stats_json_and_a_glb() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = saved_whorl(dir.path(), 2, 4);

@@ -15,7 +15,7 @@ use clap::Args;
 use image::RgbaImage;
 
 use super::simulate::{run_keyframes, set_keyframes};
-use super::{load, selection};
+use super::{at_resolution, load, selection};
 use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
 #[derive(Debug, Args)]
@@ -78,6 +78,10 @@ pub struct RenderArgs {
     /// Number of keyframes of the run (default: the project's).
     #[arg(long, value_name = "N")]
     pub keyframes: Option<u32>,
+    /// Simulate every template remeshed at this mean edge length (see
+    /// `simulate --edge`).
+    #[arg(long, value_name = "LENGTH|as-built", value_parser = super::parse_edge)]
+    pub edge: Option<anthesis_flower::Resolution>,
     /// Also write DIR/tiled.png: the frames side by side, in keyframe order.
     #[arg(long)]
     pub tile: bool,
@@ -96,6 +100,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let mut project = load(&args.project)?;
     set_keyframes(&mut project, args.keyframes)?;
     let selection = selection(&project, args.organ.as_deref())?;
+    let project = at_resolution(project, args.edge, Some((&selection, KeyframeCost::Kept)))?;
     let last_keyframe = project.settings.keyframes;
     let (width, height) = parse_size(&args.size)?;
     if !args.azimuth.is_finite() {

@@ -6,16 +6,16 @@ use std::path::Path;
 use std::time::Instant;
 
 use anthesis_export::{GlbOptions, UsdOptions};
-use anthesis_flower::MAX_KEYFRAMES;
+use anthesis_flower::{MAX_KEYFRAMES, Resolution};
 use anthesis_sim::memory::{self, KeyframeCost};
 use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
-use super::{load, selection};
+use super::{at_resolution, load, selection};
 
-pub(super) fn info(path: &Path) -> Result<()> {
-    let project = load(path)?;
+pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
+    let project = at_resolution(load(path)?, edge, None)?;
     let flower = &project.flower;
     let mut stdout = std::io::stdout().lock();
     for (i, organ) in flower.organs.iter().enumerate() {
@@ -48,6 +48,7 @@ pub(super) fn simulate(
     path: &Path,
     organ: Option<&str>,
     keyframes: Option<u32>,
+    edge: Option<Resolution>,
     stats_path: Option<&Path>,
     out: Option<&Path>,
     glb: &GlbOptions,
@@ -77,6 +78,7 @@ pub(super) fn simulate(
         Some(OutputKind::Usd) => KeyframeCost::Usd,
         Some(OutputKind::ObjFolder) => KeyframeCost::Obj,
     };
+    let project = at_resolution(project, edge, Some((&selection, cost)))?;
     memory::check_run(&project, &selection, cost)?;
 
     let mut sim = Simulation::new(&project, &selection)?;

@@ -11,7 +11,7 @@
 
 use std::path::PathBuf;
 
-use anthesis_flower::{Project, Template};
+use anthesis_flower::{Project, Resolution, Template};
 use anthesis_maps::{Blend, DirectionMap, MapKey, MapKind, ScalarMap};
 use anthesis_mesh::Mesh;
 use glam::DVec2;
@@ -102,6 +102,9 @@ pub enum ProjectEdit {
     Blend { template: usize, blend: Blend },
     /// Replace a template's mesh.
     Mesh { template: usize, mesh: Box<Mesh> },
+    /// The resolution every template is simulated at (the parameters
+    /// panel); the meshes as built stay in the project.
+    Resolution(Resolution),
     /// Replace one map of a time key.
     Map {
         template: usize,
@@ -174,6 +177,7 @@ impl ProjectEdit {
                     t.mesh = *mesh;
                 }
             }
+            ProjectEdit::Resolution(resolution) => project.settings.resolution = resolution,
             ProjectEdit::Map { template, key, map } => {
                 let Some(k) = templates
                     .get_mut(template)
@@ -245,6 +249,18 @@ impl AnthesisApp {
     /// Applies `edit` as one undo step named `label` (see
     /// [`Document::edit`]); returns whether the project changed.
     pub fn edit(&mut self, label: &str, edit: ProjectEdit) -> bool {
+        if let ProjectEdit::Resolution(resolution) = &edit {
+            // Remeshed before the document changes: a resolution that does
+            // not fit in memory or a template that cannot be remeshed is
+            // refused, and the meshes shown stay.
+            let mut trial = self.doc.project().clone();
+            trial.settings.resolution = *resolution;
+            if let Err(message) = self.resolved.prepare(&trial) {
+                self.log
+                    .error(format!("the resolution stays as it was: {message}"));
+                return false;
+            }
+        }
         let added_step = match &edit {
             ProjectEdit::AddKey { template, key } => Some((*template, key.step)),
             _ => None,
@@ -388,6 +404,7 @@ mod tests {
                     ScalarMap::from_fn(painted_size, painted_size, |uv| uv.x as f32),
                 )),
             },
+            ProjectEdit::Resolution(Resolution::MeanEdge(0.5)),
         ]
     }
 

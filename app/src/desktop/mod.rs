@@ -23,6 +23,7 @@ mod panels;
 pub mod params;
 mod project_io;
 mod prompts;
+pub mod resolution;
 pub mod session;
 pub mod timeline;
 pub mod viewport;
@@ -168,6 +169,8 @@ pub struct AnthesisApp {
     scene: viewport::SceneCache,
     /// The selected organ's outline, kept between frames.
     outline: viewport::Outline,
+    /// The project at its resolution, as simulated and shown.
+    resolved: resolution::Resolved,
     /// Commands the panels asked for this frame, applied after drawing.
     queued: Vec<Command>,
     /// Writes unsaved work for recovery (off until enabled).
@@ -253,6 +256,7 @@ impl AnthesisApp {
             has_gpu,
             scene: viewport::SceneCache::default(),
             outline: viewport::Outline::default(),
+            resolved: resolution::Resolved::default(),
             queued: Vec::new(),
             autosave: None,
             recovery_offer: None,
@@ -352,10 +356,11 @@ impl AnthesisApp {
     /// job), and follows the new keyframes.
     pub fn restart_simulation(&mut self) {
         let selection = self.selection();
+        let project = self.resolved_project();
         // A run too large for the memory would be killed by the kernel,
         // taking the window and the user's work with it.
         if let Err(e) = anthesis_sim::memory::check_run(
-            self.doc.project(),
+            &project,
             &selection,
             anthesis_sim::memory::KeyframeCost::Editable,
         ) {
@@ -363,11 +368,27 @@ impl AnthesisApp {
             self.needs_run = false;
             return;
         }
-        let project = Arc::new(self.doc.project().clone());
         self.session.start(project, selection);
         self.needs_run = false;
         if self.session.is_live() {
             self.playback.follow = true;
+        }
+    }
+
+    /// The project as simulated and shown: the document's, every template
+    /// at the project's resolution (remeshed when its mesh or the
+    /// resolution changed; a template that cannot be remeshed stays as
+    /// built and the log says why).
+    pub fn resolved_project(&mut self) -> Arc<Project> {
+        if let Some(problem) = self
+            .resolved
+            .update(self.doc.project(), self.doc.revision())
+        {
+            self.log.error(problem);
+        }
+        match self.resolved.project() {
+            Some(project) => Arc::clone(project),
+            None => Arc::new(self.doc.project().clone()),
         }
     }
 

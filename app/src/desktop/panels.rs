@@ -42,10 +42,16 @@ impl AnthesisApp {
         }
         ui.separator();
         let template = self.selected_template();
+        let resolved = self.resolved_project();
         egui::ScrollArea::vertical()
             .id_salt("parameters")
             .show(ui, |ui| {
-                chosen.extend(params::parameters_ui(ui, self.doc.project(), template));
+                chosen.extend(params::parameters_ui(
+                    ui,
+                    self.doc.project(),
+                    &resolved,
+                    template,
+                ));
             });
         self.queued.extend(chosen);
     }
@@ -91,7 +97,8 @@ impl AnthesisApp {
             overlay,
             show_others: self.shows_others(),
         };
-        let (project, session) = (self.doc.project(), &self.session);
+        let resolved = self.resolved_project();
+        let (project, session) = (resolved.as_ref(), &self.session);
         let (scene, meshes, revision) = self.scene.get(key, || {
             let scene =
                 viewport::build_scene(project, session, key.time_in_keyframes, key.show_others);
@@ -103,14 +110,9 @@ impl AnthesisApp {
             ui.label("The 3D viewport needs the wgpu renderer.");
             return;
         }
-        let outline = self.outline.edges_of(
-            &self
-                .doc
-                .project()
-                .flower
-                .template_of(self.selected_organ)
-                .mesh,
-        );
+        let outline = self
+            .outline
+            .edges_of(&resolved.flower.template_of(self.selected_organ).mesh);
         let response = viewport::viewport_ui(
             ui,
             &mut self.camera,

@@ -1,9 +1,11 @@
 //! The parameters panel: the selected organ's template (dg, thickness,
-//! Ks, Kb, joint schedule, base region) and the project's keyframe count,
-//! each with a tooltip saying what it does. An edit becomes a
-//! [`Command::Edit`], so each is undoable and restarts the simulation.
+//! Ks, Kb, joint schedule, base region), the project's keyframe count and
+//! its resolution (with the particles each organ gets), each with a tooltip
+//! saying what it does. An edit becomes a [`Command::Edit`], so each is
+//! undoable and restarts the simulation.
 
-use anthesis_flower::{JointRamp, Project, Template};
+use anthesis_flower::resolution::predicted_size;
+use anthesis_flower::{JointRamp, Project, Resolution, Template};
 use eframe::egui::{self, DragValue};
 
 use super::command::{Command, ProjectEdit};
@@ -32,13 +34,20 @@ fn number(
     changed
 }
 
-/// Shows the panel for template `template` of `project`; returns the edit
-/// the user made, if any.
-pub fn parameters_ui(ui: &mut egui::Ui, project: &Project, template: usize) -> Option<Command> {
+/// Shows the panel for template `template` of `project` (`resolved` is the
+/// project at its resolution, as simulated: it gives the particle counts);
+/// returns the edit the user made, if any.
+pub fn parameters_ui(
+    ui: &mut egui::Ui,
+    project: &Project,
+    resolved: &Project,
+    template: usize,
+) -> Option<Command> {
     let Some(original) = project.flower.templates.get(template) else {
         ui.label("No organ selected.");
         return None;
     };
+
     let mut draft: Template = original.clone();
     let mut keyframes = project.settings.keyframes;
     let name = draft.name.clone();
@@ -229,6 +238,10 @@ pub fn parameters_ui(ui: &mut egui::Ui, project: &Project, template: usize) -> O
         mark(true, "add joint ramp");
     }
 
+    ui.separator();
+    if let Some(edit) = resolution_ui(ui, project, resolved, template) {
+        return Some(edit);
+    }
     let field = changed_field?;
     Some(Command::Edit {
         label: format!("{field} of {name}"),
@@ -238,4 +251,140 @@ pub fn parameters_ui(ui: &mut egui::Ui, project: &Project, template: usize) -> O
             keyframes,
         },
     })
+}
+
+/// What the resolution control says while its value is dragged: the counts
+/// are predicted from the areas until the drag ends and the meshes are
+/// remeshed (remeshing on every frame of a drag would stall the window).
+const RESOLUTION_TOOLTIP: &str = "Every template is simulated remeshed at this mean edge \
+    length (project units), with the painted maps unchanged: coarse to paint quickly, fine for \
+    the final export. Off: the meshes as built. The project keeps the meshes as built; the \
+    setting is saved with it. Paper: lily 1.3, Eustoma 2.0.";
+
+/// The resolution row and the particles per organ; returns the edit made.
+fn resolution_ui(
+    ui: &mut egui::Ui,
+    project: &Project,
+    resolved: &Project,
+    template: usize,
+) -> Option<Command> {
+    let current = project.settings.resolution;
+    let built_edge = project
+        .flower
+        .templates
+        .get(template)
+        .map(|t| anthesis_bud::quality(&t.mesh).mean_edge)
+        .unwrap_or(1.0);
+    let draft_id = ui.scope_id().with("mean edge while dragged");
+    let dragged_edge: Option<f64> = ui.data(|d| d.get_temp(draft_id));
+    let mut chosen = None;
+    ui.strong("Resolution (whole flower)")
+        .on_hover_text(RESOLUTION_TOOLTIP);
+    egui::Grid::new("resolution")
+        .num_columns(2)
+        .spacing([12.0, 6.0])
+        .show(ui, |ui| {
+            let mut remesh = current.mean_edge().is_some();
+            if ui
+                .checkbox(&mut remesh, "mean edge")
+                .on_hover_text(RESOLUTION_TOOLTIP)
+                .changed()
+            {
+                chosen = Some(if remesh {
+                    Resolution::MeanEdge(round_to_3_digits(built_edge))
+                } else {
+                    Resolution::AsBuilt
+                });
+            }
+            match current.mean_edge() {
+                Some(edge) => {
+                    let mut value = dragged_edge.unwrap_or(edge);
+                    let response = ui
+                        .add(
+                            DragValue::new(&mut value)
+                                .speed(0.01 * edge)
+                                .range(1e-3 * built_edge..=1e3 * built_edge)
+                                .max_decimals(4),
+                        )
+                        .on_hover_text(RESOLUTION_TOOLTIP);
+                    if response.dragged() {
+                        ui.data_mut(|d| d.insert_temp(draft_id, value));
+                    } else {
+                        ui.data_mut(|d| d.remove::<f64>(draft_id));
+                        if (response.changed() || response.drag_stopped()) && value != edge {
+                            chosen = Some(Resolution::MeanEdge(value));
+                        }
+                    }
+                }
+                None => {
+                    ui.label("as built");
+                }
+            }
+            ui.end_row();
+        });
+    // Particles per organ, template by template (the organs of a template
+    // share its mesh).
+    egui::Grid::new("particles per organ")
+        .num_columns(2)
+        .spacing([12.0, 2.0])
+        .show(ui, |ui| {
+            for (i, (t, r)) in project
+                .flower
+                .templates
+                .iter()
+                .zip(&resolved.flower.templates)
+                .enumerate()
+            {
+                let organs = project.flower.organs.iter().filter(|o| o.template == i).count();
+                let name = if organs == 1 {
+                    t.name.clone()
+                } else {
+                    format!("{} ×{organs}", t.name)
+                };
+                let particles = match dragged_edge {
+                    Some(edge) => format!("≈ {}", grouped(predicted_size(&t.mesh, edge).0)),
+                    None => grouped(r.mesh.vertex_count()),
+                };
+                let label = if i == template {
+                    egui::RichText::new(name).strong()
+                } else {
+                    egui::RichText::new(name)
+                };
+                ui.label(label);
+                ui.label(format!("{particles} particles"))
+                    .on_hover_text(format!(
+                        "Particles of each organ of template “{}” at this resolution (as built: {})",
+                        t.name,
+                        grouped(t.mesh.vertex_count())
+                    ));
+                ui.end_row();
+            }
+        });
+    chosen.map(|resolution| Command::Edit {
+        label: "resolution".to_string(),
+        edit: ProjectEdit::Resolution(resolution),
+    })
+}
+
+/// `value` rounded to three significant digits (a starting edge a person
+/// can read).
+fn round_to_3_digits(value: f64) -> f64 {
+    if !(value > 0.0 && value.is_finite()) {
+        return 1.0;
+    }
+    let scale = 10f64.powi(2 - value.log10().floor() as i32);
+    (value * scale).round() / scale
+}
+
+/// `n` with a comma every three digits.
+fn grouped(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
 }

@@ -253,8 +253,10 @@ impl AnthesisApp {
     }
 
     pub(super) fn start_export(&mut self) {
+        // The keyframes are of the meshes at the project's resolution.
+        let project = self.resolved_project();
         let tracks = export::tracks(
-            self.doc.project(),
+            &project,
             self.session.organs(),
             self.session.keyframes(),
             self.export.render_level,
