@@ -218,9 +218,11 @@ pub fn run(cli: Cli) -> Result<()> {
             };
             simulate::simulate(
                 &project,
-                organ.as_deref(),
-                keyframes,
-                edge,
+                simulate::RunChoice {
+                    organ: organ.as_deref(),
+                    keyframes,
+                    edge,
+                },
                 stats.as_deref(),
                 out.as_deref(),
                 &glb,

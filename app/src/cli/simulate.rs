@@ -44,11 +44,21 @@ struct StatsFile<'a> {
     threads: usize,
 }
 
+/// What a run simulates besides the project: one organ or all, how many
+/// keyframes, at which resolution (each `None`: the project's).
+pub(super) struct RunChoice<'a> {
+    pub(super) organ: Option<&'a str>,
+    pub(super) keyframes: Option<u32>,
+    pub(super) edge: Option<Resolution>,
+}
+
 pub(super) fn simulate(
     path: &Path,
-    organ: Option<&str>,
-    keyframes: Option<u32>,
-    edge: Option<Resolution>,
+    RunChoice {
+        organ,
+        keyframes,
+        edge,
+    }: RunChoice<'_>,
     stats_path: Option<&Path>,
     out: Option<&Path>,
     glb: &GlbOptions,
@@ -64,13 +74,6 @@ pub(super) fn simulate(
     }
     if let Some(out) = out {
         check_output(out, glb, project.settings.keyframes)?;
-        // The bud and every keyframe, at the render level asked for.
-        anthesis_export::check_render_level(
-            &project.flower,
-            &selection.organs(project.flower.organs.len()),
-            project.settings.keyframes as usize + 1,
-            render_level,
-        )?;
     }
     let cost = match out.map(OutputKind::of) {
         None => KeyframeCost::Kept,
@@ -79,6 +82,16 @@ pub(super) fn simulate(
         Some(OutputKind::ObjFolder) => KeyframeCost::Obj,
     };
     let project = at_resolution(project, edge, Some((&selection, cost)))?;
+    if out.is_some() {
+        // The bud and every keyframe, at the render level asked for, of
+        // the meshes at the project's resolution.
+        anthesis_export::check_render_level(
+            &project.flower,
+            &selection.organs(project.flower.organs.len()),
+            project.settings.keyframes as usize + 1,
+            render_level,
+        )?;
+    }
     memory::check_run(&project, &selection, cost)?;
 
     let mut sim = Simulation::new(&project, &selection)?;
