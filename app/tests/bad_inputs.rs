@@ -15,6 +15,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 
+use anthesis_app::desktop::params::grouped;
 use common::text;
 
 /// Longest time a bad input may take to be refused.
@@ -675,19 +676,6 @@ fn every_bad_input_gets_its_message_and_exit_code_1() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
-}
-
-/// `n` with a comma every three digits, as the README writes it.
-fn grouped(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 #[test]

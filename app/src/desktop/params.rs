@@ -342,8 +342,8 @@ fn resolution_ui(
                     format!("{} ×{organs}", t.name)
                 };
                 let particles = match dragged_edge {
-                    Some(edge) => format!("≈ {}", grouped(predicted_size(&t.mesh, edge).0)),
-                    None => grouped(r.mesh.vertex_count()),
+                    Some(edge) => format!("≈ {}", grouped(predicted_size(&t.mesh, edge).0 as u64)),
+                    None => grouped(r.mesh.vertex_count() as u64),
                 };
                 let label = if i == template {
                     egui::RichText::new(name).strong()
@@ -355,7 +355,7 @@ fn resolution_ui(
                     .on_hover_text(format!(
                         "Particles of each organ of template “{}” at this resolution (as built: {})",
                         t.name,
-                        grouped(t.mesh.vertex_count())
+                        grouped(t.mesh.vertex_count() as u64)
                     ));
                 ui.end_row();
             }
@@ -376,8 +376,9 @@ fn round_to_3_digits(value: f64) -> f64 {
     (value * scale).round() / scale
 }
 
-/// `n` with a comma every three digits.
-fn grouped(n: usize) -> String {
+/// `n` with a comma every three digits, as the window and the README write
+/// counts.
+pub fn grouped(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {

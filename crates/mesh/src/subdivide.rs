@@ -100,15 +100,7 @@ impl Subdivision {
     /// [`MAX_SUBDIVIDED_VERTICES`].
     pub fn new(mesh: &Mesh, level: u32) -> Result<Subdivision, MeshError> {
         let vertex_count = mesh.positions.len();
-        for (triangle, tri) in mesh.triangles.iter().enumerate() {
-            if let Some(&index) = tri.iter().find(|&&i| i as usize >= vertex_count) {
-                return Err(MeshError::IndexOutOfRange {
-                    triangle,
-                    index,
-                    vertex_count,
-                });
-            }
-        }
+        crate::validate::check_indices(mesh)?;
         if mesh.uvs.len() != vertex_count {
             return Err(MeshError::UvCountMismatch {
                 vertices: vertex_count,

@@ -32,15 +32,7 @@ pub fn validate(mesh: &Mesh) -> Result<Topology, MeshError> {
         return Err(MeshError::Empty);
     }
     let vertex_count = mesh.positions.len();
-    for (triangle, tri) in mesh.triangles.iter().enumerate() {
-        if let Some(&index) = tri.iter().find(|&&i| i as usize >= vertex_count) {
-            return Err(MeshError::IndexOutOfRange {
-                triangle,
-                index,
-                vertex_count,
-            });
-        }
-    }
+    check_indices(mesh)?;
     for (triangle, &[a, b, c]) in mesh.triangles.iter().enumerate() {
         if a == b || a == c {
             return Err(MeshError::RepeatedVertex {
@@ -242,6 +234,22 @@ fn count_pieces(triangle_count: usize, topology: &Topology) -> usize {
     (0..triangle_count)
         .filter(|&t| root(&mut parent, t) == t)
         .count()
+}
+
+/// Fails with [`MeshError::IndexOutOfRange`] on the first triangle corner
+/// that names no vertex of `mesh`.
+pub(crate) fn check_indices(mesh: &Mesh) -> Result<(), MeshError> {
+    let vertex_count = mesh.positions.len();
+    for (triangle, tri) in mesh.triangles.iter().enumerate() {
+        if let Some(&index) = tri.iter().find(|&&i| i as usize >= vertex_count) {
+            return Err(MeshError::IndexOutOfRange {
+                triangle,
+                index,
+                vertex_count,
+            });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
