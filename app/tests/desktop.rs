@@ -209,6 +209,86 @@ fn timeline_buttons_and_shortcuts_scrub_step_and_play() {
 }
 
 #[test]
+fn an_edit_keeps_the_viewed_frame_stale_until_the_new_run_reaches_it() {
+    use anthesis_app::desktop::{Command, ProjectEdit};
+    let mut project = small_flower();
+    // Keys inside the run, so the timeline marks them.
+    for (key, step) in project.flower.templates[0]
+        .maps
+        .keys_mut()
+        .iter_mut()
+        .zip([6, 14])
+    {
+        key.step = step;
+    }
+    let mut harness = harness(project);
+    harness.run();
+    feed(&mut harness, None);
+    harness.state_mut().playback_mut().scrub_to(12.0, Some(20));
+    harness.run();
+    let shown = |harness: &Harness<'_, AnthesisApp>| {
+        harness.state().session().positions_at(12.0).expect("shown")
+    };
+    let old = shown(&harness);
+
+    // An edit that changes the opening (the joint ramp turns further).
+    let app = harness.state_mut();
+    let mut turned = app.project().flower.templates[0].clone();
+    turned.joint_schedule[0].angle_deg += 15.0;
+    let keyframes = app.project().settings.keyframes;
+    let run = app.session().run();
+    app.apply(Command::Edit {
+        label: "joint degrees of petal".to_string(),
+        edit: ProjectEdit::Template {
+            template: 0,
+            value: Box::new(turned),
+            keyframes,
+        },
+    });
+    harness.run();
+    let app = harness.state();
+    assert!(app.session().run() > run, "the edit started a new run");
+    assert_eq!(app.playback().time_in_keyframes, 12.0, "the playhead stays");
+    assert!(app.session().is_stale_at(12.0));
+    assert_eq!(shown(&harness), old, "the previous result stays shown");
+
+    // The new run's first keyframes arrive: keyframe 12 is still stale.
+    feed(&mut harness, Some(8));
+    harness.run();
+    assert_eq!(harness.state().playback().time_in_keyframes, 12.0);
+    assert!(harness.state().session().is_stale_at(12.0));
+    assert!(
+        harness
+            .get_by_label_contains("stale: previous result until the run reaches 12")
+            .rect()
+            .width()
+            > 0.0
+    );
+    harness.snapshot("app_stale_after_an_edit");
+
+    // It reaches keyframe 12: the new result is shown, and the time the
+    // user waited is logged once.
+    feed(&mut harness, Some(13));
+    harness.run();
+    let app = harness.state();
+    assert!(!app.session().is_stale_at(12.0));
+    assert_ne!(shown(&harness), old, "the new opening is shown");
+    assert_eq!(app.playback().time_in_keyframes, 12.0);
+    let logged: Vec<_> = app
+        .log()
+        .entries()
+        .iter()
+        .filter(|e| e.message.starts_with("edit on screen after "))
+        .map(|e| e.message.clone())
+        .collect();
+    assert_eq!(logged.len(), 1, "{logged:?}");
+    assert!(
+        logged[0].ends_with("(keyframe 12 of the whole flower)"),
+        "{logged:?}"
+    );
+}
+
+#[test]
 fn parameter_edits_restart_the_run_and_undo_redo_with_shortcuts() {
     let mut harness = opened_small_flower();
     let first_run = harness.state().session().run();
@@ -462,6 +542,20 @@ fn a_stroke_on_the_uv_canvas_paints_the_map_restarts_and_undoes_in_one_step() {
     assert!(left < was, "subtracted: {left} < {was}");
     assert!((left - right).abs() < 1e-6, "mirrored: {left} vs {right}");
     feed(&mut harness, None);
+    harness.run();
+    // The time from mouse-up to the viewed keyframe on screen is logged
+    // once; the log is cleared for the snapshot (the time varies).
+    let latency = |harness: &Harness<'_, AnthesisApp>| {
+        let log = harness.state().log().entries();
+        log.iter()
+            .filter(|e| e.message.starts_with("edit on screen after "))
+            .count()
+    };
+    assert_eq!(latency(&harness), 1);
+    harness.run();
+    assert_eq!(latency(&harness), 1, "logged once per edit");
+    harness.get_by_label("Clear").click();
+    harness.hover_at(egui::pos2(600.0, 300.0));
     harness.run();
     harness.snapshot("app_after_stroke");
 

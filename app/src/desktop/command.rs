@@ -17,6 +17,7 @@ use anthesis_mesh::Mesh;
 use glam::DVec2;
 
 use super::files::DialogPurpose;
+use super::log::Topic;
 use super::prompts::Pending;
 use super::viewport::ViewOptions;
 use super::{AnthesisApp, Document};
@@ -221,12 +222,12 @@ impl AnthesisApp {
                 self.session.cancel();
                 self.log.info("simulation stopped");
             }
-            Command::TogglePlay => self.playback.toggle_play(self.session.last_index()),
+            Command::TogglePlay => self.playback.toggle_play(self.session.shown_end()),
             Command::StepKeyframe(direction) => {
-                self.playback.step(direction, self.session.last_index());
+                self.playback.step(direction, self.session.shown_end());
             }
             Command::GoToStart => self.playback.go_to_start(),
-            Command::GoToEnd => self.playback.go_to_end(self.session.last_index()),
+            Command::GoToEnd => self.playback.go_to_end(self.session.shown_end()),
             Command::FrameAll => self.frame_all(),
             Command::SetView(view) => self.view = view,
             Command::ShowLog(on) => self.settings.show_log = on,
@@ -256,10 +257,13 @@ impl AnthesisApp {
             let mut trial = self.doc.project().clone();
             trial.settings.resolution = *resolution;
             if let Err(message) = self.resolved.prepare(&trial) {
-                self.log
-                    .error(format!("the resolution stays as it was: {message}"));
+                self.log.error_about(
+                    Topic::Resolution,
+                    format!("the resolution stays as it was: {message}"),
+                );
                 return false;
             }
+            self.log.succeeded(Topic::Resolution);
         }
         let added_step = match &edit {
             ProjectEdit::AddKey { template, key } => Some((*template, key.step)),

@@ -23,6 +23,7 @@ mod panels;
 pub mod params;
 mod project_io;
 mod prompts;
+pub mod rerun;
 pub mod resolution;
 pub mod session;
 pub mod timeline;
@@ -43,7 +44,7 @@ pub use command::{Command, ProjectEdit};
 use document::Document;
 use export::ExportDialog;
 use files::{Dialogs, Settings};
-use log::Log;
+use log::{Log, Topic};
 use paint::PaintState;
 use session::{DRAIN_BUDGET, SimSession};
 use timeline::Playback;
@@ -163,6 +164,8 @@ pub struct AnthesisApp {
     may_close: bool,
     /// The project changed since the last run started.
     needs_run: bool,
+    /// Restart pacing while painting, and the edit latency measured.
+    rerun: rerun::Rerun,
     /// The viewport's GPU state is installed.
     has_gpu: bool,
     /// The viewport's scene, rebuilt only when what it shows changes.
@@ -253,6 +256,7 @@ impl AnthesisApp {
             unit_offer: None,
             may_close: false,
             needs_run: true,
+            rerun: rerun::Rerun::default(),
             has_gpu,
             scene: viewport::SceneCache::default(),
             outline: viewport::Outline::default(),
@@ -353,8 +357,17 @@ impl AnthesisApp {
     }
 
     /// Starts simulating the project as it is now (cancelling the running
-    /// job), and follows the new keyframes.
+    /// job). The playhead stays where it is: what was shown stays shown,
+    /// marked stale, until the new run reaches it; only when nothing is
+    /// shown yet does the view follow the new keyframes.
     pub fn restart_simulation(&mut self) {
+        self.start_run(false);
+    }
+
+    /// [`AnthesisApp::restart_simulation`]; `finished_edit`: the user has
+    /// finished an edit (pointer up), so the time until its result is on
+    /// screen is measured and logged.
+    fn start_run(&mut self, finished_edit: bool) {
         let selection = self.selection();
         let project = self.resolved_project();
         // A run too large for the memory would be killed by the kernel,
@@ -364,14 +377,38 @@ impl AnthesisApp {
             &selection,
             anthesis_sim::memory::KeyframeCost::Editable,
         ) {
-            self.log.error(format!("the simulation did not start: {e}"));
+            self.log.error_about(
+                Topic::Simulation,
+                format!("the simulation did not start: {e}"),
+            );
             self.needs_run = false;
             return;
         }
-        self.session.start(project, selection);
+        let something_shown = self.session.shown_end().is_some();
+        let run = self.session.start(project, selection);
         self.needs_run = false;
-        if self.session.is_live() {
+        self.rerun.started(
+            run,
+            finished_edit && something_shown,
+            std::time::Instant::now(),
+        );
+        if self.session.is_live() && self.session.shown_end().is_none() {
             self.playback.follow = true;
+        }
+    }
+
+    /// Starts the run the project's changes want, paced while the pointer
+    /// is down (see [`rerun`]).
+    fn run_if_needed(&mut self, ctx: &egui::Context) {
+        if !self.needs_run {
+            return;
+        }
+        let dragging = ctx.input(|i| i.pointer.any_down());
+        let wait = self.rerun.wait(dragging, std::time::Instant::now());
+        if wait.is_zero() {
+            self.start_run(!dragging);
+        } else {
+            ctx.request_repaint_after(wait);
         }
     }
 
@@ -384,7 +421,7 @@ impl AnthesisApp {
             .resolved
             .update(self.doc.project(), self.doc.revision())
         {
-            self.log.error(problem);
+            self.log.error_about(Topic::Resolution, problem);
         }
         match self.resolved.project() {
             Some(project) => Arc::clone(project),
@@ -394,19 +431,28 @@ impl AnthesisApp {
 
     fn drain_worker(&mut self) {
         let drained = self.session.drain(DRAIN_BUDGET);
+        if drained.finished {
+            self.log.succeeded(Topic::Simulation);
+        }
         for failure in drained.failures {
-            self.log.error(format!("the simulation stopped: {failure}"));
+            self.log.error_about(
+                Topic::Simulation,
+                format!("the simulation stopped: {failure}"),
+            );
         }
         if let Some(end) = self.export.poll() {
             match end {
-                export::ExportState::Done { path, bytes } => self.log.info(format!(
-                    "exported {} ({:.1} MB)",
-                    path.display(),
-                    bytes as f64 / 1e6
-                )),
-                export::ExportState::Failed { message } => {
-                    self.log.error(format!("export failed: {message}"))
+                export::ExportState::Done { path, bytes } => {
+                    self.log.info(format!(
+                        "exported {} ({:.1} MB)",
+                        path.display(),
+                        bytes as f64 / 1e6
+                    ));
+                    self.log.succeeded(Topic::Export);
                 }
+                export::ExportState::Failed { message } => self
+                    .log
+                    .error_about(Topic::Export, format!("export failed: {message}")),
                 _ => {}
             }
         }
@@ -452,7 +498,7 @@ impl eframe::App for AnthesisApp {
 
         let dt = f64::from(ctx.input(|i| i.stable_dt)).min(0.1);
         self.playback
-            .advance(dt, self.session.last_index(), self.session.total());
+            .advance(dt, self.session.shown_end(), self.session.total());
 
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("timeline")
@@ -480,9 +526,7 @@ impl eframe::App for AnthesisApp {
         self.recovery_prompt(&ctx);
         self.autosave_tick(&ctx);
 
-        if self.needs_run {
-            self.restart_simulation();
-        }
+        self.run_if_needed(&ctx);
         self.update_title(&ctx);
         if self.playback.playing {
             ctx.request_repaint();

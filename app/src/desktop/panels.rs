@@ -59,7 +59,13 @@ impl AnthesisApp {
     /// The timeline panel (the playhead is scrubbed directly; buttons
     /// queue commands).
     pub(super) fn timeline_panel(&mut self, ui: &mut egui::Ui) {
-        let chosen = timeline::timeline_ui(ui, &mut self.playback, &self.session);
+        let template = &self.project().flower.templates[self.selected_template()];
+        let keys = timeline::KeyMarks {
+            template: template.name.clone(),
+            steps: template.maps.keys().iter().map(|k| k.step).collect(),
+            painted: Some(self.paint.key).filter(|&k| k < template.maps.keys().len()),
+        };
+        let chosen = timeline::timeline_ui(ui, &mut self.playback, &self.session, &keys);
         self.queued.extend(chosen);
     }
 
@@ -92,6 +98,7 @@ impl AnthesisApp {
             document_revision: self.doc.revision(),
             run: self.session.run(),
             keyframes_received: self.session.keyframes().len(),
+            shown_end: self.session.shown_end(),
             time_in_keyframes: self.playback.time_in_keyframes,
             selected_organ: self.selected_organ,
             overlay,
@@ -105,6 +112,22 @@ impl AnthesisApp {
             let meshes = viewport::scene_meshes(project, &scene, Some(key.selected_organ), overlay);
             (scene, meshes)
         });
+        if let Some(waited) = self.rerun.shown(
+            &self.session,
+            key.time_in_keyframes,
+            std::time::Instant::now(),
+        ) {
+            let what = if self.single_organ_preview {
+                format!("the preview of organ {}", self.selected_organ + 1)
+            } else {
+                "the whole flower".to_string()
+            };
+            self.log.info(format!(
+                "edit on screen after {} ms (keyframe {:.0} of {what})",
+                waited.as_millis(),
+                key.time_in_keyframes.ceil()
+            ));
+        }
         self.frame_automatically(&scene);
         if !self.has_gpu {
             ui.label("The 3D viewport needs the wgpu renderer.");

@@ -244,13 +244,24 @@ pub fn parameters_ui(
     }
     let field = changed_field?;
     Some(Command::Edit {
-        label: format!("{field} of {name}"),
+        label: edit_label(field, &name),
         edit: ProjectEdit::Template {
             template,
             value: Box::new(draft),
             keyframes,
         },
     })
+}
+
+/// The undo step's name for a changed parameter: what changed and whose it
+/// is (the keyframe count is the project's, the rest the template's).
+fn edit_label(field: &str, template_name: &str) -> String {
+    const PROJECT_FIELDS: [&str; 1] = ["keyframes"];
+    if PROJECT_FIELDS.contains(&field) {
+        format!("{field} of the project")
+    } else {
+        format!("{field} of {template_name}")
+    }
 }
 
 /// What the resolution control says while its value is dragged: the counts
@@ -388,4 +399,15 @@ pub fn grouped(n: u64) -> String {
         out.push(c);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::edit_label;
+
+    #[test]
+    fn an_undo_step_names_whose_value_changed() {
+        assert_eq!(edit_label("keyframes", "petal"), "keyframes of the project");
+        assert_eq!(edit_label("thickness", "petal"), "thickness of petal");
+    }
 }

@@ -11,6 +11,7 @@ use super::command::{LoadedMap, ProjectEdit};
 use super::document::Document;
 use super::export;
 use super::files::DialogPurpose;
+use super::log::Topic;
 use super::prompts::{Pending, UnitOffer};
 use anthesis_maps::brush::PaintTarget;
 
@@ -26,9 +27,11 @@ impl AnthesisApp {
                 self.discard_recovery();
                 self.replace_document(Document::new(project, Some(path.to_path_buf())));
                 self.log.info(format!("opened {}", path.display()));
+                self.log.succeeded(Topic::Project);
             }
             Err(e) => {
-                self.log.error(format!("cannot open the project: {e}"));
+                self.log
+                    .error_about(Topic::Project, format!("cannot open the project: {e}"));
                 if !path.exists() {
                     self.settings.forget(path);
                 }
@@ -74,9 +77,10 @@ impl AnthesisApp {
                     None => self.use_mesh(template, mesh, path),
                 }
             }
-            Err(e) => self
-                .log
-                .error(format!("cannot use {} as a mesh: {e}", path.display())),
+            Err(e) => self.log.error_about(
+                Topic::Import,
+                format!("cannot use {} as a mesh: {e}", path.display()),
+            ),
         }
     }
 
@@ -94,6 +98,7 @@ impl AnthesisApp {
         self.doc.seal();
         self.log
             .info(format!("{name} now uses the mesh of {}", path.display()));
+        self.log.succeeded(Topic::Import);
     }
 
     fn load_map(&mut self, path: &Path) {
@@ -127,20 +132,23 @@ impl AnthesisApp {
                     },
                 );
                 self.doc.seal();
+                self.log.succeeded(Topic::Import);
                 self.log.info(format!(
                     "loaded the {} map of {name} from {}",
                     target.label(),
                     path.display()
                 ));
             }
-            Err(e) => self
-                .log
-                .error(format!("cannot use {} as a map: {e}", path.display())),
+            Err(e) => self.log.error_about(
+                Topic::Import,
+                format!("cannot use {} as a map: {e}", path.display()),
+            ),
         }
     }
 
     pub(super) fn replace_document(&mut self, doc: Document) {
         self.doc = doc;
+        self.session.forget_shown();
         self.selected_organ = 0;
         self.framed = false;
         self.needs_run = true;
@@ -196,10 +204,12 @@ impl AnthesisApp {
                 self.discard_recovery();
                 self.settings.remember(path);
                 self.log.info(format!("saved {}", path.display()));
+                self.log.succeeded(Topic::Project);
                 true
             }
             Err(e) => {
-                self.log.error(format!("cannot save: {e}"));
+                self.log
+                    .error_about(Topic::Project, format!("cannot save: {e}"));
                 false
             }
         }

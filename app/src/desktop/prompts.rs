@@ -8,6 +8,7 @@ use super::AnthesisApp;
 use super::default_project;
 use super::document::Document;
 use super::files::DialogPurpose;
+use super::log::Topic;
 
 /// Something that would lose unsaved changes, waiting for the user's answer.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,8 +35,11 @@ impl AnthesisApp {
                 Ok(project) => {
                     self.discard_recovery();
                     self.replace_document(Document::new(project, None));
+                    self.log.succeeded(Topic::Project);
                 }
-                Err(e) => self.log.error(format!("cannot start a new project: {e}")),
+                Err(e) => self
+                    .log
+                    .error_about(Topic::Project, format!("cannot start a new project: {e}")),
             },
             Pending::Open(Some(path)) => self.open_path(&path),
             Pending::Open(None) => self.ask_for_path(DialogPurpose::OpenProject),

@@ -48,6 +48,11 @@ pub struct SimSession {
     total: u32,
     /// Keyframes received so far, contiguous from the bud (index 0).
     keyframes: Vec<Arc<Keyframe>>,
+    /// Keyframes of earlier runs of the same organs and meshes, shown
+    /// (marked stale) where the current run has not arrived yet, so an edit
+    /// keeps the frame the user looks at until its new version is computed.
+    /// Emptied when the current run finishes or the document is replaced.
+    previous: Vec<Arc<Keyframe>>,
     status: RunStatus,
     started_at: Option<Instant>,
     /// Newton iteration inside the keyframe being computed.
@@ -79,6 +84,7 @@ impl SimSession {
             organs: Vec::new(),
             total: 0,
             keyframes: Vec::new(),
+            previous: Vec::new(),
             status: RunStatus::Idle,
             started_at: None,
             iteration: None,
@@ -92,10 +98,26 @@ impl SimSession {
     }
 
     /// Starts a new run of `project`, superseding (and cancelling) the
-    /// current one. The keyframes shown so far are kept until the new run's
-    /// bud arrives, so the view does not flash empty.
+    /// current one. What was shown so far stays shown, as stale keyframes,
+    /// until the new run's keyframes arrive (see [`SimSession::shown_end`]);
+    /// unless it cannot fit the new run (other organs, remeshed templates).
     pub fn start(&mut self, project: Arc<Project>, selection: Selection) -> RunId {
-        self.organs = selection.organs(project.flower.organs.len());
+        let organs = selection.organs(project.flower.organs.len());
+        let mut shown = std::mem::take(&mut self.keyframes);
+        let fresh = shown.len();
+        shown.extend(self.previous.drain(..).skip(fresh));
+        shown.truncate(project.settings.keyframes as usize + 1);
+        let fits = |keyframe: &Arc<Keyframe>| {
+            keyframe.positions_in_world.len() == organs.len()
+                && organs
+                    .iter()
+                    .zip(&keyframe.positions_in_world)
+                    .all(|(&o, p)| p.len() == project.flower.template_of(o).mesh.vertex_count())
+        };
+        if organs == self.organs && shown.first().is_some_and(fits) {
+            self.previous = shown;
+        }
+        self.organs = organs;
         self.total = project.settings.keyframes;
         self.run = match &mut self.source {
             Source::Worker(worker) => worker.start(project, selection),
@@ -108,6 +130,13 @@ impl SimSession {
         self.started_at = Some(Instant::now());
         self.iteration = None;
         self.run
+    }
+
+    /// Forgets everything shown (a new or opened document: the old
+    /// project's frames must not stand in for the new one's).
+    pub fn forget_shown(&mut self) {
+        self.keyframes.clear();
+        self.previous.clear();
     }
 
     /// Cancels the current run, if any; the keyframes so far stay.
@@ -138,7 +167,10 @@ impl SimSession {
             }
         }
         for event in events {
-            drained.changed |= self.accept(event, &mut drained.failures);
+            let finished = matches!(event, Event::Finished { .. });
+            let accepted = self.accept(event, &mut drained.failures);
+            drained.changed |= accepted;
+            drained.finished |= accepted && finished;
         }
         drained
     }
@@ -160,9 +192,6 @@ impl SimSession {
                 self.status = RunStatus::Running;
             }
             Event::Keyframe { keyframe, .. } => {
-                if keyframe.index == 0 {
-                    self.keyframes.clear();
-                }
                 if keyframe.index as usize == self.keyframes.len() {
                     self.keyframes.push(keyframe);
                 }
@@ -172,6 +201,9 @@ impl SimSession {
                 self.iteration = Some((progress.keyframe, progress.iteration));
             }
             Event::Finished { seconds, .. } => {
+                // Every keyframe of the run is fresh now; earlier runs'
+                // keyframes past its end (the count was lowered) go too.
+                self.previous.clear();
                 self.status = RunStatus::Finished {
                     seconds,
                     first_computed: self.first_computed,
@@ -252,12 +284,42 @@ impl SimSession {
         Some(elapsed / f64::from(done) * f64::from(self.total.saturating_sub(done)))
     }
 
+    /// Index of the newest keyframe that can be shown: the current run's
+    /// or, past it, an earlier run's (stale).
+    pub fn shown_end(&self) -> Option<u32> {
+        let shown = self.keyframes.len().max(self.previous.len());
+        shown.checked_sub(1).map(|last| last as u32)
+    }
+
+    /// Whether the view at `time_in_keyframes` shows an earlier run's
+    /// keyframe: the current run has not computed the keyframe at or after
+    /// it yet.
+    pub fn is_stale_at(&self, time_in_keyframes: f64) -> bool {
+        let needed = time_in_keyframes.max(0.0).ceil() as usize;
+        needed >= self.keyframes.len() && needed < self.previous.len()
+    }
+
+    /// Whether the current run has computed the keyframes the view at
+    /// `time_in_keyframes` blends (the view is up to date).
+    pub fn is_current_at(&self, time_in_keyframes: f64) -> bool {
+        (time_in_keyframes.max(0.0).ceil() as usize) < self.keyframes.len()
+    }
+
+    /// Keyframe `index` as shown: the current run's, else an earlier run's.
+    fn shown(&self, index: usize) -> Option<&Arc<Keyframe>> {
+        self.keyframes
+            .get(index)
+            .or_else(|| self.previous.get(index))
+    }
+
     /// Positions of every simulated organ at `time_in_keyframes`,
-    /// interpolated linearly between the two keyframes around it; times
+    /// interpolated linearly between the two keyframes around it (each the
+    /// current run's where it has arrived, else an earlier run's); times
     /// past the newest keyframe show the newest. `None` before the bud.
     pub fn positions_at(&self, time_in_keyframes: f64) -> Option<Vec<Vec<glam::DVec3>>> {
-        let blend = KeyframeBlend::at(self.keyframes.len(), time_in_keyframes)?;
-        let (below, above) = (&self.keyframes[blend.below], &self.keyframes[blend.above]);
+        let count = self.shown_end()? as usize + 1;
+        let blend = KeyframeBlend::at(count, time_in_keyframes)?;
+        let (below, above) = (self.shown(blend.below)?, self.shown(blend.above)?);
         Some(
             below
                 .positions_in_world
@@ -273,6 +335,8 @@ impl SimSession {
 #[derive(Debug, Default)]
 pub struct Drained {
     pub changed: bool,
+    /// The current run finished.
+    pub finished: bool,
     pub failures: Vec<String>,
 }
 
@@ -295,6 +359,118 @@ mod tests {
                 contact_particles: 0,
             },
         })
+    }
+
+    /// Keyframe `index` of a run of all of `project`'s organs, every
+    /// particle at x = `x`.
+    fn keyframe_of(project: &Project, index: u32, x: f64) -> Arc<Keyframe> {
+        let positions_in_world = (0..project.flower.organs.len())
+            .map(|o| {
+                let count = project.flower.template_of(o).mesh.vertex_count();
+                vec![DVec3::new(x, 0.0, 0.0); count]
+            })
+            .collect();
+        Arc::new(Keyframe {
+            positions_in_world,
+            ..(*keyframe(index, x)).clone()
+        })
+    }
+
+    fn feed(session: &mut SimSession, project: &Project, run: RunId, xs: &[f64]) {
+        for (i, &x) in xs.iter().enumerate() {
+            let keyframe = keyframe_of(project, i as u32, x);
+            assert!(session.accept(Event::Keyframe { run, keyframe }, &mut Vec::new()));
+        }
+    }
+
+    fn x_at(session: &SimSession, time: f64) -> f64 {
+        session.positions_at(time).expect("something shown")[0][0].x
+    }
+
+    #[test]
+    fn a_new_run_shows_the_previous_keyframes_stale_until_its_own_arrive() {
+        let project = Arc::new(anthesis_sim::fixtures::whorl(2, 4, 6, 5));
+        let mut session = SimSession::recorded();
+        let first = session.start(Arc::clone(&project), Selection::All);
+        feed(
+            &mut session,
+            &project,
+            first,
+            &[0.0, 1.0, 2.0, 3.0, 4.0, 5.0],
+        );
+        assert!(session.accept(
+            Event::Finished {
+                run: first,
+                keyframes: 5,
+                seconds: 1.0
+            },
+            &mut Vec::new()
+        ));
+        assert!(!session.is_stale_at(3.0));
+
+        let second = session.start(Arc::clone(&project), Selection::All);
+        assert_eq!(session.last_index(), None, "nothing of the new run yet");
+        assert_eq!(session.shown_end(), Some(5), "the old run stays shown");
+        assert!(session.is_stale_at(3.0) && !session.is_current_at(3.0));
+        assert_eq!(x_at(&session, 3.0), 3.0);
+
+        feed(&mut session, &project, second, &[0.0, 10.0, 20.0, 30.0]);
+        assert!(!session.is_stale_at(3.0) && session.is_current_at(3.0));
+        assert_eq!(x_at(&session, 3.0), 30.0, "the new keyframe replaces it");
+        assert!(session.is_stale_at(3.5) && session.is_stale_at(5.0));
+        assert_eq!(
+            x_at(&session, 3.5),
+            0.5 * (30.0 + 4.0),
+            "blends new and old"
+        );
+        assert_eq!(x_at(&session, 5.0), 5.0);
+
+        // A third run before the second finished: the newest of each
+        // keyframe stays shown.
+        let third = session.start(Arc::clone(&project), Selection::All);
+        assert_eq!(x_at(&session, 2.0), 20.0);
+        assert_eq!(x_at(&session, 5.0), 5.0);
+        feed(
+            &mut session,
+            &project,
+            third,
+            &[0.0, 1.5, 2.5, 3.5, 4.5, 5.5],
+        );
+        assert!(session.accept(
+            Event::Finished {
+                run: third,
+                keyframes: 5,
+                seconds: 1.0
+            },
+            &mut Vec::new()
+        ));
+        assert!(!session.is_stale_at(5.0));
+        assert_eq!(x_at(&session, 5.0), 5.5);
+    }
+
+    #[test]
+    fn frames_that_cannot_fit_the_new_run_are_not_shown() {
+        let project = Arc::new(anthesis_sim::fixtures::whorl(2, 4, 6, 3));
+        let mut session = SimSession::recorded();
+        let run = session.start(Arc::clone(&project), Selection::All);
+        feed(&mut session, &project, run, &[0.0, 1.0, 2.0, 3.0]);
+
+        // Other organs (a single-organ preview): nothing to show.
+        session.start(Arc::clone(&project), Selection::Only(1));
+        assert_eq!(session.shown_end(), None);
+
+        // Other meshes (a finer resolution): nothing to show.
+        let run = session.start(Arc::clone(&project), Selection::All);
+        feed(&mut session, &project, run, &[0.0, 1.0, 2.0, 3.0]);
+        let finer = Arc::new(anthesis_sim::fixtures::whorl(2, 6, 8, 3));
+        session.start(finer, Selection::All);
+        assert_eq!(session.shown_end(), None);
+
+        // A new document forgets what was shown.
+        let run = session.start(Arc::clone(&project), Selection::All);
+        feed(&mut session, &project, run, &[0.0, 1.0]);
+        session.forget_shown();
+        assert_eq!(session.shown_end(), None);
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! The opening timeline: playback state (a time in keyframes that plays,
-//! loops and is scrubbed) and its panel — scrubber with computed and
-//! pending keyframes, transport buttons, progress, and a small plot of
-//! energy and iterations per keyframe.
+//! loops and is scrubbed) and its panel — scrubber with computed, stale
+//! (an earlier run's, shown until the new run reaches them) and pending
+//! keyframes and the time keys, transport buttons, progress, and a small
+//! plot of energy and iterations per keyframe.
 
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, StrokeKind, Vec2};
 
@@ -154,15 +155,46 @@ pub fn status_line(session: &SimSession) -> String {
     }
 }
 
+/// The time keys marked on the timeline: the steps of the selected
+/// template's keys (a step is a keyframe) and which one is painted.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct KeyMarks {
+    /// Whose keys they are (a template's name), for the tooltip.
+    pub template: String,
+    pub steps: Vec<u32>,
+    /// Index into `steps` of the key being painted.
+    pub painted: Option<usize>,
+}
+
+/// What the status says about a stale view at `time`: `None` when the view
+/// shows the current run.
+pub fn stale_line(session: &SimSession, time: f64) -> Option<String> {
+    if !session.is_stale_at(time) {
+        return None;
+    }
+    let viewed = time.max(0.0).ceil();
+    Some(format!(
+        "stale: previous result until the run reaches {viewed:.0}"
+    ))
+}
+
+/// Colour of the current run's computed keyframes.
+const COMPUTED_COLOR: Color32 = Color32::from_rgb(90, 140, 90);
+/// Colour of stale keyframes (an earlier run's, still shown).
+const STALE_COLOR: Color32 = Color32::from_rgb(150, 125, 70);
+/// Colour of the playhead and of the key being painted.
+const PLAYHEAD_COLOR: Color32 = Color32::from_rgb(230, 120, 40);
+
 /// The timeline panel: the scrubber moves `playback` directly; the
 /// buttons' commands are returned.
 pub fn timeline_ui(
     ui: &mut egui::Ui,
     playback: &mut Playback,
     session: &SimSession,
+    keys: &KeyMarks,
 ) -> Vec<Command> {
     let mut chosen = Vec::new();
-    let computed = session.last_index();
+    let shown = session.shown_end();
     let total = session.total().max(1);
     ui.horizontal(|ui| {
         if ui
@@ -223,6 +255,15 @@ pub fn timeline_ui(
         ));
         ui.separator();
         ui.label(status_line(session));
+        if let Some(stale) = stale_line(session, playback.time_in_keyframes) {
+            ui.separator();
+            ui.label(egui::RichText::new(stale).color(STALE_COLOR))
+                .on_hover_text(
+                    "The edit started a new run. The viewed keyframe shows the result from \
+                     before the edit until the new run has computed it; then the new one \
+                     replaces it (the log says how long that took).",
+                );
+        }
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
             if session.is_running() {
                 if ui
@@ -241,33 +282,52 @@ pub fn timeline_ui(
             }
         });
     });
-    scrubber(ui, playback, computed, total);
+    scrubber(ui, playback, session, keys, shown, total);
     stats_plot(ui, session, playback.time_in_keyframes);
     chosen
 }
 
-/// The scrubber: one cell per keyframe, filled where computed; the
-/// playhead; click or drag to scrub.
-fn scrubber(ui: &mut egui::Ui, playback: &mut Playback, computed: Option<u32>, total: u32) {
+/// The scrubber: one cell per keyframe, filled where computed (green) or
+/// shown from an earlier run (stale, brown); the time keys; the playhead;
+/// click or drag to scrub.
+fn scrubber(
+    ui: &mut egui::Ui,
+    playback: &mut Playback,
+    session: &SimSession,
+    keys: &KeyMarks,
+    shown: Option<u32>,
+    total: u32,
+) {
     let size = Vec2::new(ui.available_width(), 22.0);
     let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "Timeline"));
-    let response = response.on_hover_text(
-        "Timeline: filled cells are computed keyframes, hollow ones pending. Click or drag to scrub.",
-    );
+    let response = response.on_hover_text(format!(
+        "Timeline: green cells are computed keyframes, brown ones the previous result \
+         (stale, shown until the new run reaches them), empty ones pending. Triangles mark \
+         the time keys of {} (filled: the key being painted). Click or drag to scrub.",
+        keys.template
+    ));
     let x_of = |time: f64| rect.left() + (time / f64::from(total)) as f32 * rect.width();
     if (response.dragged() || response.clicked())
         && let Some(pointer) = response.interact_pointer_pos()
     {
         let time = f64::from((pointer.x - rect.left()) / rect.width()) * f64::from(total);
-        playback.scrub_to(time, computed);
+        playback.scrub_to(time, shown);
     }
     let painter = ui.painter_at(rect);
     let visuals = ui.visuals();
     painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
-    let done = computed.map_or(0.0, f64::from);
+    let done = session.last_index().map_or(0.0, f64::from);
+    let shown_to = shown.map_or(0.0, f64::from);
+    if shown_to > done {
+        let stale_rect = Rect::from_min_max(
+            Pos2::new(x_of(done), rect.top()),
+            Pos2::new(x_of(shown_to), rect.bottom()),
+        );
+        painter.rect_filled(stale_rect, 3.0, STALE_COLOR);
+    }
     let computed_rect = Rect::from_min_max(rect.min, Pos2::new(x_of(done), rect.bottom()));
-    painter.rect_filled(computed_rect, 3.0, Color32::from_rgb(90, 140, 90));
+    painter.rect_filled(computed_rect, 3.0, COMPUTED_COLOR);
     // Keyframe ticks: every keyframe when they are far enough apart,
     // otherwise every 10th.
     let every = if rect.width() / total as f32 > 4.0 {
@@ -290,10 +350,30 @@ fn scrubber(ui: &mut egui::Ui, playback: &mut Playback, computed: Option<u32>, t
         Stroke::new(1.0, visuals.widgets.noninteractive.bg_stroke.color),
         StrokeKind::Inside,
     );
+    // Keys past the last keyframe still shape the blend before it, but
+    // have no place on the timeline.
+    for (i, &step) in keys.steps.iter().enumerate().filter(|(_, s)| **s <= total) {
+        let x = x_of(f64::from(step));
+        let triangle = vec![
+            Pos2::new(x - 4.5, rect.top()),
+            Pos2::new(x + 4.5, rect.top()),
+            Pos2::new(x, rect.top() + 7.0),
+        ];
+        let fill = if keys.painted == Some(i) {
+            PLAYHEAD_COLOR
+        } else {
+            Color32::from_gray(235)
+        };
+        painter.add(egui::Shape::convex_polygon(
+            triangle,
+            fill,
+            Stroke::new(1.0, Color32::from_gray(40)),
+        ));
+    }
     let x = x_of(playback.time_in_keyframes);
     painter.line_segment(
         [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
-        Stroke::new(2.5, Color32::from_rgb(230, 120, 40)),
+        Stroke::new(2.5, PLAYHEAD_COLOR),
     );
 }
 
@@ -344,7 +424,7 @@ fn stats_plot(ui: &mut egui::Ui, session: &SimSession, time: f64) {
     let x = rect.left() + (time / f64::from(total)) as f32 * rect.width();
     painter.line_segment(
         [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
-        Stroke::new(1.0, Color32::from_rgb(230, 120, 40)),
+        Stroke::new(1.0, PLAYHEAD_COLOR),
     );
     painter.text(
         rect.left_top() + Vec2::new(4.0, 2.0),

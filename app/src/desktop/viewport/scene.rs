@@ -128,6 +128,9 @@ pub struct SceneKey {
     /// The run shown and how many of its keyframes have arrived.
     pub run: RunId,
     pub keyframes_received: usize,
+    /// The newest keyframe shown (an earlier run's where this one has not
+    /// arrived, see [`SimSession::shown_end`]).
+    pub shown_end: Option<u32>,
     pub time_in_keyframes: f64,
     pub selected_organ: usize,
     /// The overlaid map and its time key.
@@ -182,6 +185,7 @@ mod tests {
             document_revision: 7,
             run: 2,
             keyframes_received: 10,
+            shown_end: Some(9),
             time_in_keyframes: 4.5,
             selected_organ: 1,
             overlay: None,
@@ -214,6 +218,10 @@ mod tests {
                 ..key()
             },
             SceneKey {
+                shown_end: Some(20),
+                ..key()
+            },
+            SceneKey {
                 time_in_keyframes: 4.6,
                 ..key()
             },
@@ -234,7 +242,7 @@ mod tests {
             assert_eq!(get(&mut cache, changed), 2 + 2 * i as u64, "{changed:?}");
             assert_eq!(get(&mut cache, key()), 3 + 2 * i as u64, "back");
         }
-        assert_eq!(builds, 15);
-        assert_eq!(cache.builds(), 15);
+        assert_eq!(builds, 17);
+        assert_eq!(cache.builds(), 17);
     }
 }

@@ -1,0 +1,95 @@
+//! When an edit starts a new run, and how long its result takes to reach
+//! the screen.
+//!
+//! While the pointer is down (a brush stroke, a dragged value) every frame
+//! may change the project; starting a run on each would spend the solver's
+//! time on cancelled runs. So a run starts at most every
+//! [`RESTART_EVERY_WHILE_DRAGGING`] while the pointer is down, and at once
+//! when it is released. The time from that release (or from a single edit)
+//! to the viewed keyframe of the new run on screen is what a user waits
+//! for; it is logged per edit.
+
+use std::time::{Duration, Instant};
+
+use anthesis_sim::worker::RunId;
+
+use super::session::SimSession;
+
+/// Shortest time between two runs started while the pointer is down.
+pub const RESTART_EVERY_WHILE_DRAGGING: Duration = Duration::from_millis(100);
+
+/// Restart pacing and the edit latency being measured.
+#[derive(Debug, Default)]
+pub struct Rerun {
+    /// When the last run started.
+    last_start: Option<Instant>,
+    /// The run that will show the last finished edit, and when that edit
+    /// finished.
+    waiting: Option<(RunId, Instant)>,
+}
+
+impl Rerun {
+    /// How long a wanted run must still wait: zero when the pointer is up
+    /// (`dragging` false) or the last run started long enough ago.
+    pub fn wait(&self, dragging: bool, now: Instant) -> Duration {
+        match self.last_start {
+            Some(last) if dragging => {
+                RESTART_EVERY_WHILE_DRAGGING.saturating_sub(now.saturating_duration_since(last))
+            }
+            _ => Duration::ZERO,
+        }
+    }
+
+    /// Notes that `run` started at `now`. `finished_edit`: it is the run of
+    /// an edit the user has finished (pointer up) over a result already on
+    /// screen, so its latency is measured.
+    pub fn started(&mut self, run: RunId, finished_edit: bool, now: Instant) {
+        self.last_start = Some(now);
+        if finished_edit {
+            self.waiting = Some((run, now));
+        } else if self.waiting.is_some_and(|(waiting, _)| waiting != run) {
+            // A later run supersedes the one measured; the edit it showed
+            // is measured again when that run is released.
+            self.waiting = None;
+        }
+    }
+
+    /// Called each frame with what the viewport shows: the time from the
+    /// finished edit to now, once (when the viewed keyframe of its run is
+    /// on screen).
+    pub fn shown(
+        &mut self,
+        session: &SimSession,
+        time_in_keyframes: f64,
+        now: Instant,
+    ) -> Option<Duration> {
+        let (run, since) = self.waiting?;
+        if run != session.run() {
+            self.waiting = None;
+            return None;
+        }
+        if !session.is_current_at(time_in_keyframes) {
+            return None;
+        }
+        self.waiting = None;
+        Some(now.saturating_duration_since(since))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_wait_only_while_dragging_and_only_after_a_recent_start() {
+        let t0 = Instant::now();
+        let mut rerun = Rerun::default();
+        assert_eq!(rerun.wait(true, t0), Duration::ZERO, "the first dab runs");
+        rerun.started(1, false, t0);
+        let later = t0 + Duration::from_millis(30);
+        assert_eq!(rerun.wait(true, later), Duration::from_millis(70));
+        assert_eq!(rerun.wait(false, later), Duration::ZERO, "release runs");
+        let much_later = t0 + Duration::from_millis(250);
+        assert_eq!(rerun.wait(true, much_later), Duration::ZERO);
+    }
+}
