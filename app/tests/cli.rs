@@ -379,6 +379,44 @@ fn a_mesh_in_another_unit_is_named_before_the_run() {
 }
 
 #[test]
+fn a_fleshy_petal_in_another_unit_is_named_by_where_it_sits() {
+    // The lily with fleshy petals (thickness 2: 22 thicknesses long), its
+    // petal mesh then made in millimetres (×10: 220 thicknesses, a
+    // plausible organ): only where the petals sit shows the unit.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut project = anthesis_garden::builtin_lily().expect("lily");
+    let petal = project
+        .flower
+        .templates
+        .iter()
+        .position(|t| t.name == "petal")
+        .expect("a petal template");
+    project.flower.templates[petal].thickness = 2.0;
+    let fleshy = dir.path().join("fleshy.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &fleshy).expect("save");
+    for p in &mut project.flower.templates[petal].mesh.positions {
+        *p *= 10.0;
+    }
+    // Its own folder: a project's meshes are saved beside it.
+    let other = tempfile::tempdir().expect("tempdir");
+    let millimetres = other.path().join("mm.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &millimetres).expect("save");
+
+    let out = anthesis(&["info", fleshy.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for command in ["info", "simulate"] {
+        let out = one_line_error(&[command, millimetres.to_str().expect("utf-8")]);
+        let stderr = text(&out.stderr);
+        assert!(
+            stderr.contains("template \"petal\": organ petal-1's base is")
+                && stderr.contains("10 times too large, perhaps made in millimetres")
+                && stderr.contains("Scale the mesh by 0.1"),
+            "{command}: {stderr}"
+        );
+    }
+}
+
+#[test]
 fn a_reader_that_stops_reading_ends_the_output_quietly() {
     // `anthesis info builtin:lily | head -1`: the pipe's reader is gone
     // before the first line is written.

@@ -1291,3 +1291,31 @@ fn the_parameters_panel_with_a_resolution() {
         "{edits:?}"
     );
 }
+
+#[test]
+fn opening_a_project_with_a_mesh_in_another_unit_warns_and_keeps_it_open() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut project = small_flower();
+    for p in &mut project.flower.templates[0].mesh.positions {
+        *p *= 100.0;
+    }
+    let path = dir.path().join("mm.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.state_mut().open_path(&path);
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.document().path.as_deref(), Some(path.as_path()));
+    let warning = app
+        .log()
+        .entries()
+        .iter()
+        .find(|e| e.message.contains("times too large, perhaps made in"))
+        .expect("a warning names the unit");
+    assert!(
+        warning.message.ends_with("the simulation will likely fail"),
+        "{}",
+        warning.message
+    );
+}

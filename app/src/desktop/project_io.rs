@@ -28,6 +28,13 @@ impl AnthesisApp {
                 self.replace_document(Document::new(project, Some(path.to_path_buf())));
                 self.log.info(format!("opened {}", path.display()));
                 self.log.succeeded(Topic::Project);
+                // The command line refuses such a project; the window opens
+                // it (the user may fix the mesh or thickness here) and says
+                // why a run will likely fail.
+                for mismatch in anthesis_flower::scale::check_flower(&self.project().flower) {
+                    self.log
+                        .warn(format!("{mismatch}: the simulation will likely fail"));
+                }
             }
             Err(e) => {
                 self.log

@@ -9,13 +9,25 @@
 //! far, and the solver gives up at the first keyframe without a word about
 //! why. This module catches that before a run.
 //!
-//! The test: an organ's length (the longest side of its mesh's bounding
-//! box) against its thickness. Real petals and sepals are 10 to 2,000
-//! thicknesses long (a fleshy magnolia tepal about 50, a lily petal about
-//! 200 to 400, the thinnest poppy petals about 1,500); the paper's flowers
-//! are 220 (lily) and 442 (*Eustoma*). A mesh outside that range is taken
-//! to be in another unit, off by the power of ten that brings it nearest
-//! to 300 thicknesses.
+//! The first test: an organ's length (the longest side of its mesh's
+//! bounding box) against its thickness. Real petals and sepals are 10 to
+//! 2,000 thicknesses long (a fleshy magnolia tepal about 50, a lily petal
+//! about 200 to 400, the thinnest poppy petals about 1,500); the paper's
+//! flowers are 220 (lily) and 442 (*Eustoma*). A mesh outside that range is
+//! taken to be in another unit, off by the power of ten that brings it
+//! nearest to 300 thicknesses.
+//!
+//! A fleshy organ ten times too large can still be a plausible number of
+//! thicknesses long. The second test then looks at where its organs sit:
+//! in a bud, an organ's base is about as wide as the spacing to the nearest
+//! organ (1.7 to 2.1 times in the lily and *Eustoma*: neighbours overlap),
+//! and an organ is a few to a few tens of times as long as its distance
+//! from the flower's axis (16 to 25 there, 2 in a wide open whorl). A base
+//! [`CROWDED_BASE_IN_SPACINGS`] spacings wide or more on an organ
+//! [`LONG_ON_RECEPTACLE`] times its distance from the axis or more (both:
+//! either alone happens in real buds) cannot sit in its place; the mesh is
+//! taken to be off by the power of ten that brings its base nearest to
+//! [`TYPICAL_BASE_IN_SPACINGS`].
 
 use std::fmt;
 use std::ops::RangeInclusive;
@@ -44,10 +56,28 @@ pub struct ScaleMismatch {
     /// millimetres in a project in centimetres, 0.001 for one made in
     /// metres in a project in millimetres.
     pub factor: f64,
-    /// When the mesh is to replace another: that mesh's length. The
-    /// mismatch is then against it (a mesh ten times the one it replaces,
-    /// though still a plausible number of thicknesses long).
-    pub replaced_length: Option<f64>,
+    /// What the mesh was measured against.
+    pub against: Against,
+}
+
+/// What showed a mesh to be in another unit.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Against {
+    /// The template's thickness (the length is not 10 to 2,000 of it).
+    Thickness,
+    /// The mesh it is to replace, this long: a mesh ten times the one it
+    /// replaces, though still a plausible number of thicknesses long.
+    Replaced { length: f64 },
+    /// Where one of its organs sits: `organ`'s base is `base_width` wide
+    /// (template units, across the organ near its base), the nearest other
+    /// organ's base is `spacing` away and the organ sits `from_axis` from
+    /// the flower's axis.
+    Receptacle {
+        organ: String,
+        base_width: f64,
+        spacing: f64,
+        from_axis: f64,
+    },
 }
 
 impl ScaleMismatch {
@@ -71,7 +101,31 @@ impl fmt::Display for ScaleMismatch {
         } else {
             1.0 / self.factor
         };
-        if let Some(replaced) = self.replaced_length {
+        if let Against::Receptacle {
+            organ,
+            base_width,
+            spacing,
+            from_axis,
+        } = &self.against
+        {
+            return write!(
+                f,
+                "template \"{}\": organ {organ}'s base is {} wide but the nearest organ sits {} \
+                 away ({} spacings; in a bud an organ's base is about 2), and the organ is {} \
+                 long, {} times its distance {} from the axis. The mesh looks {times:.0} times \
+                 too {size}, perhaps {}. Scale the mesh by {}",
+                self.template,
+                significant(*base_width),
+                significant(*spacing),
+                significant(base_width / spacing),
+                significant(self.length),
+                significant(self.length / from_axis),
+                significant(*from_axis),
+                unit_guess(self.factor),
+                anthesis_files::short_number(1.0 / self.factor),
+            );
+        }
+        if let Against::Replaced { length: replaced } = self.against {
             return write!(
                 f,
                 "template \"{}\": the new mesh is {} long, {} times the {} of the mesh it \
@@ -172,7 +226,7 @@ fn check_length(template: &str, length: f64, thickness: f64) -> Option<ScaleMism
         length,
         thickness,
         factor: 10f64.powf(exponent),
-        replaced_length: None,
+        against: Against::Thickness,
     })
 }
 
@@ -204,13 +258,98 @@ pub fn check_replacement(template: &Template, mesh: &Mesh) -> Option<ScaleMismat
         length,
         thickness: template.thickness,
         factor: 10f64.powf(exponent),
-        replaced_length: Some(replaced),
+        against: Against::Replaced { length: replaced },
     })
 }
 
-/// Every template of `flower` whose mesh does not fit its thickness.
+/// An organ's base this many spacings to the nearest organ wide, or more,
+/// cannot sit in its place (with [`LONG_ON_RECEPTACLE`]).
+pub const CROWDED_BASE_IN_SPACINGS: f64 = 8.0;
+
+/// An organ this many times its distance from the axis long, or more, is
+/// too long for where it sits (with [`CROWDED_BASE_IN_SPACINGS`]).
+pub const LONG_ON_RECEPTACLE: f64 = 100.0;
+
+/// An organ's base width, in spacings to the nearest organ, in a bud made
+/// in one unit (about the lily's 1.9 and *Eustoma*'s 2.1).
+const TYPICAL_BASE_IN_SPACINGS: f64 = 2.0;
+
+/// The part of the organ's length, from its lowest point, that counts as
+/// its base.
+const BASE_PART: f64 = 0.05;
+
+/// The width of `mesh` across the organ (template x) near its base (the
+/// lowest [`BASE_PART`] of its length along template y, where organs
+/// grow from).
+fn base_width(mesh: &Mesh, length: f64) -> f64 {
+    let Some(lowest) = mesh.positions.iter().map(|p| p.y).reduce(f64::min) else {
+        return 0.0;
+    };
+    let across = mesh
+        .positions
+        .iter()
+        .filter(|p| p.y <= lowest + BASE_PART * length)
+        .map(|p| p.x);
+    let (low, high) = across.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    });
+    (high - low).max(0.0)
+}
+
+/// The mismatch of `template` (index `index`) against where its organs sit
+/// in `flower`, if one of them cannot fit there (see the module's notes).
+fn check_placement(flower: &Flower, index: usize) -> Option<ScaleMismatch> {
+    let template = flower.templates.get(index)?;
+    let length = organ_length(&template.mesh);
+    let width = base_width(&template.mesh, length);
+    let organs = &flower.organs;
+    organs
+        .iter()
+        .enumerate()
+        .filter(|(_, organ)| organ.template == index)
+        .find_map(|(i, organ)| {
+            let at = organ.placement.position;
+            let spacing = organs
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, other)| (other.placement.position - at).length())
+                .reduce(f64::min)?;
+            let from_axis = at.x.hypot(at.z);
+            // Organs sharing a place, or sitting on the axis, say nothing
+            // about units.
+            if spacing <= 0.0 || from_axis <= 0.0 {
+                return None;
+            }
+            let crowded = width / spacing;
+            if !(crowded >= CROWDED_BASE_IN_SPACINGS && length / from_axis >= LONG_ON_RECEPTACLE) {
+                return None;
+            }
+            let exponent = (crowded / TYPICAL_BASE_IN_SPACINGS)
+                .log10()
+                .round()
+                .max(1.0);
+            Some(ScaleMismatch {
+                template: template.name.clone(),
+                length,
+                thickness: template.thickness,
+                factor: 10f64.powf(exponent),
+                against: Against::Receptacle {
+                    organ: organ.name.clone(),
+                    base_width: width,
+                    spacing,
+                    from_axis,
+                },
+            })
+        })
+}
+
+/// Every template of `flower` whose mesh does not fit its thickness or,
+/// failing that, the place its organs sit in.
 pub fn check_flower(flower: &Flower) -> Vec<ScaleMismatch> {
-    flower.templates.iter().filter_map(check_template).collect()
+    (0..flower.templates.len())
+        .filter_map(|t| check_template(&flower.templates[t]).or_else(|| check_placement(flower, t)))
+        .collect()
 }
 
 #[cfg(test)]
@@ -244,7 +383,7 @@ mod tests {
             }),
             None
         );
-        assert!(ten.replaced_length.is_some());
+        assert!(matches!(ten.against, Against::Replaced { .. }));
         let text = ten.to_string();
         assert!(
             text.contains("10 times too large") && text.contains("millimetres"),
@@ -277,6 +416,89 @@ mod tests {
             base_region: Default::default(),
             joint_schedule: Vec::new(),
             color: [1.0; 4],
+        }
+    }
+
+    /// Three organs of `template` around a receptacle `radius` from the
+    /// axis (as the lily's inner whorl: radius 2).
+    fn whorl(template: Template, radius: f64) -> Flower {
+        let organs = (0..3)
+            .map(|i| {
+                let azimuth_deg = 120.0 * f64::from(i);
+                let (sin, cos) = azimuth_deg.to_radians().sin_cos();
+                crate::Organ {
+                    name: format!("petal-{}", i + 1),
+                    template: 0,
+                    placement: crate::Placement {
+                        position: DVec3::new(radius * sin, 0.0, radius * cos),
+                        azimuth_deg,
+                        joint_angle_deg: 10.0,
+                    },
+                }
+            })
+            .collect();
+        Flower {
+            templates: vec![template],
+            organs,
+            overlaps: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_fleshy_organ_in_another_unit_is_caught_by_where_it_sits() {
+        // 88 thicknesses long: ×10 (880) passes the thickness test, so
+        // only where its organs sit tells.
+        assert_eq!(check_flower(&whorl(petal(1.0, 0.5), 2.0)), Vec::new());
+        let flower = whorl(petal(10.0, 0.5), 2.0);
+        assert_eq!(check_template(&flower.templates[0]), None, "in range");
+        let found = check_flower(&flower);
+        let [mismatch] = found.as_slice() else {
+            panic!("one mismatch: {found:?}")
+        };
+        assert_eq!(mismatch.factor, 10.0);
+        let Against::Receptacle {
+            organ,
+            base_width,
+            spacing,
+            from_axis,
+        } = &mismatch.against
+        else {
+            panic!("{mismatch:?}")
+        };
+        assert_eq!(organ, "petal-1");
+        assert!((spacing - 2.0 * 3f64.sqrt()).abs() < 1e-9, "{spacing}");
+        assert!((from_axis - 2.0).abs() < 1e-9);
+        // The test petal's base is a quarter of its width (13 × 10).
+        assert!((base_width - 32.5).abs() < 1e-9, "{base_width}");
+        let text = mismatch.to_string();
+        assert!(
+            text.contains("organ petal-1's base is")
+                && text.contains("10 times too large")
+                && text.contains("Scale the mesh by 0.1"),
+            "{text}"
+        );
+        // Converted back, it fits.
+        let mut fixed = flower.clone();
+        fixed.templates[0].mesh = mismatch.rescaled(&fixed.templates[0].mesh);
+        assert_eq!(check_flower(&fixed), Vec::new());
+    }
+
+    #[test]
+    fn crowded_or_long_alone_and_organs_on_the_axis_are_not_units() {
+        // A wide whorl (the test fixtures), a tight one, organs 88 times as
+        // long as their distance from the axis with bases four spacings
+        // wide: all plausible buds.
+        for (scale, radius) in [(1.0, 8.0), (1.0, 1.2), (1.0, 0.5)] {
+            let flower = whorl(petal(scale, 0.5), radius);
+            assert_eq!(check_flower(&flower), Vec::new(), "×{scale} at {radius}");
+        }
+        // All organs at the axis, told apart only by their azimuth.
+        let flower = whorl(petal(10.0, 0.5), 0.0);
+        assert_eq!(check_flower(&flower), Vec::new());
+        // The whole project scaled alike (meshes, positions, thickness).
+        for scale in [0.01, 10.0, 1000.0] {
+            let flower = whorl(petal(scale, 0.5 * scale), 2.0 * scale);
+            assert_eq!(check_flower(&flower), Vec::new(), "×{scale}");
         }
     }
 
