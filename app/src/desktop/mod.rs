@@ -364,10 +364,10 @@ impl AnthesisApp {
         self.start_run(false);
     }
 
-    /// [`AnthesisApp::restart_simulation`]; `finished_edit`: the user has
-    /// finished an edit (pointer up), so the time until its result is on
-    /// screen is measured and logged.
-    fn start_run(&mut self, finished_edit: bool) {
+    /// [`AnthesisApp::restart_simulation`]; `dragging`: the pointer is
+    /// down, so the edit is not finished yet. The time until a finished
+    /// edit's result is on screen is measured and logged.
+    fn start_run(&mut self, dragging: bool) {
         let selection = self.selection();
         let project = self.resolved_project();
         // A run too large for the memory would be killed by the kernel,
@@ -389,7 +389,8 @@ impl AnthesisApp {
         self.needs_run = false;
         self.rerun.started(
             run,
-            finished_edit && something_shown,
+            !dragging && something_shown,
+            dragging,
             std::time::Instant::now(),
         );
         if self.session.is_live() && self.session.shown_end().is_none() {
@@ -406,7 +407,7 @@ impl AnthesisApp {
         let dragging = ctx.input(|i| i.pointer.any_down());
         let wait = self.rerun.wait(dragging, std::time::Instant::now());
         if wait.is_zero() {
-            self.start_run(!dragging);
+            self.start_run(dragging);
         } else {
             ctx.request_repaint_after(wait);
         }
@@ -494,6 +495,8 @@ impl eframe::App for AnthesisApp {
         if ctx.input(|i| i.pointer.any_released()) {
             self.doc.seal();
             self.paint.end_stroke();
+            self.rerun
+                .released(self.needs_run, std::time::Instant::now());
         }
 
         let dt = f64::from(ctx.input(|i| i.stable_dt)).min(0.1);

@@ -26,6 +26,9 @@ pub struct Rerun {
     /// The run that will show the last finished edit, and when that edit
     /// finished.
     waiting: Option<(RunId, Instant)>,
+    /// The last run started while the pointer was down: when no edit came
+    /// after it, it is the one that shows the edit at release.
+    started_while_dragging: Option<RunId>,
 }
 
 impl Rerun {
@@ -42,15 +45,28 @@ impl Rerun {
 
     /// Notes that `run` started at `now`. `finished_edit`: it is the run of
     /// an edit the user has finished (pointer up) over a result already on
-    /// screen, so its latency is measured.
-    pub fn started(&mut self, run: RunId, finished_edit: bool, now: Instant) {
+    /// screen, so its latency is measured. `dragging`: the pointer is down.
+    pub fn started(&mut self, run: RunId, finished_edit: bool, dragging: bool, now: Instant) {
         self.last_start = Some(now);
+        self.started_while_dragging = dragging.then_some(run);
         if finished_edit {
             self.waiting = Some((run, now));
         } else if self.waiting.is_some_and(|(waiting, _)| waiting != run) {
             // A later run supersedes the one measured; the edit it showed
             // is measured again when that run is released.
             self.waiting = None;
+        }
+    }
+
+    /// The pointer was released at `now`. When the last run started during
+    /// the drag already holds every edit (`needs_run` false: nothing
+    /// changed since), that run shows the finished edit; otherwise the run
+    /// started now will (see [`Rerun::started`]).
+    pub fn released(&mut self, needs_run: bool, now: Instant) {
+        if let Some(run) = self.started_while_dragging.take()
+            && !needs_run
+        {
+            self.waiting = Some((run, now));
         }
     }
 
@@ -85,11 +101,46 @@ mod tests {
         let t0 = Instant::now();
         let mut rerun = Rerun::default();
         assert_eq!(rerun.wait(true, t0), Duration::ZERO, "the first dab runs");
-        rerun.started(1, false, t0);
+        rerun.started(1, false, true, t0);
         let later = t0 + Duration::from_millis(30);
         assert_eq!(rerun.wait(true, later), Duration::from_millis(70));
         assert_eq!(rerun.wait(false, later), Duration::ZERO, "release runs");
         let much_later = t0 + Duration::from_millis(250);
         assert_eq!(rerun.wait(true, much_later), Duration::ZERO);
+    }
+}
+
+#[cfg(test)]
+mod release_tests {
+    use std::sync::Arc;
+
+    use anthesis_sim::Selection;
+
+    use super::*;
+
+    #[test]
+    fn a_release_after_the_last_paced_run_measures_that_run() {
+        // Slow frames: every dab of a stroke started a run, the last one
+        // holds the whole stroke, and nothing is left to run at release.
+        let project = Arc::new(anthesis_sim::fixtures::whorl(1, 4, 6, 3));
+        let mut session = SimSession::recorded();
+        let mut rerun = Rerun::default();
+        let t0 = Instant::now();
+        for dab in 0..3 {
+            let run = session.start(Arc::clone(&project), Selection::All);
+            let at = t0 + Duration::from_millis(150 * dab);
+            rerun.started(run, false, true, at);
+        }
+        let released_at = t0 + Duration::from_millis(400);
+        rerun.released(false, released_at);
+        assert_eq!(rerun.waiting, Some((session.run(), released_at)));
+
+        // With an edit left to run, the run started at release is measured.
+        let run = session.start(Arc::clone(&project), Selection::All);
+        rerun.started(run, false, true, released_at);
+        rerun.released(true, released_at);
+        let next = session.start(project, Selection::All);
+        rerun.started(next, true, false, released_at);
+        assert_eq!(rerun.waiting, Some((next, released_at)));
     }
 }
