@@ -166,6 +166,8 @@ pub struct AnthesisApp {
     needs_run: bool,
     /// Restart pacing while painting, and the edit latency measured.
     rerun: rerun::Rerun,
+    /// The document revision the last run started from.
+    simulated_revision: Option<u64>,
     /// The viewport's GPU state is installed.
     has_gpu: bool,
     /// The viewport's scene, rebuilt only when what it shows changes.
@@ -257,6 +259,7 @@ impl AnthesisApp {
             may_close: false,
             needs_run: true,
             rerun: rerun::Rerun::default(),
+            simulated_revision: None,
             has_gpu,
             scene: viewport::SceneCache::default(),
             outline: viewport::Outline::default(),
@@ -384,12 +387,16 @@ impl AnthesisApp {
             self.needs_run = false;
             return;
         }
-        let something_shown = self.session.shown_end().is_some();
+        // Measured: an edit of the document over a result on screen (not a
+        // switch to the preview, or the first run).
+        let edited = self.session.shown_end().is_some()
+            && self.simulated_revision != Some(self.doc.revision());
         let run = self.session.start(project, selection);
         self.needs_run = false;
+        self.simulated_revision = Some(self.doc.revision());
         self.rerun.started(
             run,
-            !dragging && something_shown,
+            !dragging && edited,
             dragging,
             std::time::Instant::now(),
         );
