@@ -313,6 +313,103 @@ pub fn dab_keyed(
     }
 }
 
+/// Dab spacing as a fraction of the brush radius: dabs along a stroke are
+/// at most a quarter of the radius apart, so a hard brush leaves no gaps
+/// and a soft one no visible beads.
+pub const DAB_SPACING_PER_RADIUS: f64 = 0.25;
+
+/// Where the dabs of a stroke go: points along the pointer's path (a
+/// polyline, one vertex per frame) `spacing_in_uv` apart, measured along
+/// the path, with the distance travelled since the last dab carried from
+/// one segment (frame) to the next, so the dabs are evenly spaced whatever
+/// the frame rate. Each dab comes with the direction of the segment it lies
+/// on (for direction painting).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StrokeSpacing {
+    spacing_in_uv: f64,
+    /// The path's last vertex, `None` before the stroke starts.
+    last_in_uv: Option<DVec2>,
+    /// Distance travelled along the path since the last dab.
+    since_dab_in_uv: f64,
+}
+
+/// One dab of a stroke: its centre and the stroke's direction there (unit
+/// length, zero for the first dab, which has no direction yet).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StrokeDab {
+    pub centre_in_uv: DVec2,
+    pub direction_in_uv: DVec2,
+}
+
+impl StrokeSpacing {
+    /// Spacing for `brush`: [`DAB_SPACING_PER_RADIUS`] of its radius.
+    pub fn for_brush(brush: &Brush) -> StrokeSpacing {
+        StrokeSpacing::new(brush.radius_in_uv * DAB_SPACING_PER_RADIUS)
+    }
+
+    /// Dabs `spacing_in_uv` apart (a tiny positive floor keeps a zero
+    /// spacing from producing endless dabs).
+    pub fn new(spacing_in_uv: f64) -> StrokeSpacing {
+        StrokeSpacing {
+            spacing_in_uv: spacing_in_uv.max(1e-6),
+            last_in_uv: None,
+            since_dab_in_uv: 0.0,
+        }
+    }
+
+    /// Whether a stroke has started.
+    pub fn started(&self) -> bool {
+        self.last_in_uv.is_some()
+    }
+
+    /// Starts a stroke at `point_in_uv`: one dab there.
+    pub fn start(&mut self, point_in_uv: DVec2) -> StrokeDab {
+        self.last_in_uv = Some(point_in_uv);
+        self.since_dab_in_uv = 0.0;
+        StrokeDab {
+            centre_in_uv: point_in_uv,
+            direction_in_uv: DVec2::ZERO,
+        }
+    }
+
+    /// Extends the path to `point_in_uv` (the pointer's position this
+    /// frame): the dabs on the new segment, in order. Starts the stroke
+    /// (one dab) if it had not started. Non-finite points are ignored.
+    pub fn extend_to(&mut self, point_in_uv: DVec2) -> Vec<StrokeDab> {
+        if !point_in_uv.is_finite() {
+            return Vec::new();
+        }
+        let Some(from) = self.last_in_uv else {
+            return vec![self.start(point_in_uv)];
+        };
+        let segment = point_in_uv - from;
+        let length = segment.length();
+        self.last_in_uv = Some(point_in_uv);
+        if length == 0.0 {
+            return Vec::new();
+        }
+        let direction = segment / length;
+        let mut dabs = Vec::new();
+        // Distance along this segment of the next dab.
+        let mut along = self.spacing_in_uv - self.since_dab_in_uv;
+        while along <= length {
+            dabs.push(StrokeDab {
+                centre_in_uv: from + direction * along,
+                direction_in_uv: direction,
+            });
+            along += self.spacing_in_uv;
+        }
+        self.since_dab_in_uv = length - (along - self.spacing_in_uv);
+        dabs
+    }
+
+    /// Ends the stroke: the next point starts a new one.
+    pub fn end(&mut self) {
+        self.last_in_uv = None;
+        self.since_dab_in_uv = 0.0;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -479,5 +576,84 @@ mod tests {
             (f64::from(brush.weight(0.15)) - 0.3).abs() < 1e-6,
             "half way: half strength"
         );
+    }
+
+    #[test]
+    fn stroke_dabs_are_evenly_spaced_along_the_path_whatever_the_frames() {
+        // One long frame and many short ones along the same L-shaped path
+        // give the same dabs: the remainder is carried between frames.
+        let path = [
+            DVec2::new(0.1, 0.1),
+            DVec2::new(0.8, 0.1),
+            DVec2::new(0.8, 0.6),
+        ];
+        let spacing = 0.031;
+        let mut coarse = StrokeSpacing::new(spacing);
+        let mut coarse_dabs: Vec<StrokeDab> = Vec::new();
+        for p in path {
+            coarse_dabs.extend(coarse.extend_to(p));
+        }
+        let mut fine = StrokeSpacing::new(spacing);
+        let mut fine_dabs = fine.extend_to(path[0]);
+        for pair in path.windows(2) {
+            for i in 1..=37 {
+                let t = f64::from(i) / 37.0;
+                fine_dabs.extend(fine.extend_to(pair[0].lerp(pair[1], t)));
+            }
+        }
+        // Path length 1.2: a dab at the start and one every 0.031.
+        assert_eq!(coarse_dabs.len(), 39);
+        assert_eq!(fine_dabs.len(), coarse_dabs.len());
+        for (a, b) in coarse_dabs.iter().zip(&fine_dabs) {
+            assert!(a.centre_in_uv.distance(b.centre_in_uv) < 1e-9);
+        }
+        // Consecutive dabs are never further apart than the spacing (the
+        // corner cuts it shorter), and every point of the path is within
+        // half a spacing of a dab.
+        for pair in coarse_dabs.windows(2) {
+            let gap = pair[0].centre_in_uv.distance(pair[1].centre_in_uv);
+            assert!(gap <= spacing + 1e-12, "gap {gap}");
+        }
+        for i in 0..=1200 {
+            let s = f64::from(i) / 1000.0;
+            let point = if s <= 0.7 {
+                DVec2::new(0.1 + s, 0.1)
+            } else {
+                DVec2::new(0.8, 0.1 + (s - 0.7))
+            };
+            let nearest = coarse_dabs
+                .iter()
+                .map(|d| d.centre_in_uv.distance(point))
+                .fold(f64::INFINITY, f64::min);
+            // The path's end is up to one spacing past the last dab.
+            assert!(nearest <= spacing + 1e-9, "{point} is {nearest} from a dab");
+        }
+        // Directions follow the segments; the first dab has none.
+        assert_eq!(coarse_dabs[0].direction_in_uv, DVec2::ZERO);
+        assert!((coarse_dabs[5].direction_in_uv - DVec2::X).length() < 1e-12);
+        assert!((coarse_dabs[38].direction_in_uv - DVec2::Y).length() < 1e-12);
+    }
+
+    #[test]
+    fn a_stroke_that_does_not_move_is_one_dab_and_short_moves_add_up() {
+        let mut spacing = StrokeSpacing::for_brush(&Brush {
+            radius_in_uv: 0.08,
+            ..Brush::default()
+        });
+        assert_eq!(spacing.extend_to(DVec2::new(0.5, 0.5)).len(), 1);
+        assert!(spacing.extend_to(DVec2::new(0.5, 0.5)).is_empty());
+        // Five moves of 0.005 reach the 0.02 spacing on the fourth.
+        let counts: Vec<usize> = (1..=5)
+            .map(|i| {
+                spacing
+                    .extend_to(DVec2::new(0.5 + 0.005 * f64::from(i), 0.5))
+                    .len()
+            })
+            .collect();
+        assert_eq!(counts, [0, 0, 0, 1, 0]);
+        spacing.end();
+        assert!(!spacing.started());
+        assert_eq!(spacing.extend_to(DVec2::new(0.1, 0.1)).len(), 1);
+        assert!(spacing.extend_to(DVec2::new(f64::NAN, 0.1)).is_empty());
     }
 }
