@@ -72,8 +72,15 @@ fn recorded_keyframes(project: &Project, selection: &Selection) -> Vec<Keyframe>
 }
 
 fn harness(project: Project) -> Harness<'static, AnthesisApp> {
+    // egui_kittest's default: a frame is 0.25 s (4 frames a second).
+    harness_stepping(project, 0.25)
+}
+
+/// The app with `step_seconds` of time per frame.
+fn harness_stepping(project: Project, step_seconds: f32) -> Harness<'static, AnthesisApp> {
     Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
+        .with_step_dt(step_seconds)
         .wgpu()
         .build_eframe(move |cc| {
             AnthesisApp::new(
@@ -562,6 +569,237 @@ fn a_stroke_on_the_uv_canvas_paints_the_map_restarts_and_undoes_in_one_step() {
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     harness.run();
     assert_eq!(harness.state().project(), &before, "one stroke, one undo");
+}
+
+/// The small flower with a hard, full-strength set brush of radius 0.06
+/// (two pixels of its 32-pixel maps)
+/// painting 0 on the bend map (1 everywhere before), no mirror.
+fn hard_brush_on_bend(step_seconds: f32) -> Harness<'static, AnthesisApp> {
+    use anthesis_maps::MapKind;
+    use anthesis_maps::brush::{Brush, BrushMode, PaintTarget};
+    let mut harness = harness_stepping(small_flower(), step_seconds);
+    harness.run();
+    let paint = harness.state_mut().paint_mut();
+    paint.target = PaintTarget::Scalar(MapKind::Bend);
+    paint.brush = Brush {
+        mode: BrushMode::Set,
+        radius_in_uv: 0.06,
+        strength: 1.0,
+        hardness: 1.0,
+        value: 0.0,
+        mirror: false,
+    };
+    harness.run();
+    harness
+}
+
+/// The canvas position of `point_in_uv` (the canvas at its initial view:
+/// the UV square fills it, v up).
+fn canvas_at(harness: &Harness<'_, AnthesisApp>, u: f32, v: f32) -> egui::Pos2 {
+    let canvas = harness.get_by_label("UV paint canvas").rect();
+    canvas.min + egui::vec2(u, 1.0 - v) * canvas.size()
+}
+
+fn bend_at(harness: &Harness<'_, AnthesisApp>, u: f64, v: f64) -> f64 {
+    harness.state().project().flower.templates[0].maps.keys()[0]
+        .maps
+        .bend
+        .sample(glam::DVec2::new(u, v))
+}
+
+/// `count` primary clicks (press and release) at `pos`, a frame per event.
+fn click(harness: &mut Harness<'_, AnthesisApp>, pos: egui::Pos2, count: usize) {
+    harness.hover_at(pos);
+    harness.step();
+    for pressed in [true, false].repeat(count) {
+        harness.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+    }
+    harness.step();
+}
+
+#[test]
+fn a_stroke_at_four_frames_a_second_leaves_no_gaps_between_long_pointer_jumps() {
+    // The harness steps 0.25 s per frame: the pointer jumps 0.2-0.3 UV per
+    // frame, three to five brush radii.
+    let mut harness = hard_brush_on_bend(0.25);
+    let path = [(0.2_f32, 0.3_f32), (0.45, 0.5), (0.55, 0.75), (0.8, 0.6)];
+    harness.hover_at(canvas_at(&harness, path[0].0, path[0].1));
+    harness.step();
+    harness.drag_at(canvas_at(&harness, path[0].0, path[0].1));
+    harness.step();
+    for &(u, v) in &path[1..] {
+        harness.hover_at(canvas_at(&harness, u, v));
+        harness.step();
+    }
+    harness.drop_at(canvas_at(&harness, path[3].0, path[3].1));
+    harness.step();
+    harness.step();
+    // Every point of the path is painted (a hard brush sets 0 within its
+    // radius; dabs at most a quarter radius apart leave every point well
+    // inside one).
+    for pair in path.windows(2) {
+        for i in 0..=50 {
+            let t = f64::from(i) / 50.0;
+            let u = f64::from(pair[0].0) + t * f64::from(pair[1].0 - pair[0].0);
+            let v = f64::from(pair[0].1) + t * f64::from(pair[1].1 - pair[0].1);
+            let value = bend_at(&harness, u, v);
+            assert!(value < 0.05, "a gap at ({u:.3}, {v:.3}): {value}");
+        }
+    }
+    // Away from the path nothing changed.
+    assert!((bend_at(&harness, 0.2, 0.8) - 1.0).abs() < 1e-6);
+    assert!((bend_at(&harness, 0.8, 0.2) - 1.0).abs() < 1e-6);
+    // One stroke, one undo step.
+    assert!(
+        harness
+            .state()
+            .document()
+            .undo_label()
+            .is_some_and(|l| l.contains("stroke on bend"))
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert!(
+        (bend_at(&harness, 0.45, 0.5) - 1.0).abs() < 1e-6,
+        "undone at once"
+    );
+}
+
+#[test]
+fn a_click_paints_one_dab_and_a_double_click_resets_the_view_and_paints_nothing() {
+    // 20 frames a second: a press and release a frame apart each, inside
+    // egui's 0.3 s double-click time.
+    let mut harness = hard_brush_on_bend(0.05);
+    let before = harness.state().project().clone();
+    let undo_before = harness.state().document().undo_label().map(str::to_owned);
+
+    // A double-click: nothing painted, the history as it was, also after
+    // the double-click time has passed.
+    let at = canvas_at(&harness, 0.3, 0.5);
+    click(&mut harness, at, 2);
+    for _ in 0..10 {
+        harness.step();
+    }
+    assert!(
+        harness.state().project() == &before,
+        "a double-click paints nothing"
+    );
+    assert_eq!(
+        harness.state().document().undo_label().map(str::to_owned),
+        undo_before,
+        "and leaves the history alone"
+    );
+
+    // One click, then the double-click time passes: one dab there.
+    let at = canvas_at(&harness, 0.7, 0.4);
+    click(&mut harness, at, 1);
+    for _ in 0..10 {
+        harness.step();
+    }
+    assert!(
+        bend_at(&harness, 0.7, 0.4) < 1e-6,
+        "the dab's centre is painted"
+    );
+    let map = &harness.state().project().flower.templates[0].maps.keys()[0]
+        .maps
+        .bend;
+    let (width, height) = map.size();
+    // Every changed pixel is under the one dab (within the radius of the
+    // click, with a pixel of slack).
+    let pixel = 1.0 / f64::from(width.min(height));
+    let mut changed = 0;
+    for y in 0..height {
+        for x in 0..width {
+            let value = map.values()[(y * width + x) as usize];
+            if (value - 1.0).abs() > 1e-6 {
+                changed += 1;
+                let uv = glam::DVec2::new(
+                    (f64::from(x) + 0.5) / f64::from(width),
+                    1.0 - (f64::from(y) + 0.5) / f64::from(height),
+                );
+                assert!(
+                    uv.distance(glam::DVec2::new(0.7, 0.4)) < 0.06 + pixel,
+                    "painted outside the dab at {uv}"
+                );
+            }
+        }
+    }
+    assert!(changed > 0);
+    assert!(
+        harness
+            .state()
+            .document()
+            .undo_label()
+            .is_some_and(|l| l.contains("dab on bend"))
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().project(),
+        &before,
+        "one click, one undo step"
+    );
+}
+
+#[test]
+fn alt_click_picks_the_value_under_the_pointer_as_a_set_brush() {
+    use anthesis_maps::brush::BrushMode;
+    let mut harness = hard_brush_on_bend(0.25);
+    // Paint 0 somewhere, then pick it up with the add brush selected.
+    let at = canvas_at(&harness, 0.5, 0.5);
+    click(&mut harness, at, 1);
+    for _ in 0..10 {
+        harness.step();
+    }
+    let paint = harness.state_mut().paint_mut();
+    paint.brush.mode = BrushMode::Add;
+    paint.brush.value = 0.7;
+    let before = harness.state().project().clone();
+    let pos = canvas_at(&harness, 0.5, 0.5);
+    harness.hover_at(pos);
+    for pressed in [true, false] {
+        harness.event_modifiers(
+            egui::Event::PointerButton {
+                pos,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: egui::Modifiers::ALT,
+            },
+            egui::Modifiers::ALT,
+        );
+    }
+    for _ in 0..10 {
+        harness.step();
+    }
+    let brush = harness.state_mut().paint_mut().brush;
+    assert_eq!(brush.mode, BrushMode::Set);
+    assert!(brush.value.abs() < 1e-6, "picked {}", brush.value);
+    assert_eq!(harness.state().project(), &before, "picking paints nothing");
+}
+
+#[test]
+fn the_canvas_shows_the_brush_outline_and_the_legend_of_the_map() {
+    let mut harness = hard_brush_on_bend(0.25);
+    harness.state_mut().paint_mut().brush.radius_in_uv = 0.1;
+    let pos = canvas_at(&harness, 0.35, 0.6);
+    harness.hover_at(pos);
+    harness.run();
+    assert!(
+        harness
+            .query_by_label_contains("under the pointer (u 0.35, v 0.60)")
+            .is_some()
+    );
+    assert!(
+        harness
+            .query_by_label_contains("multiplier of the template's bend stiffness")
+            .is_some()
+    );
+    harness.snapshot("paint_canvas_outline_and_legend");
 }
 
 #[test]

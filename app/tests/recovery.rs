@@ -42,13 +42,15 @@ fn launch(
 fn stroke() -> Command {
     Command::Edit {
         label: "paint".into(),
-        edit: ProjectEdit::Dab {
+        edit: ProjectEdit::Dabs {
             template: 0,
             key: 0,
             target: PaintTarget::Scalar(MapKind::EGrowth),
             brush: Brush::default(),
-            point_in_uv: glam::DVec2::new(0.5, 0.6),
-            direction_in_uv: glam::DVec2::Y,
+            dabs: vec![anthesis_maps::brush::StrokeDab {
+                centre_in_uv: glam::DVec2::new(0.5, 0.6),
+                direction_in_uv: glam::DVec2::Y,
+            }],
         },
     }
 }

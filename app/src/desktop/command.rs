@@ -14,14 +14,13 @@ use std::path::PathBuf;
 use anthesis_flower::{Project, Resolution, Template};
 use anthesis_maps::{Blend, DirectionMap, MapKey, MapKind, ScalarMap};
 use anthesis_mesh::Mesh;
-use glam::DVec2;
 
 use super::files::DialogPurpose;
 use super::log::Topic;
 use super::prompts::Pending;
 use super::viewport::ViewOptions;
 use super::{AnthesisApp, Document};
-use anthesis_maps::brush::{Brush, PaintTarget, dab_keyed};
+use anthesis_maps::brush::{Brush, PaintTarget, StrokeDab, dab_keyed};
 
 /// One user action.
 #[derive(Debug, Clone, PartialEq)]
@@ -86,14 +85,14 @@ pub enum ProjectEdit {
         keyframes: u32,
     },
     /// One brush dab on a map of a time key.
-    Dab {
+    Dabs {
         template: usize,
         key: usize,
         target: PaintTarget,
         brush: Brush,
-        point_in_uv: DVec2,
-        /// The stroke's direction (used by the direction map).
-        direction_in_uv: DVec2,
+        /// The dabs in order, each with the stroke's direction there (used
+        /// by the direction map).
+        dabs: Vec<StrokeDab>,
     },
     /// A time key (an existing step is left alone).
     AddKey { template: usize, key: Box<MapKey> },
@@ -136,23 +135,24 @@ impl ProjectEdit {
                     project.settings.keyframes = keyframes;
                 }
             }
-            ProjectEdit::Dab {
+            ProjectEdit::Dabs {
                 template,
                 key,
                 target,
                 brush,
-                point_in_uv,
-                direction_in_uv,
+                dabs,
             } => {
                 if let Some(t) = templates.get_mut(template) {
-                    dab_keyed(
-                        &mut t.maps,
-                        key,
-                        target,
-                        &brush,
-                        point_in_uv,
-                        direction_in_uv,
-                    );
+                    for dab in dabs {
+                        dab_keyed(
+                            &mut t.maps,
+                            key,
+                            target,
+                            &brush,
+                            dab.centre_in_uv,
+                            dab.direction_in_uv,
+                        );
+                    }
                 }
             }
             ProjectEdit::AddKey { template, key } => {
@@ -343,6 +343,7 @@ mod tests {
     use super::*;
     use anthesis_maps::GrowthMaps;
     use anthesis_maps::brush::BrushMode;
+    use glam::DVec2;
 
     fn project() -> Project {
         anthesis_sim::fixtures::whorl(2, 4, 6, 3)
@@ -365,7 +366,7 @@ mod tests {
                 value: Box::new(changed),
                 keyframes: project.settings.keyframes + 7,
             },
-            ProjectEdit::Dab {
+            ProjectEdit::Dabs {
                 template: 0,
                 key: 0,
                 target: PaintTarget::Scalar(MapKind::Bend),
@@ -374,16 +375,20 @@ mod tests {
                     value: 0.1,
                     ..Brush::default()
                 },
-                point_in_uv: DVec2::new(0.3, 0.5),
-                direction_in_uv: DVec2::ZERO,
+                dabs: vec![StrokeDab {
+                    centre_in_uv: DVec2::new(0.3, 0.5),
+                    direction_in_uv: DVec2::ZERO,
+                }],
             },
-            ProjectEdit::Dab {
+            ProjectEdit::Dabs {
                 template: 0,
                 key: 0,
                 target: PaintTarget::Direction,
                 brush: Brush::default(),
-                point_in_uv: DVec2::new(0.5, 0.5),
-                direction_in_uv: DVec2::new(0.1, 0.0),
+                dabs: vec![StrokeDab {
+                    centre_in_uv: DVec2::new(0.5, 0.5),
+                    direction_in_uv: DVec2::new(0.1, 0.0),
+                }],
             },
             ProjectEdit::AddKey {
                 template: 0,
@@ -473,13 +478,15 @@ mod tests {
                 value: Box::new(original.flower.templates[0].clone()),
                 keyframes: 9,
             },
-            ProjectEdit::Dab {
+            ProjectEdit::Dabs {
                 template: missing,
                 key: 0,
                 target: PaintTarget::Scalar(MapKind::Bend),
                 brush: Brush::default(),
-                point_in_uv: DVec2::splat(0.5),
-                direction_in_uv: DVec2::ZERO,
+                dabs: vec![StrokeDab {
+                    centre_in_uv: DVec2::splat(0.5),
+                    direction_in_uv: DVec2::ZERO,
+                }],
             },
             ProjectEdit::Map {
                 template: 0,

@@ -10,7 +10,14 @@ use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use glam::DVec2;
 
 use super::command::{Command, ProjectEdit};
-use anthesis_maps::brush::{Brush, BrushMode, PaintTarget};
+use anthesis_maps::brush::{Brush, BrushMode, PaintTarget, StrokeDab, StrokeSpacing};
+
+/// The radius slider's range (UV units) and the `[`/`]` step factor.
+const MIN_RADIUS_IN_UV: f64 = 0.005;
+const MAX_RADIUS_IN_UV: f64 = 0.5;
+const RADIUS_STEP: f64 = 1.25;
+/// The `Shift+[`/`Shift+]` strength step.
+const STRENGTH_STEP: f32 = 0.1;
 
 /// The paint panel's state.
 pub struct PaintState {
@@ -24,8 +31,18 @@ pub struct PaintState {
     pub new_key_step: u32,
     zoom: f32,
     pan: Vec2,
-    /// The previous point of the stroke being painted.
-    last_uv: Option<DVec2>,
+    /// Where the dabs of the stroke being painted go (along the pointer's
+    /// path, a quarter of the radius apart).
+    stroke: StrokeSpacing,
+    /// A click waiting to become one dab once the double-click time has
+    /// passed without a second click (a double-click resets the view and
+    /// paints nothing): where, and when (egui time, seconds).
+    pending_click: Option<(DVec2, f64)>,
+    /// The eyedropper: the next primary click on the canvas picks the value
+    /// under the pointer instead of painting (Alt+click always picks).
+    pub eyedropper: bool,
+    /// Where the pointer is over the canvas (for the value under it).
+    hover_uv: Option<DVec2>,
     texture: Option<egui::TextureHandle>,
 }
 
@@ -39,7 +56,10 @@ impl Default for PaintState {
             new_key_step: 50,
             zoom: 1.0,
             pan: Vec2::ZERO,
-            last_uv: None,
+            stroke: StrokeSpacing::new(1.0),
+            pending_click: None,
+            eyedropper: false,
+            hover_uv: None,
             texture: None,
         }
     }
@@ -89,49 +109,139 @@ fn map_image(template: &Template, key: usize, target: PaintTarget) -> egui::Colo
 }
 
 impl PaintState {
-    /// One dab at `point_in_uv` on template `template` of `project` (from
-    /// the canvas or the 3D organ); the stroke direction comes from the
-    /// previous dab. `None` while a direction stroke has no direction yet.
+    /// The stroke continues to `point_in_uv` on template `template` of
+    /// `project` (from the canvas or the 3D organ): the dabs along the path
+    /// since the last point, a quarter of the brush radius apart
+    /// ([`StrokeSpacing`]), as one edit; the first point of a stroke is one
+    /// dab. Direction dabs take the stroke's direction, so the first point
+    /// of a direction stroke paints nothing. `None` when there is nothing to
+    /// paint.
+    pub fn stroke_to(
+        &mut self,
+        project: &Project,
+        template: usize,
+        point_in_uv: DVec2,
+    ) -> Option<Command> {
+        if !self.stroke.started() {
+            self.stroke = StrokeSpacing::for_brush(&self.brush);
+        }
+        let dabs = self.stroke.extend_to(point_in_uv);
+        self.edit(project, template, dabs, "stroke")
+    }
+
+    /// One dab at `point_in_uv` (a click), as its own edit.
     pub fn dab(
         &mut self,
         project: &Project,
         template: usize,
         point_in_uv: DVec2,
     ) -> Option<Command> {
-        let direction = self.last_uv.map_or(DVec2::ZERO, |last| point_in_uv - last);
+        let dab = StrokeDab {
+            centre_in_uv: point_in_uv,
+            direction_in_uv: DVec2::ZERO,
+        };
+        self.edit(project, template, vec![dab], "dab")
+    }
+
+    /// The dabs as one [`ProjectEdit::Dabs`] named after `what` ("stroke",
+    /// "dab"): a click's dab and a stroke after it are two undo steps.
+    fn edit(
+        &self,
+        project: &Project,
+        template: usize,
+        mut dabs: Vec<StrokeDab>,
+        what: &str,
+    ) -> Option<Command> {
         if self.target == PaintTarget::Direction
             && matches!(self.brush.mode, BrushMode::Set | BrushMode::Add)
-            && direction.length() < 0.1 * self.brush.radius_in_uv
         {
-            // Wait until the stroke has a direction.
-            if self.last_uv.is_none() {
-                self.last_uv = Some(point_in_uv);
-            }
+            // A direction is painted only where the stroke has one.
+            dabs.retain(|d| d.direction_in_uv != DVec2::ZERO);
+        }
+        if dabs.is_empty() {
             return None;
         }
-        self.last_uv = Some(point_in_uv);
         let (key, target, brush) = (self.key, self.target, self.brush);
         let name = &project.flower.templates.get(template)?.name;
         Some(Command::Edit {
             label: format!(
-                "{} stroke on {} of {name}",
+                "{} {what} on {} of {name}",
                 brush.mode.label(),
                 target.label()
             ),
-            edit: ProjectEdit::Dab {
+            edit: ProjectEdit::Dabs {
                 template,
                 key,
                 target,
                 brush,
-                point_in_uv,
-                direction_in_uv: direction,
+                dabs,
             },
         })
     }
 
-    /// Ends the stroke (pointer released).
+    /// The eyedropper: the brush takes the value of the shown scalar map at
+    /// `point_in_uv` and becomes a set brush (set moves values towards the
+    /// brush value, so painting then lays down the picked value). The
+    /// direction map has no brush value: nothing is picked there. Returns
+    /// the value picked.
+    pub fn pick(&mut self, template: &Template, point_in_uv: DVec2) -> Option<f32> {
+        let value = self.value_at(template, point_in_uv)?;
+        self.brush.value = value;
+        self.brush.mode = BrushMode::Set;
+        self.eyedropper = false;
+        Some(value)
+    }
+
+    /// The value of the shown scalar map at `point_in_uv` (bilinear, as
+    /// the simulation samples it); `None` for the direction map.
+    pub fn value_at(&self, template: &Template, point_in_uv: DVec2) -> Option<f32> {
+        match self.target {
+            PaintTarget::Scalar(kind) => Some(
+                template
+                    .maps
+                    .key_clamped(self.key)
+                    .maps
+                    .scalar(kind)
+                    .sample(point_in_uv) as f32,
+            ),
+            PaintTarget::Direction => None,
+        }
+    }
+
+    /// Radius steps of the `]` / `[` shortcuts: one step is a factor of
+    /// 1.25, within the radius slider's range.
+    pub fn grow_radius(&mut self) {
+        self.brush.radius_in_uv = (self.brush.radius_in_uv * RADIUS_STEP).min(MAX_RADIUS_IN_UV);
+    }
+
+    /// See [`PaintState::grow_radius`].
+    pub fn shrink_radius(&mut self) {
+        self.brush.radius_in_uv = (self.brush.radius_in_uv / RADIUS_STEP).max(MIN_RADIUS_IN_UV);
+    }
+
+    /// Strength steps of the `Shift+]` / `Shift+[` shortcuts: 0.1, within
+    /// `[0, 1]`.
+    pub fn raise_strength(&mut self) {
+        self.brush.strength = (self.brush.strength + STRENGTH_STEP).min(1.0);
+    }
+
+    /// See [`PaintState::raise_strength`].
+    pub fn lower_strength(&mut self) {
+        self.brush.strength = (self.brush.strength - STRENGTH_STEP).max(0.0);
+    }
+
+    /// The `X` shortcut: add becomes subtract and subtract add; any other
+    /// mode becomes add (so `X` always leaves an add/subtract brush).
+    pub fn toggle_mode(&mut self) {
+        self.brush.mode = match self.brush.mode {
+            BrushMode::Add => BrushMode::Subtract,
+            _ => BrushMode::Add,
+        };
+    }
+
+    /// Ends the stroke (pointer released, or left the organ).
     pub fn end_stroke(&mut self) {
-        self.last_uv = None;
+        self.stroke.end();
     }
 
     /// The paint panel for template `template` of `project`; returns the
@@ -257,6 +367,7 @@ impl PaintState {
             });
 
         chosen.extend(self.canvas(ui, project, template, current));
+        self.legend_ui(ui, current);
         ui.separator();
         egui::ScrollArea::vertical()
             .id_salt("brush settings")
@@ -287,9 +398,15 @@ impl PaintState {
                 ui.end_row();
             };
             let label = ui.label("radius").id;
-            ui.add(egui::Slider::new(&mut self.brush.radius_in_uv, 0.005..=0.5).logarithmic(true))
-                .labelled_by(label)
-                .on_hover_text("Brush radius in UV units (the layout is 1 wide)");
+            ui.add(
+                egui::Slider::new(
+                    &mut self.brush.radius_in_uv,
+                    MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV,
+                )
+                .logarithmic(true),
+            )
+            .labelled_by(label)
+            .on_hover_text("Brush radius in UV units (the layout is 1 wide)");
             ui.end_row();
             slider(
                 ui,
@@ -310,6 +427,11 @@ impl PaintState {
                 "What set moves towards, and what add and subtract add or take away",
             );
         });
+        ui.toggle_value(&mut self.eyedropper, "Eyedropper")
+            .on_hover_text(
+                "Click the canvas to pick the value under the pointer as a set brush \
+                 (Alt+click always picks)",
+            );
         ui.checkbox(&mut self.brush.mirror, "Mirror about the midrib (u = 0.5)");
         ui.checkbox(&mut self.on_3d, "Paint on the 3D organ (drag on it)")
             .on_hover_text(
@@ -324,7 +446,7 @@ impl PaintState {
         project: &Project,
         template: usize,
         current: &Template,
-    ) -> Option<Command> {
+    ) -> Vec<Command> {
         let side = ui
             .available_width()
             .min(0.6 * ui.available_height())
@@ -332,9 +454,6 @@ impl PaintState {
         let (rect, response) = ui.allocate_exact_size(Vec2::splat(side), Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "UV paint canvas"));
-        let response = response.on_hover_text(
-            "Drag to paint; scroll to zoom; right- or middle-drag to pan; double-click to reset the view",
-        );
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
             if scroll != 0.0 {
@@ -370,15 +489,51 @@ impl PaintState {
             )
         };
 
-        // A dab where the pointer is pressed or moves while held: holding
-        // still does not paint again on every redraw.
-        let fresh = ui.input(|i| i.pointer.primary_pressed() || i.pointer.delta() != Vec2::ZERO);
-        let painting = (response.dragged_by(egui::PointerButton::Primary) && fresh)
-            || (response.clicked() && !response.double_clicked());
-        let dab = match response.interact_pointer_pos() {
-            Some(pointer) if painting => self.dab(project, template, to_uv(pointer)),
-            _ => None,
-        };
+        // Strokes: from where the drag began along the pointer's path,
+        // dabs spaced along each frame's segment (whatever the frame rate).
+        // A click is one dab, painted once the double-click time has passed
+        // without a second click: a double-click resets the view and paints
+        // nothing. Alt+click, or a click with the eyedropper, picks.
+        let (now, alt, press_origin) =
+            ui.input(|i| (i.time, i.modifiers.alt, i.pointer.press_origin()));
+        let double_click_seconds = ui.ctx().options(|o| o.input_options.max_double_click_delay);
+        let picking = alt || self.eyedropper;
+        let mut dabs = Vec::new();
+        if response.drag_started_by(egui::PointerButton::Primary) && !picking {
+            // A pending click belongs to no stroke: paint it first.
+            dabs.extend(self.flush_click(project, template));
+            if let Some(origin) = press_origin {
+                dabs.extend(self.stroke_to(project, template, to_uv(origin)));
+            }
+        }
+        if response.dragged_by(egui::PointerButton::Primary)
+            && !picking
+            && let Some(pointer) = response.interact_pointer_pos()
+        {
+            dabs.extend(self.stroke_to(project, template, to_uv(pointer)));
+        }
+        if response.clicked_by(egui::PointerButton::Primary)
+            && let Some(pointer) = response.interact_pointer_pos()
+        {
+            if picking {
+                self.pick(current, to_uv(pointer));
+            } else if response.double_clicked() {
+                self.pending_click = None;
+            } else {
+                self.pending_click = Some((to_uv(pointer), now));
+            }
+        }
+        match self.pending_click {
+            Some((_, at)) if now - at > double_click_seconds => {
+                dabs.extend(self.flush_click(project, template));
+            }
+            Some((_, at)) => ui
+                .ctx()
+                .request_repaint_after(std::time::Duration::from_secs_f64(
+                    (double_click_seconds - (now - at)).max(0.0) + 0.01,
+                )),
+            None => {}
+        }
 
         // The document as it is before this frame's dab (the app draws
         // again once the dab is applied).
@@ -448,8 +603,16 @@ impl PaintState {
                 }
             }
         }
+        self.hover_uv = response.hover_pos().map(to_uv);
         if let Some(pointer) = response.hover_pos() {
+            // The brush outline: a circle of the brush radius in canvas
+            // pixels (and its mirror image with mirroring).
             let r = self.brush.radius_in_uv as f32 * size;
+            painter.circle_stroke(
+                pointer,
+                r + 1.0,
+                Stroke::new(1.0, Color32::from_black_alpha(160)),
+            );
             painter.circle_stroke(pointer, r, Stroke::new(1.0, Color32::WHITE));
             if self.brush.mirror {
                 let uv = to_uv(pointer);
@@ -460,7 +623,148 @@ impl PaintState {
                 );
             }
         }
-        dab
+        dabs
+    }
+
+    /// The pending click as one dab, if there is one.
+    fn flush_click(&mut self, project: &Project, template: usize) -> Option<Command> {
+        let (point_in_uv, _) = self.pending_click.take()?;
+        self.dab(project, template, point_in_uv)
+    }
+
+    /// The colour bar of the shown map with its values, what 0 and 1 mean
+    /// for that map, and the value under the pointer on the canvas.
+    fn legend_ui(&mut self, ui: &mut egui::Ui, current: &Template) {
+        let hovered = self.hover_uv.take();
+        // The canvas's hint as a line, not a tooltip over the legend.
+        ui.label(
+            egui::RichText::new(
+                "Drag to paint, click for one dab; Alt+click picks; scroll to zoom; \
+                 right- or middle-drag to pan; double-click to reset the view",
+            )
+            .small()
+            .weak(),
+        );
+        match self.target {
+            PaintTarget::Scalar(kind) => {
+                let (area, _) =
+                    ui.allocate_exact_size(Vec2::new(ui.available_width(), 26.0), Sense::hover());
+                let bar = Rect::from_min_size(area.min, Vec2::new(area.width(), 12.0));
+                let painter = ui.painter_at(area);
+                let steps = 64;
+                for i in 0..steps {
+                    let t0 = i as f32 / steps as f32;
+                    let t1 = (i + 1) as f32 / steps as f32;
+                    painter.rect_filled(
+                        Rect::from_x_y_ranges(
+                            bar.left() + t0 * bar.width()..=bar.left() + t1 * bar.width(),
+                            bar.y_range(),
+                        ),
+                        0.0,
+                        ramp((t0 + t1) / 2.0),
+                    );
+                }
+                let value_under = hovered.and_then(|uv| self.value_at(current, uv));
+                if let Some(value) = value_under {
+                    let x = bar.left() + value.clamp(0.0, 1.0) * bar.width();
+                    painter.line_segment(
+                        [Pos2::new(x, bar.top()), Pos2::new(x, bar.bottom())],
+                        Stroke::new(2.0, Color32::BLACK),
+                    );
+                }
+                // Values under the bar.
+                for t in [0.0_f32, 0.25, 0.5, 0.75, 1.0] {
+                    let x = bar.left() + t * bar.width();
+                    let align = if t == 0.0 {
+                        egui::Align2::LEFT_TOP
+                    } else if t == 1.0 {
+                        egui::Align2::RIGHT_TOP
+                    } else {
+                        egui::Align2::CENTER_TOP
+                    };
+                    painter.line_segment(
+                        [Pos2::new(x, bar.bottom()), Pos2::new(x, bar.bottom() + 3.0)],
+                        Stroke::new(1.0, ui.visuals().text_color()),
+                    );
+                    painter.text(
+                        Pos2::new(x, bar.bottom() + 2.0),
+                        align,
+                        format!("{t}"),
+                        egui::FontId::proportional(11.0),
+                        ui.visuals().text_color(),
+                    );
+                }
+                ui.label(egui::RichText::new(legend(kind, current.dg)).small());
+                ui.label(match (hovered, value_under) {
+                    (Some(uv), Some(value)) => format!(
+                        "under the pointer (u {:.2}, v {:.2}): {value:.3}{}",
+                        uv.x,
+                        uv.y,
+                        meaning(kind, current.dg, value)
+                    ),
+                    _ => "under the pointer: –".to_string(),
+                });
+            }
+            PaintTarget::Direction => {
+                ui.label(
+                    egui::RichText::new(
+                        "direction: arrows show the growth direction in UV (e-growth acts \
+                         along it, w-growth across it); brighter grey = longer vector, \
+                         dark = no direction painted",
+                    )
+                    .small(),
+                );
+                let under = hovered.map(|uv| {
+                    let d = current.maps.key_clamped(self.key).maps.direction.sample(uv);
+                    format!(
+                        "under the pointer (u {:.2}, v {:.2}): direction ({:.2}, {:.2})",
+                        uv.x, uv.y, d.x, d.y
+                    )
+                });
+                ui.label(under.unwrap_or_else(|| "under the pointer: –".to_string()));
+            }
+        }
+    }
+}
+
+/// What 0 and 1 mean for map `kind` of a template growing at most `dg` per
+/// step (rate = 1 + dg · value, paper eq. 2; stiffness = template constant
+/// · value).
+pub fn legend(kind: MapKind, dg: f64) -> String {
+    let percent = 100.0 * dg;
+    match kind {
+        MapKind::EGrowth | MapKind::WGrowth | MapKind::EGrowthIn | MapKind::WGrowthIn => {
+            let (layer, way) = match kind {
+                MapKind::EGrowth => ("base layer", "along the growth direction"),
+                MapKind::WGrowth => ("base layer", "across the growth direction"),
+                MapKind::EGrowthIn => ("inner layer", "along the growth direction"),
+                _ => ("inner layer", "across the growth direction"),
+            };
+            format!(
+                "{}: relative growth per step of the {layer} {way}. 0 = no growth, \
+                 1 = {percent:+.1} % per step (the template's dg = {dg}; rate = 1 + dg · value). \
+                 Inner > base bends the organ outwards.",
+                kind.label()
+            )
+        }
+        MapKind::Stretch | MapKind::Bend => format!(
+            "{}: multiplier of the template's {} stiffness. 0 = none (limp), \
+             1 = the template's full stiffness (the default).",
+            kind.label(),
+            if kind == MapKind::Stretch {
+                "stretch"
+            } else {
+                "bend"
+            }
+        ),
+    }
+}
+
+/// `value` of map `kind` in the map's own terms, e.g. " = +1.2 % per step".
+fn meaning(kind: MapKind, dg: f64, value: f32) -> String {
+    match kind {
+        MapKind::Stretch | MapKind::Bend => format!(" = {:.0} % of the stiffness", 100.0 * value),
+        _ => format!(" = {:+.2} % per step", 100.0 * dg * f64::from(value)),
     }
 }
 
@@ -469,10 +773,11 @@ mod tests {
     use super::*;
     use crate::desktop::document::Document;
 
-    /// A dab on template 0 applied to `doc` as the app applies it: whether
+    /// The stroke on template 0 continued to `point_in_uv`, applied to `doc`
+    /// as the app applies it: whether
     /// the project changed.
     fn dab(paint: &mut PaintState, doc: &mut Document, point_in_uv: DVec2) -> bool {
-        match paint.dab(doc.project(), 0, point_in_uv) {
+        match paint.stroke_to(doc.project(), 0, point_in_uv) {
             Some(Command::Edit { label, edit }) => doc.edit(&label, |p| edit.apply(p)),
             Some(other) => panic!("a dab is an edit, not {other:?}"),
             None => false,
@@ -490,7 +795,7 @@ mod tests {
             assert!(dab(
                 &mut paint,
                 &mut doc,
-                DVec2::new(0.3 + 0.02 * f64::from(i), 0.5)
+                DVec2::new(0.3 + 0.03 * f64::from(i), 0.5)
             ));
         }
         paint.end_stroke();
@@ -504,9 +809,48 @@ mod tests {
             "no direction yet"
         );
         assert!(dab(&mut paint, &mut doc, DVec2::new(0.4, 0.5)));
+        paint.end_stroke();
         let keys = doc.project().flower.templates[0].maps.keys();
         let d = keys[0].maps.direction.sample(DVec2::new(0.4, 0.5));
         assert!(d.x > 0.3, "painted towards +u: {d}");
+    }
+
+    #[test]
+    fn shortcut_steps_stay_in_the_sliders_ranges_and_x_swaps_add_and_subtract() {
+        let mut paint = PaintState::default();
+        let r = paint.brush.radius_in_uv;
+        paint.grow_radius();
+        assert!((paint.brush.radius_in_uv - r * RADIUS_STEP).abs() < 1e-12);
+        paint.shrink_radius();
+        assert!((paint.brush.radius_in_uv - r).abs() < 1e-12);
+        for _ in 0..100 {
+            paint.grow_radius();
+        }
+        assert_eq!(paint.brush.radius_in_uv, MAX_RADIUS_IN_UV);
+        for _ in 0..100 {
+            paint.shrink_radius();
+        }
+        assert_eq!(paint.brush.radius_in_uv, MIN_RADIUS_IN_UV);
+
+        paint.brush.strength = 0.5;
+        paint.raise_strength();
+        assert!((paint.brush.strength - 0.6).abs() < 1e-6);
+        for _ in 0..20 {
+            paint.lower_strength();
+        }
+        assert_eq!(paint.brush.strength, 0.0);
+        for _ in 0..20 {
+            paint.raise_strength();
+        }
+        assert_eq!(paint.brush.strength, 1.0);
+
+        paint.brush.mode = BrushMode::Set;
+        paint.toggle_mode();
+        assert_eq!(paint.brush.mode, BrushMode::Add);
+        paint.toggle_mode();
+        assert_eq!(paint.brush.mode, BrushMode::Subtract);
+        paint.toggle_mode();
+        assert_eq!(paint.brush.mode, BrushMode::Add);
     }
 
     #[test]

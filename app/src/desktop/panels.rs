@@ -147,14 +147,22 @@ impl AnthesisApp {
             Some((self.selected_organ, outline)),
             Some(self.paint.key),
             self.paint.on_3d,
+            self.paint.brush.radius_in_uv,
         );
         let template = self.selected_template();
         match response.painting {
             Some(hit) if self.project().flower.organs[hit.organ].template == template => {
-                let dab = self
+                // The same spacing as on the canvas, in UV along the
+                // picked path.
+                let dabs = self
                     .paint
-                    .dab(self.doc.project(), template, hit.point_in_uv);
-                self.queued.extend(dab);
+                    .stroke_to(self.doc.project(), template, hit.point_in_uv);
+                self.queued.extend(dabs);
+            }
+            _ if response.painting_off_organ => {
+                // Off the organ (or on another one): the stroke goes on
+                // from where the pointer comes back, not across the gap.
+                self.paint.end_stroke();
             }
             _ => {
                 if let Some(hit) = response.clicked {

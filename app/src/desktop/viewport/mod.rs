@@ -14,7 +14,7 @@ use anthesis_flower::Project;
 use anthesis_maps::MapKind;
 use anthesis_mesh::ray::nearest_hit;
 use anthesis_render::{OrbitCamera, OrganMesh};
-use eframe::egui::{self, Pos2, Sense, Vec2};
+use eframe::egui::{self, Color32, Pos2, Sense, Stroke, Vec2};
 use eframe::egui_wgpu;
 use glam::{DVec2, DVec3};
 
@@ -78,6 +78,8 @@ pub struct ViewportResponse {
     /// The primary button is down and the pointer on an organ, with a
     /// paint modifier held (for painting on the 3D organ).
     pub painting: Option<Hit>,
+    /// Painting, but the pointer is on no organ (the stroke breaks there).
+    pub painting_off_organ: bool,
 }
 
 /// Draws the viewport into the rest of `ui`: the organs through the paint
@@ -96,6 +98,7 @@ pub fn viewport_ui(
     selected: Option<(usize, &[[u32; 2]])>,
     direction_key: Option<usize>,
     paint_modifier: bool,
+    brush_radius_in_uv: f64,
 ) -> ViewportResponse {
     let rect = ui.available_rect_before_wrap();
     let response = ui.allocate_rect(rect, Sense::click_and_drag());
@@ -150,6 +153,7 @@ pub fn viewport_ui(
         result.hovered = hit_at(pos);
         if painting && fresh {
             result.painting = result.hovered;
+            result.painting_off_organ = result.hovered.is_none();
         }
     }
     if response.clicked()
@@ -184,6 +188,24 @@ pub fn viewport_ui(
         selected,
         direction_key,
     );
+    if paint_modifier
+        && let (Some(pos), Some(hit), Some((organ, _))) =
+            (response.hover_pos(), result.hovered, selected)
+        && hit.organ == organ
+        && let Some(radius) = brush_radius_on_screen(scene, &hit, brush_radius_in_uv, &|p| {
+            overlays::project_to_screen(&view_projection, rect, p)
+        })
+    {
+        // The brush outline on the organ: a screen-space circle of the
+        // brush's UV radius scaled by the picked triangle (see
+        // `brush_radius_on_screen`).
+        painter.circle_stroke(
+            pos,
+            radius + 1.0,
+            Stroke::new(1.0, Color32::from_black_alpha(160)),
+        );
+        painter.circle_stroke(pos, radius, Stroke::new(1.0, Color32::WHITE));
+    }
     if scene.is_empty() {
         painter.text(
             rect.center(),
@@ -194,6 +216,34 @@ pub fn viewport_ui(
         );
     }
     result
+}
+
+/// The brush radius in screen points at `hit`: `radius_in_uv` times the
+/// picked triangle's screen size per UV unit (the square root of its
+/// screen area over its UV area, so a stretched or foreshortened triangle
+/// gives the mean of its two scales). `None` for a triangle degenerate in
+/// UV or behind the camera.
+fn brush_radius_on_screen(
+    scene: &[SceneOrgan],
+    hit: &Hit,
+    radius_in_uv: f64,
+    to_screen: &dyn Fn(glam::DVec3) -> Option<Pos2>,
+) -> Option<f32> {
+    let organ = scene.iter().find(|o| o.organ == hit.organ)?;
+    let corners = organ.triangles.get(hit.triangle)?;
+    let uv = corners.map(|i| organ.uvs[i as usize]);
+    let screen = [
+        to_screen(organ.positions_in_world[corners[0] as usize])?,
+        to_screen(organ.positions_in_world[corners[1] as usize])?,
+        to_screen(organ.positions_in_world[corners[2] as usize])?,
+    ];
+    let area_in_uv = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+    let (a, b) = (screen[1] - screen[0], screen[2] - screen[0]);
+    let area_on_screen = 0.5 * f64::from((a.x * b.y - a.y * b.x).abs());
+    if area_in_uv < 1e-12 {
+        return None;
+    }
+    Some((radius_in_uv * (area_on_screen / area_in_uv).sqrt()) as f32)
 }
 
 #[cfg(test)]
