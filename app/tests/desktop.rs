@@ -1052,6 +1052,8 @@ fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
     let centre = harness.get_by_label("3D viewport").rect().center();
     harness.hover_at(centre);
     harness.run();
+    // The brush outline follows the pointer on the organ.
+    harness.snapshot("paint_3d_brush_outline");
     harness.drag_at(centre);
     harness.run();
     harness.hover_at(centre + egui::vec2(4.0, 3.0));
@@ -1376,6 +1378,8 @@ fn orbiting_the_camera_keeps_the_scene_and_a_new_keyframe_or_edit_rebuilds_it() 
     let centre = harness.get_by_label("3D viewport").rect().center();
     harness.hover_at(centre);
     harness.run();
+    // The brush outline follows the pointer on the organ.
+    harness.snapshot("paint_3d_brush_outline");
     harness.drag_at(centre);
     harness.run();
     for i in 1..=10 {
