@@ -321,4 +321,50 @@ mod tests {
         mesh.uvs.truncate(3);
         assert_eq!(sorted(&mut outline, &mesh), [[0, 1], [0, 2], [1, 2]]);
     }
+
+    #[test]
+    fn the_brush_outline_on_the_organ_scales_with_the_picked_triangle_on_screen() {
+        // The unit square in UV shown 200 points wide: 200 points per UV
+        // unit, whatever the triangle.
+        let scene = [flat_square()];
+        let to_screen = |p: DVec3| {
+            Some(Pos2::new(
+                100.0 + 200.0 * p.x as f32,
+                50.0 - 200.0 * p.y as f32,
+            ))
+        };
+        for triangle in 0..2 {
+            let hit = Hit {
+                organ: 3,
+                triangle,
+                point_in_uv: DVec2::splat(0.5),
+                distance: 1.0,
+            };
+            let radius = brush_radius_on_screen(&scene, &hit, 0.05, &to_screen);
+            assert!(
+                radius.is_some_and(|r| (r - 10.0).abs() < 1e-4),
+                "{radius:?}"
+            );
+        }
+        // Squashed to half height on screen: the mean scale, sqrt(1/2).
+        let squashed = |p: DVec3| {
+            Some(Pos2::new(
+                100.0 + 200.0 * p.x as f32,
+                50.0 - 100.0 * p.y as f32,
+            ))
+        };
+        let hit = Hit {
+            organ: 3,
+            triangle: 0,
+            point_in_uv: DVec2::splat(0.5),
+            distance: 1.0,
+        };
+        let radius = brush_radius_on_screen(&scene, &hit, 0.05, &squashed);
+        assert!(
+            radius.is_some_and(|r| (r - 10.0 * 0.5_f32.sqrt()).abs() < 1e-4),
+            "{radius:?}"
+        );
+        // Behind the camera: no outline.
+        assert!(brush_radius_on_screen(&scene, &hit, 0.05, &|_| None).is_none());
+    }
 }
