@@ -4,6 +4,8 @@
 //! file's content in a message. Writing the files Anthesis saves so that
 //! nothing is lost ([`write`]): the one atomic writer.
 
+#![warn(missing_docs)]
+
 pub mod read;
 pub mod write;
 

@@ -25,13 +25,18 @@ use std::path::{Component, Path, PathBuf};
 /// Why a file was not read. The messages leave the path to the caller.
 #[derive(Debug, thiserror::Error)]
 pub enum FileError {
+    /// Nothing exists at the path (or a folder on the way is missing).
     #[error("it does not exist")]
     NotFound,
+    /// The path is a folder, a named pipe, a device or a socket; it was
+    /// not opened (reading a pipe could block forever).
     #[error("it is {kind}, not a regular file; only regular files are read")]
     NotARegularFile {
         /// What it is instead, e.g. "a named pipe (FIFO)".
         kind: &'static str,
     },
+    /// The file is larger than the caller's limit for its kind; it was not
+    /// read (or reading stopped at the limit).
     #[error(
         "it is {} ({size} bytes), more than the limit of {} for {what}",
         human_bytes(*size),
@@ -40,21 +45,30 @@ pub enum FileError {
     TooLarge {
         /// Its size, or for a file that grew while being read, a lower bound.
         size: u64,
+        /// The most bytes the caller accepts for this kind of file.
         limit: u64,
         /// What kind of file the limit is for, e.g. "an OBJ mesh".
         what: &'static str,
     },
+    /// The operating system could not read the file (permissions, an I/O
+    /// failure) or its text is not UTF-8; holds the underlying error.
     #[error("cannot read it: {0}")]
     Io(io::Error),
+    /// A project file names a file with an empty path.
     #[error("the path is empty")]
     EmptyPath,
+    /// A project file names a file by an absolute path; paths in a project
+    /// are relative to its folder so the project can be moved and shared.
     #[error(
         "the path is absolute; files named in a project must be given relative to the \
          project's folder"
     )]
     Absolute,
+    /// A path's `..` components climb above the project's folder.
     #[error("the path leaves the project's folder through `..`")]
     ClimbsOut,
+    /// A path stays inside the project's folder as written, but a symbolic
+    /// link on the way leads outside it.
     #[error(
         "the path leads outside the project's folder through a symbolic link; files named \
          in a project must lie inside its folder"

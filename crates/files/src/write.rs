@@ -28,20 +28,66 @@ use std::path::{Path, PathBuf};
 /// Why a file could not be written. Every message names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
+    /// The folder the file should go in does not exist (it is not created
+    /// here; the user picks an existing folder or [`create_folder`] makes it).
     #[error("cannot write {}: the folder {} does not exist", .path.display(), .folder.display())]
-    MissingFolder { path: PathBuf, folder: PathBuf },
+    MissingFolder {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The folder that does not exist: the file's folder, or where it
+        /// could be found, the outermost missing ancestor of it.
+        folder: PathBuf,
+    },
+    /// A part of the path that must be a folder is a regular file.
     #[error("cannot write {}: {} is a file, not a folder", .path.display(), .folder.display())]
-    NotAFolder { path: PathBuf, folder: PathBuf },
+    NotAFolder {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The ancestor of `path` that is a file where a folder should be.
+        folder: PathBuf,
+    },
+    /// The destination is a folder, which is never replaced by a file.
     #[error("cannot write {}: a folder of that name exists", .path.display())]
-    IsAFolder { path: PathBuf },
+    IsAFolder {
+        /// The destination, an existing folder.
+        path: PathBuf,
+    },
+    /// The destination is a block device or a socket, which is refused and
+    /// left untouched (character devices and named pipes are written to).
     #[error("cannot write {}: it is {what}, not a file, and is left as it is", .path.display())]
-    NotAFile { path: PathBuf, what: &'static str },
+    NotAFile {
+        /// The destination.
+        path: PathBuf,
+        /// What it is instead, in words, e.g. "a socket".
+        what: &'static str,
+    },
+    /// The user may not write there (permission denied or a read-only
+    /// file system); another location is needed.
     #[error("cannot write {}: the location is not writable ({source})", .path.display())]
-    NotWritable { path: PathBuf, source: io::Error },
+    NotWritable {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The operating system's error.
+        source: io::Error,
+    },
+    /// The disk is full or the user's quota is used up; the previous file,
+    /// if any, is unchanged.
     #[error("cannot write {}: the disk is full or the quota is exceeded ({source})", .path.display())]
-    DiskFull { path: PathBuf, source: io::Error },
+    DiskFull {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The operating system's error.
+        source: io::Error,
+    },
+    /// Any other I/O failure while writing; the previous file, if any, is
+    /// unchanged.
     #[error("cannot write {}: {source}", .path.display())]
-    Io { path: PathBuf, source: io::Error },
+    Io {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The operating system's error.
+        source: io::Error,
+    },
 }
 
 impl WriteError {
