@@ -9,6 +9,8 @@
 //! - UV `u` runs across the organ (midrib at `u = 0.5`), `v` from the base
 //!   (`0`) to the tip (`1`).
 
+#![warn(missing_docs)]
+
 mod error;
 pub mod generate;
 pub mod nearest;
@@ -32,16 +34,24 @@ use glam::{DVec2, DVec3};
 /// A triangle mesh with one UV per vertex.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Mesh {
+    /// Vertex positions, in the space and units of whoever holds the mesh
+    /// (an organ template's frame in the project's units, for templates).
     pub positions: Vec<DVec3>,
+    /// One UV per vertex, same index as `positions`: `u` across the organ,
+    /// `v` from base (0) to tip (1).
     pub uvs: Vec<DVec2>,
+    /// Vertex indices of each triangle, counter-clockwise around the normal
+    /// of the organ's inner side.
     pub triangles: Vec<[u32; 3]>,
 }
 
 impl Mesh {
+    /// How many vertices (positions, and UVs) the mesh has.
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
     }
 
+    /// How many triangles the mesh has.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }

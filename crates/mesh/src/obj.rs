@@ -69,7 +69,9 @@ impl fmt::Display for ObjWarning {
 /// A mesh read from an OBJ file, and what was read past.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ObjFile {
+    /// The mesh, validated (see [`validate()`](fn@crate::validate)).
     pub mesh: Mesh,
+    /// Statements that were ignored (lines, points), to show the user.
     pub warnings: Vec<ObjWarning>,
 }
 

@@ -6,7 +6,9 @@ use crate::{Mesh, MeshError};
 /// the edge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EdgeSide {
+    /// The triangle's index in the mesh.
     pub triangle: u32,
+    /// The vertex index of the triangle's corner that is not on the edge.
     pub opposite: u32,
 }
 
@@ -17,12 +19,18 @@ pub struct EdgeSide {
 /// if present, contains `vertices[1] -> vertices[0]`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Edge {
+    /// The edge's two vertex indices, in the winding of `left`.
     pub vertices: [u32; 2],
+    /// The triangle that runs `vertices[0] -> vertices[1]`.
     pub left: EdgeSide,
+    /// The triangle that runs `vertices[1] -> vertices[0]`; `None` on the
+    /// mesh's outline.
     pub right: Option<EdgeSide>,
 }
 
 impl Edge {
+    /// Whether the edge has a triangle on one side only (it lies on the
+    /// outline of the surface).
     pub fn is_boundary(&self) -> bool {
         self.right.is_none()
     }
@@ -44,6 +52,7 @@ impl Edge {
 /// Edge topology of a manifold, consistently oriented triangle mesh.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Topology {
+    /// Every edge of the mesh once, interior and boundary.
     pub edges: Vec<Edge>,
     /// For each triangle, the edge index of its sides `(t0,t1)`, `(t1,t2)`,
     /// `(t2,t0)`.
@@ -117,10 +126,12 @@ impl Topology {
         })
     }
 
+    /// How many edges have a triangle on both sides (the hinges).
     pub fn interior_edge_count(&self) -> usize {
         self.edges.iter().filter(|e| !e.is_boundary()).count()
     }
 
+    /// How many edges lie on the outline of the surface.
     pub fn boundary_edge_count(&self) -> usize {
         self.edges.iter().filter(|e| e.is_boundary()).count()
     }
