@@ -23,9 +23,15 @@ use crate::pattern::BlockPattern;
 /// satisfy `(x - point) . normal >= offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
+    /// The held particle's index in this organ.
     pub particle: u32,
+    /// The tracking point on the neighbouring organ's surface, in the same
+    /// frame as the particle positions (world, in the simulation).
     pub point: DVec3,
+    /// Unit normal at `point`, pointing to the side the particle must stay on.
     pub normal: DVec3,
+    /// How far past `point` along `normal` the particle must stay, in
+    /// lengths of the positions (the project's collision offset).
     pub offset: f64,
 }
 
@@ -42,7 +48,10 @@ impl Contact {
 pub struct Elastic {
     /// Particle pairs of every edge (topology order).
     pub edges: Vec<[u32; 2]>,
+    /// Rest length `L0` per edge, in the units of the positions; growth
+    /// changes them each step.
     pub rest_lengths: Vec<f64>,
+    /// Spring stiffness `ks` per edge (energy per length squared).
     pub stretch_stiffness: Vec<f64>,
     /// Interior edges as hinges `[i, j, k, l]` with their edge index.
     pub hinges: Vec<([u32; 4], u32)>,
@@ -56,6 +65,7 @@ pub struct Elastic {
     /// `anchor_stiffness` (the simulation holds an organ's base particles
     /// where the receptacle and the joint schedule put them).
     pub anchors: Vec<(u32, DVec3)>,
+    /// Stiffness of the anchor springs (0 = no anchoring).
     pub anchor_stiffness: f64,
     /// The consistent model's membrane; `None` for the paper's springs
     /// (`stretch_stiffness` then holds their stiffness; either way it sets
@@ -127,6 +137,8 @@ impl Elastic {
         (sum / n).max(f64::MIN_POSITIVE)
     }
 
+    /// The total energy `E` (springs or membrane, hinges, anchors and the
+    /// `contacts`' penalties) at particle positions `x`.
     pub fn energy(&self, x: &[DVec3], contacts: &[Contact]) -> f64 {
         let mut e = 0.0;
         if let Some(m) = &self.membrane {

@@ -53,10 +53,16 @@ use glam::{DVec2, DVec3};
 /// means no growth) and its growth direction in UV.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GrowthRates {
+    /// Stretch factor of the base (outer) layer along the growth direction.
     pub e: f64,
+    /// Stretch factor of the base layer across the growth direction.
     pub w: f64,
+    /// Stretch factor of the inner layer along the growth direction.
     pub e_in: f64,
+    /// Stretch factor of the inner layer across the growth direction.
     pub w_in: f64,
+    /// The growth direction as a vector in the triangle's UV layout (any
+    /// length; `(0, 1)` is along `v`, base to tip).
     pub direction_in_uv: DVec2,
 }
 
@@ -89,7 +95,10 @@ pub enum BendBase {
 pub struct GrowthModel {
     /// Distance of the inner surface from the base surface (> 0).
     pub thickness: f64,
+    /// How the difference between inner and base growth becomes rest
+    /// angles.
     pub bend_rule: BendRule,
+    /// Which angle a hinge's growth starts from.
     pub bend_base: BendBase,
 }
 
@@ -326,6 +335,7 @@ fn curvature_hinge_angle(x: [DVec3; 4], sides: [&TriangleBend; 2], angle_from: f
 /// `(t2,t0)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GrownTriangle {
+    /// The grown rest length of each edge, in the units of the positions.
     pub lengths: [f64; 3],
     /// `atan(s' / thickness)` per edge: this triangle's share of the edge's
     /// new rest angle.

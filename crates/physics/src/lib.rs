@@ -3,6 +3,8 @@
 //! finds the shape that honours them; shape matching (§5.3) attaches the
 //! organ to the receptacle.
 
+#![warn(missing_docs)]
+
 pub mod elastic;
 pub mod growth;
 pub mod hinge;

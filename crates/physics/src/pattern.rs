@@ -49,18 +49,23 @@ impl BlockPattern {
         }
     }
 
+    /// The number of scalar unknowns, three per particle.
     pub fn dimension(&self) -> usize {
         3 * self.particles
     }
 
+    /// The number of stored entries (upper triangle, diagonal included).
     pub fn nonzeros(&self) -> usize {
         self.row_idx.len()
     }
 
+    /// CSC column pointers: column `c`'s entries are
+    /// `row_idx()[col_ptr()[c]..col_ptr()[c + 1]]` (`dimension() + 1` values).
     pub fn col_ptr(&self) -> &[usize] {
         &self.col_ptr
     }
 
+    /// CSC row indices of the stored entries, sorted within each column.
     pub fn row_idx(&self) -> &[usize] {
         &self.row_idx
     }

@@ -14,12 +14,16 @@ use crate::elastic::outer;
 /// A rigid motion `x -> rotation * (x - from_centre) + to_centre`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RigidTransform {
+    /// The rotation about `from_centre` (unit quaternion).
     pub rotation: DQuat,
+    /// The centroid of the points moved (the rotation's pivot).
     pub from_centre: DVec3,
+    /// Where `from_centre` goes: the centroid of the target points.
     pub to_centre: DVec3,
 }
 
 impl RigidTransform {
+    /// The point `x` moved by this transform.
     pub fn apply(&self, x: DVec3) -> DVec3 {
         self.rotation * (x - self.from_centre) + self.to_centre
     }

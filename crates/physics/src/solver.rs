@@ -57,16 +57,34 @@ pub struct StepReport {
     pub step_fraction: f64,
 }
 
+/// Why a solve stopped without an answer; the simulation reports it for the
+/// organ and keyframe where it happened and keeps the keyframes before.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum SolverError {
+    /// A position or the energy became NaN or infinite (growth or
+    /// stiffness values far too large for the mesh).
     #[error("a particle position or the energy became NaN or infinite")]
     NonFinite,
+    /// The Hessian stayed not positive definite after twelve rounds of
+    /// growing diagonal regularisation.
     #[error("the Hessian could not be factorised even with regularisation {regularisation:.3e}")]
-    Factorisation { regularisation: f64 },
+    Factorisation {
+        /// The last regularisation tried, added to the Hessian's diagonal.
+        regularisation: f64,
+    },
+    /// The Newton direction does not point downhill, or no fraction of the
+    /// step lowers the energy (even with a fresh factorisation), before the
+    /// tolerance was met.
     #[error(
         "no step along the Newton direction lowers the energy (relative gradient {relative_gradient:.3e})"
     )]
-    NoDescent { relative_gradient: f64 },
+    NoDescent {
+        /// `max_i |dE/dx_i| / force_scale` where the search stopped (see
+        /// [`StepReport::relative_gradient`]).
+        relative_gradient: f64,
+    },
+    /// The symbolic analysis of the sparsity pattern failed (faer's
+    /// message); a bug or an out-of-memory rather than bad input.
     #[error("sparse analysis failed: {0}")]
     Analysis(String),
 }
