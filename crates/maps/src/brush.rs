@@ -12,6 +12,7 @@ use crate::{DirectionMap, KeyedMaps, MapKind, ScalarMap};
 /// the template has no raster map to match.
 pub const DEFAULT_PAINT_SIZE: u32 = 128;
 
+/// What a dab does to the values under the brush.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum BrushMode {
     /// Moves values towards the brush value.
@@ -28,6 +29,7 @@ pub enum BrushMode {
 }
 
 impl BrushMode {
+    /// Every mode, in the order the paint panel offers them.
     pub const ALL: [BrushMode; 5] = [
         BrushMode::Set,
         BrushMode::Add,
@@ -36,6 +38,7 @@ impl BrushMode {
         BrushMode::Reset,
     ];
 
+    /// The mode's name as shown to people, e.g. `subtract`.
     pub fn label(self) -> &'static str {
         match self {
             BrushMode::Set => "set",
@@ -47,8 +50,11 @@ impl BrushMode {
     }
 }
 
+/// A brush: what it does, its size and falloff in UV space, and the value
+/// it paints.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Brush {
+    /// What a dab does (set, add, subtract, smooth, reset).
     pub mode: BrushMode,
     /// Radius in UV units (the UV square is 1 wide).
     pub radius_in_uv: f64,
@@ -267,11 +273,15 @@ pub fn ensure_direction_raster(map: &mut DirectionMap, size: (u32, u32)) {
 /// Which map a stroke paints.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum PaintTarget {
+    /// One of the six scalar maps (growth or stiffness).
     Scalar(MapKind),
+    /// The growth direction map: `Set` and `Add` dabs paint the stroke
+    /// direction (see [`dab_direction`]).
     Direction,
 }
 
 impl PaintTarget {
+    /// The target's name as shown to people, e.g. `e-growth` or `direction`.
     pub fn label(self) -> &'static str {
         match self {
             PaintTarget::Scalar(kind) => kind.label(),
@@ -337,7 +347,10 @@ pub struct StrokeSpacing {
 /// length, zero for the first dab, which has no direction yet).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StrokeDab {
+    /// Where the dab goes, in the UV square.
     pub centre_in_uv: DVec2,
+    /// The stroke's direction at the dab, a unit UV vector (zero for the
+    /// first dab); what a direction-map dab paints.
     pub direction_in_uv: DVec2,
 }
 

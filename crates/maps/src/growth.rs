@@ -29,6 +29,7 @@ pub enum MapKind {
 pub const DIRECTION_MAP_NAME: &str = "direction";
 
 impl MapKind {
+    /// Every scalar map kind, in the order files and panels list them.
     pub const ALL: [MapKind; 6] = [
         MapKind::EGrowth,
         MapKind::WGrowth,
@@ -82,12 +83,27 @@ impl MapKind {
 /// organ checks it with `check_size`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GrowthMaps {
+    /// [`MapKind::EGrowth`]: growth of the base layer along the growth
+    /// direction: 0 = none, 1 = the template's full rate `dg` (a file holds
+    /// `[0, 1]`).
     pub e_growth: ScalarMap,
+    /// [`MapKind::WGrowth`]: growth of the base layer across the growth
+    /// direction, on the same scale.
     pub w_growth: ScalarMap,
+    /// [`MapKind::EGrowthIn`]: growth of the inner layer along the growth
+    /// direction, on the same scale.
     pub e_growth_in: ScalarMap,
+    /// [`MapKind::WGrowthIn`]: growth of the inner layer across the growth
+    /// direction, on the same scale.
     pub w_growth_in: ScalarMap,
+    /// [`MapKind::Stretch`]: multiplier of the template's stretch
+    /// stiffness (1 = unchanged).
     pub stretch: ScalarMap,
+    /// [`MapKind::Bend`]: multiplier of the template's bend stiffness
+    /// (1 = unchanged).
     pub bend: ScalarMap,
+    /// The growth direction at each point, a vector in UV space (`(0, 1)`
+    /// is along `v`, from the base towards the tip).
     pub direction: DirectionMap,
 }
 
@@ -107,6 +123,7 @@ impl GrowthMaps {
         }
     }
 
+    /// The scalar map of kind `kind`.
     pub fn scalar(&self, kind: MapKind) -> &ScalarMap {
         match kind {
             MapKind::EGrowth => &self.e_growth,
@@ -118,6 +135,7 @@ impl GrowthMaps {
         }
     }
 
+    /// The scalar map of kind `kind`, to paint or replace.
     pub fn scalar_mut(&mut self, kind: MapKind) -> &mut ScalarMap {
         match kind {
             MapKind::EGrowth => &mut self.e_growth,

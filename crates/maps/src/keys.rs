@@ -24,6 +24,8 @@ pub enum Blend {
     /// logistic function and k the steepness. Small k approaches `Linear`,
     /// large k a step at s = ½; the sign of k does not matter.
     Logistic {
+        /// The steepness `k` (any sign; the default is
+        /// [`Blend::DEFAULT_STEEPNESS`]).
         #[serde(default = "default_steepness")]
         steepness: f64,
     },
@@ -90,7 +92,9 @@ fn normalised_logistic(s: f64, steepness: f64) -> f64 {
 /// The maps that hold at one simulation step.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MapKey {
+    /// The simulation step (keyframe) at which these maps hold exactly.
     pub step: u32,
+    /// The maps at that step.
     pub maps: GrowthMaps,
 }
 
@@ -101,6 +105,7 @@ pub struct MapKey {
 #[derive(Clone, Debug, PartialEq)]
 pub struct KeyedMaps {
     keys: Vec<MapKey>,
+    /// How values pass from one key to the next between their steps.
     pub blend: Blend,
 }
 
@@ -248,6 +253,7 @@ impl KeyedMaps {
 #[derive(Clone, Debug, PartialEq)]
 pub struct KeySchedule {
     steps: Vec<u32>,
+    /// How values pass from one key to the next between their steps.
     pub blend: Blend,
 }
 

@@ -33,6 +33,8 @@
 //!   value ≈ 2·(c / max) − 1, but with the 50 % grey of paint programs (128)
 //!   exactly zero, and zero survives a save and load exactly.
 
+#![warn(missing_docs)]
+
 pub mod brush;
 mod error;
 mod growth;

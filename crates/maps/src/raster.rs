@@ -64,10 +64,12 @@ impl<T> Raster<T> {
         }
     }
 
+    /// Width in pixels (across `u`).
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Height in pixels (along `v`).
     pub fn height(&self) -> u32 {
         self.height
     }
@@ -82,6 +84,8 @@ impl<T> Raster<T> {
         &self.values
     }
 
+    /// All values in image order (first row = top = `v = 1`), to change
+    /// in place; the size stays.
     pub fn values_mut(&mut self) -> &mut [T] {
         &mut self.values
     }
