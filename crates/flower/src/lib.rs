@@ -2,6 +2,8 @@
 //! on the receptacle, and which organ lies inside which (for collisions).
 //! The project file format that stores all this is in [`project`].
 
+#![warn(missing_docs)]
+
 pub mod project;
 mod receptacle;
 pub mod resolution;
@@ -20,8 +22,14 @@ use glam::{DQuat, DVec3};
 /// ARCHITECTURE.md), its growth maps over time and its material constants.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Template {
+    /// Unique name among the project's templates; organs refer to it in the
+    /// project file.
     pub name: String,
+    /// The organ's bud shape in the template frame, lengths in the
+    /// project's units, UVs across (`u`) and along (`v`) the organ.
     pub mesh: Mesh,
+    /// The growth maps over the mesh's UV square at their key times;
+    /// every map of a template has the same size.
     pub maps: KeyedMaps,
     /// Maximum growth per step: rate = 1 + dg * map value (paper eq. 2).
     /// Negative values shrink (decay, wilting).
@@ -45,8 +53,9 @@ pub struct Template {
 pub struct BaseRegion {
     /// Particles with `v <= v_max` are base particles.
     pub v_max: f64,
-    /// Optional limits across (`u_min <= u <= u_max`).
+    /// Lower limit across: particles need `u >= u_min` (0 = no limit).
     pub u_min: f64,
+    /// Upper limit across: particles need `u <= u_max` (1 = no limit).
     pub u_max: f64,
 }
 
@@ -61,6 +70,7 @@ impl Default for BaseRegion {
 }
 
 impl BaseRegion {
+    /// Whether a particle at `uv` (the mesh's UV square) is a base particle.
     pub fn contains(&self, uv: glam::DVec2) -> bool {
         uv.y <= self.v_max && uv.x >= self.u_min && uv.x <= self.u_max
     }
@@ -78,7 +88,9 @@ impl BaseRegion {
 /// `from_step = 0, to_step = 60`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointRamp {
+    /// The step after which the ramp starts (it adds nothing up to here).
     pub from_step: u32,
+    /// The step at which the ramp has added all of `angle_deg` (and holds).
     pub to_step: u32,
     /// What the ramp adds to the joint angle, in degrees (`degrees` in the
     /// project file).
@@ -105,8 +117,13 @@ pub fn joint_angle_after(schedule: &[JointRamp], step: u32) -> f64 {
 /// `position`. A positive joint angle tilts the organ outwards.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Placement {
+    /// Where the template's origin (the organ's base) goes, in the world
+    /// frame and the project's units.
     pub position: DVec3,
+    /// Turn about the flower axis (+Y), in degrees; 0 opens towards +Z.
     pub azimuth_deg: f64,
+    /// Initial tilt about the joint axis, in degrees (positive outwards);
+    /// the template's joint schedule adds to it over time.
     pub joint_angle_deg: f64,
 }
 
@@ -128,9 +145,12 @@ impl Placement {
 /// One organ: an instance of a template on the receptacle.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Organ {
+    /// Unique name among the project's organs (shown in the app, used in
+    /// exports and in overlaps).
     pub name: String,
     /// Index into [`Flower::templates`].
     pub template: usize,
+    /// Where and how the organ sits on the receptacle.
     pub placement: Placement,
 }
 
@@ -139,22 +159,32 @@ pub struct Organ {
 /// and each particle of `outer` near `inner` on `inner`'s outer side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Overlap {
+    /// Index into [`Flower::organs`] of the organ nearer the axis.
     pub inner: usize,
+    /// Index into [`Flower::organs`] of the organ farther from the axis.
     pub outer: usize,
 }
 
+/// A flower: organ types, the organs placed on the receptacle and which
+/// organ lies inside which.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Flower {
+    /// The organ types; organs refer to them by index.
     pub templates: Vec<Template>,
+    /// The organs, each an instance of a template.
     pub organs: Vec<Organ>,
+    /// Pairs of organs kept apart by collision handling.
     pub overlaps: Vec<Overlap>,
 }
 
 impl Flower {
+    /// The template of organ `organ` (an index into [`Flower::organs`]).
+    /// Panics if either index is out of range.
     pub fn template_of(&self, organ: usize) -> &Template {
         &self.templates[self.organs[organ].template]
     }
 
+    /// The index of the organ named `name`, if there is one.
     pub fn organ_index(&self, name: &str) -> Option<usize> {
         self.organs.iter().position(|o| o.name == name)
     }
@@ -171,6 +201,8 @@ pub struct SimulationSettings {
     /// Number of keyframes after the bud (paper: N = 100), 1 to
     /// [`MAX_KEYFRAMES`].
     pub keyframes: u32,
+    /// How each step's energy minimisation converges (tolerance, iteration
+    /// limit).
     pub solver: SolverSettings,
     /// Distance a colliding particle is pushed past its neighbour (paper:
     /// 0.01).
@@ -200,8 +232,11 @@ impl Default for SimulationSettings {
 /// A whole project: a flower and how to simulate it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Project {
+    /// The project's name as shown to the user and written in exports.
     pub name: String,
+    /// What grows.
     pub flower: Flower,
+    /// How it is simulated.
     pub settings: SimulationSettings,
 }
 

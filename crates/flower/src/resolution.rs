@@ -57,22 +57,41 @@ pub struct ResolutionError {
     pub template: String,
     /// The edge asked for.
     pub mean_edge: f64,
+    /// What went wrong.
     pub problem: ResolutionProblem,
 }
 
 /// What went wrong remeshing a template.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ResolutionProblem {
+    /// The remesher could not build a mesh at this edge length (too long
+    /// or too short for the organ, or too many particles).
     #[error(transparent)]
     Remesh(#[from] BudError),
+    /// No particle of the new mesh lies in the template's base region, so
+    /// the organ would float free of the receptacle.
     #[error(
         "no particle of the new mesh lies in the base region (v ≤ {v_max}, {u_min} ≤ u ≤ {u_max}), so nothing would attach it; widen base_region or use a finer edge"
     )]
-    NoBase { v_max: f64, u_min: f64, u_max: f64 },
+    NoBase {
+        /// The base region's upper `v` limit.
+        v_max: f64,
+        /// The base region's lower `u` limit.
+        u_min: f64,
+        /// The base region's upper `u` limit.
+        u_max: f64,
+    },
+    /// The new mesh has fewer base particles than needed to hold the organ
+    /// (two, or the old mesh's count if that was smaller).
     #[error(
         "the new mesh has {particles} base particles where the old had {old}; at least two are needed to hold the organ"
     )]
-    TooFewBaseParticles { particles: usize, old: usize },
+    TooFewBaseParticles {
+        /// Base particles in the new mesh.
+        particles: usize,
+        /// Base particles in the mesh as built.
+        old: usize,
+    },
 }
 
 /// The options the remesh uses at `mean_edge`.

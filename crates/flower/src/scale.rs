@@ -48,9 +48,12 @@ const TYPICAL_LENGTH_IN_THICKNESSES: f64 = 300.0;
 /// another unit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ScaleMismatch {
+    /// The template's name.
     pub template: String,
     /// The longest side of the mesh's bounding box, in project units.
     pub length: f64,
+    /// The template's thickness, in project units, that the length is
+    /// measured against.
     pub thickness: f64,
     /// The power of ten the mesh looks too large by: 10 for a mesh made in
     /// millimetres in a project in centimetres, 0.001 for one made in
@@ -67,15 +70,26 @@ pub enum Against {
     Thickness,
     /// The mesh it is to replace, this long: a mesh ten times the one it
     /// replaces, though still a plausible number of thicknesses long.
-    Replaced { length: f64 },
+    Replaced {
+        /// The replaced mesh's length (longest side of its bounding box),
+        /// in project units.
+        length: f64,
+    },
     /// Where one of its organs sits: `organ`'s base is `base_width` wide
     /// (template units, across the organ near its base), the nearest other
     /// organ's base is `spacing` away and the organ sits `from_axis` from
     /// the flower's axis.
     Receptacle {
+        /// The organ's name.
         organ: String,
+        /// Width of the template's base, across the organ, as the mesh's
+        /// numbers give it (the unit in question).
         base_width: f64,
+        /// Distance from this organ's base to the nearest other organ's
+        /// base, in project units.
         spacing: f64,
+        /// Distance of this organ's base from the flower's axis, in project
+        /// units.
         from_axis: f64,
     },
 }

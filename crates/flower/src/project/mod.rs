@@ -137,6 +137,7 @@ pub const UNNAMED_PROJECT: &str = "(project text)";
 /// A loaded project and the warnings met loading it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LoadedProject {
+    /// The project as read, with its meshes and maps loaded and checked.
     pub project: Project,
     /// Things read past, each naming its file (e.g. an OBJ's loose edges).
     pub warnings: Vec<String>,

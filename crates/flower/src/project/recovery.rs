@@ -59,10 +59,13 @@ pub struct RecoveryFolder {
 }
 
 impl RecoveryFolder {
+    /// The recovery folder at `dir` (usually in the user's data
+    /// directory); nothing is created until [`RecoveryFolder::write`].
     pub fn new(dir: impl Into<PathBuf>) -> RecoveryFolder {
         RecoveryFolder { dir: dir.into() }
     }
 
+    /// The folder this recovery folder lives at.
     pub fn dir(&self) -> &Path {
         &self.dir
     }
