@@ -19,9 +19,11 @@ use glam::DVec3;
 
 /// One organ's current geometry as collisions see it.
 pub struct Surface<'a> {
+    /// The organ's particle positions, in the world frame.
     pub positions: &'a [DVec3],
     /// Unit normals pointing to the organ's inner side.
     pub normals: &'a [DVec3],
+    /// The organ's triangles, as indices into `positions`.
     pub triangles: &'a [[u32; 3]],
     /// The triangles around each particle.
     pub triangles_around: &'a [Vec<u32>],
@@ -50,6 +52,8 @@ pub struct Tracker {
 const MAX_CELLS: i64 = 1 << 20;
 
 impl Tracker {
+    /// A lookup over `positions` (one organ's particles) that answers
+    /// queries within `radius` (world lengths).
     pub fn new(positions: &[DVec3], radius: f64) -> Tracker {
         let (lo, hi) = positions.iter().fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),

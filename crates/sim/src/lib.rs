@@ -8,6 +8,8 @@
 //! sequential and collisions read a snapshot, so results are bit-identical
 //! whatever the thread count.
 
+#![warn(missing_docs)]
+
 pub mod collide;
 #[cfg(any(test, feature = "fault-hook"))]
 pub mod fault;
@@ -53,6 +55,7 @@ impl Selection {
 /// Statistics of one keyframe.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct KeyframeStats {
+    /// The keyframe's number (0 is the bud).
     pub index: u32,
     /// Total elastic energy of the simulated organs after minimisation.
     pub energy: f64,
@@ -75,44 +78,81 @@ pub struct KeyframeStats {
 /// One keyframe: world positions of every simulated organ.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Keyframe {
+    /// The keyframe's number: 0 is the bud, `k` the state after `k` steps.
     pub index: u32,
     /// One position list per simulated organ, in the order of
     /// [`Simulation::organs`], in the world frame.
     pub positions_in_world: Vec<Vec<DVec3>>,
+    /// How the keyframe's solve went (energy, iterations, time, contacts).
     pub stats: KeyframeStats,
 }
 
 /// Why a run stopped early. Each names the keyframe and organ involved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
+    /// A template's mesh fails validation, so the run does not start.
     #[error("template `{template}` has a bad mesh: {error}")]
-    BadMesh { template: String, error: MeshError },
+    BadMesh {
+        /// The template's name.
+        template: String,
+        /// What is wrong with its mesh.
+        error: MeshError,
+    },
+    /// A template's parameters are out of range (e.g. a thickness of 0),
+    /// or its solver could not be set up; the run does not start.
     #[error("template `{template}`: {message}")]
-    BadTemplate { template: String, message: String },
+    BadTemplate {
+        /// The template's name.
+        template: String,
+        /// Which value is wrong, or why the solver could not be set up.
+        message: String,
+    },
+    /// A single organ was asked to be simulated by an index the project
+    /// does not have.
     #[error("organ index {0} does not exist")]
     NoSuchOrgan(usize),
+    /// The energy minimisation of one organ failed (see [`SolverError`]).
     #[error("keyframe {keyframe}, organ `{organ}`: the solver diverged: {error}")]
     Diverged {
+        /// The keyframe being computed.
         keyframe: u32,
+        /// The organ's name.
         organ: String,
+        /// How the solver failed.
         error: SolverError,
     },
+    /// An organ's energy became non-finite or rose more than a
+    /// million-fold from the previous keyframe: growth too strong for the
+    /// mesh or its stiffness.
     #[error(
         "keyframe {keyframe}, organ `{organ}`: the energy blew up to {energy:.3e} (from {previous:.3e})"
     )]
     EnergyBlowUp {
+        /// The keyframe being computed.
         keyframe: u32,
+        /// The organ's name.
         organ: String,
+        /// Its elastic energy at this keyframe.
         energy: f64,
+        /// Its elastic energy at the previous keyframe.
         previous: f64,
     },
+    /// The organs did not settle within the solver's iteration limit
+    /// (`max_iterations` per contact round); a higher limit or a looser
+    /// tolerance may help.
     #[error(
         "keyframe {keyframe}, organ `{organ}`: not converged after {iterations} iterations (relative gradient {relative_gradient:.3e})"
     )]
     NotConverged {
+        /// The keyframe being computed.
         keyframe: u32,
+        /// The organ furthest from converging.
         organ: String,
+        /// The Newton iterations taken in the keyframe, over all contact
+        /// rounds.
         iterations: u32,
+        /// That organ's relative gradient when the limit was reached (see
+        /// [`KeyframeStats::relative_gradient`]).
         relative_gradient: f64,
     },
     /// A bug: the simulation panicked. Caught so the worker and the
@@ -123,8 +163,11 @@ pub enum SimError {
         run: Option<u64>,
         /// The keyframe being computed, if the panic came from a step.
         keyframe: Option<u32>,
+        /// The panic's message.
         message: String,
     },
+    /// The caller asked the step to stop (a newer run replaced it); not a
+    /// failure, and the keyframes before are kept.
     #[error("cancelled")]
     Cancelled,
 }
@@ -156,8 +199,13 @@ pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 /// Progress inside a keyframe, reported after every iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IterationProgress {
+    /// The keyframe being computed.
     pub keyframe: u32,
+    /// Which Newton iteration of the keyframe this is, from 0, counted
+    /// over all contact rounds.
     pub iteration: u32,
+    /// The largest relative gradient over the organs at the start of this
+    /// iteration; the keyframe converges below the relative tolerance.
     pub relative_gradient: f64,
 }
 
@@ -205,6 +253,10 @@ pub struct Simulation {
 }
 
 impl Simulation {
+    /// Sets up a run of `project` (all organs or one, per `selection`) at
+    /// the bud: validates every template and builds its solver. Fails with
+    /// [`SimError::BadMesh`], [`SimError::BadTemplate`] or
+    /// [`SimError::NoSuchOrgan`].
     pub fn new(project: &Project, selection: &Selection) -> Result<Simulation, SimError> {
         let flower = &project.flower;
         if let Selection::Only(i) = selection
@@ -363,6 +415,8 @@ impl Simulation {
         self.organs.iter().map(|o| o.factorisations()).sum()
     }
 
+    /// How many keyframes the run computes after the bud (the project's
+    /// setting).
     pub fn keyframe_count(&self) -> u32 {
         self.settings.keyframes
     }

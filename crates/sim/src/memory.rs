@@ -91,6 +91,7 @@ pub struct MemoryEstimate {
     pub solver_bytes: u64,
     /// The keyframes kept, the bud included.
     pub keyframes: u64,
+    /// The memory those keyframes take, in bytes.
     pub keyframe_bytes: u64,
     /// Everything: the two above and the program itself.
     pub bytes: u64,
@@ -186,8 +187,11 @@ pub const LIMIT_VARIABLE: &str = "ANTHESIS_MEMORY_LIMIT_MIB";
 /// Why a run may not start.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum MemoryError {
+    /// The run's estimated peak memory is more than the memory allowed.
     #[error(transparent)]
     TooLarge(#[from] TooLarge),
+    /// [`LIMIT_VARIABLE`] is set but is not a whole number of MiB above 0;
+    /// holds an escaped excerpt of its value.
     #[error("{LIMIT_VARIABLE} must be a whole number of MiB above 0, found {0}")]
     BadLimit(String),
 }
@@ -231,7 +235,10 @@ pub fn check_run(
     human_bytes(*.available)
 )]
 pub struct TooLarge {
+    /// What the run is expected to need.
     pub estimate: MemoryEstimate,
+    /// The memory allowed, in bytes (available now, capped by
+    /// [`LIMIT_VARIABLE`]).
     pub available: u64,
 }
 

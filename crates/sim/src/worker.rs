@@ -32,38 +32,58 @@ pub type RunId = u64;
 /// `Cancelled`.
 #[derive(Debug, Clone)]
 pub enum Event {
+    /// The run has set up its simulation and starts computing.
     Started {
+        /// The run.
         run: RunId,
+        /// Names of the simulated organs, in the order keyframes hold them.
         organs: Vec<String>,
+        /// How many keyframes the run computes after the bud.
         keyframes: u32,
         /// The first keyframe this run computes; those before it are the
         /// last run's, which the edit could not change, and are sent again
         /// at once (1 when the run starts from the bud).
         first_computed: u32,
     },
+    /// One keyframe, reused or newly computed, in increasing order.
     Keyframe {
+        /// The run.
         run: RunId,
+        /// The keyframe (shared: the worker keeps it to resume a later run).
         keyframe: Arc<Keyframe>,
     },
+    /// One Newton iteration of the keyframe being computed.
     Progress {
+        /// The run.
         run: RunId,
+        /// Where the iteration stands.
         progress: IterationProgress,
     },
+    /// Every keyframe has been sent.
     Finished {
+        /// The run.
         run: RunId,
+        /// How many keyframes the run holds after the bud.
         keyframes: u32,
+        /// Wall time of the run, in seconds, from its start to its end.
         seconds: f64,
     },
+    /// The run stopped on an error; the keyframes sent before stay valid.
     Failed {
+        /// The run.
         run: RunId,
+        /// Why it stopped (names the keyframe and organ).
         error: SimError,
     },
+    /// The run was stopped because a newer run or a cancel replaced it.
     Cancelled {
+        /// The run.
         run: RunId,
     },
 }
 
 impl Event {
+    /// The run this event belongs to.
     pub fn run(&self) -> RunId {
         match self {
             Event::Started { run, .. }
