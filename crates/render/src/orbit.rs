@@ -70,6 +70,57 @@ impl OrbitCamera {
         self.distance = framed.eye.distance(framed.target).max(1e-3);
     }
 
+    /// Looks at `points_in_world` from the current direction, at the
+    /// centre of their box, from the distance at which the farthest of
+    /// them from the view's axis is at `fill` of the way from the image's
+    /// centre to the middle of its shorter side (0.8: the points fill about
+    /// 80 % of the shorter side when they are symmetric about the
+    /// centre). Points behind the eye cannot happen: the eye stays beyond
+    /// every point. Does nothing without points.
+    pub fn frame_points(&mut self, points_in_world: &[DVec3], fill: f64) {
+        let Some(first) = points_in_world.first() else {
+            return;
+        };
+        let (lo, hi) = points_in_world
+            .iter()
+            .fold((*first, *first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let target = 0.5 * (lo + hi);
+        let (towards_eye, up) = orbit_directions(self.azimuth_deg, self.elevation_deg);
+        let right = up.cross(towards_eye);
+        let tan_half = (0.5 * ORBIT_FOV_DEG.to_radians()).tan() * fill.clamp(0.05, 1.0);
+        let radius = 0.5 * (hi - lo).length();
+        let mut distance = 1.01 * radius.max(1e-6);
+        for p in points_in_world {
+            let offset = *p - target;
+            let across = offset.dot(right).abs().max(offset.dot(up).abs());
+            distance = distance.max(offset.dot(towards_eye) + across / tan_half);
+        }
+        self.target = target;
+        self.distance = distance.clamp(1e-3, 1e6);
+    }
+
+    /// How far out the points reach in the image, as a fraction of the way
+    /// from its centre to the middle of its shorter side (1 = touching it;
+    /// the image's longer side reaches further). Points behind the eye
+    /// count as infinitely far out.
+    pub fn reach_in_image(&self, points_in_world: &[DVec3]) -> f64 {
+        let camera = self.camera();
+        let (towards_eye, up) = orbit_directions(self.azimuth_deg, self.elevation_deg);
+        let right = up.cross(towards_eye);
+        let tan_half = (0.5 * ORBIT_FOV_DEG.to_radians()).tan();
+        points_in_world
+            .iter()
+            .map(|p| {
+                let offset = *p - camera.eye;
+                let depth = -offset.dot(towards_eye);
+                if depth <= 0.0 {
+                    return f64::INFINITY;
+                }
+                offset.dot(right).abs().max(offset.dot(up).abs()) / (depth * tan_half)
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// Turns the camera by a drag of `drag_in_points` (x right, y down):
     /// 0.4° per point, elevation kept within ±89°.
     pub fn orbit(&mut self, drag_in_points: DVec2) {
@@ -107,6 +158,42 @@ mod tests {
         let before = orbit.distance;
         orbit.zoom(2.0);
         assert!((orbit.distance - before / 2.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn framing_points_puts_the_farthest_at_the_asked_reach_from_any_direction() {
+        // A tall bud-like cloud off the origin, not symmetric.
+        let points: Vec<DVec3> = (0..200)
+            .map(|i| {
+                let t = f64::from(i) / 199.0;
+                let angle = 7.0 * t;
+                DVec3::new(3.0 + 2.0 * angle.cos() * t, 10.0 + 30.0 * t, -1.0 + angle.sin())
+            })
+            .collect();
+        for (az, el) in [(30.0, 25.0), (0.0, 0.0), (-120.0, 70.0), (200.0, -40.0)] {
+            let mut orbit = OrbitCamera {
+                azimuth_deg: az,
+                elevation_deg: el,
+                ..OrbitCamera::default()
+            };
+            orbit.frame_points(&points, 0.8);
+            let reach = orbit.reach_in_image(&points);
+            assert!((reach - 0.8).abs() < 1e-9, "from ({az}, {el}): {reach}");
+            // The projection agrees: the farthest point's NDC on a square
+            // image is at 0.8.
+            let clip = orbit.camera().view_projection(1.0);
+            let ndc = points
+                .iter()
+                .map(|p| {
+                    let c = clip * p.as_vec3().extend(1.0);
+                    f64::from((c.x / c.w).abs().max((c.y / c.w).abs()))
+                })
+                .fold(0.0, f64::max);
+            assert!((ndc - 0.8).abs() < 1e-4, "NDC reach {ndc}");
+        }
+        let mut orbit = OrbitCamera::default();
+        orbit.frame_points(&[], 0.8);
+        assert_eq!(orbit, OrbitCamera::default(), "no points, no change");
     }
 
     #[test]
