@@ -1317,7 +1317,7 @@ fn edits_applied_as_commands_are_undone_and_redone_by_the_undo_and_redo_commands
     let app = harness.state_mut();
     let run = app.session().run();
     for (i, edit) in edits.into_iter().enumerate() {
-        app.apply(Command::Edit {
+        app.apply(anthesis_app::desktop::Command::Edit {
             label: format!("edit {i}"),
             edit,
         });
@@ -1560,4 +1560,334 @@ fn opening_a_project_with_a_mesh_in_another_unit_warns_and_keeps_it_open() {
         "{}",
         warning.message
     );
+}
+
+/// Queues `events` for the next frame, all in that one frame.
+fn in_one_frame(harness: &mut Harness<'_, AnthesisApp>, events: Vec<egui::Event>) {
+    harness.input_mut().events.extend(events);
+    harness.step();
+}
+
+fn press(key: egui::Key, modifiers: egui::Modifiers) -> egui::Event {
+    egui::Event::Key {
+        key,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers,
+    }
+}
+
+#[test]
+fn five_key_presses_in_one_frame_are_five_steps() {
+    let mut harness = opened_small_flower();
+    harness.key_press(egui::Key::Home);
+    harness.run();
+    assert_eq!(harness.state().playback().time_in_keyframes, 0.0);
+    let right = press(egui::Key::ArrowRight, egui::Modifiers::NONE);
+    in_one_frame(&mut harness, vec![right; 5]);
+    harness.run();
+    assert_eq!(harness.state().playback().time_in_keyframes, 5.0);
+    let left = press(egui::Key::ArrowLeft, egui::Modifiers::NONE);
+    in_one_frame(&mut harness, vec![left; 3]);
+    assert_eq!(harness.state().playback().time_in_keyframes, 2.0);
+}
+
+#[test]
+fn bracket_keys_change_the_brush_on_every_layout_and_x_swaps_add_and_subtract() {
+    use anthesis_maps::brush::BrushMode;
+    let mut harness = opened_small_flower();
+    let radius = harness.state_mut().paint_mut().brush.radius_in_uv;
+    let none = egui::Modifiers::NONE;
+    let shift = egui::Modifiers::SHIFT;
+    in_one_frame(
+        &mut harness,
+        vec![press(egui::Key::CloseBracket, none); 3],
+    );
+    let larger = harness.state_mut().paint_mut().brush.radius_in_uv;
+    assert!(
+        (larger - radius * 1.25f64.powi(3)).abs() < 1e-9,
+        "3 × ] in one frame: {radius} -> {larger}"
+    );
+    harness.key_press(egui::Key::OpenBracket);
+    harness.run();
+    let smaller = harness.state_mut().paint_mut().brush.radius_in_uv;
+    assert!((smaller - radius * 1.25f64.powi(2)).abs() < 1e-9);
+
+    harness.state_mut().paint_mut().brush.strength = 0.5;
+    // Shift+[ as a US layout reports it ('{' with Shift), as a layout that
+    // keeps '[' reports it, and Shift+] both ways: each press counts.
+    in_one_frame(
+        &mut harness,
+        vec![
+            press(egui::Key::OpenCurlyBracket, shift),
+            press(egui::Key::OpenBracket, shift),
+            press(egui::Key::OpenCurlyBracket, shift),
+        ],
+    );
+    let strength = harness.state_mut().paint_mut().brush.strength;
+    assert!((strength - 0.2).abs() < 1e-6, "strength {strength}");
+    assert!(
+        (harness.state_mut().paint_mut().brush.radius_in_uv - smaller).abs() < 1e-12,
+        "Shift+[ is not [",
+    );
+    in_one_frame(
+        &mut harness,
+        vec![
+            press(egui::Key::CloseCurlyBracket, shift),
+            press(egui::Key::CloseBracket, shift),
+        ],
+    );
+    let strength = harness.state_mut().paint_mut().brush.strength;
+    assert!((strength - 0.4).abs() < 1e-6, "strength {strength}");
+
+    harness.state_mut().paint_mut().brush.mode = BrushMode::Add;
+    harness.key_press(egui::Key::X);
+    harness.run();
+    assert_eq!(harness.state_mut().paint_mut().brush.mode, BrushMode::Subtract);
+    harness.key_press(egui::Key::X);
+    harness.run();
+    assert_eq!(harness.state_mut().paint_mut().brush.mode, BrushMode::Add);
+}
+
+#[test]
+fn shortcuts_do_not_fire_while_a_text_field_has_the_keyboard() {
+    let mut harness = opened_small_flower();
+    harness.state_mut().open_export();
+    harness.run();
+    harness.get_by_label("Export to").click();
+    harness.run();
+    let radius = harness.state_mut().paint_mut().brush.radius_in_uv;
+    let time = harness.state().playback().time_in_keyframes;
+    harness.key_press(egui::Key::OpenBracket);
+    harness.key_press(egui::Key::ArrowLeft);
+    harness.key_press(egui::Key::X);
+    harness.run();
+    assert_eq!(harness.state_mut().paint_mut().brush.radius_in_uv, radius);
+    assert_eq!(harness.state().playback().time_in_keyframes, time);
+}
+
+#[test]
+fn the_history_window_lists_the_steps_and_a_click_goes_back_or_forwards() {
+    let mut harness = opened_small_flower();
+    for (label, dg) in [("first change", 0.011), ("second change", 0.012), ("third change", 0.013)] {
+        let mut template = harness.state().project().flower.templates[0].clone();
+        template.dg = dg;
+        let keyframes = harness.state().project().settings.keyframes;
+        let app = harness.state_mut();
+        app.apply(anthesis_app::desktop::Command::Edit {
+            label: label.to_string(),
+            edit: anthesis_app::desktop::ProjectEdit::Template {
+                template: 0,
+                value: Box::new(template),
+                keyframes,
+            },
+        });
+    }
+    harness.get_by_label("View").click();
+    harness.run();
+    harness.get_by_label("Undo history  (H)").click();
+    harness.run();
+    harness.get_by_label("third change");
+    harness.snapshot("history_window");
+    harness.get_by_label("first change").click();
+    harness.run();
+    assert_eq!(harness.state().document().history_position(), 1);
+    assert_eq!(harness.state().project().flower.templates[0].dg, 0.011);
+    // The undone steps stay listed: a click redoes up to one.
+    harness.get_by_label("third change").click();
+    harness.run();
+    assert_eq!(harness.state().document().history_position(), 3);
+    assert_eq!(harness.state().project().flower.templates[0].dg, 0.013);
+    harness.get_by_label("Opened").click();
+    harness.run();
+    assert_eq!(harness.state().document().history_position(), 0);
+    assert!(!harness.state().document().is_dirty());
+}
+
+#[test]
+fn help_shortcuts_lists_every_shortcut() {
+    let mut harness = opened_small_flower();
+    harness.get_by_label("Help").click();
+    harness.run();
+    harness.get_by_label("Shortcuts").click();
+    harness.run();
+    for keys in ["Ctrl+Z", "Ctrl+Shift+Z", "[", "]", "Shift+[", "Shift+]", "X", "Right"] {
+        harness.get_by_label(keys);
+    }
+    harness.get_by_label("Swap the brush between add and subtract");
+    harness.snapshot("shortcuts_window");
+}
+
+/// How far out the shown flower reaches in the viewport (a fraction of
+/// the way to the middle of its shorter side).
+fn reach_of_shown_flower(harness: &mut Harness<'_, AnthesisApp>) -> f64 {
+    let app = harness.state();
+    let shows_others = app.view_options().show_others || !app.single_organ_preview();
+    let scene = anthesis_app::desktop::viewport::build_scene(
+        app.project(),
+        app.session(),
+        app.playback().time_in_keyframes,
+        shows_others,
+    );
+    let points: Vec<glam::DVec3> = scene
+        .iter()
+        .flat_map(|o| o.positions_in_world.iter().copied())
+        .collect();
+    assert!(!points.is_empty(), "a flower is shown");
+    harness.state_mut().camera_mut().reach_in_image(&points)
+}
+
+#[test]
+fn the_camera_frames_the_flower_at_launch_on_a_preview_switch_and_on_new() {
+    let mut harness = opened_small_flower();
+    let reach = reach_of_shown_flower(&mut harness);
+    assert!((0.6..=0.9).contains(&reach), "at launch: {reach}");
+    // Zoomed far out by hand, then the preview switched on: framed on
+    // the one organ when its keyframes arrive.
+    harness.state_mut().camera_mut().distance *= 5.0;
+    harness.key_press(egui::Key::P);
+    harness.run();
+    assert!(harness.state().single_organ_preview());
+    feed(&mut harness, None);
+    harness.run();
+    let reach = reach_of_shown_flower(&mut harness);
+    assert!((0.6..=0.9).contains(&reach), "single organ: {reach}");
+    // And back to the whole flower.
+    harness.state_mut().camera_mut().distance *= 0.2;
+    harness.key_press(egui::Key::P);
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    let reach = reach_of_shown_flower(&mut harness);
+    assert!((0.6..=0.9).contains(&reach), "whole flower again: {reach}");
+    // File → New: the default lily, framed.
+    harness.state_mut().camera_mut().distance *= 7.0;
+    harness
+        .state_mut()
+        .apply(anthesis_app::desktop::Command::NewProject);
+    harness.run();
+    feed(&mut harness, Some(0));
+    harness.run();
+    let reach = reach_of_shown_flower(&mut harness);
+    assert!((0.6..=0.9).contains(&reach), "new project's bud: {reach}");
+}
+
+/// A double click on the widget labelled `label`, in one frame.
+fn double_click(harness: &mut Harness<'_, AnthesisApp>, label: &str) {
+    let pos = harness.get_by_label(label).rect().center();
+    let mut events = vec![egui::Event::PointerMoved(pos)];
+    for pressed in [true, false, true, false] {
+        events.push(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+    }
+    in_one_frame(harness, events);
+}
+
+/// The app on `project` saved at `path`, using the in-app file browser.
+fn harness_with_file_browser(path: &std::path::Path) -> Harness<'static, AnthesisApp> {
+    let project = small_flower();
+    anthesis_flower::project::save_project(&project, path).expect("saves");
+    let path = path.to_path_buf();
+    // egui_file titles its window with an emoji (📂, 💾) that egui's
+    // bundled fonts lack: it draws as a box.
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .allow_missing_glyphs()
+        .wgpu()
+        .build_eframe(move |cc| {
+            let mut app = AnthesisApp::new(
+                cc,
+                Startup {
+                    project: Some((project, Some(path))),
+                    live: false,
+                    restore: false,
+                },
+            )
+            .expect("the app starts");
+            app.use_in_app_file_browser();
+            app
+        });
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    harness
+}
+
+#[test]
+fn the_in_app_file_browser_navigates_filters_and_opens_saves_and_exports() {
+    // A fixed folder: the browser shows its path, and the snapshot with it.
+    let root = std::path::Path::new("/tmp/anthesis-file-browser-test");
+    let _ = std::fs::remove_dir_all(root);
+    let sub = root.join("other flowers");
+    std::fs::create_dir_all(&sub).expect("folders");
+    std::fs::write(root.join("notes.txt"), "not a project").expect("write");
+    let mut harness = harness_with_file_browser(&root.join("mine.anthesis.toml"));
+    anthesis_flower::project::save_project(&small_flower(), &sub.join("theirs.anthesis.toml"))
+        .expect("saves");
+
+    // Open: the project's folder, projects and folders only.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
+    harness.run();
+    harness.get_by_label("🗀 other flowers");
+    harness.get_by_label("🗋 mine.anthesis.toml");
+    assert!(harness.query_by_label("🗋 notes.txt").is_none(), "filtered out");
+    harness.snapshot("file_browser_open");
+    // Into the folder, up again, into it again and pick the project there.
+    double_click(&mut harness, "🗀 other flowers");
+    harness.run();
+    harness.get_by_label("🗋 theirs.anthesis.toml");
+    harness.get_by_label("⬆").click();
+    harness.run();
+    double_click(&mut harness, "🗀 other flowers");
+    harness.run();
+    harness.get_by_label("🗋 theirs.anthesis.toml").click();
+    harness.run();
+    harness.get_by_label("Open").click();
+    harness.run();
+    assert_eq!(
+        harness.state().document().path.as_deref(),
+        Some(sub.join("theirs.anthesis.toml").as_path()),
+        "the pick became FileChosen, which opened it"
+    );
+
+    // Save as: the suggested name in the project's folder.
+    harness.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
+    harness.run();
+    harness.get_by_label("Save").click();
+    harness.run();
+    assert!(sub.join("flower.anthesis.toml").is_file(), "saved");
+    assert_eq!(
+        harness.state().document().path.as_deref(),
+        Some(sub.join("flower.anthesis.toml").as_path())
+    );
+
+    // Export → Browse…: the path goes into the export dialog; Cancel
+    // leaves it.
+    harness.state_mut().open_export();
+    harness.run();
+    harness.get_by_label("Browse…").click();
+    harness.run();
+    harness.get_by_label("Save").click();
+    harness.run();
+    assert_eq!(
+        harness.state().export_dialog().path,
+        sub.join("flower.glb").display().to_string()
+    );
+    harness.get_by_label("Browse…").click();
+    harness.run();
+    harness.get_by_label("Cancel").click();
+    harness.run();
+    assert_eq!(
+        harness.state().export_dialog().path,
+        sub.join("flower.glb").display().to_string()
+    );
+    let _ = std::fs::remove_dir_all(root);
 }

@@ -42,6 +42,12 @@ pub enum Command {
     OpenExportDialog,
     /// Ask where to export.
     BrowseExportPath,
+    /// A file dialog (native or the in-app browser) answered: the path
+    /// chosen for `purpose`, or `None` when cancelled.
+    FileChosen {
+        purpose: DialogPurpose,
+        path: Option<PathBuf>,
+    },
     /// Export the computed keyframes with the dialog's settings.
     StartExport,
     Undo,
@@ -71,6 +77,18 @@ pub enum Command {
     SetView(ViewOptions),
     /// Show or hide the log panel.
     ShowLog(bool),
+    /// Show or hide the undo history window.
+    ShowHistory(bool),
+    /// Show or hide the Help → Shortcuts window.
+    ShowShortcuts(bool),
+    /// Undo or redo until this many steps of the history are applied.
+    GoToHistory(usize),
+    /// Multiply the brush radius by this factor (kept in the slider's range).
+    ScaleBrushRadius(f64),
+    /// Add this to the brush strength (kept in 0..=1).
+    ChangeBrushStrength(f32),
+    /// Add becomes subtract and subtract add.
+    SwapBrushAddSubtract,
 }
 
 /// A change to the project. Indices are into the project's templates and a
@@ -209,6 +227,7 @@ impl AnthesisApp {
             Command::DropFile(path) => self.drop_file(&path),
             Command::OpenExportDialog => self.open_export(),
             Command::BrowseExportPath => self.ask_for_path(DialogPurpose::ExportGlb),
+            Command::FileChosen { purpose, path } => self.file_chosen(purpose, path),
             Command::StartExport => self.start_export(),
             Command::Undo => self.undo(),
             Command::Redo => self.redo(),
@@ -231,6 +250,28 @@ impl AnthesisApp {
             Command::FrameAll => self.frame_all(),
             Command::SetView(view) => self.view = view,
             Command::ShowLog(on) => self.settings.show_log = on,
+            Command::ShowHistory(on) => self.settings.show_history = on,
+            Command::ShowShortcuts(on) => self.show_shortcuts = on,
+            Command::GoToHistory(position) => {
+                if !self.doc.go_to(position).is_empty() {
+                    self.log.info(format!(
+                        "history: {} of {} steps applied",
+                        self.doc.history_position(),
+                        self.doc.history_labels().count()
+                    ));
+                    self.after_history_change();
+                }
+            }
+            Command::ScaleBrushRadius(factor) => self.paint.scale_radius(factor),
+            Command::ChangeBrushStrength(delta) => self.paint.change_strength(delta),
+            Command::SwapBrushAddSubtract => {
+                if !self.paint.swap_add_subtract() {
+                    self.log.info(format!(
+                        "X swaps add and subtract; the brush is on {}",
+                        self.paint.brush.mode.label()
+                    ));
+                }
+            }
         }
     }
 
@@ -326,6 +367,8 @@ impl AnthesisApp {
         if on != self.single_organ_preview {
             self.single_organ_preview = on;
             self.needs_run = true;
+            // One organ or the whole flower: frame what is shown next.
+            self.reframe();
         }
     }
 }

@@ -134,6 +134,35 @@ impl Document {
         self.redo.last().map(|s| s.label.as_str())
     }
 
+    /// Every step's label, oldest first: the steps that can be undone, then
+    /// the ones that can be redone (the next redo first).
+    pub fn history_labels(&self) -> impl Iterator<Item = &str> {
+        let undo = self.undo.iter();
+        let redo = self.redo.iter().rev();
+        undo.chain(redo).map(|s| s.label.as_str())
+    }
+
+    /// How many steps of [`Document::history_labels`] are applied now.
+    pub fn history_position(&self) -> usize {
+        self.undo.len()
+    }
+
+    /// Undoes or redoes until `position` steps are applied (clamped to the
+    /// history); returns the labels undone or redone, in order.
+    pub fn go_to(&mut self, position: usize) -> Vec<String> {
+        let mut moved = Vec::new();
+        while self.undo.len() > position {
+            moved.extend(self.undo());
+        }
+        while self.undo.len() < position {
+            match self.redo() {
+                Some(label) => moved.push(label),
+                None => break,
+            }
+        }
+        moved
+    }
+
     /// Whether there are changes since the project was opened or saved.
     pub fn is_dirty(&self) -> bool {
         self.saved_at != Some(self.undo.len())
@@ -224,6 +253,35 @@ mod tests {
         assert!(doc.is_dirty());
         assert!(doc.redo().is_none());
         assert_eq!(doc.title(), "x.anthesis.toml *");
+    }
+
+    #[test]
+    fn going_to_a_history_step_undoes_or_redoes_up_to_it() {
+        let mut doc = doc();
+        let original = doc.project().clone();
+        for (i, label) in ["dg", "thickness", "kb"].iter().enumerate() {
+            doc.edit(label, |p| p.flower.templates[0].dg = 0.1 * (i + 1) as f64);
+            doc.seal();
+        }
+        let after_first = {
+            let mut d = doc.clone();
+            d.go_to(1);
+            d.project().clone()
+        };
+        assert_eq!(doc.history_labels().collect::<Vec<_>>(), ["dg", "thickness", "kb"]);
+        assert_eq!(doc.history_position(), 3);
+        assert_eq!(doc.go_to(1), ["kb", "thickness"]);
+        assert_eq!(doc.history_position(), 1);
+        assert_eq!(doc.project().flower.templates[0].dg, 0.1);
+        assert_eq!(doc.project(), &after_first);
+        // The redo steps stay listed, after the applied ones.
+        assert_eq!(doc.history_labels().collect::<Vec<_>>(), ["dg", "thickness", "kb"]);
+        assert_eq!(doc.go_to(0), ["dg"]);
+        assert_eq!(doc.project(), &original);
+        assert!(!doc.is_dirty());
+        assert_eq!(doc.go_to(99), ["dg", "thickness", "kb"], "clamped to the history");
+        assert!((doc.project().flower.templates[0].dg - 0.3).abs() < 1e-12);
+        assert!(doc.go_to(3).is_empty());
     }
 
     #[test]

@@ -1,11 +1,20 @@
-//! Native file dialogs (rfd) on their own thread so the window keeps
-//! drawing while one is open, the recent-files list, and the settings that
-//! eframe persists between launches.
+//! File dialogs: the native one (rfd) on its own thread so the window
+//! keeps drawing while it is open, or, where no native dialog can be shown,
+//! the in-app file browser (egui_file); the recent-files list; the
+//! settings that eframe persists between launches.
+//!
+//! rfd's portal backend, when the desktop portal is missing, falls back to
+//! `zenity`; when that is missing too it returns `None`, exactly as for a
+//! cancel. So before the first native dialog the dialog thread checks
+//! whether either can answer ([`native_dialog_missing`]: the portal's name
+//! on the session bus, `zenity` on `PATH`); if neither can, the app says so
+//! in the log and every dialog from then on is the in-app browser.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_render::OrbitCamera;
+use eframe::egui;
 
 use super::timeline::Playback;
 use super::viewport::ViewOptions;
@@ -16,6 +25,9 @@ pub const RECENT_LIMIT: usize = 10;
 /// The file-name pattern of project files.
 pub const PROJECT_EXTENSION: &str = "toml";
 
+/// The D-Bus name of the desktop portal (whose FileChooser rfd asks).
+const PORTAL_BUS_NAME: &str = "org.freedesktop.portal.Desktop";
+
 /// What a file dialog was opened for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DialogPurpose {
@@ -24,81 +36,243 @@ pub enum DialogPurpose {
     ExportGlb,
 }
 
-/// At most one native dialog at a time, answered on a thread named
-/// `anthesis-dialog`.
+impl DialogPurpose {
+    fn title(self) -> &'static str {
+        match self {
+            DialogPurpose::OpenProject => "Open an Anthesis project",
+            DialogPurpose::SaveProjectAs => "Save the project as",
+            DialogPurpose::ExportGlb => "Export the animation (.glb, .usda or .gif)",
+        }
+    }
+
+    /// The file name offered when saving.
+    fn suggested_name(self) -> Option<&'static str> {
+        match self {
+            DialogPurpose::OpenProject => None,
+            DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml"),
+            DialogPurpose::ExportGlb => Some("flower.glb"),
+        }
+    }
+
+    /// The extensions of the files listed (and offered by the native
+    /// dialog's filters).
+    pub fn extensions(self) -> &'static [&'static str] {
+        match self {
+            DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => &[PROJECT_EXTENSION],
+            DialogPurpose::ExportGlb => &["glb", "usda", "usd", "gif"],
+        }
+    }
+}
+
+/// Why no native file dialog can be shown, or `None` when one can: the
+/// desktop portal owns (or can start) its name on the session bus, or
+/// `zenity` is on `PATH` (rfd's fallback when the portal fails).
+pub fn native_dialog_missing() -> Option<String> {
+    if program_on_path("zenity", std::env::var_os("PATH").as_deref()) {
+        return None;
+    }
+    match portal_on_session_bus() {
+        Ok(true) => None,
+        Ok(false) => Some(format!(
+            "no desktop portal ({PORTAL_BUS_NAME} is not on the session bus) and no zenity on PATH"
+        )),
+        Err(e) => Some(format!(
+            "no session bus to find the desktop portal on ({e}) and no zenity on PATH"
+        )),
+    }
+}
+
+/// Whether an executable file `name` is in one of the folders of `path`.
+pub fn program_on_path(name: &str, path: Option<&std::ffi::OsStr>) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    let Some(path) = path else {
+        return false;
+    };
+    std::env::split_paths(path).any(|folder| {
+        std::fs::metadata(folder.join(name))
+            .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+    })
+}
+
+/// Whether the desktop portal is running or can be started on the session
+/// bus.
+fn portal_on_session_bus() -> zbus::Result<bool> {
+    pollster::block_on(async {
+        let connection = zbus::Connection::session().await?;
+        let bus = zbus::fdo::DBusProxy::new(&connection).await?;
+        let name = zbus::names::BusName::try_from(PORTAL_BUS_NAME)?;
+        if bus.name_has_owner(name).await? {
+            return Ok(true);
+        }
+        let activatable = bus.list_activatable_names().await?;
+        Ok(activatable.iter().any(|n| n.as_str() == PORTAL_BUS_NAME))
+    })
+}
+
+/// What the dialog thread answers.
+enum Answer {
+    /// The native dialog's answer (`None`: cancelled).
+    Chosen(Option<PathBuf>),
+    /// No native dialog can be shown, and why.
+    NoNativeDialog(String),
+}
+
+/// What [`Dialogs::poll`] hands the app.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Polled {
+    /// The path chosen, or `None` when cancelled.
+    Chosen(DialogPurpose, Option<PathBuf>),
+    /// No native dialog can be shown (why): the in-app browser opened
+    /// instead.
+    InAppInstead(String),
+}
+
+/// At most one file dialog at a time: native ones answered on a thread
+/// named `anthesis-dialog`, or the in-app browser.
 #[derive(Default)]
 pub struct Dialogs {
-    pending: Option<(DialogPurpose, Receiver<Option<PathBuf>>)>,
+    pending: Option<(DialogPurpose, Option<PathBuf>, Receiver<Answer>)>,
+    browser: Option<(DialogPurpose, egui_file::FileDialog)>,
+    /// No native dialog can be shown: use the in-app browser.
+    in_app: bool,
 }
 
 impl Dialogs {
-    pub fn is_open(&self) -> bool {
-        self.pending.is_some()
+    /// Dialogs that always use the in-app browser (for tests; the app
+    /// switches by itself when no native dialog can be shown).
+    pub fn in_app() -> Dialogs {
+        Dialogs {
+            in_app: true,
+            ..Dialogs::default()
+        }
     }
 
-    /// Opens the native dialog for `purpose`; `wake` is called when it is
-    /// answered. Does nothing while another dialog is open.
+    pub fn is_open(&self) -> bool {
+        self.pending.is_some() || self.browser.is_some()
+    }
+
+    /// Opens a dialog for `purpose` in `folder`; `wake` is called when a
+    /// native one is answered. Does nothing while another dialog is open.
     pub fn open(
         &mut self,
         purpose: DialogPurpose,
         folder: Option<&Path>,
         wake: impl Fn() + Send + 'static,
     ) {
-        if self.pending.is_some() {
+        if self.is_open() {
+            return;
+        }
+        if self.in_app {
+            self.open_browser(purpose, folder);
             return;
         }
         // One answer per dialog.
         let (send, receive) = sync_channel(1);
         let folder = folder.map(Path::to_path_buf);
+        let thread_folder = folder.clone();
         let spawned = std::thread::Builder::new()
             .name("anthesis-dialog".into())
             .spawn(move || {
-                let mut dialog = rfd::FileDialog::new();
-                if let Some(folder) = folder {
-                    dialog = dialog.set_directory(folder);
-                }
-                let answer = match purpose {
-                    DialogPurpose::OpenProject => dialog
-                        .set_title("Open an Anthesis project")
-                        .add_filter("Anthesis project", &[PROJECT_EXTENSION])
-                        .pick_file(),
-                    DialogPurpose::SaveProjectAs => dialog
-                        .set_title("Save the project as")
-                        .add_filter("Anthesis project", &[PROJECT_EXTENSION])
-                        .set_file_name("flower.anthesis.toml")
-                        .save_file(),
-                    DialogPurpose::ExportGlb => dialog
-                        .set_title("Export the animation (.glb, .usda or .gif)")
-                        .add_filter("glTF binary", &["glb"])
-                        .add_filter("USD layer", &["usda", "usd"])
-                        .add_filter("GIF animation", &["gif"])
-                        .set_file_name("flower.glb")
-                        .save_file(),
+                let answer = match native_dialog_missing() {
+                    Some(why) => Answer::NoNativeDialog(why),
+                    None => Answer::Chosen(native_dialog(purpose, thread_folder)),
                 };
                 let _ = send.send(answer);
                 wake();
             });
         if spawned.is_ok() {
-            self.pending = Some((purpose, receive));
+            self.pending = Some((purpose, folder, receive));
         }
     }
 
-    /// The answer of the open dialog, once there is one (`None` inside
-    /// when the user cancelled or no dialog could be shown).
-    pub fn poll(&mut self) -> Option<(DialogPurpose, Option<PathBuf>)> {
-        let (purpose, receive) = self.pending.as_ref()?;
+    fn open_browser(&mut self, purpose: DialogPurpose, folder: Option<&Path>) {
+        let start = folder
+            .map(Path::to_path_buf)
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_default();
+        let extensions = purpose.extensions();
+        let listed: egui_file::Filter<PathBuf> = Box::new(move |path: &Path| {
+            path.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
+        });
+        let mut browser = match purpose {
+            DialogPurpose::OpenProject => egui_file::FileDialog::open_file(),
+            DialogPurpose::SaveProjectAs | DialogPurpose::ExportGlb => {
+                egui_file::FileDialog::save_file()
+            }
+        }
+        .title(purpose.title())
+        .initial_path(start)
+        .show_files_filter(listed)
+        .show_rename(false)
+        .default_size(egui::vec2(560.0, 420.0));
+        if let Some(name) = purpose.suggested_name() {
+            browser = browser.default_filename(name);
+        }
+        browser.open();
+        self.browser = Some((purpose, browser));
+    }
+
+    /// The in-app browser, when open: drawn; its answer once given.
+    pub fn browser_ui(&mut self, ctx: &egui::Context) -> Option<(DialogPurpose, Option<PathBuf>)> {
+        let (purpose, browser) = self.browser.as_mut()?;
+        let purpose = *purpose;
+        let answer = match browser.show(ctx).state() {
+            egui_file::State::Open => return None,
+            egui_file::State::Selected => browser.path().map(Path::to_path_buf),
+            egui_file::State::Cancelled | egui_file::State::Closed => None,
+        };
+        self.browser = None;
+        Some((purpose, answer))
+    }
+
+    /// The answer of the open native dialog, once there is one; when no
+    /// native dialog could be shown, the in-app browser is opened instead.
+    pub fn poll(&mut self) -> Option<Polled> {
+        let (purpose, folder, receive) = self.pending.as_ref()?;
         let purpose = *purpose;
         match receive.try_recv() {
-            Ok(answer) => {
+            Ok(Answer::Chosen(answer)) => {
                 self.pending = None;
-                Some((purpose, answer))
+                Some(Polled::Chosen(purpose, answer))
+            }
+            Ok(Answer::NoNativeDialog(why)) => {
+                let folder = folder.clone();
+                self.pending = None;
+                self.in_app = true;
+                self.open_browser(purpose, folder.as_deref());
+                Some(Polled::InAppInstead(why))
             }
             Err(TryRecvError::Empty) => None,
             Err(TryRecvError::Disconnected) => {
                 self.pending = None;
-                Some((purpose, None))
+                Some(Polled::Chosen(purpose, None))
             }
         }
+    }
+}
+
+/// Shows the native dialog for `purpose` (blocks until answered).
+fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<PathBuf> {
+    let mut dialog = rfd::FileDialog::new().set_title(purpose.title());
+    if let Some(folder) = folder {
+        dialog = dialog.set_directory(folder);
+    }
+    match purpose {
+        DialogPurpose::OpenProject => dialog
+            .add_filter("Anthesis project", purpose.extensions())
+            .pick_file(),
+        DialogPurpose::SaveProjectAs => dialog
+            .add_filter("Anthesis project", purpose.extensions())
+            .set_file_name(purpose.suggested_name().unwrap_or_default())
+            .save_file(),
+        DialogPurpose::ExportGlb => dialog
+            .add_filter("glTF binary", &["glb"])
+            .add_filter("USD layer", &["usda", "usd"])
+            .add_filter("GIF animation", &["gif"])
+            .set_file_name(purpose.suggested_name().unwrap_or_default())
+            .save_file(),
     }
 }
 
@@ -116,6 +290,8 @@ pub struct Settings {
     pub looping: bool,
     pub speed: f64,
     pub show_log: bool,
+    /// The undo history window is open.
+    pub show_history: bool,
     /// Unsaved work is saved for recovery at most this often, in seconds.
     pub autosave_seconds: u64,
 }
@@ -132,6 +308,7 @@ impl Default for Settings {
             looping: playback.looping,
             speed: playback.speed,
             show_log: true,
+            show_history: false,
             autosave_seconds: super::autosave::DEFAULT_INTERVAL_SECONDS,
         }
     }
@@ -153,6 +330,21 @@ impl Settings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_program_is_found_on_path_only_where_it_is_and_executable() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().expect("temp dir");
+        let tool = dir.path().join("zenity");
+        std::fs::write(&tool, "#!/bin/sh\n").expect("write");
+        let path = std::env::join_paths(["/nonexistent/bin".as_ref(), dir.path()]).expect("path");
+        std::fs::set_permissions(&tool, std::fs::Permissions::from_mode(0o644)).expect("chmod");
+        assert!(!program_on_path("zenity", Some(&path)), "not executable");
+        std::fs::set_permissions(&tool, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+        assert!(program_on_path("zenity", Some(&path)));
+        assert!(!program_on_path("zenity", Some("/nonexistent/bin".as_ref())));
+        assert!(!program_on_path("zenity", None));
+    }
 
     #[test]
     fn recent_files_are_unique_newest_first_and_bounded() {

@@ -1,66 +1,349 @@
 //! The menu bar and the keyboard shortcuts. Both only make [`Command`]s;
 //! [`AnthesisApp::apply`] carries them out.
 
-use eframe::egui::{self, Key, KeyboardShortcut, Modifiers};
+use eframe::egui::{self, Event, Key, KeyboardShortcut, Modifiers};
 
 use super::AnthesisApp;
 use super::command::Command;
 
+/// Where a shortcut works.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scope {
+    /// Also while a text field has the keyboard (Ctrl+S, Ctrl+O...).
+    Everywhere,
+    /// Not while a text field has the keyboard: the key types or edits
+    /// text there (plain keys, Ctrl+Z).
+    NotTyping,
+}
+
+/// One keyboard shortcut: the keys that trigger it, what it does, and the
+/// command it makes. [`SHORTCUTS`] is the one list the handler matches
+/// and the Help → Shortcuts window and the README show.
+pub struct Shortcut {
+    /// The keys, the first as shown; the others are the same key as other
+    /// keyboard layouts report it (Shift+[ arrives as `{` on a US layout).
+    pub keys: &'static [KeyboardShortcut],
+    /// What it does, as the Shortcuts window says it.
+    pub does: &'static str,
+    pub scope: Scope,
+    /// The command, from the app's state (toggles read what is on now).
+    pub command: fn(&AnthesisApp) -> Command,
+}
+
+impl Shortcut {
+    /// How the shortcut is written: `Ctrl+Shift+Z`, `[`, `Left`.
+    pub fn label(&self) -> String {
+        let Some(shortcut) = self.keys.first() else {
+            return String::new();
+        };
+        let mut text = egui::ModifierNames::NAMES.format(&shortcut.modifiers, false);
+        if !text.is_empty() {
+            text.push('+');
+        }
+        let key = shortcut.logical_key;
+        text.push_str(match key {
+            Key::ArrowLeft | Key::ArrowRight | Key::ArrowUp | Key::ArrowDown => key.name(),
+            _ => key.symbol_or_name(),
+        });
+        text
+    }
+
+    /// Whether a press of `key` with `modifiers` is this shortcut. Ctrl and
+    /// Shift must be exactly as listed; Alt is ignored (AltGr types `[` on
+    /// some layouts).
+    fn matches(&self, key: Key, modifiers: Modifiers) -> bool {
+        self.keys.iter().any(|s| {
+            s.logical_key == key
+                && s.modifiers.command == (modifiers.command || modifiers.ctrl)
+                && s.modifiers.shift == modifiers.shift
+        })
+    }
+}
+
+const fn plain(key: Key) -> KeyboardShortcut {
+    KeyboardShortcut::new(Modifiers::NONE, key)
+}
+const fn shift(key: Key) -> KeyboardShortcut {
+    KeyboardShortcut::new(Modifiers::SHIFT, key)
+}
+const fn ctrl(key: Key) -> KeyboardShortcut {
+    KeyboardShortcut::new(Modifiers::COMMAND, key)
+}
+const fn ctrl_shift(key: Key) -> KeyboardShortcut {
+    KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), key)
+}
+
+/// Factor of one `[` / `]` press on the brush radius.
+pub const RADIUS_STEP: f64 = 1.25;
+/// Change of one `Shift+[` / `Shift+]` press on the brush strength.
+pub const STRENGTH_STEP: f32 = 0.1;
+
+/// Every keyboard shortcut of the window.
+pub const SHORTCUTS: &[Shortcut] = &[
+    Shortcut {
+        keys: &[ctrl(Key::Z)],
+        does: "Undo",
+        scope: Scope::NotTyping,
+        command: |_| Command::Undo,
+    },
+    Shortcut {
+        keys: &[ctrl_shift(Key::Z), ctrl(Key::Y)],
+        does: "Redo",
+        scope: Scope::NotTyping,
+        command: |_| Command::Redo,
+    },
+    Shortcut {
+        keys: &[ctrl(Key::N)],
+        does: "New project",
+        scope: Scope::Everywhere,
+        command: |_| Command::NewProject,
+    },
+    Shortcut {
+        keys: &[ctrl(Key::O)],
+        does: "Open a project",
+        scope: Scope::Everywhere,
+        command: |_| Command::OpenProject(None),
+    },
+    Shortcut {
+        keys: &[ctrl(Key::S)],
+        does: "Save",
+        scope: Scope::Everywhere,
+        command: |_| Command::Save,
+    },
+    Shortcut {
+        keys: &[ctrl_shift(Key::S)],
+        does: "Save as",
+        scope: Scope::Everywhere,
+        command: |_| Command::SaveAs,
+    },
+    Shortcut {
+        keys: &[ctrl(Key::E)],
+        does: "Export the animation",
+        scope: Scope::Everywhere,
+        command: |_| Command::OpenExportDialog,
+    },
+    Shortcut {
+        keys: &[plain(Key::OpenBracket)],
+        does: "Smaller brush (radius ÷ 1.25)",
+        scope: Scope::NotTyping,
+        command: |_| Command::ScaleBrushRadius(1.0 / RADIUS_STEP),
+    },
+    Shortcut {
+        keys: &[plain(Key::CloseBracket)],
+        does: "Larger brush (radius × 1.25)",
+        scope: Scope::NotTyping,
+        command: |_| Command::ScaleBrushRadius(RADIUS_STEP),
+    },
+    Shortcut {
+        keys: &[
+            shift(Key::OpenBracket),
+            shift(Key::OpenCurlyBracket),
+            plain(Key::OpenCurlyBracket),
+        ],
+        does: "Weaker brush (strength − 0.1)",
+        scope: Scope::NotTyping,
+        command: |_| Command::ChangeBrushStrength(-STRENGTH_STEP),
+    },
+    Shortcut {
+        keys: &[
+            shift(Key::CloseBracket),
+            shift(Key::CloseCurlyBracket),
+            plain(Key::CloseCurlyBracket),
+        ],
+        does: "Stronger brush (strength + 0.1)",
+        scope: Scope::NotTyping,
+        command: |_| Command::ChangeBrushStrength(STRENGTH_STEP),
+    },
+    Shortcut {
+        keys: &[plain(Key::X)],
+        does: "Swap the brush between add and subtract",
+        scope: Scope::NotTyping,
+        command: |_| Command::SwapBrushAddSubtract,
+    },
+    Shortcut {
+        keys: &[plain(Key::Space)],
+        does: "Play or pause",
+        scope: Scope::NotTyping,
+        command: |_| Command::TogglePlay,
+    },
+    Shortcut {
+        keys: &[plain(Key::ArrowLeft)],
+        does: "One keyframe back",
+        scope: Scope::NotTyping,
+        command: |_| Command::StepKeyframe(-1),
+    },
+    Shortcut {
+        keys: &[plain(Key::ArrowRight)],
+        does: "One keyframe forwards",
+        scope: Scope::NotTyping,
+        command: |_| Command::StepKeyframe(1),
+    },
+    Shortcut {
+        keys: &[plain(Key::Home)],
+        does: "First keyframe",
+        scope: Scope::NotTyping,
+        command: |_| Command::GoToStart,
+    },
+    Shortcut {
+        keys: &[plain(Key::End)],
+        does: "Newest keyframe (and follow new ones)",
+        scope: Scope::NotTyping,
+        command: |_| Command::GoToEnd,
+    },
+    Shortcut {
+        keys: &[plain(Key::F)],
+        does: "Frame the camera on the flower",
+        scope: Scope::NotTyping,
+        command: |_| Command::FrameAll,
+    },
+    Shortcut {
+        keys: &[plain(Key::W)],
+        does: "Wireframe on or off",
+        scope: Scope::NotTyping,
+        command: |app| {
+            let mut view = app.view;
+            view.wireframe = !view.wireframe;
+            Command::SetView(view)
+        },
+    },
+    Shortcut {
+        keys: &[plain(Key::P)],
+        does: "Single-organ preview on or off",
+        scope: Scope::NotTyping,
+        command: |app| Command::SetSingleOrganPreview(!app.single_organ_preview),
+    },
+    Shortcut {
+        keys: &[plain(Key::H)],
+        does: "Undo history window",
+        scope: Scope::NotTyping,
+        command: |app| Command::ShowHistory(!app.settings.show_history),
+    },
+];
+
+/// The shortcut of `does` as written (for menu entries); empty if none.
+pub fn shortcut_label(does: &str) -> String {
+    SHORTCUTS
+        .iter()
+        .find(|s| s.does == does)
+        .map(Shortcut::label)
+        .unwrap_or_default()
+}
+
+/// The shortcuts as a Markdown table (the README's list is this text, a
+/// test checks).
+#[cfg(test)]
+fn shortcuts_markdown() -> String {
+    let mut text = String::from("| keys | does |\n|---|---|\n");
+    for s in SHORTCUTS {
+        let keys = s.label().replace('|', "\\|");
+        text.push_str(&format!("| `{keys}` | {} |\n", s.does));
+    }
+    text
+}
+
 impl AnthesisApp {
-    /// The commands of this frame's keyboard shortcuts. Shortcuts that
-    /// edit or move in time are left to a text field that has the
-    /// keyboard.
+    /// The commands of this frame's keyboard shortcuts, one per key press
+    /// (five presses of Right in one frame are five steps). A text field
+    /// that has the keyboard keeps the keys it types or edits with (see
+    /// [`Scope`]); the presses taken are removed from the frame's input.
     pub(super) fn shortcut_commands(&self, ctx: &egui::Context) -> Vec<Command> {
-        let command = |key| KeyboardShortcut::new(Modifiers::COMMAND, key);
-        let command_shift = |key| KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, key);
-        let consume = |shortcut: KeyboardShortcut| ctx.input_mut(|i| i.consume_shortcut(&shortcut));
+        let typing = ctx.text_edit_focused();
         let mut commands = Vec::new();
-        // Shift variants first: Ctrl+Shift+Z also matches Ctrl+Z. A text
-        // field that has the keyboard keeps Ctrl+Z for itself.
-        if !ctx.egui_wants_keyboard_input() {
-            if consume(command_shift(Key::Z)) || consume(command(Key::Y)) {
-                commands.push(Command::Redo);
-            }
-            if consume(command(Key::Z)) {
-                commands.push(Command::Undo);
-            }
-        }
-        let with_command = [
-            (command_shift(Key::S), Command::SaveAs),
-            (command(Key::S), Command::Save),
-            (command(Key::O), Command::OpenProject(None)),
-            (command(Key::N), Command::NewProject),
-            (command(Key::E), Command::OpenExportDialog),
-        ];
-        for (shortcut, action) in with_command {
-            if consume(shortcut) {
-                commands.push(action);
-            }
-        }
-        if ctx.egui_wants_keyboard_input() {
-            return commands;
-        }
-        let mut wireframe = self.view;
-        wireframe.wireframe = !wireframe.wireframe;
-        let plain = [
-            (Key::Space, Command::TogglePlay),
-            (Key::ArrowLeft, Command::StepKeyframe(-1)),
-            (Key::ArrowRight, Command::StepKeyframe(1)),
-            (Key::Home, Command::GoToStart),
-            (Key::End, Command::GoToEnd),
-            (Key::F, Command::FrameAll),
-            (Key::W, Command::SetView(wireframe)),
-            (
-                Key::P,
-                Command::SetSingleOrganPreview(!self.single_organ_preview),
-            ),
-        ];
-        for (key, action) in plain {
-            if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
-                commands.push(action);
-            }
-        }
+        ctx.input_mut(|i| {
+            i.events.retain(|event| {
+                let Event::Key {
+                    key,
+                    modifiers,
+                    pressed: true,
+                    ..
+                } = event
+                else {
+                    return true;
+                };
+                let found = SHORTCUTS.iter().find(|s| {
+                    (s.scope == Scope::Everywhere || !typing) && s.matches(*key, *modifiers)
+                });
+                match found {
+                    Some(shortcut) => {
+                        commands.push((shortcut.command)(self));
+                        false
+                    }
+                    None => true,
+                }
+            });
+        });
         commands
+    }
+
+    /// Help → Shortcuts: every shortcut of [`SHORTCUTS`].
+    pub(super) fn shortcuts_window(&mut self, ctx: &egui::Context) {
+        let mut open = self.show_shortcuts;
+        egui::Window::new("Shortcuts")
+            .open(&mut open)
+            .resizable(false)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                egui::Grid::new("shortcuts")
+                    .num_columns(2)
+                    .striped(true)
+                    .show(ui, |ui| {
+                        for s in SHORTCUTS {
+                            ui.monospace(s.label());
+                            ui.label(s.does);
+                            ui.end_row();
+                        }
+                    });
+                ui.label("Keys without Ctrl do nothing while a text field has the keyboard.");
+            });
+        if open != self.show_shortcuts {
+            self.queued.push(Command::ShowShortcuts(open));
+        }
+    }
+
+    /// The undo history: every step by its label, the applied ones first;
+    /// a click undoes or redoes up to that step.
+    pub(super) fn history_window(&mut self, ctx: &egui::Context) {
+        if !self.settings.show_history {
+            return;
+        }
+        let mut open = true;
+        let position = self.doc.history_position();
+        let mut chosen = None;
+        egui::Window::new("History")
+            .open(&mut open)
+            .default_width(260.0)
+            .show(ctx, |ui| {
+                egui::ScrollArea::vertical()
+                    .max_height(320.0)
+                    .show(ui, |ui| {
+                        let opened = ui
+                            .selectable_label(position == 0, "Opened")
+                            .on_hover_text("The project as opened (undo everything)");
+                        if opened.clicked() {
+                            chosen = Some(0);
+                        }
+                        for (i, label) in self.doc.history_labels().enumerate() {
+                            let step = i + 1;
+                            let text = if step <= position {
+                                egui::RichText::new(label)
+                            } else {
+                                // Undone: redo up to here by clicking.
+                                egui::RichText::new(label).weak().italics()
+                            };
+                            if ui.selectable_label(step == position, text).clicked() {
+                                chosen = Some(step);
+                            }
+                        }
+                    });
+            });
+        if let Some(step) = chosen
+            && step != position
+        {
+            self.queued.push(Command::GoToHistory(step));
+        }
+        if !open {
+            self.queued.push(Command::ShowHistory(false));
+        }
     }
 
     /// The menu bar; what is chosen is queued as commands.
@@ -71,7 +354,7 @@ impl AnthesisApp {
                 if ui.button("New").clicked() {
                     chosen.push(Command::NewProject);
                 }
-                if ui.button("Open…  (Ctrl+O)").clicked() {
+                if ui.button(with_keys("Open…", "Open a project")).clicked() {
                     chosen.push(Command::OpenProject(None));
                 }
                 ui.menu_button("Open recent", |ui| {
@@ -85,14 +368,17 @@ impl AnthesisApp {
                     }
                 });
                 ui.separator();
-                if ui.button("Save  (Ctrl+S)").clicked() {
+                if ui.button(with_keys("Save", "Save")).clicked() {
                     chosen.push(Command::Save);
                 }
-                if ui.button("Save as…  (Ctrl+Shift+S)").clicked() {
+                if ui.button(with_keys("Save as…", "Save as")).clicked() {
                     chosen.push(Command::SaveAs);
                 }
                 ui.separator();
-                if ui.button("Export animation…  (Ctrl+E)").clicked() {
+                if ui
+                    .button(with_keys("Export animation…", "Export the animation"))
+                    .clicked()
+                {
                     chosen.push(Command::OpenExportDialog);
                 }
                 ui.separator();
@@ -101,7 +387,10 @@ impl AnthesisApp {
                 }
             });
             ui.menu_button("Edit", |ui| {
-                let undo = self.doc.undo_label().map(|l| format!("Undo {l}  (Ctrl+Z)"));
+                let undo = self
+                    .doc
+                    .undo_label()
+                    .map(|l| with_keys(&format!("Undo {l}"), "Undo"));
                 if ui
                     .add_enabled(
                         undo.is_some(),
@@ -114,7 +403,7 @@ impl AnthesisApp {
                 let redo = self
                     .doc
                     .redo_label()
-                    .map(|l| format!("Redo {l}  (Ctrl+Shift+Z)"));
+                    .map(|l| with_keys(&format!("Redo {l}"), "Redo"));
                 if ui
                     .add_enabled(
                         redo.is_some(),
@@ -127,7 +416,10 @@ impl AnthesisApp {
             });
             ui.menu_button("View", |ui| {
                 let mut view = self.view;
-                ui.checkbox(&mut view.wireframe, "Wireframe  (W)");
+                ui.checkbox(
+                    &mut view.wireframe,
+                    with_keys("Wireframe", "Wireframe on or off"),
+                );
                 ui.checkbox(&mut view.direction_arrows, "Growth direction arrows");
                 ui.checkbox(&mut view.show_others, "Other organs as buds in preview");
                 ui.menu_button("Map overlay", |ui| {
@@ -139,15 +431,90 @@ impl AnthesisApp {
                 if view != self.view {
                     chosen.push(Command::SetView(view));
                 }
-                if ui.button("Frame all  (F)").clicked() {
+                if ui
+                    .button(with_keys("Frame all", "Frame the camera on the flower"))
+                    .clicked()
+                {
                     chosen.push(Command::FrameAll);
                 }
                 let mut show_log = self.settings.show_log;
                 if ui.checkbox(&mut show_log, "Log panel").changed() {
                     chosen.push(Command::ShowLog(show_log));
                 }
+                let mut show_history = self.settings.show_history;
+                if ui
+                    .checkbox(
+                        &mut show_history,
+                        with_keys("Undo history", "Undo history window"),
+                    )
+                    .changed()
+                {
+                    chosen.push(Command::ShowHistory(show_history));
+                }
+            });
+            ui.menu_button("Help", |ui| {
+                if ui.button("Shortcuts").clicked() {
+                    chosen.push(Command::ShowShortcuts(true));
+                }
             });
         });
         self.queued.extend(chosen);
+    }
+}
+
+/// A menu entry's text with its shortcut (from [`SHORTCUTS`]), if any.
+fn with_keys(text: &str, does: &str) -> String {
+    match shortcut_label(does) {
+        keys if keys.is_empty() => text.to_string(),
+        keys => format!("{text}  ({keys})"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_readme_lists_every_shortcut_as_the_table_has_it() {
+        let readme = include_str!("../../../README.md");
+        let table = shortcuts_markdown();
+        assert!(
+            readme.contains(&table),
+            "README.md's shortcut list differs from SHORTCUTS; put this in it:\n{table}"
+        );
+    }
+
+    #[test]
+    fn no_two_shortcuts_share_a_key() {
+        for (i, a) in SHORTCUTS.iter().enumerate() {
+            for b in &SHORTCUTS[i + 1..] {
+                for key in a.keys {
+                    assert!(
+                        !b.matches(key.logical_key, key.modifiers),
+                        "{} and {} share {}",
+                        a.does,
+                        b.does,
+                        a.label()
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn shift_bracket_is_not_bracket_and_labels_read_as_written() {
+        let find = |does: &str| SHORTCUTS.iter().find(|s| s.does.starts_with(does));
+        let smaller = find("Smaller brush").expect("listed");
+        let weaker = find("Weaker brush").expect("listed");
+        assert!(smaller.matches(Key::OpenBracket, Modifiers::NONE));
+        assert!(!smaller.matches(Key::OpenBracket, Modifiers::SHIFT));
+        // A US layout reports Shift+[ as '{' with Shift held.
+        assert!(weaker.matches(Key::OpenCurlyBracket, Modifiers::SHIFT));
+        assert!(weaker.matches(Key::OpenBracket, Modifiers::SHIFT));
+        assert!(!weaker.matches(Key::OpenBracket, Modifiers::NONE));
+        assert_eq!(smaller.label(), "[");
+        assert_eq!(weaker.label(), "Shift+[");
+        assert_eq!(find("Redo").expect("listed").label(), "Ctrl+Shift+Z");
+        assert_eq!(find("One keyframe back").expect("listed").label(), "Left");
     }
 }

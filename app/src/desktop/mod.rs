@@ -178,6 +178,8 @@ pub struct AnthesisApp {
     resolved: resolution::Resolved,
     /// Commands the panels asked for this frame, applied after drawing.
     queued: Vec<Command>,
+    /// The Help → Shortcuts window is open.
+    show_shortcuts: bool,
     /// Writes unsaved work for recovery (off until enabled).
     autosave: Option<autosave::Autosave>,
     /// Work recovered after a crash, waiting for "recover or discard?".
@@ -265,6 +267,7 @@ impl AnthesisApp {
             outline: viewport::Outline::default(),
             resolved: resolution::Resolved::default(),
             queued: Vec::new(),
+            show_shortcuts: false,
             autosave: None,
             recovery_offer: None,
             title: String::new(),
@@ -530,6 +533,9 @@ impl eframe::App for AnthesisApp {
             .show(ui, |ui| self.paint_panel(ui));
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport_panel(ui));
         self.export_window(&ctx);
+        self.history_window(&ctx);
+        self.shortcuts_window(&ctx);
+        self.file_browser(&ctx);
         self.apply_queued();
         self.unsaved_prompt(&ctx);
         self.unit_prompt(&ctx);

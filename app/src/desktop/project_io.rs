@@ -5,12 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use anthesis_flower::project::{keep_backup, load_project, save_project};
+use eframe::egui;
 
 use super::AnthesisApp;
-use super::command::{LoadedMap, ProjectEdit};
+use super::command::{Command, LoadedMap, ProjectEdit};
 use super::document::Document;
 use super::export;
-use super::files::DialogPurpose;
+use super::files::{DialogPurpose, Polled};
 use super::log::Topic;
 use super::prompts::{Pending, UnitOffer};
 use anthesis_maps::brush::PaintTarget;
@@ -157,7 +158,7 @@ impl AnthesisApp {
         self.doc = doc;
         self.session.forget_shown();
         self.selected_organ = 0;
-        self.framed = false;
+        self.reframe();
         self.needs_run = true;
         self.playback.time_in_keyframes = 0.0;
         self.playback.follow = true;
@@ -222,11 +223,36 @@ impl AnthesisApp {
         }
     }
 
+    /// Uses the in-app file browser from now on, as the app does by itself
+    /// when no native dialog can be shown (tests).
+    pub fn use_in_app_file_browser(&mut self) {
+        self.dialogs = super::files::Dialogs::in_app();
+    }
+
+    /// The native dialog's answer, as a [`Command::FileChosen`]; when no
+    /// native dialog can be shown, says so (the in-app browser is open
+    /// instead).
     pub(super) fn handle_dialog_answers(&mut self) {
-        let Some((purpose, answer)) = self.dialogs.poll() else {
-            return;
-        };
-        let Some(path) = answer else {
+        match self.dialogs.poll() {
+            None => {}
+            Some(Polled::Chosen(purpose, path)) => self.apply(Command::FileChosen { purpose, path }),
+            Some(Polled::InAppInstead(why)) => self.log.warn(format!(
+                "no native file dialog can be shown ({why}): using the in-app file browser"
+            )),
+        }
+    }
+
+    /// The in-app file browser, when open; its answer is queued as a
+    /// [`Command::FileChosen`].
+    pub(super) fn file_browser(&mut self, ctx: &egui::Context) {
+        if let Some((purpose, path)) = self.dialogs.browser_ui(ctx) {
+            self.queued.push(Command::FileChosen { purpose, path });
+        }
+    }
+
+    /// `path` was chosen (or, `None`, the dialog cancelled) for `purpose`.
+    pub(super) fn file_chosen(&mut self, purpose: DialogPurpose, path: Option<PathBuf>) {
+        let Some(path) = path else {
             // Cancelled: a pending action waiting for "save as" is dropped.
             if purpose == DialogPurpose::SaveProjectAs {
                 self.pending = None;
