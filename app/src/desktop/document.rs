@@ -268,18 +268,28 @@ mod tests {
             d.go_to(1);
             d.project().clone()
         };
-        assert_eq!(doc.history_labels().collect::<Vec<_>>(), ["dg", "thickness", "kb"]);
+        assert_eq!(
+            doc.history_labels().collect::<Vec<_>>(),
+            ["dg", "thickness", "kb"]
+        );
         assert_eq!(doc.history_position(), 3);
         assert_eq!(doc.go_to(1), ["kb", "thickness"]);
         assert_eq!(doc.history_position(), 1);
         assert_eq!(doc.project().flower.templates[0].dg, 0.1);
         assert_eq!(doc.project(), &after_first);
         // The redo steps stay listed, after the applied ones.
-        assert_eq!(doc.history_labels().collect::<Vec<_>>(), ["dg", "thickness", "kb"]);
+        assert_eq!(
+            doc.history_labels().collect::<Vec<_>>(),
+            ["dg", "thickness", "kb"]
+        );
         assert_eq!(doc.go_to(0), ["dg"]);
         assert_eq!(doc.project(), &original);
         assert!(!doc.is_dirty());
-        assert_eq!(doc.go_to(99), ["dg", "thickness", "kb"], "clamped to the history");
+        assert_eq!(
+            doc.go_to(99),
+            ["dg", "thickness", "kb"],
+            "clamped to the history"
+        );
         assert!((doc.project().flower.templates[0].dg - 0.3).abs() < 1e-12);
         assert!(doc.go_to(3).is_empty());
     }

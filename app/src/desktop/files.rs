@@ -342,7 +342,10 @@ mod tests {
         assert!(!program_on_path("zenity", Some(&path)), "not executable");
         std::fs::set_permissions(&tool, std::fs::Permissions::from_mode(0o755)).expect("chmod");
         assert!(program_on_path("zenity", Some(&path)));
-        assert!(!program_on_path("zenity", Some("/nonexistent/bin".as_ref())));
+        assert!(!program_on_path(
+            "zenity",
+            Some("/nonexistent/bin".as_ref())
+        ));
         assert!(!program_on_path("zenity", None));
     }
 

@@ -77,12 +77,8 @@ impl AnthesisApp {
         }
         if matches!(self.session.status(), RunStatus::Finished { .. }) {
             let last = f64::from(self.session.last_index().unwrap_or(0));
-            let open = viewport::build_scene(
-                self.doc.project(),
-                &self.session,
-                last,
-                self.shows_others(),
-            );
+            let open =
+                viewport::build_scene(self.doc.project(), &self.session, last, self.shows_others());
             let bud = viewport::build_scene(self.doc.project(), &self.session, 0.0, true);
             let mut both = positions(&open);
             both.extend(positions(&bud));

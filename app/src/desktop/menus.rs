@@ -293,7 +293,10 @@ impl AnthesisApp {
                             ui.end_row();
                         }
                     });
-                ui.label("Keys without Ctrl do nothing while a text field has the keyboard.");
+                ui.label(
+                    "While a text field has the keyboard, it keeps the keys without \
+                     Ctrl and Ctrl+Z / Ctrl+Shift+Z.",
+                );
             });
         if open != self.show_shortcuts {
             self.queued.push(Command::ShowShortcuts(open));

@@ -235,7 +235,9 @@ impl AnthesisApp {
     pub(super) fn handle_dialog_answers(&mut self) {
         match self.dialogs.poll() {
             None => {}
-            Some(Polled::Chosen(purpose, path)) => self.apply(Command::FileChosen { purpose, path }),
+            Some(Polled::Chosen(purpose, path)) => {
+                self.apply(Command::FileChosen { purpose, path })
+            }
             Some(Polled::InAppInstead(why)) => self.log.warn(format!(
                 "no native file dialog can be shown ({why}): using the in-app file browser"
             )),

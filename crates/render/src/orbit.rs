@@ -167,7 +167,11 @@ mod tests {
             .map(|i| {
                 let t = f64::from(i) / 199.0;
                 let angle = 7.0 * t;
-                DVec3::new(3.0 + 2.0 * angle.cos() * t, 10.0 + 30.0 * t, -1.0 + angle.sin())
+                DVec3::new(
+                    3.0 + 2.0 * angle.cos() * t,
+                    10.0 + 30.0 * t,
+                    -1.0 + angle.sin(),
+                )
             })
             .collect();
         for (az, el) in [(30.0, 25.0), (0.0, 0.0), (-120.0, 70.0), (200.0, -40.0)] {
