@@ -1728,7 +1728,7 @@ fn help_shortcuts_lists_every_shortcut() {
     ] {
         harness.get_by_label(keys);
     }
-    harness.get_by_label("Swap the brush between add and subtract");
+    harness.get_by_label("Brush to subtract from add, else to add");
     harness.snapshot("shortcuts_window");
 }
 

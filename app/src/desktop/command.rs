@@ -83,11 +83,16 @@ pub enum Command {
     ShowShortcuts(bool),
     /// Undo or redo until this many steps of the history are applied.
     GoToHistory(usize),
-    /// Multiply the brush radius by this factor (kept in the slider's range).
-    ScaleBrushRadius(f64),
-    /// Add this to the brush strength (kept in 0..=1).
-    ChangeBrushStrength(f32),
-    /// Add becomes subtract and subtract add.
+    /// One step larger (`true`) or smaller brush radius
+    /// ([`PaintState::grow_radius`](super::paint::PaintState::grow_radius)).
+    StepBrushRadius {
+        larger: bool,
+    },
+    /// One step stronger (`true`) or weaker brush.
+    StepBrushStrength {
+        stronger: bool,
+    },
+    /// Add becomes subtract, any other mode add.
     SwapBrushAddSubtract,
 }
 
@@ -262,16 +267,11 @@ impl AnthesisApp {
                     self.after_history_change();
                 }
             }
-            Command::ScaleBrushRadius(factor) => self.paint.scale_radius(factor),
-            Command::ChangeBrushStrength(delta) => self.paint.change_strength(delta),
-            Command::SwapBrushAddSubtract => {
-                if !self.paint.swap_add_subtract() {
-                    self.log.info(format!(
-                        "X swaps add and subtract; the brush is on {}",
-                        self.paint.brush.mode.label()
-                    ));
-                }
-            }
+            Command::StepBrushRadius { larger: true } => self.paint.grow_radius(),
+            Command::StepBrushRadius { larger: false } => self.paint.shrink_radius(),
+            Command::StepBrushStrength { stronger: true } => self.paint.raise_strength(),
+            Command::StepBrushStrength { stronger: false } => self.paint.lower_strength(),
+            Command::SwapBrushAddSubtract => self.paint.toggle_mode(),
         }
     }
 

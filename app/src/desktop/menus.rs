@@ -73,11 +73,6 @@ const fn ctrl_shift(key: Key) -> KeyboardShortcut {
     KeyboardShortcut::new(Modifiers::COMMAND.plus(Modifiers::SHIFT), key)
 }
 
-/// Factor of one `[` / `]` press on the brush radius.
-pub const RADIUS_STEP: f64 = 1.25;
-/// Change of one `Shift+[` / `Shift+]` press on the brush strength.
-pub const STRENGTH_STEP: f32 = 0.1;
-
 /// Every keyboard shortcut of the window.
 pub const SHORTCUTS: &[Shortcut] = &[
     Shortcut {
@@ -126,13 +121,13 @@ pub const SHORTCUTS: &[Shortcut] = &[
         keys: &[plain(Key::OpenBracket)],
         does: "Smaller brush (radius ÷ 1.25)",
         scope: Scope::NotTyping,
-        command: |_| Command::ScaleBrushRadius(1.0 / RADIUS_STEP),
+        command: |_| Command::StepBrushRadius { larger: false },
     },
     Shortcut {
         keys: &[plain(Key::CloseBracket)],
         does: "Larger brush (radius × 1.25)",
         scope: Scope::NotTyping,
-        command: |_| Command::ScaleBrushRadius(RADIUS_STEP),
+        command: |_| Command::StepBrushRadius { larger: true },
     },
     Shortcut {
         keys: &[
@@ -142,7 +137,7 @@ pub const SHORTCUTS: &[Shortcut] = &[
         ],
         does: "Weaker brush (strength − 0.1)",
         scope: Scope::NotTyping,
-        command: |_| Command::ChangeBrushStrength(-STRENGTH_STEP),
+        command: |_| Command::StepBrushStrength { stronger: false },
     },
     Shortcut {
         keys: &[
@@ -152,11 +147,11 @@ pub const SHORTCUTS: &[Shortcut] = &[
         ],
         does: "Stronger brush (strength + 0.1)",
         scope: Scope::NotTyping,
-        command: |_| Command::ChangeBrushStrength(STRENGTH_STEP),
+        command: |_| Command::StepBrushStrength { stronger: true },
     },
     Shortcut {
         keys: &[plain(Key::X)],
-        does: "Swap the brush between add and subtract",
+        does: "Brush to subtract from add, else to add",
         scope: Scope::NotTyping,
         command: |_| Command::SwapBrushAddSubtract,
     },
