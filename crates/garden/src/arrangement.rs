@@ -22,6 +22,7 @@ pub struct Whorl {
     pub name: String,
     /// Index of the organs' template in the flower.
     pub template: usize,
+    /// How many organs the ring holds, evenly spaced in azimuth.
     pub count: usize,
     /// Azimuth of the first organ; the others follow every 360°/count.
     pub offset_deg: f64,
@@ -83,7 +84,9 @@ pub fn angular_distance_deg(a: f64, b: f64) -> f64 {
 /// Organs placed by whorls, and their overlap rules.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Arrangement {
+    /// The organs, placed, in the order their whorls or spiral give them.
     pub organs: Vec<Organ>,
+    /// Which organ lies inside which, as indices into `organs`.
     pub overlaps: Vec<Overlap>,
 }
 
@@ -141,18 +144,26 @@ pub fn contorted_whorl(whorl: &Whorl) -> Option<Arrangement> {
 /// A phyllotactic spiral (`sketch-based-floral-blossom.txt` §3.2).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spiral {
+    /// Organ names are `<name>-1`, `<name>-2`, … from the first (outermost)
+    /// organ inwards.
     pub name: String,
+    /// Index of the organs' template in the flower.
     pub template: usize,
+    /// How many organs the spiral holds.
     pub count: usize,
     /// Divergence between consecutive organs, normally [`GOLDEN_ANGLE_DEG`].
     pub divergence_deg: f64,
     /// Base of the first (outermost, oldest) organ.
     pub first_radius: f64,
+    /// Height of the first organ's base on the receptacle.
     pub first_height: f64,
     /// Each later organ sits this much nearer the axis and this much higher.
     pub radius_step: f64,
+    /// How much higher each later organ's base sits than the one before.
     pub height_step: f64,
+    /// Initial joint angle of every organ (positive tilts outwards).
     pub joint_angle_deg: f64,
+    /// Half the angle about the axis an organ covers at its widest.
     pub half_span_deg: f64,
 }
 

@@ -15,16 +15,26 @@ use crate::paint::{Painting, above_base, midrib_band, smoothstep};
 /// Why a default flower could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GardenError {
+    /// An organ's bud mesh could not be built (e.g. an `edge_scale` too
+    /// small or too large for the organ).
     #[error("the {organ} bud: {error}")]
     Bud {
+        /// Which organ, e.g. "petal" or "sepal".
         organ: &'static str,
+        /// Why the remesher refused.
         error: BudError,
     },
+    /// An organ's painted growth maps could not be built.
     #[error("the {organ} maps: {error}")]
     Maps {
+        /// Which organ, e.g. "petal" or "sepal".
         organ: &'static str,
+        /// What is wrong with the maps.
         error: MapError,
     },
+    /// The organs cannot be arranged with the overlap rules the flower
+    /// needs (e.g. Eustoma petals too narrow to overlap their neighbours);
+    /// the message says which organs and why.
     #[error("{0}")]
     Arrangement(String),
 }
@@ -70,10 +80,16 @@ pub fn flower_at_resolution(name: &str, edge_scale: f64) -> Option<Result<Projec
 
 /// Table 1: the lily's growth scale, thickness and stiffness.
 pub const LILY_DG: f64 = 0.003;
+/// Table 1: the lily's thickness (distance of the imaginary inner surface),
+/// in the project's length units.
 pub const LILY_THICKNESS: f64 = 0.2;
+/// Table 1: the lily's stiffness, used for both the stretch (`Ks`) and
+/// the bend (`Kb`) scale of its templates.
 pub const LILY_STIFFNESS: f64 = 20.0;
 /// Table 1: mean edge of the lily's petal and sepal meshes.
 pub const LILY_PETAL_EDGE: f64 = 1.3;
+/// Table 1: mean edge of the lily's sepal mesh, in the project's length
+/// units (before any `edge_scale`).
 pub const LILY_SEPAL_EDGE: f64 = 1.4;
 /// Distance between the petal and sepal surfaces in the bud.
 pub const LILY_SEPAL_GAP: f64 = 1.2;
@@ -405,12 +421,14 @@ pub enum Cultivar {
 }
 
 impl Cultivar {
+    /// The three cultivars, in the paper's order.
     pub const ALL: [Cultivar; 3] = [
         Cultivar::MellowYellow,
         Cultivar::MaiteLady,
         Cultivar::Pinocchio,
     ];
 
+    /// The project's name, e.g. `Eustoma 'Mellow Yellow'`.
     pub fn project_name(self) -> &'static str {
         match self {
             Cultivar::MellowYellow => "Eustoma 'Mellow Yellow'",
@@ -419,6 +437,8 @@ impl Cultivar {
         }
     }
 
+    /// The project's folder under `assets/flowers/`, e.g.
+    /// `eustoma-mellow-yellow` (one of [`FLOWER_NAMES`]).
     pub fn folder_name(self) -> &'static str {
         match self {
             Cultivar::MellowYellow => "eustoma-mellow-yellow",
@@ -438,8 +458,13 @@ impl Cultivar {
 
 /// Table 1: Eustoma's growth scale, thickness, stiffness and mean edge.
 pub const EUSTOMA_DG: f64 = 0.003;
+/// Table 1: Eustoma's thickness, in the project's length units.
 pub const EUSTOMA_THICKNESS: f64 = 0.1;
+/// Table 1: Eustoma's stiffness, used for both the stretch and the bend
+/// scale of its petals.
 pub const EUSTOMA_STIFFNESS: f64 = 10.0;
+/// Table 1: mean edge of Eustoma's petal mesh, in the project's length
+/// units (before any `edge_scale`).
 pub const EUSTOMA_EDGE: f64 = 2.0;
 /// How much further out each petal's left margin lies than its right one:
 /// enough that where neighbours overlap in the bud they lie about 2.6
@@ -488,9 +513,14 @@ fn eustoma_regions(v: f64) -> [f64; 3] {
 /// excess) the growth direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EustomaGrowth {
+    /// E-growth map value, `[stage][region]`, stages early and late,
+    /// regions lower, middle and upper.
     pub e: [[f64; 3]; 2],
+    /// How much the e-growth-in map exceeds `e`, `[stage][region]`.
     pub e_in_excess: [[f64; 3]; 2],
+    /// W-growth map value, `[stage][region]`.
     pub w: [[f64; 3]; 2],
+    /// How much the w-growth-in map exceeds `w`, `[stage][region]`.
     pub w_in_excess: [[f64; 3]; 2],
     /// How much the growth direction fans out towards the margins.
     pub fan: f64,

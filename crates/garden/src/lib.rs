@@ -18,6 +18,8 @@
 //! `cargo run -p anthesis-garden --bin make-flowers` and a test checks that
 //! they equal what the builders here make.
 
+#![warn(missing_docs)]
+
 pub mod arrangement;
 pub mod buds;
 pub mod flowers;

@@ -82,16 +82,26 @@ fn quantise_signed(value: f64) -> f32 {
 /// Growth maps for the base and inner layers from four painting
 /// functions plus stiffness and direction; a convenience for the builders.
 pub struct Painting<'a> {
+    /// The e-growth map's value at a UV point.
     pub e_growth: &'a dyn Fn(DVec2) -> f64,
+    /// The w-growth map's value at a UV point.
     pub w_growth: &'a dyn Fn(DVec2) -> f64,
+    /// The e-growth-in map's value at a UV point.
     pub e_growth_in: &'a dyn Fn(DVec2) -> f64,
+    /// The w-growth-in map's value at a UV point.
     pub w_growth_in: &'a dyn Fn(DVec2) -> f64,
+    /// The stretch stiffness multiplier at a UV point.
     pub stretch: &'a dyn Fn(DVec2) -> f64,
+    /// The bend stiffness multiplier at a UV point.
     pub bend: &'a dyn Fn(DVec2) -> f64,
+    /// The growth direction at a UV point, as a UV vector (`(0, 1)` is
+    /// along `v`, base to tip).
     pub direction: &'a dyn Fn(DVec2) -> DVec2,
 }
 
 impl Painting<'_> {
+    /// The seven maps, each function sampled by [`scalar_map`] or
+    /// [`direction_map`] (quantised as a 16-bit PNG holds it).
     pub fn paint(&self) -> GrowthMaps {
         GrowthMaps {
             e_growth: scalar_map(self.e_growth),

@@ -184,10 +184,24 @@ pub struct OrganShape {
 /// Why a shape could not be measured.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ShapeError {
+    /// A point the measures sample (on the midrib or a cross line) lies
+    /// outside every triangle of the organ's UV layout.
     #[error("the organ's UV layout does not cover (u, v) = ({u:.2}, {v:.2})")]
-    UvNotCovered { u: f64, v: f64 },
+    UvNotCovered {
+        /// The point's `u` (across the organ).
+        u: f64,
+        /// The point's `v` (base to tip).
+        v: f64,
+    },
+    /// The keyframe's positions do not match the template mesh.
     #[error("{positions} positions for a mesh of {vertices} vertices")]
-    WrongCount { positions: usize, vertices: usize },
+    WrongCount {
+        /// How many positions were given.
+        positions: usize,
+        /// How many vertices the template mesh has.
+        vertices: usize,
+    },
+    /// The template mesh is not a manifold, consistently oriented surface.
     #[error("the organ's mesh has no surface topology: {0}")]
     Mesh(#[from] anthesis_mesh::MeshError),
 }
@@ -277,6 +291,7 @@ fn inner_normal_near(mesh: &Mesh, positions_in_world: &[DVec3], point_in_uv: DVe
 /// lily's petals): each organ's shape and their means.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlowerShape {
+    /// Each organ's shape, in the order the organs were given.
     pub organs: Vec<OrganShape>,
     /// Means over the organs of each [`OrganShape`] field.
     pub mean: OrganShape,
