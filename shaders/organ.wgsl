@@ -1,4 +1,5 @@
-// Lit, two-sided flower organs and the viewport background.
+// Lit, two-sided flower organs and the viewport background with a soft
+// ground shadow under the flower.
 //
 // Used by `anthesis-render` (crates/render/src/pipeline.rs); the uniform
 // structs below must match `FrameUniform` and `OrganUniform` there byte for
@@ -27,6 +28,13 @@ struct Frame {
     // y: brightness of the back (outer) side relative to the front side.
     // zw: unused.
     output_flags: vec4<f32>,
+    // The inverse of view_projection: the background finds the world ray
+    // through each pixel with it.
+    inverse_view_projection: mat4x4<f32>,
+    // The ground under the flower: xz the flower's centre, y the ground's
+    // height (world), w the flower's radius around its centre (0: no
+    // ground shadow).
+    ground: vec4<f32>,
 }
 
 struct Organ {
@@ -98,32 +106,45 @@ fn to_target(linear: vec3<f32>) -> vec3<f32> {
     return linear;
 }
 
+// Petal tissue: thin, pale and translucent. Both sides are lit alike
+// (each with its own normal); light that reaches the other side shows
+// through, tinted by the tissue, so a side turned from the light glows
+// in the petal's colour instead of going dark and muddy.
 @fragment
 fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
     var normal = normalize(in.normal_in_world);
     var side_brightness = 1.0;
     if !is_front {
-        // The back (outer) side: shade with the flipped normal, a bit darker.
+        // The back (outer) side: shade with the flipped normal, a little
+        // less bright.
         normal = -normal;
         side_brightness = frame.output_flags.y;
     }
     let to_eye = normalize(frame.eye_in_world.xyz - in.position_in_world);
 
-    // Key light: a directional light from near the camera.
+    // Key light: a directional light from near the camera, wrapped so the
+    // light falls off softly towards the silhouette.
     let light = frame.light_direction_in_world.xyz;
-    let key = max(dot(normal, light), 0.0);
-    // Hemisphere ambient: sky above (+Y), warm ground below.
+    let wrap = 0.4;
+    let key = max((dot(normal, light) + wrap) / (1.0 + wrap), 0.0);
+    // Light through the tissue from the other side.
+    let through = max(dot(-normal, light), 0.0);
+    // Hemisphere ambient: sky above (+Y), a neutral pale ground below.
     let sky = vec3<f32>(0.95, 0.97, 1.0);
-    let ground = vec3<f32>(0.55, 0.50, 0.46);
+    let ground = vec3<f32>(0.72, 0.70, 0.68);
     let ambient = mix(ground, sky, 0.5 + 0.5 * normal.y);
     // A faint broad sheen so curvature reads on pale petals.
     let halfway = normalize(light + to_eye);
-    let sheen = 0.05 * pow(max(dot(normal, halfway), 0.0), 16.0);
+    let sheen = 0.04 * pow(max(dot(normal, halfway), 0.0), 16.0);
 
     var base = organ.color_linear.rgb;
     base = mix(base, overlay_ramp(in.overlay), clamp(organ.overlay_mix.x, 0.0, 1.0));
 
-    let lit = (base * (0.3 * ambient + 0.72 * key) + vec3<f32>(sheen)) * side_brightness;
+    let reflected = base * (0.42 * ambient + 0.6 * key);
+    // Transmitted light is filtered by the tissue twice over (its colour
+    // squared): more saturated than the reflected colour.
+    let transmitted = 0.5 * through * base * base;
+    let lit = (reflected + transmitted + vec3<f32>(sheen)) * side_brightness;
     return vec4<f32>(to_target(lit), organ.color_linear.a);
 }
 
@@ -131,6 +152,8 @@ struct BackgroundOut {
     @builtin(position) position_in_clip: vec4<f32>,
     // 0 at the top of the image, 1 at the bottom.
     @location(0) down: f32,
+    // The pixel in normalised device coordinates (x right, y up).
+    @location(1) ndc: vec2<f32>,
 }
 
 // A full-screen triangle at the far plane (depth 0 with reversed depth).
@@ -141,12 +164,44 @@ fn vs_background(@builtin(vertex_index) index: u32) -> BackgroundOut {
     var out: BackgroundOut;
     out.position_in_clip = vec4<f32>(x, y, 0.0, 1.0);
     out.down = 0.5 - 0.5 * y;
+    out.ndc = vec2<f32>(x, y);
     return out;
+}
+
+// How dark the ground shadow is at its centre (a fraction of the
+// background's brightness taken away).
+const GROUND_SHADOW_STRENGTH: f32 = 0.38;
+
+// The soft shadow the flower casts on the ground under it, as seen through
+// the pixel at `ndc`: 0 (none) to GROUND_SHADOW_STRENGTH. The ground is the
+// plane y = ground.y; the shadow a disc about the flower's radius, fading
+// out towards its rim.
+fn ground_shadow(ndc: vec2<f32>) -> f32 {
+    let radius = frame.ground.w;
+    if radius <= 0.0 {
+        return 0.0;
+    }
+    // Two points on the pixel's ray (reversed depth: 1 is the near plane).
+    let near = frame.inverse_view_projection * vec4<f32>(ndc, 1.0, 1.0);
+    let middle = frame.inverse_view_projection * vec4<f32>(ndc, 0.5, 1.0);
+    let origin = near.xyz / near.w;
+    let direction = middle.xyz / middle.w - origin;
+    if abs(direction.y) < 1e-12 {
+        return 0.0;
+    }
+    let t = (frame.ground.y - origin.y) / direction.y;
+    if t <= 0.0 {
+        return 0.0;
+    }
+    let hit = origin + t * direction;
+    let distance = length(hit.xz - frame.ground.xz) / radius;
+    return GROUND_SHADOW_STRENGTH * (1.0 - smoothstep(0.15, 1.15, distance));
 }
 
 @fragment
 fn fs_background(in: BackgroundOut) -> @location(0) vec4<f32> {
-    let srgb = mix(frame.background_top_srgb.rgb, frame.background_bottom_srgb.rgb, clamp(in.down, 0.0, 1.0));
+    let gradient = mix(frame.background_top_srgb.rgb, frame.background_bottom_srgb.rgb, clamp(in.down, 0.0, 1.0));
+    let srgb = gradient * (1.0 - ground_shadow(in.ndc));
     var out = srgb;
     if frame.output_flags.x < 0.5 {
         // The target encodes to sRGB itself: hand it linear values.

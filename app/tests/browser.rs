@@ -46,13 +46,16 @@ fn image_at(path: &str) -> RgbaImage {
 }
 
 /// Pixels `anthesis render` drew an organ on: anything clearly away from
-/// the magenta background (antialiased edges half-way count).
+/// the magenta background, which the ground shadow darkens but leaves
+/// magenta (red as strong as blue, no green); antialiased edges half-way
+/// count.
 fn anthesis_mask(picture: &RgbaImage) -> Vec<bool> {
     picture
         .pixels()
         .map(|p| {
             let [r, g, b, _] = p.0.map(i32::from);
-            (255 - r).abs() + g + (255 - b).abs() > 3 * 64
+            let magenta = g < 80 && (r - b).abs() < 80;
+            !magenta
         })
         .collect()
 }

@@ -10,8 +10,14 @@ pub const SHADER_SOURCE: &str = include_str!("../../../shaders/organ.wgsl");
 /// 0 is infinitely far).
 pub const DEPTH_CLEAR_VALUE: f32 = 0.0;
 
-/// Brightness of an organ's back (outer) side relative to its front.
-const BACK_SIDE_BRIGHTNESS: f32 = 0.78;
+/// Brightness of an organ's back (outer) side relative to its front: a
+/// little less, so the two sides read apart, not so much that the outer
+/// side of a bud goes muddy.
+const BACK_SIDE_BRIGHTNESS: f32 = 0.92;
+
+/// How far below the flower's lowest point the ground is, in flower radii
+/// (the shadow is a contact shadow: close under the flower).
+const GROUND_GAP_IN_RADII: f64 = 0.02;
 
 /// The attachments a pipeline draws into. Render passes must match it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -90,6 +96,8 @@ struct FrameUniform {
     background_top_srgb: [f32; 4],
     background_bottom_srgb: [f32; 4],
     output_flags: [f32; 4],
+    inverse_view_projection: [[f32; 4]; 4],
+    ground: [f32; 4],
 }
 
 /// Matches `Organ` in organ.wgsl.
@@ -135,6 +143,9 @@ pub struct OrganPipeline {
     organ_bind_group: wgpu::BindGroup,
     organs: Vec<GpuOrgan>,
     background: Background,
+    /// The ground shadow's place, as `Frame.ground` in organ.wgsl: set from
+    /// the organs' bounds, written with the camera.
+    ground: [f32; 4],
 }
 
 fn round_up(value: u64, alignment: u64) -> u64 {
@@ -280,6 +291,7 @@ impl OrganPipeline {
             organ_uniform_buffer,
             organ_bind_group,
             organs: Vec::new(),
+            ground: [0.0; 4],
             background: Background::default(),
         }
     }
@@ -345,6 +357,7 @@ impl OrganPipeline {
             mesh.check()
                 .map_err(|reason| RenderError::InvalidMesh { organ, reason })?;
         }
+        self.ground = ground_under(organs);
         if organs.len() > self.organ_uniform_capacity {
             let capacity = organs.len().next_power_of_two();
             let (buffer, bind_group) = Self::create_organ_uniforms(
@@ -463,6 +476,8 @@ impl OrganPipeline {
                 0.0,
                 0.0,
             ],
+            inverse_view_projection: camera.view_projection(aspect).inverse().to_cols_array_2d(),
+            ground: self.ground,
         };
         queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniform));
     }
@@ -542,6 +557,28 @@ impl OrganPipeline {
         });
         self.draw(&mut pass);
     }
+}
+
+/// Where the ground shadow goes under `organs`, as `Frame.ground` in
+/// organ.wgsl: the centre of their bounds across (xz), the ground just
+/// below their lowest point (y), and their radius across (w; 0 when there
+/// is nothing to cast a shadow).
+fn ground_under(organs: &[OrganMesh]) -> [f32; 4] {
+    let Some((low, high)) = crate::organs_bounds_in_world(organs) else {
+        return [0.0; 4];
+    };
+    let centre = 0.5 * (low + high);
+    let radius = 0.5 * (high.x - low.x).max(high.z - low.z);
+    if !radius.is_finite() || radius <= 0.0 {
+        return [0.0; 4];
+    }
+    let ground_y = low.y - GROUND_GAP_IN_RADII * radius;
+    [
+        centre.x as f32,
+        ground_y as f32,
+        centre.z as f32,
+        radius as f32,
+    ]
 }
 
 /// egui_wgpu keeps callback resources in a map that requires `Send + Sync`.
