@@ -365,14 +365,9 @@ impl AnthesisApp {
     /// Starts simulating the project as it is now (cancelling the running
     /// job). The playhead stays where it is: what was shown stays shown,
     /// marked stale, until the new run reaches it; only when nothing is
-    /// shown yet does the view follow the new keyframes.
-    pub fn restart_simulation(&mut self) {
-        self.start_run(false);
-    }
-
-    /// [`AnthesisApp::restart_simulation`]; `dragging`: the pointer is
-    /// down, so the edit is not finished yet. The time until a finished
-    /// edit's result is on screen is measured and logged.
+    /// shown yet does the view follow the new keyframes. `dragging`: the
+    /// pointer is down, so the edit is not finished yet; the time until a
+    /// finished edit's result is on screen is measured and logged.
     fn start_run(&mut self, dragging: bool) {
         let selection = self.selection();
         let project = self.resolved_project();
