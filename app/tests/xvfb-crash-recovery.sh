@@ -28,15 +28,7 @@ unset WGPU_BACKEND  # empty means "no backends"
 xvfb-run -a -s "-screen 0 1600x1000x24" bash -c '
   set -euo pipefail
   out="$1"; binary="$2"; import="$3"; data="$4"
-  wait_window() {
-    for _ in $(seq 1 240); do
-      window=$(xdotool search --name "Anthesis" 2>/dev/null | head -n1 || true)
-      [ -n "$window" ] && break
-      sleep 0.5
-    done
-    [ -n "$window" ] || { echo "no Anthesis window" >&2; exit 1; }
-    xdotool windowsize "$window" 1600 1000 windowmove "$window" 0 0
-  }
+  . app/tests/xvfb-window.sh
 
   "$binary" & app=$!
   wait_window
@@ -61,7 +53,7 @@ xvfb-run -a -s "-screen 0 1600x1000x24" bash -c '
   sleep 15
   "$import" -window root "$out/crash-2-offer.png"
   # The prompt is centred in the 1600x1000 window; its Recover button
-  # sits at its lower left (for the default flower's prompt).
+  # sits at its lower left (for the prompt of the default flower).
   xdotool mousemove "${RECOVER_X:-541}" "${RECOVER_Y:-529}" click 1
   sleep 15
   "$import" -window root "$out/crash-3-recovered.png"

@@ -28,15 +28,10 @@ unset WGPU_BACKEND  # empty means "no backends"
 xvfb-run -a -s "-screen 0 1600x1000x24" bash -c '
   set -euo pipefail
   binary="$1"; log="$2"; strokes="$3"
+  . app/tests/xvfb-window.sh
   "$binary" > "$log" 2>&1 & app=$!
   trap "kill $app 2>/dev/null || true" EXIT
-  for _ in $(seq 1 120); do
-    window=$(xdotool search --name "Anthesis" 2>/dev/null | head -n1 || true)
-    [ -n "$window" ] && break
-    sleep 0.5
-  done
-  [ -n "$window" ] || { echo "no Anthesis window" >&2; exit 1; }
-  xdotool windowsize "$window" 1600 1000 windowmove "$window" 0 0
+  wait_window
   # CPU ticks (1/100 s) the app used in the last second: the solver
   # thread keeps it near 100 while a run computes.
   ticks() { awk "{ print \$14 + \$15 }" /proc/$app/stat; }

@@ -24,16 +24,10 @@ unset WGPU_BACKEND  # empty means "no backends"
 xvfb-run -a -s "-screen 0 1600x1000x24" bash -c '
   set -euo pipefail
   out="$1"; binary="$2"; import="$3"
+  . app/tests/xvfb-window.sh
   "$binary" & app=$!
   trap "kill $app 2>/dev/null || true" EXIT
-  # Wait for the window.
-  for _ in $(seq 1 120); do
-    window=$(xdotool search --name "Anthesis" 2>/dev/null | head -n1 || true)
-    [ -n "$window" ] && break
-    sleep 0.5
-  done
-  [ -n "$window" ] || { echo "no Anthesis window" >&2; exit 1; }
-  xdotool windowsize "$window" 1600 1000 windowmove "$window" 0 0
+  wait_window
   sleep 4
   "$import" -window root "$out/app-start.png"
   sleep 25
