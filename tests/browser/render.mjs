@@ -7,6 +7,8 @@
 //   "camera": { "eye": [x,y,z], "target": [x,y,z], "up": [x,y,z],
 //               "vertical_fov_deg": F, "near": N },
 //   "hide": [mesh names left out of the ids picture],
+//   "shape_times": [seconds, ...] (optional: compare every vertex and
+//     normal at these times with the first file's, see page.html),
 //   "files": [{ "name": "dense", "path": "/abs/lily-dense.glb" }, ...],
 //   "out": "/abs/folder" }
 //
@@ -14,7 +16,9 @@
 // OUT/NAME-I-ids.png (one flat colour per mesh on black) for time I, and
 // prints a JSON report: browser and three.js versions, the console errors
 // and warnings, page errors and failed requests, and per file its meshes,
-// morph target counts, animations and per time the pixels of each mesh.
+// morph target counts, animations, per time the pixels of each mesh, and
+// (from the second file on) the largest position and normal differences
+// from the first file at the shape times.
 //
 // Uses Debian's Chromium (/usr/bin/chromium, or CHROMIUM) with software
 // WebGL (SwiftShader); never downloads a browser. Exit status: 0 when a
@@ -94,8 +98,11 @@ try {
   await page.waitForFunction("window.pageReady === true", { timeout: 30000 });
 
   const files = [];
-  for (const file of job.files) {
-    const spec = { width: job.width, height: job.height, times: job.times, camera: job.camera, hide: job.hide ?? [] };
+  for (const [index, file] of job.files.entries()) {
+    const spec = {
+      width: job.width, height: job.height, times: job.times, camera: job.camera, hide: job.hide ?? [],
+      shape_times: job.shape_times ?? [], reference: index === 0,
+    };
     let report;
     try {
       report = await page.evaluate(

@@ -164,11 +164,21 @@ fn gltf_crate_rebuilds_every_keyframe_from_its_target() {
 
 /// At t_0 all weights are 0; at t_k (k >= 1) target k-1 is 1 and the rest 0.
 fn assert_one_hot(weights: &[f32], keyframes: usize) {
+    assert_weights(weights, keyframes, |k, t| k >= 1 && t == k - 1);
+}
+
+/// At t_k targets 0..k are 1 and the rest 0 (targets hold the step from
+/// the previous keyframe).
+fn assert_cumulative(weights: &[f32], keyframes: usize) {
+    assert_weights(weights, keyframes, |k, t| t < k);
+}
+
+fn assert_weights(weights: &[f32], keyframes: usize, one: impl Fn(usize, usize) -> bool) {
     let targets = keyframes - 1;
     assert_eq!(weights.len(), keyframes * targets);
     for k in 0..keyframes {
         for t in 0..targets {
-            let expected = if k >= 1 && t == k - 1 { 1.0 } else { 0.0 };
+            let expected = if one(k, t) { 1.0 } else { 0.0 };
             assert_eq!(
                 weights[k * targets + t],
                 expected,
@@ -176,6 +186,21 @@ fn assert_one_hot(weights: &[f32], keyframes: usize) {
             );
         }
     }
+}
+
+/// `base + sum_i weights[i] * deltas[i]`, vertex by vertex: what a
+/// renderer draws.
+fn morphed(base: &[DVec3], deltas: &[Vec<DVec3>], weights: &[f64]) -> Vec<DVec3> {
+    (0..base.len())
+        .map(|v| {
+            base[v]
+                + deltas
+                    .iter()
+                    .zip(weights)
+                    .map(|(d, w)| d[v] * *w)
+                    .sum::<DVec3>()
+        })
+        .collect()
 }
 
 /// The JSON part that the `gltf` crate does not expose without extra
@@ -229,61 +254,73 @@ fn meshes_name_their_targets_and_carry_materials() {
 #[test]
 fn playback_between_keyframes_blends_the_two_neighbours() {
     let tracks = fixture(KEYFRAMES);
-    let options = GlbOptions {
-        timing: Timing::FramesPerSecond(10.0),
-        ..GlbOptions::default()
-    };
-    let glb = parse_glb(&export(&tracks, &options));
-    let json = &glb.json;
-    let sampler = &json["animations"][0]["samplers"][0];
-    let times: Vec<f64> = read_accessor(&glb, sampler["input"].as_u64().expect("input") as usize)
-        .iter()
-        .map(|t| t[0])
-        .collect();
-    let weights: Vec<f64> =
-        read_accessor(&glb, sampler["output"].as_u64().expect("output") as usize)
+    for encoding in Encoding::ALL {
+        let options = GlbOptions {
+            timing: Timing::FramesPerSecond(10.0),
+            encoding,
+            ..GlbOptions::default()
+        };
+        let glb = parse_glb(&export(&tracks, &options));
+        let json = &glb.json;
+        let sampler = &json["animations"][0]["samplers"][0];
+        let times: Vec<f64> =
+            read_accessor(&glb, sampler["input"].as_u64().expect("input") as usize)
+                .iter()
+                .map(|t| t[0])
+                .collect();
+        let weights: Vec<f64> =
+            read_accessor(&glb, sampler["output"].as_u64().expect("output") as usize)
+                .iter()
+                .map(|w| w[0])
+                .collect();
+        let targets = KEYFRAMES - 1;
+        let (translation, scale) = node_transform(&json["nodes"][0]);
+        let mesh = &json["meshes"][0]["primitives"][0];
+        let base = vec3s(&read_accessor(
+            &glb,
+            mesh["attributes"]["POSITION"].as_u64().expect("p") as usize,
+        ));
+        let deltas: Vec<Vec<DVec3>> = mesh["targets"]
+            .as_array()
+            .expect("targets")
             .iter()
-            .map(|w| w[0])
+            .map(|t| {
+                vec3s(&read_accessor(
+                    &glb,
+                    t["POSITION"].as_u64().expect("p") as usize,
+                ))
+            })
             .collect();
-    let targets = KEYFRAMES - 1;
-    let mesh = &json["meshes"][0]["primitives"][0];
-    let base = vec3s(&read_accessor(
-        &glb,
-        mesh["attributes"]["POSITION"].as_u64().expect("p") as usize,
-    ));
-    let deltas: Vec<Vec<DVec3>> = mesh["targets"]
-        .as_array()
-        .expect("targets")
-        .iter()
-        .map(|t| {
-            vec3s(&read_accessor(
-                &glb,
-                t["POSITION"].as_u64().expect("p") as usize,
-            ))
-        })
-        .collect();
+        // Quantized positions: within half a step of the i16 grid.
+        let tolerance = if is_quantized(encoding) {
+            scale / 32767.0
+        } else {
+            5e-5
+        };
 
-    for (k, fraction) in [(0usize, 0.25f64), (7, 0.5), (19, 0.9)] {
-        // glTF LINEAR sampling of the weights at a time between t_k and t_k+1.
-        let t = times[k] + fraction * (times[k + 1] - times[k]);
-        let f = (t - times[k]) / (times[k + 1] - times[k]);
-        let w: Vec<f64> = (0..targets)
-            .map(|i| (1.0 - f) * weights[k * targets + i] + f * weights[(k + 1) * targets + i])
-            .collect();
-        let played: Vec<DVec3> = (0..base.len())
-            .map(|v| base[v] + (0..targets).map(|i| deltas[i][v] * w[i]).sum::<DVec3>())
-            .collect();
-        let blended: Vec<DVec3> = tracks[0].keyframes[k]
-            .iter()
-            .zip(&tracks[0].keyframes[k + 1])
-            .map(|(a, b)| a.lerp(*b, f))
-            .collect();
-        assert_close(
-            &played,
-            &blended,
-            5e-5,
-            &format!("between keyframes {k} and {}", k + 1),
-        );
+        for (k, fraction) in [(0usize, 0.25f64), (7, 0.5), (19, 0.9)] {
+            // glTF LINEAR sampling of the weights at a time between t_k and t_k+1.
+            let t = times[k] + fraction * (times[k + 1] - times[k]);
+            let f = (t - times[k]) / (times[k + 1] - times[k]);
+            let w: Vec<f64> = (0..targets)
+                .map(|i| (1.0 - f) * weights[k * targets + i] + f * weights[(k + 1) * targets + i])
+                .collect();
+            let played: Vec<DVec3> = morphed(&base, &deltas, &w)
+                .iter()
+                .map(|p| translation + *p * scale)
+                .collect();
+            let blended: Vec<DVec3> = tracks[0].keyframes[k]
+                .iter()
+                .zip(&tracks[0].keyframes[k + 1])
+                .map(|(a, b)| a.lerp(*b, f))
+                .collect();
+            assert_close(
+                &played,
+                &blended,
+                tolerance,
+                &format!("{encoding} between keyframes {k} and {}", k + 1),
+            );
+        }
     }
 }
 
@@ -302,6 +339,18 @@ fn every_encoding_rebuilds_every_keyframe() {
         );
         let glb = parse_glb(&bytes);
         let json = &glb.json;
+        let output = json["animations"][0]["samplers"][0]["output"]
+            .as_u64()
+            .expect("output") as usize;
+        let weights: Vec<f64> = read_accessor(&glb, output).iter().map(|w| w[0]).collect();
+        let as_f32: Vec<f32> = weights.iter().map(|&w| w as f32).collect();
+        // meshopt's targets hold the step from the keyframe before (they
+        // compress far better); the others hold the change from the bud.
+        if encoding == Encoding::Meshopt {
+            assert_cumulative(&as_f32, KEYFRAMES);
+        } else {
+            assert_one_hot(&as_f32, KEYFRAMES);
+        }
         for (i, track) in tracks.iter().enumerate() {
             let (translation, scale) = node_transform(&json["nodes"][i]);
             let to_world = |p: DVec3| translation + p * scale;
@@ -342,40 +391,36 @@ fn every_encoding_rebuilds_every_keyframe() {
             );
             let empty = Vec::new();
             let targets = primitive["targets"].as_array().unwrap_or(&empty);
+            let animated = track.keyframes.len() > 1;
             assert_eq!(targets.len(), track.keyframes.len() - 1);
-            for (k, target) in targets.iter().enumerate() {
-                let what = format!("{} {encoding} target {k}", track.name);
-                let deltas = read(&target["POSITION"]);
-                let rebuilt: Vec<DVec3> = base
+            if !animated {
+                continue;
+            }
+            let deltas: Vec<Vec<DVec3>> = targets.iter().map(|t| read(&t["POSITION"])).collect();
+            let normal_deltas: Vec<Vec<DVec3>> =
+                targets.iter().map(|t| read(&t["NORMAL"])).collect();
+            for k in 1..track.keyframes.len() {
+                let what = format!("{} {encoding} keyframe {k}", track.name);
+                let w = &weights[k * (KEYFRAMES - 1)..(k + 1) * (KEYFRAMES - 1)];
+                let rebuilt: Vec<DVec3> = morphed(&base, &deltas, w)
                     .iter()
-                    .zip(&deltas)
-                    .map(|(b, d)| to_world(*b + *d))
+                    .map(|p| to_world(*p))
                     .collect();
-                assert_close(&rebuilt, &track.keyframes[k + 1], tolerance, &what);
-                // Normals as a renderer sees them: base + delta, renormalized.
-                let normal_deltas = read(&target["NORMAL"]);
-                let rebuilt: Vec<DVec3> = base_normals
+                assert_close(&rebuilt, &track.keyframes[k], tolerance, &what);
+                // Normals as a renderer sees them: base + deltas, renormalized.
+                let rebuilt: Vec<DVec3> = morphed(&base_normals, &normal_deltas, w)
                     .iter()
-                    .zip(&normal_deltas)
-                    .map(|(b, d)| (*b + *d).normalize())
+                    .map(|n| n.normalize())
                     .collect();
                 let normal_tolerance = if is_quantized(encoding) { 0.01 } else { 1e-6 };
                 assert_close(
                     &rebuilt,
-                    &normals(&track.keyframes[k + 1], track),
+                    &normals(&track.keyframes[k], track),
                     normal_tolerance,
                     &what,
                 );
             }
         }
-        let output = json["animations"][0]["samplers"][0]["output"]
-            .as_u64()
-            .expect("output") as usize;
-        let weights: Vec<f32> = read_accessor(&glb, output)
-            .iter()
-            .map(|w| w[0] as f32)
-            .collect();
-        assert_one_hot(&weights, KEYFRAMES);
     }
 }
 
@@ -602,4 +647,67 @@ fn write_glb_reports_a_missing_folder_before_exporting() {
     );
     assert!(error.to_string().contains("renders"), "{error}");
     assert_eq!(calls, 0, "no work done for a destination that cannot exist");
+}
+
+/// meshopt's targets are steps between keyframes; their rounding must not
+/// pile up along the animation. A sheet creeping by a third of a
+/// quantization step per keyframe over 250 targets: rounding each step on
+/// its own would lose the whole motion (every step rounds to zero); the
+/// sum of the stored steps stays within half a grid step of every
+/// keyframe, the same bound as a single quantized position.
+#[test]
+fn meshopt_steps_do_not_accumulate_rounding() {
+    let sheet = anthesis_mesh::generate::flat_sheet(3.0, 8.0, 7, 13);
+    let keyframes = 251;
+    // The box spans the sheet and its drift: about 8.4 units from the centre
+    // to a corner, so a grid step is about 8.4 / 32767.
+    let step = 8.4 / 32767.0;
+    let track = Track {
+        name: "creeping".into(),
+        triangles: sheet.triangles.clone(),
+        uvs: sheet.uvs.clone(),
+        base_color: [1.0; 4],
+        keyframes: (0..keyframes)
+            .map(|k| {
+                let shift = DVec3::new(0.0, 0.0, k as f64 * step / 3.0);
+                sheet.positions.iter().map(|p| *p + shift).collect()
+            })
+            .collect(),
+        base_color_png: None,
+    };
+    let options = GlbOptions {
+        encoding: Encoding::Meshopt,
+        ..GlbOptions::default()
+    };
+    let glb = parse_glb(&export(std::slice::from_ref(&track), &options));
+    let json = &glb.json;
+    let (translation, scale) = node_transform(&json["nodes"][0]);
+    let primitive = &json["meshes"][0]["primitives"][0];
+    let read = |index: &serde_json::Value| {
+        vec3s(&read_accessor(
+            &glb,
+            index.as_u64().expect("accessor") as usize,
+        ))
+    };
+    let base = read(&primitive["attributes"]["POSITION"]);
+    let targets = primitive["targets"].as_array().expect("targets");
+    assert_eq!(targets.len(), keyframes - 1);
+    let deltas: Vec<Vec<DVec3>> = targets.iter().map(|t| read(&t["POSITION"])).collect();
+    let output = json["animations"][0]["samplers"][0]["output"]
+        .as_u64()
+        .expect("output") as usize;
+    let weights: Vec<f64> = read_accessor(&glb, output).iter().map(|w| w[0]).collect();
+    let half_step = 0.5 * scale / 32767.0;
+    let mut worst = 0.0f64;
+    for k in 0..keyframes {
+        let w = &weights[k * (keyframes - 1)..(k + 1) * (keyframes - 1)];
+        let rebuilt = morphed(&base, &deltas, w);
+        for (p, expected) in rebuilt.iter().zip(&track.keyframes[k]) {
+            worst = worst.max((translation + *p * scale - *expected).abs().max_element());
+        }
+    }
+    assert!(
+        worst <= half_step * 1.001,
+        "worst error {worst}, half a grid step {half_step}"
+    );
 }

@@ -3,6 +3,7 @@
 
 use serde_json::{Map, Value, json};
 
+use super::encode::TargetDeltas;
 use crate::{Encoding, ExportError};
 
 const BYTE: u32 = 5120;
@@ -135,16 +136,7 @@ enum Layout {
     /// Triangle indices of `index_size` bytes each (2 or 4): meshopt's
     /// `TRIANGLES` mode.
     Triangles { index_size: usize },
-    /// `f32` 3-vectors that may be stored lossily through meshopt's
-    /// `EXPONENTIAL` filter (see [`EXP_FILTER_MANTISSA_BITS`]).
-    ExponentialVec3,
 }
-
-/// Mantissa bits (sign included) of the `EXPONENTIAL` filter for `f32`
-/// normal deltas, whose exponent is shared per component over the view:
-/// deltas up to 2 in size keep steps of 2 / 2^9 < 0.004, the rounding of
-/// the `i8` deltas (steps of 1/127) used where a delta fits in [-1, 1].
-const EXP_FILTER_MANTISSA_BITS: i32 = 10;
 
 /// The binary chunk and the buffer views and accessors that describe it.
 pub(super) struct GltfBuilder {
@@ -157,8 +149,8 @@ pub(super) struct GltfBuilder {
     /// Size of the uncompressed data the compressed views decode into (the
     /// fallback buffer, which holds no bytes in the file).
     fallback_len: usize,
-    /// With meshopt, vertex attributes of one element size (and filter)
-    /// share one buffer view, written by [`GltfBuilder::finish`]: one
+    /// With meshopt, vertex attributes of one element size share one buffer
+    /// view, written by [`GltfBuilder::finish`]: one
     /// compressed stream instead of one per accessor keeps the JSON and
     /// the per-stream overhead small (hundreds of morph targets).
     groups: Vec<Group>,
@@ -167,7 +159,6 @@ pub(super) struct GltfBuilder {
 /// Vertex data waiting to become one shared buffer view.
 struct Group {
     element_size: usize,
-    exponential: bool,
     bytes: Vec<u8>,
     /// The accessors over this data, each at its byte offset.
     accessors: Vec<usize>,
@@ -217,11 +208,10 @@ impl GltfBuilder {
                 stride: extension_stride,
                 count,
                 mode,
-                filter,
             }) => {
                 let fallback_offset = self.fallback_len;
                 self.fallback_len += bytes.len().next_multiple_of(4);
-                let mut extension = json!({
+                let extension = json!({
                     "buffer": 0,
                     "byteOffset": self.bin.len(),
                     "byteLength": compressed.len(),
@@ -229,9 +219,6 @@ impl GltfBuilder {
                     "count": count,
                     "mode": mode,
                 });
-                if let Some(filter) = filter {
-                    extension["filter"] = filter.into();
-                }
                 self.bin.extend_from_slice(&compressed);
                 json!({
                     "buffer": 1,
@@ -277,20 +264,18 @@ impl GltfBuilder {
         &mut self,
         bytes: &[u8],
         element_size: usize,
-        exponential: bool,
         element: Element,
         count: usize,
     ) -> Value {
         let at = match self
             .groups
             .iter()
-            .position(|g| g.element_size == element_size && g.exponential == exponential)
+            .position(|g| g.element_size == element_size)
         {
             Some(at) => at,
             None => {
                 self.groups.push(Group {
                     element_size,
-                    exponential,
                     bytes: Vec::new(),
                     accessors: Vec::new(),
                 });
@@ -311,12 +296,8 @@ impl GltfBuilder {
     /// Writes each group as one buffer view and points its accessors at it.
     fn write_groups(&mut self) {
         for group in std::mem::take(&mut self.groups) {
-            let layout = if group.exponential {
-                Layout::ExponentialVec3
-            } else {
-                Layout::Vertices {
-                    element_size: group.element_size,
-                }
+            let layout = Layout::Vertices {
+                element_size: group.element_size,
             };
             let view = self.view_of(
                 &group.bytes,
@@ -355,7 +336,7 @@ impl GltfBuilder {
         count: usize,
     ) -> Value {
         if self.meshopt {
-            return self.grouped(bytes, element_size, false, element, count);
+            return self.grouped(bytes, element_size, element, count);
         }
         // A padded element needs its stride spelt out.
         let stride = padded.then_some(element_size);
@@ -366,13 +347,7 @@ impl GltfBuilder {
 
     pub(super) fn vec3_f32(&mut self, values: &[[f32; 3]], with_min_max: bool) -> usize {
         let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
-        let mut accessor = if self.meshopt && !with_min_max {
-            // Without min/max (which must match the stored values
-            // exactly) the values may go through the lossy filter.
-            self.grouped(&bytes, 12, true, VEC3_F32, values.len())
-        } else {
-            self.stored_vertices(&bytes, 12, false, VEC3_F32, values.len())
-        };
+        let mut accessor = self.stored_vertices(&bytes, 12, false, VEC3_F32, values.len());
         if with_min_max {
             set_min_max(&mut accessor, values);
         }
@@ -500,16 +475,27 @@ impl GltfBuilder {
         self.accessor(accessor)
     }
 
-    /// One-hot weights: at exported keyframe `k >= 1` target `k - 1` has
-    /// weight 1, all else 0.
+    /// The weights at each exported keyframe: one-hot for targets from the
+    /// bud (at keyframe `k >= 1` target `k - 1` has weight 1, all else 0),
+    /// cumulative for targets from the previous keyframe (at keyframe `k`
+    /// targets `0..k` have weight 1), see [`TargetDeltas`].
     pub(super) fn weights(
         &mut self,
         keyframes: usize,
         targets: usize,
         encoding: Encoding,
+        deltas: TargetDeltas,
     ) -> usize {
         let count = keyframes * targets;
-        let ones = (1..keyframes).map(|k| k * targets + (k - 1));
+        let ones: Vec<usize> = (1..keyframes)
+            .flat_map(|k| {
+                let first = match deltas {
+                    TargetDeltas::FromBud => k - 1,
+                    TargetDeltas::FromPrevious => 0,
+                };
+                (first..k).map(move |t| k * targets + t)
+            })
+            .collect();
         let accessor = match encoding {
             Encoding::Dense => {
                 let mut values = vec![0.0f32; count];
@@ -520,7 +506,7 @@ impl GltfBuilder {
                 self.stored(&bytes, None, None, SCALAR_F32, count)
             }
             Encoding::Sparse => {
-                let positions: Vec<usize> = ones.collect();
+                let positions = ones;
                 let index_type = index_component_type(count);
                 let values = le_bytes(positions.iter().map(|_| 1.0f32), f32::to_le_bytes);
                 let mut accessor = SCALAR_F32.accessor(None, count);
@@ -621,13 +607,12 @@ fn index_bytes(indices: &[usize], component_type: u32) -> Vec<u8> {
 }
 
 /// A buffer view's bytes as `EXT_meshopt_compression` stores them, with the
-/// extension's `byteStride`, `count`, `mode` and `filter`.
+/// extension's `byteStride`, `count` and `mode`.
 struct Compressed {
     bytes: Vec<u8>,
     stride: usize,
     count: usize,
     mode: &'static str,
-    filter: Option<&'static str>,
 }
 
 /// `bytes` compressed with meshoptimizer for `EXT_meshopt_compression`;
@@ -638,7 +623,7 @@ struct Compressed {
 /// specifies (meshoptimizer 1.x writes version 1 unless asked);
 /// the index codec's version 1 is the extension's.
 fn compress(bytes: &[u8], layout: Layout) -> Option<Compressed> {
-    let (compressed, stride, mode, filter) = match layout {
+    let (compressed, stride, mode) = match layout {
         Layout::Raw => return None,
         Layout::Vertices { element_size } => {
             if !bytes.len().is_multiple_of(element_size) {
@@ -650,25 +635,7 @@ fn compress(bytes: &[u8], layout: Layout) -> Option<Compressed> {
                 12 => encode_vertices::<12>(bytes),
                 _ => return None,
             }?;
-            (compressed, element_size, "ATTRIBUTES", None)
-        }
-        Layout::ExponentialVec3 => {
-            if !bytes.len().is_multiple_of(12) {
-                return None;
-            }
-            let vectors: Vec<[f32; 3]> = bytes
-                .chunks_exact(12)
-                .map(|c| {
-                    [0, 4, 8].map(|i| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]))
-                })
-                .collect();
-            let filtered = meshopt::encode_filter_exp(
-                &vectors,
-                EXP_FILTER_MANTISSA_BITS,
-                meshopt::EncodeExpMode::SharedComponent,
-            );
-            let compressed = meshopt::encode_vertex_buffer_level(&filtered, 2, Some(0)).ok()?;
-            (compressed, 12, "ATTRIBUTES", Some("EXPONENTIAL"))
+            (compressed, element_size, "ATTRIBUTES")
         }
         Layout::Triangles { index_size } => {
             let indices: Vec<u32> = match index_size {
@@ -687,7 +654,7 @@ fn compress(bytes: &[u8], layout: Layout) -> Option<Compressed> {
             }
             let vertex_count = indices.iter().max().map_or(0, |&i| i as usize + 1);
             let compressed = meshopt::encode_index_buffer(&indices, vertex_count).ok()?;
-            (compressed, index_size, "TRIANGLES", None)
+            (compressed, index_size, "TRIANGLES")
         }
     };
     (compressed.len() < bytes.len()).then(|| Compressed {
@@ -695,7 +662,6 @@ fn compress(bytes: &[u8], layout: Layout) -> Option<Compressed> {
         bytes: compressed,
         stride,
         mode,
-        filter,
     })
 }
 
@@ -706,41 +672,4 @@ fn encode_vertices<const N: usize>(bytes: &[u8]) -> Option<Vec<u8>> {
         .map(|c| c.try_into().unwrap_or([0; N]))
         .collect();
     meshopt::encode_vertex_buffer_level(&elements, 2, Some(0)).ok()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn exponential_filter_keeps_large_normal_deltas_within_its_step() {
-        // Normal deltas as a curled tip makes them: up to 1.84 per component.
-        let deltas: Vec<[f32; 3]> = (0..500)
-            .map(|i| {
-                let t = i as f32 / 499.0;
-                [1.84 * t - 0.9, (7.0 * t).sin(), -0.3 * t]
-            })
-            .collect();
-        let bytes = le_bytes(deltas.iter().flatten().copied(), f32::to_le_bytes);
-        let compressed = compress(&bytes, Layout::ExponentialVec3).expect("compresses");
-        assert!(compressed.bytes.len() * 2 < bytes.len());
-        assert_eq!(
-            (
-                compressed.stride,
-                compressed.count,
-                compressed.mode,
-                compressed.filter
-            ),
-            (12, 500, "ATTRIBUTES", Some("EXPONENTIAL"))
-        );
-        let mut decoded =
-            meshopt::decode_vertex_buffer::<[u32; 3]>(&compressed.bytes, 500).expect("decodes");
-        meshopt::decode_filter_exp(&mut decoded);
-        for (d, e) in deltas.iter().zip(&decoded) {
-            for c in 0..3 {
-                let back = f32::from_bits(e[c]);
-                assert!((back - d[c]).abs() < 0.004, "{} -> {back}", d[c]);
-            }
-        }
-    }
 }

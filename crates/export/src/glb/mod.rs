@@ -19,7 +19,7 @@ use builder::{
     CLAMP_TO_EDGE, GltfBuilder, KHR_MESH_QUANTIZATION, LINEAR, LINEAR_MIPMAP_LINEAR, TRIANGLES,
     f32_json,
 };
-use encode::encode_mesh;
+use encode::{TargetDeltas, encode_mesh};
 
 /// Builds the animated .glb of `tracks` in memory (see the crate
 /// documentation for its layout). `progress` is called with values rising
@@ -151,9 +151,14 @@ pub fn glb_bytes(
     if !animated_nodes.is_empty() {
         let sample_times = animation_times(options.timing, keyframe_count, &sample_at)?;
         let input = gltf.times(&sample_times);
-        let output = gltf.weights(sample_at.len(), target_count, options.encoding);
-        // All animated meshes share the keyframe times and the one-hot
-        // weights, so they share one sampler's accessors.
+        let output = gltf.weights(
+            sample_at.len(),
+            target_count,
+            options.encoding,
+            TargetDeltas::of(options.encoding),
+        );
+        // All animated meshes share the keyframe times and the weights, so
+        // they share one sampler's accessors.
         let samplers: Vec<Value> = animated_nodes
             .iter()
             .map(|_| json!({ "input": input, "output": output, "interpolation": "LINEAR" }))
