@@ -61,20 +61,21 @@ pub enum Command {
         #[arg(long, value_name = "FILE.json")]
         stats: Option<PathBuf>,
         /// Write the animation: FILE.glb for an animated glTF, FILE.usda
-        /// for a USD layer (one time sample per keyframe), otherwise a
+        /// (text) or FILE.usdc (binary) for a USD layer (one time sample
+        /// per keyframe), otherwise a
         /// folder that receives one OBJ per keyframe.
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
-        /// Keyframes per second in the .glb or .usda (default 24).
+        /// Keyframes per second in the .glb or USD layer (default 24).
         #[arg(long, conflicts_with = "duration")]
         fps: Option<f64>,
-        /// Length of the whole .glb or .usda animation in seconds.
+        /// Length of the whole .glb or USD animation in seconds.
         #[arg(long)]
         duration: Option<f64>,
         /// Most morph targets per mesh in the .glb; longer runs are resampled.
         #[arg(long, default_value_t = anthesis_export::DEFAULT_MAX_MORPH_TARGETS)]
         max_targets: usize,
-        /// Leave normals out of the .glb or .usda (smaller; clients compute
+        /// Leave normals out of the .glb or USD layer (smaller; clients compute
         /// them: three.js shades a .glb without normals flat).
         #[arg(long)]
         no_normals: bool,

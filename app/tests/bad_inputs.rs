@@ -539,14 +539,6 @@ fn catalogue() -> Vec<Case> {
             "an animation needs at least one morph target per mesh"
         ),
         case!(
-            "binary USD asked for",
-            |d| {
-                let out = in_dir(d, "x.usdc");
-                simulate(d, &["--out", &out])
-            },
-            "binary .usdc is not written yet"
-        ),
-        case!(
             "output where nothing can be written",
             |d| simulate(d, &["--out", "/proc/x.glb"]),
             "cannot write /proc/x.glb: No such file or directory (os error 2)"

@@ -286,7 +286,7 @@ fn check_output(out: &Path, glb: &GlbOptions, keyframes: u32) -> Result<()> {
         }
         OutputKind::Usd => anthesis_export::check_usd_destination(out)?,
         OutputKind::ObjFolder if out.exists() && !out.is_dir() => bail!(
-            "--out {} must be a .glb or .usda file or a folder for OBJ files",
+            "--out {} must be a .glb, .usda or .usdc file or a folder for OBJ files",
             out.display()
         ),
         OutputKind::ObjFolder if out.is_dir() => {}

@@ -41,7 +41,7 @@ impl DialogPurpose {
         match self {
             DialogPurpose::OpenProject => "Open an Anthesis project",
             DialogPurpose::SaveProjectAs => "Save the project as",
-            DialogPurpose::ExportGlb => "Export the animation (.glb, .usda or .gif)",
+            DialogPurpose::ExportGlb => "Export the animation (.glb, .usda, .usdc or .gif)",
         }
     }
 
@@ -59,7 +59,7 @@ impl DialogPurpose {
     pub fn extensions(self) -> &'static [&'static str] {
         match self {
             DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => &[PROJECT_EXTENSION],
-            DialogPurpose::ExportGlb => &["glb", "usda", "usd", "gif"],
+            DialogPurpose::ExportGlb => &["glb", "usda", "usdc", "usd", "gif"],
         }
     }
 }
@@ -269,7 +269,7 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
             .save_file(),
         DialogPurpose::ExportGlb => dialog
             .add_filter("glTF binary", &["glb"])
-            .add_filter("USD layer", &["usda", "usd"])
+            .add_filter("USD layer", &["usda", "usdc", "usd"])
             .add_filter("GIF animation", &["gif"])
             .set_file_name(purpose.suggested_name().unwrap_or_default())
             .save_file(),

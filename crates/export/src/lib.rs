@@ -1,6 +1,7 @@
 //! Exports a simulated flower: an animated glTF binary (.glb) with one morph
-//! target per keyframe, a USD layer (.usda) with one time-sampled mesh per
-//! organ (see [`write_usd`]), and one Wavefront OBJ per keyframe, each file
+//! target per keyframe, a USD layer (.usda text or .usdc binary) with one
+//! time-sampled mesh per organ (see [`write_usd`]), and one Wavefront OBJ
+//! per keyframe, each file
 //! written with [`anthesis_files::write_atomic`].
 //!
 //! [`organ_tracks`] turns a simulation's keyframes into one [`Track`] per
@@ -22,6 +23,11 @@
 //!   interpolation; at time `t_0` all weights are zero and at `t_k` target
 //!   `k - 1` has weight 1 and the others 0, so playback blends two
 //!   consecutive keyframes linearly, just like the application's timeline;
+//! - except with [`Encoding::Meshopt`], whose targets hold the step from
+//!   keyframe `k - 1` to `k` (compressing several times better) and whose
+//!   weights are cumulative: at `t_k` targets `0..k` have weight 1, so the
+//!   steps add up to keyframe `k`, and between `t_k` and `t_k+1` only target
+//!   `k` ramps, which blends the two keyframes linearly as well;
 //! - a material per track: `baseColorFactor` = [`Track::base_color`],
 //!   optionally a PNG base-colour texture, non-metallic, double-sided (organs
 //!   are thin sheets seen from both sides).
@@ -58,6 +64,7 @@ mod prepare;
 mod report;
 mod tracks;
 mod usd;
+mod usdc;
 
 use std::path::Path;
 
@@ -72,7 +79,7 @@ pub use tracks::{
     MAX_RENDER_POSITIONS, TrackLook, check_render_level, flower_tracks, organ_tracks,
 };
 pub use usd::{
-    USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, write_usd,
+    USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, usdc_bytes, write_usd,
 };
 
 /// One organ (or the receptacle) over time: a fixed triangulation and UV
@@ -130,14 +137,24 @@ pub enum Encoding {
     /// import the extension; Blender shows the dequantization as the
     /// object's scale and location (the mesh itself spans `[-1, 1]`).
     Quantized,
-    /// `Quantized`, with every vertex and index buffer view compressed by
+    /// Quantized like `Quantized`, with morph targets holding the step from
+    /// the previous keyframe (cumulative weights, see the crate
+    /// documentation) and every vertex and index buffer view compressed by
     /// meshoptimizer (`EXT_meshopt_compression`, required: the file holds
-    /// only the compressed bytes). Normal deltas that leave `[-1, 1]` stay
-    /// `f32` as in `Quantized` (tools that clamp them to normalized `i8`
-    /// shade curled petal tips wrongly), stored through meshopt's
-    /// `EXPONENTIAL` filter with 10-bit mantissas (steps under 0.004). three.js decodes it with its
-    /// `MeshoptDecoder` (`GLTFLoader.setMeshoptDecoder`); Blender 3.4 and
-    /// the `gltf` crate do not read it.
+    /// only the compressed bytes). Position steps are differences of the
+    /// keyframes' rounded `i16` box positions, so they add up to each
+    /// keyframe within half a grid step however many there are; normals
+    /// (the bud's and every step) live on the normalized `i8` grid, so the
+    /// steps add up exactly to each keyframe's rounded normal (within
+    /// 0.004 per component). A normal step leaves `[-1, 1]` only when a
+    /// normal turns by about 60 degrees between two keyframes; such a
+    /// target's normal steps are stored as exact `f32` rather than clamped
+    /// (clamping shades curled petal tips wrongly). three.js decodes it
+    /// with its `MeshoptDecoder` (`GLTFLoader.setMeshoptDecoder`); three.js
+    /// sizes a mesh's bounds as if one target at a time were on, so with
+    /// steps they cover the bud and one step: set `frustumCulled = false`
+    /// on the meshes for close-ups. Blender 3.4 and the `gltf` crate do not
+    /// read it.
     Meshopt,
 }
 

@@ -1,14 +1,15 @@
-//! The USD writer (`.usda` text layers), for film pipelines: Blender,
-//! Houdini, Maya, usdview.
+//! The USD writer, for film pipelines (Blender, Houdini, Maya, usdview):
+//! text layers (`.usda`, or `.usd`) and binary crate files (`.usdc`).
 //!
 //! The layer is built and written with the `openusd` crate (a Rust
 //! implementation of USD's scene description and file formats) rather than
-//! by hand, so quoting, value syntax and metadata follow the format. Its
-//! version 0.6 (the last that builds with this project's Rust) has two
-//! flaws Pixar's USD trips over, both fixed upstream in 0.8: a one-item
-//! `apiSchemas` list loses its brackets (repaired here after writing), and
-//! binary `.usdc` files store prim child lists with the wrong type (so
-//! `.usdc` is not offered; see [`write_usd`]).
+//! by hand, so quoting, value syntax, metadata and the crate file's layout
+//! follow the format. Its version 0.6 (the last that builds with this
+//! project's Rust) has two flaws Pixar's USD trips over, both fixed
+//! upstream in 0.8 and both repaired here after writing: a one-item
+//! `apiSchemas` list loses its brackets in text, and crate files type prim
+//! and property child lists as token arrays instead of token vectors (see
+//! the `usdc` module).
 //!
 //! # The stage
 //!
@@ -48,8 +49,8 @@ use crate::{ExportError, Timing, Track};
 
 /// Whether `path` names a USD file (`.usda`, `.usd` or `.usdc`), so that a
 /// caller sends it to [`write_usd`] (which writes text to `.usda` and
-/// `.usd`, USD telling text from binary by the contents, and explains why
-/// it refuses `.usdc`).
+/// `.usd`, USD telling text from binary by the contents, and the binary
+/// crate form to `.usdc`).
 pub fn is_usd_path(path: &Path) -> bool {
     usd_extension(path).is_some_and(|e| matches!(e.as_str(), "usda" | "usd" | "usdc"))
 }
@@ -91,6 +92,30 @@ pub fn usd_bytes(
     options: &UsdOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<Vec<u8>, ExportError> {
+    let layer = build_layer(tracks, options, progress)?;
+    let bytes = layer.into_text()?.into_bytes();
+    progress(1.0);
+    Ok(bytes)
+}
+
+/// The same layer as [`usd_bytes`], as a binary crate file (`.usdc`).
+pub fn usdc_bytes(
+    tracks: &[Track],
+    options: &UsdOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<Vec<u8>, ExportError> {
+    let layer = build_layer(tracks, options, progress)?;
+    let bytes = crate::usdc::crate_bytes(&layer.data)?;
+    progress(1.0);
+    Ok(bytes)
+}
+
+/// The layer of [`usd_bytes`], with `progress` rising to 0.95.
+fn build_layer(
+    tracks: &[Track],
+    options: &UsdOptions,
+    progress: &mut dyn FnMut(f32),
+) -> Result<LayerBuilder, ExportError> {
     let keyframe_count = validate_tracks(tracks)?;
     validate_timing(options.timing)?;
     let frames_per_second = match options.timing {
@@ -151,21 +176,14 @@ pub fn usd_bytes(
             },
         )?;
     }
-
-    let bytes = layer.into_text()?.into_bytes();
-    progress(1.0);
-    Ok(bytes)
+    Ok(layer)
 }
 
-/// Builds the USD layer (see [`usd_bytes`]) and writes it to `path` (a
-/// `.usda` or `.usd` file) atomically (see [`anthesis_files::write_atomic`]):
-/// an existing file at `path` is replaced only by a completely written one.
-///
-/// `.usdc` (the binary crate format) is refused with an error that says
-/// why: the USD library this project can build (openusd 0.6; later versions
-/// need a newer Rust) writes crate files whose child lists Pixar's USD does
-/// not read, so the prims would be missing. `usdcat FILE.usda -o FILE.usdc`
-/// converts a written layer.
+/// Builds the USD layer (see [`usd_bytes`]) and writes it to `path`
+/// atomically (see [`anthesis_files::write_atomic`]): an existing file at
+/// `path` is replaced only by a completely written one. A `.usda` or `.usd`
+/// file gets the text form, a `.usdc` file the binary crate form
+/// ([`usdc_bytes`]).
 pub fn write_usd(
     path: &Path,
     tracks: &[Track],
@@ -173,25 +191,22 @@ pub fn write_usd(
     progress: &mut dyn FnMut(f32),
 ) -> Result<(), ExportError> {
     check_usd_destination(path)?;
-    let bytes = usd_bytes(tracks, options, progress)?;
+    let bytes = if usd_extension(path).as_deref() == Some("usdc") {
+        usdc_bytes(tracks, options, progress)?
+    } else {
+        usd_bytes(tracks, options, progress)?
+    };
     Ok(anthesis_files::write_atomic(path, &bytes)?)
 }
 
 /// The checks [`write_usd`] makes before any work, for callers that want
-/// to fail before a long simulation: the file name ends in `.usda` or
-/// `.usd` (a `.usdc` gets an error that says why and how to convert), and
-/// its folder exists and is a folder.
+/// to fail before a long simulation: the file name ends in `.usda`, `.usd`
+/// or `.usdc`, and its folder exists and is a folder.
 pub fn check_usd_destination(path: &Path) -> Result<(), ExportError> {
     match usd_extension(path).as_deref() {
-        Some("usda" | "usd") => Ok(anthesis_files::check_destination(path)?),
-        Some("usdc") => Err(ExportError::InvalidOptions(format!(
-            "{}: binary .usdc is not written yet (the USD library Anthesis builds with \
-             writes crate files Pixar's USD cannot read); export .usda and convert it \
-             with `usdcat FILE.usda -o FILE.usdc` if you need the binary form",
-            path.display()
-        ))),
+        Some("usda" | "usd" | "usdc") => Ok(anthesis_files::check_destination(path)?),
         _ => Err(ExportError::InvalidOptions(format!(
-            "{} does not end in .usda or .usd",
+            "{} does not end in .usda, .usd or .usdc",
             path.display()
         ))),
     }
