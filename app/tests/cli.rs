@@ -136,19 +136,22 @@ fn simulate_writes_stats_json_and_a_glb() {
 }
 
 #[test]
-fn simulate_writes_a_usd_layer_with_every_organ_and_the_receptacle() {
+fn simulate_writes_usd_layers_as_text_and_binary() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = saved_whorl(dir.path(), 2, 4);
+    let simulate_to = |file: &std::path::Path| {
+        let out = anthesis(&[
+            "simulate",
+            path.to_str().expect("utf-8"),
+            "--fps",
+            "12",
+            "--out",
+            file.to_str().expect("utf-8"),
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+    };
     let usda = dir.path().join("flower.usda");
-    let out = anthesis(&[
-        "simulate",
-        path.to_str().expect("utf-8"),
-        "--fps",
-        "12",
-        "--out",
-        usda.to_str().expect("utf-8"),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    simulate_to(&usda);
     // Pixar's USD reads such layers back in anthesis-export's tests; here
     // the command line's choices show in the text.
     let layer = std::fs::read_to_string(&usda).expect("usda written");
@@ -167,25 +170,12 @@ fn simulate_writes_a_usd_layer_with_every_organ_and_the_receptacle() {
     // normals and extent.
     assert_eq!(layer.matches("\n            4.0: [(").count(), 2 * 3);
     assert_eq!(layer.matches("\n            5.0: [(").count(), 0);
-}
 
-/// `--out FILE.usdc` writes the binary crate form, which Pixar's USD (the
-/// pinned usd-core that anthesis-export's USD tests use) opens with every
-/// mesh, every keyframe and the command line's frame rate.
-#[test]
-fn simulate_writes_binary_usd_that_pixars_usd_reads() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path = saved_whorl(dir.path(), 2, 4);
+    // `--out FILE.usdc` writes the binary crate form, which Pixar's USD
+    // (the pinned usd-core of anthesis-export's USD tests) opens with every
+    // mesh, every keyframe and the command line's frame rate.
     let usdc = dir.path().join("flower.usdc");
-    let out = anthesis(&[
-        "simulate",
-        path.to_str().expect("utf-8"),
-        "--fps",
-        "12",
-        "--out",
-        usdc.to_str().expect("utf-8"),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    simulate_to(&usdc);
     let bytes = std::fs::read(&usdc).expect("usdc written");
     assert!(bytes.starts_with(b"PXR-USDC"), "not a crate file");
 
