@@ -2,6 +2,7 @@
 //! batch work, CI and benchmarks. Errors print as one line and exit
 //! non-zero. Each subcommand lives in a module of `cli/`.
 
+mod blossom;
 mod bud;
 mod render;
 mod simulate;
@@ -94,6 +95,10 @@ pub enum Command {
     /// Mesh an organ from a parametric surface (a built-in petal, a Bézier
     /// patch or a PDE sweep surface), write it as OBJ and print its quality.
     Bud(BudArgs),
+    /// Animate one organ from two shapes, its bud and its open state (the
+    /// two-state blossom: per-triangle growth ellipses, G(t; g, T) and a
+    /// spherical interpolation of directions), without a growth simulation.
+    Blossom(blossom::BlossomArgs),
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -232,6 +237,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Render(args)) => render::render(&args),
         Some(Command::Bud(args)) => bud::bud(&args),
+        Some(Command::Blossom(args)) => blossom::blossom(&args),
     }
 }
 

@@ -639,3 +639,73 @@ fn a_render_level_too_fine_is_refused_with_the_vertex_count_before_the_run() {
     assert!(!glb.exists());
     assert!(!stats.exists());
 }
+
+#[test]
+fn blossom_animates_a_simulated_petal_from_its_bud_to_its_open_state() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let frames = dir.path().join("frames");
+    let out = anthesis(&[
+        "simulate",
+        "builtin:lily",
+        "--organ",
+        "petal-1",
+        "--keyframes",
+        "12",
+        "--out",
+        frames.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (bud, open) = (
+        frames.join("keyframe_0000.obj"),
+        frames.join("keyframe_0012.obj"),
+    );
+    let (bud, open) = (bud.to_str().expect("utf-8"), open.to_str().expect("utf-8"));
+    let two = dir.path().join("two");
+    let out = anthesis(&[
+        "blossom",
+        bud,
+        open,
+        "--object",
+        "petal-1",
+        "--keyframes",
+        "8",
+        "--out",
+        two.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // The last keyframe written is the open state, point for point.
+    let last = std::fs::read_to_string(two.join("keyframe_0008.obj")).expect("written");
+    let want = std::fs::read_to_string(frames.join("keyframe_0012.obj")).expect("read");
+    let points = |obj: &str| -> Vec<[f64; 3]> {
+        let petal = anthesis_mesh::obj::object_text(obj, Some("petal-1")).expect("petal-1");
+        anthesis_mesh::parse_obj(&petal)
+            .expect("parses")
+            .positions
+            .iter()
+            .map(|p| p.to_array())
+            .collect()
+    };
+    let (got, want) = (points(&last), points(&want));
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.iter().zip(&want) {
+        for k in 0..3 {
+            assert!((g[k] - w[k]).abs() < 1e-6, "{g:?} vs {w:?}");
+        }
+    }
+    assert_eq!(std::fs::read_dir(&two).expect("list").count(), 9);
+    assert!(text(&out.stdout).contains("cells"), "{}", text(&out.stdout));
+
+    // Without --object the two-organ files are refused, naming the objects.
+    let err = text(&one_line_error(&["blossom", bud, open]).stderr);
+    assert!(err.contains("petal-1, receptacle"), "{err}");
+    // Shapes of different meshes are refused.
+    let sheet = |name: &str, cells: usize| {
+        let path = dir.path().join(name);
+        let mesh = anthesis_mesh::generate::flat_sheet(1.0, 1.0, cells, cells);
+        std::fs::write(&path, anthesis_mesh::obj_string(&mesh)).expect("write");
+        path.to_str().expect("utf-8").to_owned()
+    };
+    let (small, large) = (sheet("small.obj", 2), sheet("large.obj", 3));
+    let err = text(&one_line_error(&["blossom", &small, &large]).stderr);
+    assert!(err.contains("must be the same mesh"), "{err}");
+}

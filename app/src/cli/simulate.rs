@@ -128,27 +128,7 @@ pub(super) fn simulate(
             frames.iter().map(Vec::as_slice),
             render_level,
         )?;
-        let kind = OutputKind::of(out);
-        match kind {
-            OutputKind::Glb => anthesis_export::write_glb(out, &tracks, glb, &mut |_| {})
-                .with_context(|| format!("cannot write {}", out.display()))?,
-            OutputKind::Usd => {
-                let usd = UsdOptions {
-                    timing: glb.timing,
-                    normals: glb.normals,
-                };
-                anthesis_export::write_usd(out, &tracks, &usd, &mut |_| {})
-                    .with_context(|| format!("cannot write {}", out.display()))?
-            }
-            OutputKind::ObjFolder => {
-                if !out.is_dir() {
-                    std::fs::create_dir(out)
-                        .with_context(|| format!("cannot create the folder {}", out.display()))?;
-                }
-                anthesis_export::write_obj_sequence(out, &tracks)
-                    .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
-            }
-        }
+        write_tracks(out, OutputKind::of(out), &tracks, glb)?;
         eprintln!("wrote {} (keyframes 0 to {done})", out.display());
         written = Some(out);
     }
@@ -252,14 +232,14 @@ pub(super) fn run_keyframes(
 
 /// What `--out` asks for, by its extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum OutputKind {
+pub(super) enum OutputKind {
     Glb,
     Usd,
     ObjFolder,
 }
 
 impl OutputKind {
-    fn of(path: &Path) -> OutputKind {
+    pub(super) fn of(path: &Path) -> OutputKind {
         if path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
@@ -273,11 +253,42 @@ impl OutputKind {
     }
 }
 
+/// Writes `tracks` to `out` as `kind` says: a .glb, a USD layer, or one OBJ
+/// per keyframe into a folder (created when missing).
+pub(super) fn write_tracks(
+    out: &Path,
+    kind: OutputKind,
+    tracks: &[anthesis_export::Track],
+    glb: &GlbOptions,
+) -> Result<()> {
+    match kind {
+        OutputKind::Glb => anthesis_export::write_glb(out, tracks, glb, &mut |_| {})
+            .with_context(|| format!("cannot write {}", out.display()))?,
+        OutputKind::Usd => {
+            let usd = UsdOptions {
+                timing: glb.timing,
+                normals: glb.normals,
+            };
+            anthesis_export::write_usd(out, tracks, &usd, &mut |_| {})
+                .with_context(|| format!("cannot write {}", out.display()))?
+        }
+        OutputKind::ObjFolder => {
+            if !out.is_dir() {
+                std::fs::create_dir(out)
+                    .with_context(|| format!("cannot create the folder {}", out.display()))?;
+            }
+            anthesis_export::write_obj_sequence(out, tracks)
+                .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
+        }
+    }
+    Ok(())
+}
+
 /// Fails early, before a long simulation, when `--out` cannot be written:
 /// a .glb needs a folder and export options that fit `keyframes`; a folder
 /// for OBJ files may be missing if its parent exists (it is created when
 /// the files are written).
-fn check_output(out: &Path, glb: &GlbOptions, keyframes: u32) -> Result<()> {
+pub(super) fn check_output(out: &Path, glb: &GlbOptions, keyframes: u32) -> Result<()> {
     match OutputKind::of(out) {
         OutputKind::Glb => {
             anthesis_files::check_destination(out)?;

@@ -224,6 +224,10 @@ pub enum MeshError {
     /// The mesh file could not be read; the message names the file and why.
     #[error("cannot read mesh: {0}")]
     Io(String),
+    /// An OBJ has no object (`o` statement) of the name asked for, or has
+    /// several objects and none was named.
+    #[error("{0}")]
+    Object(String),
 }
 
 fn line_prefix(line: Option<usize>) -> String {

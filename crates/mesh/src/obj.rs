@@ -117,6 +117,98 @@ pub fn parse_obj_unvalidated(text: &str) -> Result<Mesh, MeshError> {
     parse(text).map(|parsed| parsed.mesh)
 }
 
+/// The OBJ text of one object of `text` alone (its `v`, `vt` and `f`
+/// statements, face indices renumbered from 1), for files that hold several
+/// organs such as `anthesis simulate --out FOLDER/` writes: the object
+/// called `name`, or with no name the only object. A file without `o`
+/// statements is one object. Needs each object's `v` and `vt` statements
+/// after its `o` statement (as Anthesis and most tools write them) and
+/// positive face indices.
+pub fn object_text(text: &str, name: Option<&str>) -> Result<String, MeshError> {
+    // Object name and its lines; lines before the first `o` go to "".
+    let mut objects: Vec<(String, Vec<&str>)> = vec![(String::new(), Vec::new())];
+    for line in text.lines() {
+        match line.trim_start().strip_prefix("o ") {
+            Some(rest) => objects.push((rest.trim().to_owned(), Vec::new())),
+            None => {
+                if let Some((_, lines)) = objects.last_mut() {
+                    lines.push(line);
+                }
+            }
+        }
+    }
+    let is_face = |l: &&str| l.trim_start().starts_with("f ");
+    if objects.len() > 1 && !objects[0].1.iter().any(is_face) {
+        objects.remove(0);
+    }
+    let names: Vec<&str> = objects.iter().map(|(n, _)| n.as_str()).collect();
+    let chosen = match name {
+        Some(name) => names.iter().position(|n| *n == name).ok_or_else(|| {
+            MeshError::Object(format!(
+                "the OBJ has no object `{name}` (it has: {})",
+                names.join(", ")
+            ))
+        })?,
+        None if objects.len() == 1 => 0,
+        None => {
+            return Err(MeshError::Object(format!(
+                "the OBJ holds {} objects ({}); say which one",
+                objects.len(),
+                names.join(", ")
+            )));
+        }
+    };
+    let count = |lines: &[&str], keyword: &str| {
+        lines
+            .iter()
+            .filter(|l| {
+                l.trim_start()
+                    .strip_prefix(keyword)
+                    .is_some_and(|r| r.starts_with(' '))
+            })
+            .count()
+    };
+    let (v_before, vt_before) = objects[..chosen]
+        .iter()
+        .fold((0, 0), |(v, vt), (_, lines)| {
+            (v + count(lines, "v"), vt + count(lines, "vt"))
+        });
+    let mut out = String::new();
+    for line in &objects[chosen].1 {
+        let Some(corners) = line.trim_start().strip_prefix("f ") else {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        };
+        out.push('f');
+        for corner in corners.split_whitespace() {
+            let mut parts = corner.split('/');
+            let mut renumber = |before: usize| -> Result<String, MeshError> {
+                match parts.next() {
+                    None | Some("") => Ok(String::new()),
+                    Some(index) => match index.parse::<usize>() {
+                        Ok(i) if i > before => Ok((i - before).to_string()),
+                        _ => Err(MeshError::Object(format!(
+                            "face corner `{corner}` of object `{}` does not index the object's own vertices",
+                            names[chosen]
+                        ))),
+                    },
+                }
+            };
+            let v = renumber(v_before)?;
+            let vt = renumber(vt_before)?;
+            out.push(' ');
+            out.push_str(&v);
+            if !vt.is_empty() {
+                out.push('/');
+                out.push_str(&vt);
+            }
+        }
+        out.push('\n');
+    }
+    Ok(out)
+}
+
 /// One corner of an OBJ face: 0-based position and texture coordinate
 /// indices.
 #[derive(Debug, Clone, Copy)]
@@ -551,6 +643,49 @@ vt 0 1
 vn 0 0 1
 f 1/1/1 2/2/1 3/3/1 4/4/1
 ";
+
+    #[test]
+    fn one_object_is_read_alone_from_a_file_of_several() {
+        let square = generate::flat_sheet(1.0, 2.0, 2, 3);
+        let other = generate::test_petal(4.0, 1.0, 3, 4);
+        let first = obj_string(&other);
+        let second = obj_string(&square);
+        // Two objects, the second's indices counted after the first's.
+        let offset = other.vertex_count();
+        let shifted: String = second
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| match l.strip_prefix("f ") {
+                Some(corners) => {
+                    let moved: Vec<String> = corners
+                        .split_whitespace()
+                        .map(|c| {
+                            c.split('/')
+                                .map(|i| (i.parse::<usize>().unwrap() + offset).to_string())
+                                .collect::<Vec<_>>()
+                                .join("/")
+                        })
+                        .collect();
+                    format!("f {}\n", moved.join(" "))
+                }
+                None => format!("{l}\n"),
+            })
+            .collect();
+        let text = format!("o leaf\n{first}o petal-1\n{shifted}");
+        let alone = parse_obj(&object_text(&text, Some("petal-1")).unwrap()).unwrap();
+        assert_eq!(alone, square);
+        let leaf = parse_obj(&object_text(&text, Some("leaf")).unwrap()).unwrap();
+        assert_eq!(leaf, other);
+        let err = object_text(&text, None).unwrap_err().to_string();
+        assert!(err.contains("2 objects (leaf, petal-1)"), "{err}");
+        let err = object_text(&text, Some("sepal")).unwrap_err().to_string();
+        assert!(err.contains("no object `sepal`"), "{err}");
+        // A file without objects is its own only object.
+        assert_eq!(
+            parse_obj(&object_text(&second, None).unwrap()).unwrap(),
+            square
+        );
+    }
 
     #[test]
     fn polygon_is_fan_triangulated_and_ignored_statements_are_skipped() {
