@@ -36,7 +36,7 @@ pub struct Cli {
 pub enum Command {
     /// Print one line per organ: name, template, particles, triangles, edges.
     Info {
-        /// A project file (*.anthesis.toml).
+        /// A project file (*.anthesis.toml), its folder, or builtin:NAME.
         project: PathBuf,
         /// Count the particles at this resolution (see `simulate --edge`).
         #[arg(long, value_name = "LENGTH|as-built", value_parser = parse_edge)]
@@ -44,7 +44,7 @@ pub enum Command {
     },
     /// Simulate a project and write statistics and the animation.
     Simulate {
-        /// A project file (*.anthesis.toml).
+        /// A project file (*.anthesis.toml), its folder, or builtin:NAME.
         project: PathBuf,
         /// Simulate only this organ (single-organ preview, no collisions).
         #[arg(long)]

@@ -709,3 +709,19 @@ fn blossom_animates_a_simulated_petal_from_its_bud_to_its_open_state() {
     let err = text(&one_line_error(&["blossom", &small, &large]).stderr);
     assert!(err.contains("must be the same mesh"), "{err}");
 }
+
+#[test]
+fn a_project_folder_works_where_a_project_file_is_expected() {
+    let lily = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/flowers/lily");
+    let folder = anthesis(&["info", lily.to_str().expect("utf-8")]);
+    assert!(folder.status.success(), "{}", text(&folder.stderr));
+    let file = anthesis(&[
+        "info",
+        lily.join("lily.anthesis.toml").to_str().expect("utf-8"),
+    ]);
+    assert_eq!(text(&folder.stdout), text(&file.stdout));
+    assert!(text(&folder.stdout).starts_with("petal-1 petal "));
+    let empty = tempfile::tempdir().expect("tempdir");
+    let err = text(&one_line_error(&["info", empty.path().to_str().expect("utf-8")]).stderr);
+    assert!(err.contains("holds no project file"), "{err}");
+}

@@ -438,6 +438,16 @@ fn save_then_open_round_trips_and_a_bad_file_is_an_error_that_keeps_the_work() {
     let app = harness.state();
     assert_eq!(app.project().flower.templates[0].joint_schedule.len(), 2);
     assert_eq!(app.document().path.as_deref(), Some(path.as_path()));
+
+    // The project's folder opens its one project file, which becomes the
+    // document's path (so Save writes the file, not the folder).
+    std::fs::remove_file(&bad).expect("remove");
+    harness.state_mut().open_path(dir.path());
+    harness.run();
+    assert_eq!(
+        harness.state().document().path.as_deref(),
+        Some(path.as_path())
+    );
 }
 
 #[test]

@@ -20,7 +20,7 @@ use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// A project file (*.anthesis.toml).
+    /// A project file (*.anthesis.toml), its folder, or builtin:NAME.
     pub project: PathBuf,
     /// Keyframes to render, comma-separated; 0 is the bud (default: the bud
     /// and every quarter of the run).

@@ -20,6 +20,10 @@ impl AnthesisApp {
     /// Opens the project at `path`; on failure the current work stays and
     /// the error is shown.
     pub fn open_path(&mut self, path: &Path) {
+        // A project folder opens its project file, which is then the
+        // document's path (saved to, remembered).
+        let resolved = anthesis_flower::project::project_file(path);
+        let path = resolved.as_deref().unwrap_or(path);
         match load_project(path) {
             Ok(project) => {
                 self.settings.remember(path);

@@ -1326,3 +1326,31 @@ fn a_mean_edge_that_is_not_a_length_is_refused() {
         );
     }
 }
+
+#[test]
+fn a_project_folder_opens_its_one_project_file() {
+    let lily = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/flowers/lily");
+    let from_folder = load_project(&lily).expect("the folder opens");
+    let from_file = load_project(&lily.join("lily.anthesis.toml")).expect("the file opens");
+    assert_eq!(from_folder, from_file);
+    assert_eq!(
+        anthesis_flower::project::project_file(&lily).expect("found"),
+        lily.join("lily.anthesis.toml")
+    );
+
+    let dir = tempfile::tempdir().expect("tempdir");
+    let err = load_project(dir.path()).unwrap_err().to_string();
+    assert!(err.contains("holds no project file"), "{err}");
+    fs::write(dir.path().join("a.anthesis.toml"), "").expect("write");
+    fs::write(dir.path().join("notes.toml"), "").expect("write");
+    // One project file among other files: that one (here empty, so its
+    // own error shows, naming it).
+    let err = load_project(dir.path()).unwrap_err().to_string();
+    assert!(err.contains("a.anthesis.toml"), "{err}");
+    fs::write(dir.path().join("b.anthesis.toml"), "").expect("write");
+    let err = load_project(dir.path()).unwrap_err().to_string();
+    assert!(
+        err.contains("several project files (a.anthesis.toml, b.anthesis.toml)"),
+        "{err}"
+    );
+}

@@ -149,13 +149,16 @@ pub fn load_project(path: &Path) -> Result<Project, ProjectError> {
     load_project_with_warnings(path).map(|loaded| loaded.project)
 }
 
-/// Reads the project file at `path` and the meshes and PNG maps it names,
+/// Reads the project file at `path` (or in the project folder `path`, see
+/// [`project_file`]) and the meshes and PNG maps it names,
 /// as a file from a stranger: only regular files within their size limits
 /// ([`MAX_PROJECT_BYTES`], `anthesis_mesh::obj::MAX_OBJ_BYTES`,
 /// `anthesis_maps::MAX_PNG_BYTES`), and only files inside the project's
 /// folder: a path that is absolute, climbs out with `..` or leads out
 /// through a symbolic link is refused, naming the entry and why.
 pub fn load_project_with_warnings(path: &Path) -> Result<LoadedProject, ProjectError> {
+    let file = project_file(path)?;
+    let path = file.as_path();
     let text = anthesis_files::read_regular_text(path, MAX_PROJECT_BYTES, "a project file")
         .map_err(|error| ProjectError::Io {
             path: path.to_path_buf(),
@@ -177,6 +180,50 @@ pub fn load_project_with_warnings(path: &Path) -> Result<LoadedProject, ProjectE
         project,
         warnings: loader.warnings.into_inner(),
     })
+}
+
+/// The extension a project file's name ends with.
+pub const PROJECT_EXTENSION: &str = ".anthesis.toml";
+
+/// The project file `path` names: `path` itself, or for a folder the one
+/// `*.anthesis.toml` file directly inside it (as `assets/flowers/lily`
+/// holds `lily.anthesis.toml`), so a project folder works wherever a
+/// project file does. A folder with none or several is refused, naming
+/// what it holds.
+pub fn project_file(path: &Path) -> Result<std::path::PathBuf, ProjectError> {
+    if !path.is_dir() {
+        return Ok(path.to_path_buf());
+    }
+    let refuse = |message: String| ProjectError::Io {
+        path: path.to_path_buf(),
+        message,
+    };
+    let entries = std::fs::read_dir(path).map_err(|e| refuse(e.to_string()))?;
+    let mut found: Vec<std::path::PathBuf> = entries
+        .filter_map(Result::ok)
+        .map(|entry| entry.path())
+        .filter(|p| {
+            p.is_file()
+                && p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.ends_with(PROJECT_EXTENSION))
+        })
+        .collect();
+    found.sort();
+    match found.len() {
+        1 => Ok(found.remove(0)),
+        0 => Err(refuse(format!(
+            "the folder holds no project file (*{PROJECT_EXTENSION})"
+        ))),
+        _ => Err(refuse(format!(
+            "the folder holds several project files ({}): name one",
+            found
+                .iter()
+                .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))),
+    }
 }
 
 /// Reads a project from its TOML text; `files` returns the bytes of a mesh
