@@ -8,6 +8,7 @@ pub mod project;
 mod receptacle;
 pub mod resolution;
 pub mod scale;
+pub mod structure;
 
 pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
 pub use resolution::Resolution;

@@ -1,0 +1,563 @@
+//! Bracketed parametric L-systems as `lsystem-bezier-flower.txt` §2–§3
+//! writes them: an axiom, productions rewritten in parallel for a number
+//! of derivation steps, and named constants.
+//!
+//! The text, one statement per line (blank lines are skipped):
+//!
+//! ```text
+//! initial line width = 20        (a constant: NAME = number)
+//! lenA = 500
+//! axiom: /(154) &(72) #A!B       (or `ω:`)
+//! p1: B -> D/(60)D/(60)D         (an optional label, `->` or `→`)
+//! A(x) -> F(x) A(x * 0.9)        (formal parameters, used in expressions)
+//! ```
+//!
+//! A module is one character (a letter, or a turtle symbol
+//! `F f + - & ^ / \ [ ] # !`), `~` followed by the letter of a surface, each
+//! optionally followed by parameters in parentheses: arithmetic expressions
+//! (`+ - * /`, unary minus, parentheses, numbers, constants and, in a
+//! production's successor, its formal parameters). Spaces between modules
+//! are ignored. Constant names may contain spaces (`initial line width`);
+//! the turtle's defaults are the constants `angle` (degrees, default 90),
+//! `step` (1), `initial line width` or `width` (1), `line width increment`
+//! or `width increment` (1) and `scale` (1).
+
+use std::collections::BTreeMap;
+
+use thiserror::Error;
+
+/// The most modules a derived word may hold; a system that grows past it
+/// is refused (a file from a stranger must not exhaust the memory).
+pub const MAX_MODULES: usize = 1_000_000;
+
+/// A syntax error, or a word that grows too long.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum LSystemError {
+    /// The text does not follow the syntax; `line` and `column` count from
+    /// 1 (columns in characters).
+    #[error("L-system line {line}, column {column}: expected {expected}, found {found}")]
+    Syntax {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column, in characters.
+        column: usize,
+        /// What the parser wanted there.
+        expected: String,
+        /// What it found (a quoted character or "the end of the line").
+        found: String,
+    },
+    /// A statement is missing or said twice.
+    #[error("L-system: {0}")]
+    Statement(String),
+    /// A name in an expression is neither a constant nor a parameter.
+    #[error("L-system line {line}: `{name}` is not a constant or a parameter")]
+    UnknownName {
+        /// 1-based line of the statement.
+        line: usize,
+        /// The name.
+        name: String,
+    },
+    /// A module was rewritten with fewer parameters than its production
+    /// names.
+    #[error(
+        "L-system: module {symbol} has {given} parameters but the production on line {line} needs {needed}"
+    )]
+    Arity {
+        /// The module's symbol.
+        symbol: String,
+        /// Parameters it has.
+        given: usize,
+        /// Parameters the production names.
+        needed: usize,
+        /// 1-based line of the production.
+        line: usize,
+    },
+    /// The derived word became too long.
+    #[error("the L-system grows past {MAX_MODULES} modules at derivation step {step}")]
+    TooLong {
+        /// 1-based derivation step.
+        step: u32,
+    },
+}
+
+/// A module of a derived word: a symbol and its parameter values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Module {
+    /// One character, or `~X` for a surface.
+    pub symbol: String,
+    /// Parameter values.
+    pub params: Vec<f64>,
+}
+
+/// An arithmetic expression of a production's successor.
+#[derive(Debug, Clone, PartialEq)]
+enum Expr {
+    Number(f64),
+    /// Index of a formal parameter.
+    Param(usize),
+    Neg(Box<Expr>),
+    Binary(char, Box<Expr>, Box<Expr>),
+}
+
+impl Expr {
+    fn eval(&self, args: &[f64]) -> f64 {
+        match self {
+            Expr::Number(v) => *v,
+            Expr::Param(i) => args.get(*i).copied().unwrap_or(0.0),
+            Expr::Neg(e) => -e.eval(args),
+            Expr::Binary(op, a, b) => {
+                let (a, b) = (a.eval(args), b.eval(args));
+                match op {
+                    '+' => a + b,
+                    '-' => a - b,
+                    '*' => a * b,
+                    _ => a / b,
+                }
+            }
+        }
+    }
+}
+
+/// A module of a successor, with expressions for parameters.
+#[derive(Debug, Clone, PartialEq)]
+struct Template {
+    symbol: String,
+    params: Vec<Expr>,
+}
+
+/// `predecessor(formals) -> successor`.
+#[derive(Debug, Clone, PartialEq)]
+struct Production {
+    symbol: String,
+    formals: Vec<String>,
+    successor: Vec<Template>,
+    line: usize,
+}
+
+/// A parsed L-system.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LSystem {
+    /// Constants by name (lower case, single spaces).
+    pub constants: BTreeMap<String, f64>,
+    /// The axiom, its parameters evaluated.
+    pub axiom: Vec<Module>,
+    productions: Vec<Production>,
+}
+
+impl LSystem {
+    /// Parses the text (see the module documentation).
+    pub fn parse(text: &str) -> Result<LSystem, LSystemError> {
+        let mut constants = BTreeMap::new();
+        let mut axiom: Option<(usize, &str)> = None;
+        let mut production_lines = Vec::new();
+        for (index, line) in text.lines().enumerate() {
+            let number = index + 1;
+            let trimmed = line.trim();
+            if trimmed.is_empty() {
+                continue;
+            }
+            if let Some((name, value)) = constant(trimmed) {
+                let value = value.trim().parse::<f64>().map_err(|_| {
+                    let column = column_of(line, value.trim());
+                    syntax(number, column, "a number", first_char(value.trim()))
+                })?;
+                constants.insert(name, value);
+            } else if let Some(rest) = strip_label(trimmed, &["axiom", "ω"]) {
+                if axiom.is_some() {
+                    return Err(LSystemError::Statement(format!(
+                        "a second axiom on line {number}"
+                    )));
+                }
+                axiom = Some((number, rest));
+            } else {
+                production_lines.push((number, line));
+            }
+        }
+        let (axiom_line, axiom_text) = axiom
+            .ok_or_else(|| LSystemError::Statement("no axiom (a line `axiom: WORD`)".to_owned()))?;
+        let full = line_of(text, axiom_line);
+        let start = full.chars().count() - axiom_text.chars().count();
+        let axiom_templates = Parser::new(axiom_line, full, start, None).word(&constants, &[])?;
+        let axiom = axiom_templates
+            .iter()
+            .map(|t| Module {
+                symbol: t.symbol.clone(),
+                params: t.params.iter().map(|e| e.eval(&[])).collect(),
+            })
+            .collect();
+        let mut productions = Vec::new();
+        for (number, line) in production_lines {
+            productions.push(parse_production(number, line, &constants)?);
+        }
+        Ok(LSystem {
+            constants,
+            axiom,
+            productions,
+        })
+    }
+
+    /// The word after `steps` parallel rewritings of the axiom: every
+    /// module with a production (the first whose symbol matches) is
+    /// replaced by its successor, evaluated with the module's parameters;
+    /// the others are kept.
+    pub fn derive(&self, steps: u32) -> Result<Vec<Module>, LSystemError> {
+        let mut word = self.axiom.clone();
+        for step in 1..=steps {
+            let mut next = Vec::with_capacity(word.len());
+            for module in &word {
+                match self.productions.iter().find(|p| p.symbol == module.symbol) {
+                    Some(p) => {
+                        if module.params.len() < p.formals.len() {
+                            return Err(LSystemError::Arity {
+                                symbol: module.symbol.clone(),
+                                given: module.params.len(),
+                                needed: p.formals.len(),
+                                line: p.line,
+                            });
+                        }
+                        next.extend(p.successor.iter().map(|t| Module {
+                            symbol: t.symbol.clone(),
+                            params: t.params.iter().map(|e| e.eval(&module.params)).collect(),
+                        }));
+                    }
+                    None => next.push(module.clone()),
+                }
+                if next.len() > MAX_MODULES {
+                    return Err(LSystemError::TooLong { step });
+                }
+            }
+            word = next;
+        }
+        Ok(word)
+    }
+
+    /// A constant by name (case and spacing as in [`constant_key`]).
+    pub fn constant(&self, name: &str) -> Option<f64> {
+        self.constants.get(&constant_key(name)).copied()
+    }
+}
+
+/// How constant names are compared: lower case, runs of spaces and `_` as
+/// one space.
+pub fn constant_key(name: &str) -> String {
+    name.split(|c: char| c.is_whitespace() || c == '_')
+        .filter(|w| !w.is_empty())
+        .map(str::to_lowercase)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// `NAME = value` where NAME is words of letters, digits, `_` and spaces
+/// starting with a letter (so `p1: B -> ...` is not one).
+fn constant(line: &str) -> Option<(String, &str)> {
+    let (name, value) = line.split_once('=')?;
+    let name = name.trim();
+    let ok = name.chars().next().is_some_and(char::is_alphabetic)
+        && name
+            .chars()
+            .all(|c| c.is_alphanumeric() || c == '_' || c == ' ');
+    ok.then(|| (constant_key(name), value))
+}
+
+fn strip_label<'a>(line: &'a str, labels: &[&str]) -> Option<&'a str> {
+    let (label, rest) = line.split_once(':')?;
+    labels
+        .iter()
+        .any(|l| label.trim().eq_ignore_ascii_case(l))
+        .then_some(rest)
+}
+
+fn line_of(text: &str, number: usize) -> &str {
+    text.lines().nth(number - 1).unwrap_or("")
+}
+
+fn column_of(line: &str, part: &str) -> usize {
+    match line.find(part) {
+        Some(byte) => line[..byte].chars().count() + 1,
+        None => 1,
+    }
+}
+
+fn first_char(s: &str) -> String {
+    s.chars()
+        .next()
+        .map_or_else(|| "the end of the line".to_owned(), |c| format!("`{c}`"))
+}
+
+fn syntax(line: usize, column: usize, expected: &str, found: String) -> LSystemError {
+    LSystemError::Syntax {
+        line,
+        column,
+        expected: expected.to_owned(),
+        found,
+    }
+}
+
+fn parse_production(
+    number: usize,
+    line: &str,
+    constants: &BTreeMap<String, f64>,
+) -> Result<Production, LSystemError> {
+    let chars: Vec<char> = line.chars().collect();
+    let arrow = (0..chars.len()).find_map(|i| {
+        if chars[i] == '→' {
+            Some((i, 1))
+        } else if chars[i] == '-' && chars.get(i + 1) == Some(&'>') {
+            Some((i, 2))
+        } else {
+            None
+        }
+    });
+    let Some((at, len)) = arrow else {
+        return Err(syntax(
+            number,
+            chars.len() + 1,
+            "`->` (a production), `axiom:` or `NAME = number`",
+            "the end of the line".to_owned(),
+        ));
+    };
+    // An optional label `p1:` before the predecessor.
+    let start = chars[..at]
+        .iter()
+        .position(|&c| c == ':')
+        .map_or(0, |c| c + 1);
+    let mut left = Parser::new(number, line, start, Some(at));
+    left.skip_spaces();
+    let symbol = left.symbol()?;
+    let mut formals = Vec::new();
+    if left.peek() == Some('(') {
+        left.pos += 1;
+        loop {
+            left.skip_spaces();
+            formals.push(left.name()?);
+            left.skip_spaces();
+            match left.peek() {
+                Some(',') => left.pos += 1,
+                Some(')') => {
+                    left.pos += 1;
+                    break;
+                }
+                other => return Err(left.error("`,` or `)`", other)),
+            }
+        }
+    }
+    left.skip_spaces();
+    if let Some(c) = left.peek() {
+        return Err(left.error("`->`", Some(c)));
+    }
+    let successor = Parser::new(number, line, at + len, None).word(constants, &formals)?;
+    Ok(Production {
+        symbol,
+        formals,
+        successor,
+        line: number,
+    })
+}
+
+/// The characters a module symbol may be, besides letters.
+const TURTLE_SYMBOLS: &str = "+-&^/\\[]#!";
+
+/// A cursor over one line's characters, from `pos` to `end`.
+struct Parser {
+    line: usize,
+    chars: Vec<char>,
+    pos: usize,
+    end: usize,
+}
+
+impl Parser {
+    fn new(line: usize, text: &str, start: usize, end: Option<usize>) -> Parser {
+        let chars: Vec<char> = text.chars().collect();
+        let end = end.unwrap_or(chars.len());
+        Parser {
+            line,
+            chars,
+            pos: start,
+            end,
+        }
+    }
+
+    fn peek(&self) -> Option<char> {
+        (self.pos < self.end).then(|| self.chars[self.pos])
+    }
+
+    fn skip_spaces(&mut self) {
+        while self.peek().is_some_and(char::is_whitespace) {
+            self.pos += 1;
+        }
+    }
+
+    fn error(&self, expected: &str, found: Option<char>) -> LSystemError {
+        syntax(
+            self.line,
+            self.pos + 1,
+            expected,
+            found.map_or_else(|| "the end of the line".to_owned(), |c| format!("`{c}`")),
+        )
+    }
+
+    /// A module symbol: a letter, a turtle symbol, or `~` and a letter.
+    fn symbol(&mut self) -> Result<String, LSystemError> {
+        match self.peek() {
+            Some('~') => {
+                self.pos += 1;
+                match self.peek() {
+                    Some(c) if c.is_alphabetic() => {
+                        self.pos += 1;
+                        Ok(format!("~{c}"))
+                    }
+                    other => Err(self.error("the letter of a surface after `~`", other)),
+                }
+            }
+            Some(c) if c.is_alphabetic() || TURTLE_SYMBOLS.contains(c) => {
+                self.pos += 1;
+                Ok(c.to_string())
+            }
+            other => Err(self.error(
+                "a module (a letter or one of + - & ^ / \\ [ ] # ! ~)",
+                other,
+            )),
+        }
+    }
+
+    /// A name: a letter then letters, digits and `_`.
+    fn name(&mut self) -> Result<String, LSystemError> {
+        let start = self.pos;
+        match self.peek() {
+            Some(c) if c.is_alphabetic() => self.pos += 1,
+            other => return Err(self.error("a name", other)),
+        }
+        while self.peek().is_some_and(|c| c.is_alphanumeric() || c == '_') {
+            self.pos += 1;
+        }
+        Ok(self.chars[start..self.pos].iter().collect())
+    }
+
+    /// Modules up to the end.
+    fn word(
+        &mut self,
+        constants: &BTreeMap<String, f64>,
+        formals: &[String],
+    ) -> Result<Vec<Template>, LSystemError> {
+        let mut modules = Vec::new();
+        loop {
+            self.skip_spaces();
+            if self.peek().is_none() {
+                return Ok(modules);
+            }
+            let symbol = self.symbol()?;
+            let mut params = Vec::new();
+            self.skip_spaces();
+            if self.peek() == Some('(') {
+                self.pos += 1;
+                loop {
+                    params.push(self.expression(constants, formals)?);
+                    self.skip_spaces();
+                    match self.peek() {
+                        Some(',') => self.pos += 1,
+                        Some(')') => {
+                            self.pos += 1;
+                            break;
+                        }
+                        other => return Err(self.error("`,`, `)` or an operator", other)),
+                    }
+                }
+            }
+            modules.push(Template { symbol, params });
+        }
+    }
+
+    /// sum := product (('+' | '-') product)*
+    fn expression(
+        &mut self,
+        constants: &BTreeMap<String, f64>,
+        formals: &[String],
+    ) -> Result<Expr, LSystemError> {
+        let mut left = self.product(constants, formals)?;
+        loop {
+            self.skip_spaces();
+            match self.peek() {
+                Some(op @ ('+' | '-')) => {
+                    self.pos += 1;
+                    let right = self.product(constants, formals)?;
+                    left = Expr::Binary(op, Box::new(left), Box::new(right));
+                }
+                _ => return Ok(left),
+            }
+        }
+    }
+
+    /// product := factor (('*' | '/') factor)*
+    fn product(
+        &mut self,
+        constants: &BTreeMap<String, f64>,
+        formals: &[String],
+    ) -> Result<Expr, LSystemError> {
+        let mut left = self.factor(constants, formals)?;
+        loop {
+            self.skip_spaces();
+            match self.peek() {
+                Some(op @ ('*' | '/')) => {
+                    self.pos += 1;
+                    let right = self.factor(constants, formals)?;
+                    left = Expr::Binary(op, Box::new(left), Box::new(right));
+                }
+                _ => return Ok(left),
+            }
+        }
+    }
+
+    /// factor := number | name | '-' factor | '(' sum ')'
+    fn factor(
+        &mut self,
+        constants: &BTreeMap<String, f64>,
+        formals: &[String],
+    ) -> Result<Expr, LSystemError> {
+        self.skip_spaces();
+        match self.peek() {
+            Some('-') => {
+                self.pos += 1;
+                Ok(Expr::Neg(Box::new(self.factor(constants, formals)?)))
+            }
+            Some('(') => {
+                self.pos += 1;
+                let inner = self.expression(constants, formals)?;
+                self.skip_spaces();
+                match self.peek() {
+                    Some(')') => {
+                        self.pos += 1;
+                        Ok(inner)
+                    }
+                    other => Err(self.error("`)`", other)),
+                }
+            }
+            Some(c) if c.is_ascii_digit() || c == '.' => {
+                let start = self.pos;
+                while self
+                    .peek()
+                    .is_some_and(|c| c.is_ascii_digit() || c == '.' || c == 'e' || c == 'E')
+                {
+                    self.pos += 1;
+                }
+                let text: String = self.chars[start..self.pos].iter().collect();
+                text.parse::<f64>()
+                    .map(Expr::Number)
+                    .map_err(|_| syntax(self.line, start + 1, "a number", format!("`{text}`")))
+            }
+            Some(c) if c.is_alphabetic() => {
+                let name = self.name()?;
+                if let Some(i) = formals.iter().position(|f| *f == name) {
+                    Ok(Expr::Param(i))
+                } else if let Some(v) = constants.get(&constant_key(&name)) {
+                    Ok(Expr::Number(*v))
+                } else {
+                    Err(LSystemError::UnknownName {
+                        line: self.line,
+                        name,
+                    })
+                }
+            }
+            other => Err(self.error("a number, a name, `-` or `(`", other)),
+        }
+    }
+}

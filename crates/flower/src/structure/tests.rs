@@ -1,0 +1,240 @@
+use glam::{DMat3, DVec3};
+
+use super::lsystem::{LSystem, LSystemError, Module};
+use super::turtle::{Defaults, Drawing, interpret, r_h, r_l, r_u};
+
+fn word_text(word: &[Module]) -> String {
+    word.iter()
+        .map(|m| {
+            if m.params.is_empty() {
+                m.symbol.clone()
+            } else {
+                let p: Vec<String> = m.params.iter().map(|v| format!("{v}")).collect();
+                format!("{}({})", m.symbol, p.join(","))
+            }
+        })
+        .collect()
+}
+
+fn draw(text: &str, steps: u32) -> Drawing {
+    let system = LSystem::parse(text).unwrap();
+    interpret(&system.derive(steps).unwrap(), &Defaults::of(&system))
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    (a - b).length() < 1e-12
+}
+
+#[test]
+fn productions_are_applied_in_parallel() {
+    // The Fibonacci words: every letter rewritten at once each step.
+    let system = LSystem::parse("axiom: A\nA -> AB\nB -> A").unwrap();
+    let words: Vec<String> = (0..=5)
+        .map(|n| word_text(&system.derive(n).unwrap()))
+        .collect();
+    assert_eq!(
+        words,
+        ["A", "AB", "ABA", "ABAAB", "ABAABABA", "ABAABABAABAAB"]
+    );
+}
+
+#[test]
+fn parametric_productions_evaluate_their_parameters() {
+    let system = LSystem::parse(
+        "shrink = 0.5\n\
+         axiom: A(1)\n\
+         p1: A(x) -> F(x) [ +(30) A(x * shrink) ] A(2 * x - -1)",
+    )
+    .unwrap();
+    assert_eq!(
+        word_text(&system.derive(1).unwrap()),
+        "F(1)[+(30)A(0.5)]A(3)"
+    );
+    assert_eq!(
+        word_text(&system.derive(2).unwrap()),
+        "F(1)[+(30)F(0.5)[+(30)A(0.25)]A(2)]F(3)[+(30)A(1.5)]A(7)"
+    );
+}
+
+#[test]
+fn the_turtle_starts_heading_up_with_left_towards_minus_x() {
+    let d = draw("axiom: F(2) ~p", 0);
+    assert!(close(d.segments[0].end, DVec3::new(0.0, 2.0, 0.0)));
+    let p = &d.surfaces[0];
+    assert_eq!(p.frame, DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z));
+    // H × L = U.
+    assert!(close(p.frame.x_axis.cross(p.frame.y_axis), p.frame.z_axis));
+    // At the start the template frame is the world frame.
+    assert_eq!(p.template_rotation(), DMat3::IDENTITY);
+}
+
+#[test]
+fn every_rotation_symbol_turns_as_its_equation_says() {
+    // Worked by hand from eqs. (1.1)–(1.4), starting at H = Y, L = -X, U = Z.
+    // + (R_U): H' = cos a H - sin a L, L' = sin a H + cos a L.
+    let d = draw("axiom: +(90) ~p", 0);
+    let f = d.surfaces[0].frame;
+    assert!(close(f.x_axis, DVec3::X) && close(f.y_axis, DVec3::Y) && close(f.z_axis, DVec3::Z));
+    // & (R_L): H' = cos a H + sin a U, U' = -sin a H + cos a U.
+    let f = draw("axiom: &(90) ~p", 0).surfaces[0].frame;
+    assert!(close(f.x_axis, DVec3::Z) && close(f.y_axis, -DVec3::X) && close(f.z_axis, -DVec3::Y));
+    // / (R_H): L' = cos a L + sin a U, U' = -sin a L + cos a U.
+    let f = draw("axiom: /(90) ~p", 0).surfaces[0].frame;
+    assert!(close(f.x_axis, DVec3::Y) && close(f.y_axis, DVec3::Z) && close(f.z_axis, DVec3::X));
+    // The opposite symbols undo them, at any angle.
+    for (a, b) in [("+", "-"), ("&", "^"), ("/", "\\")] {
+        let f = draw(&format!("axiom: {a}(37) {b}(37) ~p"), 0).surfaces[0].frame;
+        assert!(
+            f.abs_diff_eq(DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z), 1e-12),
+            "{a}{b}"
+        );
+    }
+    // The matrices are rotations, and R(a) R(-a) = I.
+    for r in [r_u(0.7), r_l(0.7), r_h(0.7)] {
+        assert!((r.determinant() - 1.0).abs() < 1e-12);
+        assert!((r * r.transpose()).abs_diff_eq(DMat3::IDENTITY, 1e-12));
+    }
+    assert!((r_u(0.3) * r_u(-0.3)).abs_diff_eq(DMat3::IDENTITY, 1e-12));
+}
+
+#[test]
+fn parameterless_symbols_take_the_defaults() {
+    let d = draw("angle = 90\nstep = 3\naxiom: + F", 0);
+    assert!(close(d.segments[0].end, DVec3::new(3.0, 0.0, 0.0)));
+    let d = draw("axiom: F f F", 0);
+    assert!(close(d.segments[1].start, DVec3::new(0.0, 2.0, 0.0)));
+    // Widths: set, increased and decreased by the increment.
+    let d = draw(
+        "initial line width = 20\nline width increment = 5\naxiom: F # F ! ! F #(7) F",
+        0,
+    );
+    let widths: Vec<f64> = d.segments.iter().map(|s| s.width).collect();
+    assert_eq!(widths, [20.0, 25.0, 15.0, 7.0]);
+}
+
+#[test]
+fn brackets_nest_and_restore_position_frame_and_width() {
+    let d = draw(
+        "axiom: F(1) [ +(90) #(4) F(1) [ &(90) F(1) ] F(1) ] F(1)",
+        0,
+    );
+    let ends: Vec<DVec3> = d.segments.iter().map(|s| s.end).collect();
+    let want = [
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(2.0, 1.0, 0.0),
+        DVec3::new(0.0, 2.0, 0.0),
+    ];
+    for (got, want) in ends.iter().zip(want) {
+        assert!(close(*got, want), "{ends:?}");
+    }
+    let widths: Vec<f64> = d.segments.iter().map(|s| s.width).collect();
+    assert_eq!(widths, [1.0, 4.0, 4.0, 4.0, 1.0]);
+}
+
+/// The seed's apple flower, L-system (3), as written there.
+const APPLE: &str = "\
+initial line width = 20
+line width increment = 5
+lenA = 500
+lenF = 100
+ω :/(154) &(72) #A!B
+p1:B → D/(60)D/(60)D/(60)D/(60)D/(60)D
+p2:D → [C][P][S]
+p3:A → F(lenA)
+p4:C → ~c
+p5:P → ~p
+p6:S → F(lenF)[- (18)F(lenF)][+ (18)F(lenF)]
+";
+
+#[test]
+fn the_apple_flower_of_the_seed_places_six_segments() {
+    let system = LSystem::parse(APPLE).unwrap();
+    let word = system.derive(3).unwrap();
+    let d = interpret(&word, &Defaults::of(&system));
+    let count = |x: char| d.surfaces.iter().filter(|s| s.surface == x).count();
+    // Six segments of calyx, petal and stamen: 6 ~c, 6 ~p, and a stem plus
+    // three lines per stamen.
+    assert_eq!((count('c'), count('p')), (6, 6));
+    assert_eq!(d.segments.len(), 1 + 6 * 3);
+    // The stem: 500 long, width 20 + 5; the stamens after `!`: 20.
+    let stem = &d.segments[0];
+    assert!(((stem.end - stem.start).length() - 500.0).abs() < 1e-9);
+    assert_eq!(stem.width, 25.0);
+    assert!(d.segments[1..].iter().all(|s| s.width == 20.0));
+    // Every organ sits at the stem's end; successive petals are 60° apart
+    // about the heading.
+    for s in &d.surfaces {
+        assert!((s.position - stem.end).length() < 1e-9);
+    }
+    let petals: Vec<_> = d.surfaces.iter().filter(|s| s.surface == 'p').collect();
+    for pair in petals.windows(2) {
+        let (a, b) = (pair[0].frame, pair[1].frame);
+        assert!((a.x_axis - b.x_axis).length() < 1e-9, "same heading");
+        let cos = a.y_axis.dot(b.y_axis);
+        assert!((cos - 60f64.to_radians().cos()).abs() < 1e-9, "{cos}");
+    }
+    // A stamen's two side lines leave its tip 18° either side of it.
+    let (main, left, right) = (&d.segments[1], &d.segments[2], &d.segments[3]);
+    let axis = (main.end - main.start).normalize();
+    for side in [left, right] {
+        assert!((side.start - main.end).length() < 1e-9);
+        let angle = axis
+            .dot((side.end - side.start).normalize())
+            .acos()
+            .to_degrees();
+        assert!((angle - 18.0).abs() < 1e-9, "{angle}");
+    }
+}
+
+#[test]
+fn syntax_errors_name_the_line_the_column_and_what_was_expected() {
+    let err = LSystem::parse("axiom: A\nA -> F(1 B").unwrap_err();
+    assert_eq!(
+        err,
+        LSystemError::Syntax {
+            line: 2,
+            column: 10,
+            expected: "`,`, `)` or an operator".into(),
+            found: "`B`".into()
+        }
+    );
+    let err = LSystem::parse("axiom: F ~(2)").unwrap_err();
+    assert!(
+        matches!(&err, LSystemError::Syntax { line: 1, column: 11, expected, .. } if expected.contains("surface")),
+        "{err}"
+    );
+    let err = LSystem::parse("axiom: A\nB D").unwrap_err();
+    assert!(matches!(err, LSystemError::Syntax { line: 2, .. }), "{err}");
+    assert!(err.to_string().contains("expected `->`"), "{err}");
+    let err = LSystem::parse("axiom: A\nA -> F(len)").unwrap_err();
+    assert_eq!(
+        err,
+        LSystemError::UnknownName {
+            line: 2,
+            name: "len".into()
+        }
+    );
+    let err = LSystem::parse("A -> B").unwrap_err();
+    assert!(err.to_string().contains("no axiom"), "{err}");
+    let err = LSystem::parse("axiom: A\nA(x, y) -> B(x)\naxiom: B").unwrap_err();
+    assert!(err.to_string().contains("second axiom on line 3"), "{err}");
+    // A module with fewer parameters than its production names.
+    let system = LSystem::parse("axiom: A(1)\nA(x, y) -> B(x)").unwrap();
+    assert!(matches!(
+        system.derive(1).unwrap_err(),
+        LSystemError::Arity {
+            given: 1,
+            needed: 2,
+            line: 2,
+            ..
+        }
+    ));
+    // Exponential growth is stopped, not run out of memory.
+    let system = LSystem::parse("axiom: A\nA -> AA").unwrap();
+    assert!(matches!(
+        system.derive(40).unwrap_err(),
+        LSystemError::TooLong { step: 20 }
+    ));
+}
