@@ -484,9 +484,13 @@ fn catalogue() -> Vec<Case> {
             "missing.anthesis.toml: it does not exist"
         ),
         case!(
-            "project path that is a folder",
-            |d| vec!["info".into(), d.display().to_string()],
-            "it is a folder, not a regular file"
+            "project folder without a project file",
+            |d| {
+                let folder = d.join("no-project");
+                std::fs::create_dir_all(&folder).expect("mkdir");
+                vec!["info".into(), folder.display().to_string()]
+            },
+            "no-project: the folder holds no project file (*.anthesis.toml)"
         ),
         case!(
             "project path that is a device",
