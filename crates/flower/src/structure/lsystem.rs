@@ -357,6 +357,9 @@ fn parse_production(
 /// The characters a module symbol may be, besides letters.
 const TURTLE_SYMBOLS: &str = "+-&^/\\[]#!";
 
+/// One level of the expression grammar: parses an operand.
+type Operand = fn(&mut Parser, &BTreeMap<String, f64>, &[String]) -> Result<Expr, LSystemError>;
+
 /// A cursor over one line's characters, from `pos` to `end`.
 struct Parser {
     line: usize,
@@ -473,18 +476,7 @@ impl Parser {
         constants: &BTreeMap<String, f64>,
         formals: &[String],
     ) -> Result<Expr, LSystemError> {
-        let mut left = self.product(constants, formals)?;
-        loop {
-            self.skip_spaces();
-            match self.peek() {
-                Some(op @ ('+' | '-')) => {
-                    self.pos += 1;
-                    let right = self.product(constants, formals)?;
-                    left = Expr::Binary(op, Box::new(left), Box::new(right));
-                }
-                _ => return Ok(left),
-            }
-        }
+        self.left_associative(['+', '-'], constants, formals, Parser::product)
     }
 
     /// product := factor (('*' | '/') factor)*
@@ -493,13 +485,24 @@ impl Parser {
         constants: &BTreeMap<String, f64>,
         formals: &[String],
     ) -> Result<Expr, LSystemError> {
-        let mut left = self.factor(constants, formals)?;
+        self.left_associative(['*', '/'], constants, formals, Parser::factor)
+    }
+
+    /// operand (op operand)* for the two operators `ops`, left to right.
+    fn left_associative(
+        &mut self,
+        ops: [char; 2],
+        constants: &BTreeMap<String, f64>,
+        formals: &[String],
+        operand: Operand,
+    ) -> Result<Expr, LSystemError> {
+        let mut left = operand(self, constants, formals)?;
         loop {
             self.skip_spaces();
             match self.peek() {
-                Some(op @ ('*' | '/')) => {
+                Some(op) if ops.contains(&op) => {
                     self.pos += 1;
-                    let right = self.factor(constants, formals)?;
+                    let right = operand(self, constants, formals)?;
                     left = Expr::Binary(op, Box::new(left), Box::new(right));
                 }
                 _ => return Ok(left),
