@@ -725,3 +725,110 @@ fn a_project_folder_works_where_a_project_file_is_expected() {
     let err = text(&one_line_error(&["info", empty.path().to_str().expect("utf-8")]).stderr);
     assert!(err.contains("holds no project file"), "{err}");
 }
+
+/// The lily's folder copied to `dir`, its listed organs and rules replaced
+/// by `structure` (TOML text).
+fn lily_with_structure(dir: &Path, structure: &str) -> PathBuf {
+    let lily = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/flowers/lily");
+    for sub in ["maps", "meshes"] {
+        std::fs::create_dir_all(dir.join(sub)).expect("mkdir");
+        for entry in std::fs::read_dir(lily.join(sub)).expect("list") {
+            let path = entry.expect("entry").path();
+            std::fs::copy(&path, dir.join(sub).join(path.file_name().expect("name")))
+                .expect("copy");
+        }
+    }
+    let text = std::fs::read_to_string(lily.join("lily.anthesis.toml")).expect("read");
+    let head = &text[..text.find("[[organs]]").expect("organs")];
+    let head = head.replacen("version = 2", "version = 4", 1);
+    let path = dir.join("lily.anthesis.toml");
+    std::fs::write(&path, format!("{head}{structure}")).expect("write");
+    path
+}
+
+#[test]
+fn organs_placed_by_whorls_or_an_lsystem_load_and_simulate() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let whorls = lily_with_structure(
+        &dir.path().join("whorls"),
+        "[structure]\nkind = \"whorls\"\n\n\
+         [[structure.whorls]]\nname = \"petal\"\ntemplate = \"petal\"\ncount = 3\nradius = 2.0\nhalf_span_deg = 50.0\n\n\
+         [[structure.whorls]]\nname = \"sepal\"\ntemplate = \"sepal\"\ncount = 3\noffset_deg = 60.0\n\
+         radius = 2.8\nheight = -0.9\nhalf_span_deg = 45.0\n",
+    );
+    let w = whorls.to_str().expect("utf-8");
+    let out = anthesis(&["info", w]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let names: Vec<String> = text(&out.stdout)
+        .lines()
+        .map(|l| l.split(' ').next().expect("name").to_owned())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "petal-1", "petal-2", "petal-3", "sepal-1", "sepal-2", "sepal-3"
+        ]
+    );
+    let out = anthesis(&["simulate", w, "--keyframes", "2"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+
+    // The same flower by an L-system: each segment rolled by / about the
+    // heading (the flower axis), then pitched down by & to move out by f
+    // and back up by ^, so each organ stands upright facing away from the
+    // axis; sepals first, so they lie outside the petals.
+    let lsystem = lily_with_structure(
+        &dir.path().join("lsystem"),
+        "[structure]\nkind = \"lsystem\"\n\n[structure.lsystem]\nsteps = 2\n\
+         surfaces = { p = \"petal\", s = \"sepal\" }\n\
+         text = \"\"\"\naxiom: B\nB -> D /(120) D /(120) D\n\
+         D -> /(60) [ &(90) f(2.8) ^(90) f(-0.9) ~s ] \\\\(60) [ &(90) f(2) ^(90) ~p ]\n\"\"\"\n",
+    );
+    let l = lsystem.to_str().expect("utf-8");
+    let out = anthesis(&["info", l]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let by_lsystem: Vec<String> = text(&out.stdout).lines().map(str::to_owned).collect();
+    assert_eq!(by_lsystem.len(), 6);
+    // The organs are where the whorls put them: same names, bases, tips and
+    // joint axes.
+    let by_whorls = anthesis_flower::project::load_project(&whorls).expect("loads");
+    let by_lsystem = anthesis_flower::project::load_project(&lsystem).expect("loads");
+    for organ in &by_whorls.flower.organs {
+        let i = by_lsystem
+            .flower
+            .organ_index(&organ.name)
+            .expect("same names");
+        let other = &by_lsystem.flower.organs[i].placement;
+        for p in [glam::DVec3::ZERO, glam::DVec3::Y, glam::DVec3::Z] {
+            let (a, b) = (
+                organ.placement.world_from_template(p, 0.3),
+                other.world_from_template(p, 0.3),
+            );
+            assert!((a - b).length() < 1e-9, "{}: {a} vs {b}", organ.name);
+        }
+    }
+    // And the same overlap rules: each petal inside the two sepals beside it.
+    let rules = |p: &anthesis_flower::Project| {
+        let name = |i: usize| p.flower.organs[i].name.clone();
+        let mut rules: Vec<(String, String)> = p
+            .flower
+            .overlaps
+            .iter()
+            .map(|o| (name(o.inner), name(o.outer)))
+            .collect();
+        rules.sort();
+        rules
+    };
+    assert_eq!(rules(&by_lsystem), rules(&by_whorls));
+    assert_eq!(rules(&by_whorls).len(), 6);
+    let out = anthesis(&["simulate", l, "--keyframes", "2"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+
+    // A syntax error in the L-system names the project, the line and column.
+    let broken = lily_with_structure(
+        &dir.path().join("broken"),
+        "[structure]\nkind = \"lsystem\"\n\n[structure.lsystem]\nsteps = 1\n\
+         surfaces = { p = \"petal\" }\ntext = \"axiom: ~p(\"\n",
+    );
+    let err = text(&one_line_error(&["info", broken.to_str().expect("utf-8")]).stderr);
+    assert!(err.contains("L-system line 1, column 11"), "{err}");
+}

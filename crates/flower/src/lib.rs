@@ -112,10 +112,12 @@ pub fn joint_angle_after(schedule: &[JointRamp], step: u32) -> f64 {
         .to_radians()
 }
 
-/// Where an organ sits on the receptacle. The template frame is turned by
-/// `azimuth_deg` about the flower axis (+Y), tilted by the joint angle about
-/// its joint axis (the template's +X, turned with it), and moved to
-/// `position`. A positive joint angle tilts the organ outwards.
+/// Where an organ sits on the receptacle. The template frame is tilted by
+/// the joint angle about its joint axis (the template's +X), turned by
+/// `orientation` (the identity for organs on a receptacle; any frame for
+/// organs an L-system places), then by `azimuth_deg` about the flower axis
+/// (+Y), and moved to `position`. A positive joint angle tilts the organ
+/// outwards.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Placement {
     /// Where the template's origin (the organ's base) goes, in the world
@@ -126,18 +128,24 @@ pub struct Placement {
     /// Initial tilt about the joint axis, in degrees (positive outwards);
     /// the template's joint schedule adds to it over time.
     pub joint_angle_deg: f64,
+    /// The organ's frame before the azimuth turn: a unit quaternion taking
+    /// template axes to the frame the organ grows in (identity: upright,
+    /// facing +Z).
+    pub orientation: DQuat,
 }
 
 impl Placement {
     /// The joint axis in the world frame (unit length).
     pub fn joint_axis(&self) -> DVec3 {
-        DQuat::from_rotation_y(self.azimuth_deg.to_radians()) * DVec3::X
+        (DQuat::from_rotation_y(self.azimuth_deg.to_radians()) * self.orientation * DVec3::X)
+            .normalize()
     }
 
     /// World position of a template-frame point with `extra_joint` radians
     /// added to the initial joint angle.
     pub fn world_from_template(&self, point_in_template: DVec3, extra_joint: f64) -> DVec3 {
         let rotation = DQuat::from_rotation_y(self.azimuth_deg.to_radians())
+            * self.orientation
             * DQuat::from_rotation_x(self.joint_angle_deg.to_radians() + extra_joint);
         self.position + rotation * point_in_template
     }
@@ -176,6 +184,11 @@ pub struct Flower {
     pub organs: Vec<Organ>,
     /// Pairs of organs kept apart by collision handling.
     pub overlaps: Vec<Overlap>,
+    /// Where the first organs and overlap rules came from, when the project
+    /// describes them by whorls, a spiral or an L-system: `organs` and
+    /// `overlaps` start with what [`structure::Structure::arrange`] makes
+    /// (saved as the structure, not one by one); the rest are listed.
+    pub structure: Option<structure::Structure>,
 }
 
 impl Flower {
@@ -264,6 +277,7 @@ mod tests {
             position: DVec3::new(0.0, 0.0, 1.0),
             azimuth_deg: 0.0,
             joint_angle_deg: 10.0,
+            orientation: glam::DQuat::IDENTITY,
         };
         let tip = placement.world_from_template(DVec3::Y, 0.0);
         // Outwards from the axis at azimuth 0 is +Z.

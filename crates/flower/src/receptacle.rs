@@ -128,12 +128,14 @@ mod tests {
                 position: DVec3::new(x, 0.2, z),
                 azimuth_deg: 0.0,
                 joint_angle_deg: 0.0,
+                orientation: glam::DQuat::IDENTITY,
             },
         };
         let mut flower = Flower {
             templates: Vec::new(),
             organs: vec![organ_at(1.0, 0.0), organ_at(-3.0, 4.0), organ_at(0.0, -4.5)],
             overlaps: Vec::new(),
+            structure: None,
         };
         // The farthest base is 5 from the axis (its height does not count).
         assert_eq!(

@@ -447,6 +447,7 @@ mod tests {
                         position: DVec3::new(radius * sin, 0.0, radius * cos),
                         azimuth_deg,
                         joint_angle_deg: 10.0,
+                        orientation: glam::DQuat::IDENTITY,
                     },
                 }
             })
@@ -455,6 +456,7 @@ mod tests {
             templates: vec![template],
             organs,
             overlaps: Vec::new(),
+            structure: None,
         }
     }
 

@@ -10,6 +10,7 @@ use anthesis_flower::project::{
     FORMAT_VERSION, ProjectError, UNNAMED_PROJECT, load_project, parse_project, project_to_toml,
     save_project,
 };
+use anthesis_flower::structure::{Spiral, Structure, Whorl};
 use anthesis_flower::{
     BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, Resolution,
     SimulationSettings, Template,
@@ -141,6 +142,7 @@ fn lily() -> Project {
             ),
             azimuth_deg,
             joint_angle_deg,
+            orientation: glam::DQuat::IDENTITY,
         },
     };
     Project {
@@ -153,6 +155,7 @@ fn lily() -> Project {
                 organ("sepal-1", 1, 60.0, 12.5),
             ],
             overlaps: vec![Overlap { inner: 0, outer: 2 }],
+            structure: None,
         },
         settings: SimulationSettings {
             keyframes: 80,
@@ -425,21 +428,21 @@ fn a_newer_version_says_so() {
     // A newer version may have fields this build does not know: the version
     // error must win over the unknown field.
     edit(&path, |text| {
-        replace_once(text, "version = 2", "version = 4\nwind = \"strong\"")
+        replace_once(text, "version = 2", "version = 5\nwind = \"strong\"")
     });
     let error = load_project(&path).expect_err("newer");
     assert_eq!(
         error,
         ProjectError::NewerVersion {
             path: path.clone(),
-            found: 4,
+            found: 5,
             supported: FORMAT_VERSION,
         }
     );
     assert_eq!(
         error.to_string(),
         format!(
-            "{} was written by a newer Anthesis (format version 4; this build reads up to 3)",
+            "{} was written by a newer Anthesis (format version 5; this build reads up to 4)",
             path.display()
         )
     );
@@ -845,6 +848,7 @@ template = "petal"
             position: DVec3::ZERO,
             azimuth_deg: 0.0,
             joint_angle_deg: 0.0,
+            orientation: glam::DQuat::IDENTITY,
         }
     );
 
@@ -1353,4 +1357,212 @@ fn a_project_folder_opens_its_one_project_file() {
         err.contains("several project files (a.anthesis.toml, b.anthesis.toml)"),
         "{err}"
     );
+}
+
+/// The test lily with its organs given by a structure instead.
+fn lily_by(structure: Structure) -> Project {
+    let mut project = lily();
+    let derived = structure
+        .arrange(&project.flower.templates)
+        .expect("arranges");
+    project.flower.organs = derived.organs;
+    project.flower.overlaps = derived.overlaps;
+    project.flower.structure = Some(structure);
+    project
+}
+
+fn lily_whorls() -> Structure {
+    let petals = Whorl {
+        name: "petal".into(),
+        template: 0,
+        count: 3,
+        offset_deg: 0.0,
+        radius: 0.8,
+        height: 0.1,
+        joint_angle_deg: 10.0,
+        half_span_deg: 50.0,
+    };
+    let sepals = Whorl {
+        name: "sepal".into(),
+        template: 1,
+        offset_deg: 60.0,
+        radius: 1.0,
+        half_span_deg: 45.0,
+        ..petals.clone()
+    };
+    Structure::Whorls {
+        whorls: vec![petals, sepals],
+        contorted: false,
+    }
+}
+
+#[test]
+fn organs_placed_by_a_structure_are_saved_as_the_structure() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    for (name, structure) in [
+        ("whorls", lily_whorls()),
+        (
+            "spiral",
+            Structure::Spiral(Spiral {
+                name: "tepal".into(),
+                template: 0,
+                count: 8,
+                divergence_deg: anthesis_flower::structure::GOLDEN_ANGLE_DEG,
+                first_radius: 1.2,
+                first_height: 0.0,
+                radius_step: 0.05,
+                height_step: 0.02,
+                joint_angle_deg: 5.0,
+                half_span_deg: 40.0,
+            }),
+        ),
+        (
+            "lsystem",
+            Structure::LSystem {
+                text: "axiom: f(0.1) B\nB -> D/(120)D/(120)D\nD -> [&(5)~s][~p]".into(),
+                steps: 2,
+                surfaces: [('p', 0), ('s', 1)].into_iter().collect(),
+            },
+        ),
+    ] {
+        let project = lily_by(structure);
+        let path = folder.path().join(name).join("flower.anthesis.toml");
+        save_project(&project, &path).expect("saves");
+        let text = fs::read_to_string(&path).expect("read");
+        assert!(text.contains("version = 4"), "{text}");
+        assert!(text.contains(&format!("kind = \"{name}\"")), "{text}");
+        assert!(
+            !text.contains("[[organs]]"),
+            "made organs are not listed:\n{text}"
+        );
+        assert!(
+            !text.contains("[[overlaps]]"),
+            "made rules are not listed:\n{text}"
+        );
+        let loaded = load_project(&path).expect("loads");
+        assert_eq!(loaded, project, "{name}");
+        assert!(!loaded.flower.organs.is_empty());
+    }
+}
+
+#[test]
+fn an_lsystem_places_organs_in_the_turtle_frame_and_layers_templates_in_order() {
+    let project = lily_by(Structure::LSystem {
+        text: "axiom: f(0.1) B\nB -> D/(120)D/(120)D\nD -> [&(5)~s][~p]".into(),
+        steps: 2,
+        surfaces: [('p', 0), ('s', 1)].into_iter().collect(),
+    });
+    let flower = &project.flower;
+    let names: Vec<&str> = flower.organs.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "Outer sepal-1",
+            "Petal-1",
+            "Outer sepal-2",
+            "Petal-2",
+            "Outer sepal-3",
+            "Petal-3",
+        ]
+    );
+    // Every organ at the end of f(0.1); petals upright but turned 120°
+    // about the axis (the heading), so their tips stay on the axis.
+    for organ in &flower.organs {
+        assert!((organ.placement.position - DVec3::new(0.0, 0.1, 0.0)).length() < 1e-12);
+    }
+    let tip = |i: usize| {
+        flower.organs[i]
+            .placement
+            .world_from_template(DVec3::Y, 0.0)
+    };
+    assert!((tip(1) - DVec3::new(0.0, 1.1, 0.0)).length() < 1e-12);
+    // A sepal is pitched by & (5°): its tip leaves the axis.
+    assert!(tip(0).x.hypot(tip(0).z) > 0.05);
+    // Sepals came first in the word, so each petal lies inside the sepal
+    // of its own segment (same place, facing the same way), and only that.
+    let mut overlaps = flower.overlaps.clone();
+    overlaps.sort_by_key(|o| (o.inner, o.outer));
+    assert_eq!(
+        overlaps,
+        [
+            Overlap { inner: 1, outer: 0 },
+            Overlap { inner: 3, outer: 2 },
+            Overlap { inner: 5, outer: 4 },
+        ]
+    );
+}
+
+#[test]
+fn a_listed_rule_overrides_the_made_one_for_its_pair_and_survives_saving() {
+    let (_folder, path) = saved_lily();
+    edit(&path, |text| {
+        let text = replace_once(text, "version = 2", "version = 4");
+        // Drop the listed organs and rule; whorls make them instead.
+        let start = text.find("[[organs]]").expect("organs");
+        let mut text = text[..start].to_string();
+        text.push_str(
+            "[structure]\nkind = \"whorls\"\n\n\
+             [[structure.whorls]]\nname = \"petal\"\ntemplate = \"Petal\"\ncount = 3\n\
+             radius = 0.8\nheight = 0.1\njoint_angle_deg = 10.0\nhalf_span_deg = 50.0\n\n\
+             [[structure.whorls]]\nname = \"sepal\"\ntemplate = \"Outer sepal\"\ncount = 3\n\
+             offset_deg = 60.0\nradius = 1.0\nheight = 0.1\njoint_angle_deg = 10.0\n\
+             half_span_deg = 45.0\n\n\
+             [[overlaps]]\ninner = \"sepal-1\"\nouter = \"petal-1\"\n",
+        );
+        text
+    });
+    let project = load_project(&path).expect("loads");
+    let index = |name: &str| project.flower.organ_index(name).expect("organ");
+    let (petal, sepal) = (index("petal-1"), index("sepal-1"));
+    assert!(project.flower.overlaps.contains(&Overlap {
+        inner: sepal,
+        outer: petal
+    }));
+    assert!(!project.flower.overlaps.contains(&Overlap {
+        inner: petal,
+        outer: sepal
+    }));
+    // The other made rules stay.
+    assert!(project.flower.overlaps.len() > 1);
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert_eq!(text.matches("[[overlaps]]").count(), 1, "{text}");
+    assert_eq!(load_project(&path).expect("reloads"), project);
+}
+
+#[test]
+fn a_broken_structure_is_refused_naming_what_is_wrong() {
+    let (_folder, path) = saved_lily();
+    let with = |structure: &str| {
+        let (_f, path) = saved_lily();
+        edit(&path, |text| {
+            let text = replace_once(text, "version = 2", "version = 4");
+            format!("{text}\n{structure}")
+        });
+        load_project(&path).expect_err("refused").to_string()
+    };
+    let _ = path;
+    let err = with(
+        "[structure]\nkind = \"lsystem\"\n[structure.lsystem]\nsteps = 1\n\
+                    text = \"axiom: ~p\\nA -> F(1\"\nsurfaces = { p = \"Petal\" }\n",
+    );
+    assert!(err.contains("line 2, column 9"), "{err}");
+    let err = with(
+        "[structure]\nkind = \"lsystem\"\n[structure.lsystem]\nsteps = 1\n\
+                    text = \"axiom: ~q\"\nsurfaces = { p = \"Petal\" }\n",
+    );
+    assert!(err.contains("surface `q`"), "{err}");
+    let err = with("[structure]\nkind = \"spiral\"\n");
+    assert!(err.contains("needs a [structure.spiral] table"), "{err}");
+    let err = with(
+        "[structure]\nkind = \"lsystem\"\n[structure.lsystem]\nsteps = 1\n\
+                    text = \"axiom: ~p\"\nsurfaces = { p = \"stamen\" }\n",
+    );
+    assert!(err.contains("template \"stamen\""), "{err}");
+    // Made organs whose names clash with listed ones.
+    let err = with(
+        "[structure]\nkind = \"whorls\"\n[[structure.whorls]]\nname = \"petal\"\n\
+                    template = \"Petal\"\ncount = 2\nradius = 1.0\nhalf_span_deg = 40.0\n",
+    );
+    assert!(err.contains("petal-1"), "{err}");
 }

@@ -401,6 +401,7 @@ fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
             templates,
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
+            structure: None,
         },
         settings: SimulationSettings::default(),
     })
@@ -704,6 +705,7 @@ pub fn eustoma_of(
             )?],
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
+            structure: None,
         },
         settings: SimulationSettings::default(),
     })

@@ -20,7 +20,7 @@
 
 #![warn(missing_docs)]
 
-pub mod arrangement;
+pub use anthesis_flower::structure::whorl as arrangement;
 pub mod buds;
 pub mod flowers;
 pub mod paint;

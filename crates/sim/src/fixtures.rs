@@ -148,6 +148,7 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
                     position: DVec3::new(radius * a.sin(), 0.0, radius * a.cos()),
                     azimuth_deg,
                     joint_angle_deg: 0.0,
+                    orientation: glam::DQuat::IDENTITY,
                 },
             }
         })
@@ -170,6 +171,7 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
             templates,
             organs: organs_list,
             overlaps,
+            structure: None,
         },
         settings: SimulationSettings {
             keyframes,

@@ -8,12 +8,15 @@ use anthesis_files::FileError;
 
 use anthesis_maps::{Blend, DirectionMap, GrowthMaps, KeyedMaps, MapKey, MapKind, ScalarMap};
 use anthesis_mesh::{Mesh, MeshError};
-use glam::{DVec2, DVec3};
+use glam::{DQuat, DVec2, DVec3};
 
 use super::check::{SizeCheck, check_names, check_project, check_unique};
 use super::error::{ProjectError, map_error};
-use super::schema::{DirectionEntry, ProjectFile, ScalarEntry, TemplateFile};
+use super::schema::{
+    DirectionEntry, ProjectFile, ScalarEntry, StructureFile, StructureKind, TemplateFile,
+};
 use super::{FORMAT_NAME, FORMAT_VERSION};
+use crate::structure::{Arrangement, Spiral, Structure, Whorl};
 use crate::{BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, Template};
 
 /// The largest project file read, in bytes; a project file names its
@@ -75,6 +78,97 @@ impl Loader<'_> {
         Ok(project)
     }
 
+    /// `[structure]` with template names resolved; the part its `kind`
+    /// names must be there.
+    fn structure(
+        &self,
+        file: &StructureFile,
+        templates: &[Template],
+    ) -> Result<Structure, ProjectError> {
+        let template = |name: &str, what: &str| {
+            templates
+                .iter()
+                .position(|t| t.name == name)
+                .ok_or_else(|| {
+                    self.invalid(format!(
+                    "[structure] {what} uses template \"{name}\", which the project does not have"
+                ))
+                })
+        };
+        match file.kind {
+            StructureKind::Whorls => {
+                if file.whorls.is_empty() {
+                    return Err(self.invalid(
+                        "[structure] kind = \"whorls\" needs at least one [[structure.whorls]]"
+                            .to_owned(),
+                    ));
+                }
+                let whorls = file
+                    .whorls
+                    .iter()
+                    .map(|w| {
+                        Ok(Whorl {
+                            name: w.name.clone(),
+                            template: template(&w.template, &format!("whorl \"{}\"", w.name))?,
+                            count: w.count,
+                            offset_deg: w.offset_deg,
+                            radius: w.radius,
+                            height: w.height,
+                            joint_angle_deg: w.joint_angle_deg,
+                            half_span_deg: w.half_span_deg,
+                        })
+                    })
+                    .collect::<Result<Vec<_>, ProjectError>>()?;
+                Ok(Structure::Whorls {
+                    whorls,
+                    contorted: file.contorted,
+                })
+            }
+            StructureKind::Spiral => {
+                let s = file.spiral.as_ref().ok_or_else(|| {
+                    self.invalid(
+                        "[structure] kind = \"spiral\" needs a [structure.spiral] table".to_owned(),
+                    )
+                })?;
+                Ok(Structure::Spiral(Spiral {
+                    name: s.name.clone(),
+                    template: template(&s.template, "spiral")?,
+                    count: s.count,
+                    divergence_deg: s.divergence_deg,
+                    first_radius: s.first_radius,
+                    first_height: s.first_height,
+                    radius_step: s.radius_step,
+                    height_step: s.height_step,
+                    joint_angle_deg: s.joint_angle_deg,
+                    half_span_deg: s.half_span_deg,
+                }))
+            }
+            StructureKind::Lsystem => {
+                let l = file.lsystem.as_ref().ok_or_else(|| {
+                    self.invalid(
+                        "[structure] kind = \"lsystem\" needs a [structure.lsystem] table"
+                            .to_owned(),
+                    )
+                })?;
+                let mut surfaces = std::collections::BTreeMap::new();
+                for (letter, name) in &l.surfaces {
+                    let mut chars = letter.chars();
+                    let (Some(c), None) = (chars.next(), chars.next()) else {
+                        return Err(self.invalid(format!(
+                            "[structure.lsystem.surfaces]: `{letter}` is not one letter"
+                        )));
+                    };
+                    surfaces.insert(c, template(name, &format!("surface `{letter}`"))?);
+                }
+                Ok(Structure::LSystem {
+                    text: l.text.clone(),
+                    steps: l.steps,
+                    surfaces,
+                })
+            }
+        }
+    }
+
     fn syntax(&self, error: &toml::de::Error) -> ProjectError {
         ProjectError::Syntax {
             path: self.project_path.to_path_buf(),
@@ -102,35 +196,64 @@ impl Loader<'_> {
             "template",
             path,
         )?;
-        check_unique(file.organs.iter().map(|o| o.name.as_str()), "organ", path)?;
         let templates = file
             .templates
             .into_iter()
             .map(|template| self.template(template))
             .collect::<Result<Vec<_>, _>>()?;
-        let organs = file
-            .organs
-            .iter()
-            .map(|organ| {
-                let template = templates
-                    .iter()
-                    .position(|t| t.name == organ.template)
-                    .ok_or_else(|| ProjectError::UnknownTemplate {
-                        path: path.to_path_buf(),
-                        organ: organ.name.clone(),
-                        template: organ.template.clone(),
-                    })?;
-                Ok(Organ {
-                    name: organ.name.clone(),
-                    template,
-                    placement: Placement {
-                        position: DVec3::from_array(organ.position),
-                        azimuth_deg: organ.azimuth_deg,
-                        joint_angle_deg: organ.joint_angle_deg,
-                    },
-                })
-            })
-            .collect::<Result<Vec<_>, ProjectError>>()?;
+        let structure = match &file.structure {
+            Some(structure) => Some(self.structure(structure, &templates)?),
+            None => None,
+        };
+        let derived = match &structure {
+            Some(s) => s
+                .arrange(&templates)
+                .map_err(|error| self.invalid(error.to_string()))?,
+            None => Arrangement::default(),
+        };
+        check_unique(
+            derived
+                .organs
+                .iter()
+                .map(|o| o.name.as_str())
+                .chain(file.organs.iter().map(|o| o.name.as_str())),
+            "organ",
+            path,
+        )?;
+        let mut organs = derived.organs;
+        for organ in &file.organs {
+            let template = templates
+                .iter()
+                .position(|t| t.name == organ.template)
+                .ok_or_else(|| ProjectError::UnknownTemplate {
+                    path: path.to_path_buf(),
+                    organ: organ.name.clone(),
+                    template: organ.template.clone(),
+                })?;
+            let orientation = match organ.orientation {
+                None => DQuat::IDENTITY,
+                Some(q) => {
+                    let q = DQuat::from_array(q);
+                    if !q.is_finite() || q.length() < 1e-9 {
+                        return Err(self.invalid(format!(
+                            "organ \"{}\": orientation must be a rotation (a non-zero quaternion [x, y, z, w])",
+                            organ.name
+                        )));
+                    }
+                    q.normalize()
+                }
+            };
+            organs.push(Organ {
+                name: organ.name.clone(),
+                template,
+                placement: Placement {
+                    position: DVec3::from_array(organ.position),
+                    azimuth_deg: organ.azimuth_deg,
+                    joint_angle_deg: organ.joint_angle_deg,
+                    orientation,
+                },
+            });
+        }
         let organ_index = |name: &str| {
             organs
                 .iter()
@@ -140,22 +263,26 @@ impl Loader<'_> {
                     name: name.to_string(),
                 })
         };
-        let overlaps = file
-            .overlaps
-            .iter()
-            .map(|overlap| {
-                Ok(Overlap {
-                    inner: organ_index(&overlap.inner)?,
-                    outer: organ_index(&overlap.outer)?,
-                })
-            })
-            .collect::<Result<Vec<_>, ProjectError>>()?;
+        // Listed rules come after the derived ones and override a derived
+        // rule for the same pair of organs.
+        let mut overlaps = derived.overlaps;
+        for overlap in &file.overlaps {
+            let listed = Overlap {
+                inner: organ_index(&overlap.inner)?,
+                outer: organ_index(&overlap.outer)?,
+            };
+            overlaps.retain(|o| !(o.inner == listed.outer && o.outer == listed.inner));
+            if !overlaps.contains(&listed) {
+                overlaps.push(listed);
+            }
+        }
         Ok(Project {
             name: file.name,
             flower: Flower {
                 templates,
                 organs,
                 overlaps,
+                structure,
             },
             settings: file.simulation.settings(file.version),
         })

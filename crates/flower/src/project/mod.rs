@@ -53,10 +53,36 @@
 //! position = [0.0, 0.0, 0.8]   # optional, default the origin
 //! azimuth_deg = 0.0            # optional, default 0
 //! joint_angle_deg = 10.0       # optional, default 0
+//! orientation = [0, 0, 0, 1]   # optional (version 4): a quaternion [x, y, z, w]
 //!
-//! [[overlaps]]                 # organ names
+//! [[overlaps]]                 # organ names; overrides a made rule of the pair
 //! inner = "petal-1"
 //! outer = "sepal-1"
+//!
+//! # Version 4: organs made by a structure, before the listed ones.
+//! [structure]
+//! kind = "whorls"              # or "spiral" or "lsystem"
+//! contorted = false            # whorls: one contorted whorl (Eustoma)
+//!
+//! [[structure.whorls]]         # innermost first; organs <name>-1, <name>-2, ...
+//! name = "tepal"
+//! template = "petal"
+//! count = 3
+//! offset_deg = 0.0             # optional
+//! radius = 0.8
+//! height = 0.0                 # optional
+//! joint_angle_deg = 10.0       # optional
+//! half_span_deg = 50.0         # the angle an organ covers: rules where spans meet
+//!
+//! # kind = "spiral": [structure.spiral] with name, template, count,
+//! # divergence_deg (default the golden angle 137.5°), first_radius,
+//! # first_height, radius_step, height_step, joint_angle_deg, half_span_deg:
+//! # organ k at radius first_radius − k·radius_step and height
+//! # first_height + k·height_step.
+//! #
+//! # kind = "lsystem": [structure.lsystem] with steps, text (the L-system,
+//! # see `structure::lsystem`) and surfaces = { p = "petal", c = "sepal" }:
+//! # each ~X places an organ of that template in the turtle's frame.
 //! ```
 //!
 //! # Rules
@@ -123,7 +149,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 /// Where saved meshes go, relative to the project file.
 pub const MESH_FOLDER: &str = "meshes";

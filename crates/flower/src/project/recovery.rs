@@ -198,9 +198,11 @@ mod tests {
                         position: glam::DVec3::ZERO,
                         azimuth_deg: 0.0,
                         joint_angle_deg: 0.0,
+                        orientation: glam::DQuat::IDENTITY,
                     },
                 }],
                 overlaps: Vec::new(),
+                structure: None,
             },
             settings: SimulationSettings::default(),
         }

@@ -8,10 +8,12 @@ use anthesis_maps::{BitDepth, MapKind};
 use super::check::{SizeCheck, check_project};
 use super::error::{ProjectError, map_error};
 use super::schema::{
-    BaseRegionFile, BlendFile, DirectionEntry, JointRampFile, KeyFile, OrganFile, OverlapFile,
-    ProjectFile, ScalarEntry, SimulationFile, TemplateFile,
+    BaseRegionFile, BlendFile, DirectionEntry, JointRampFile, KeyFile, LSystemFile, OrganFile,
+    OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SpiralFile, StructureFile,
+    StructureKind, TemplateFile, WhorlFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
+use crate::structure::{Arrangement, Structure};
 use crate::{Project, Resolution, Template};
 
 /// The files of a saved project: the TOML text and the meshes and maps, by
@@ -36,8 +38,9 @@ pub(super) fn plan_save(
     for (template, stem) in flower.templates.iter().zip(&stems) {
         templates.push(template_file(template, stem, folder, &mut files)?);
     }
-    let organs = flower
-        .organs
+    // Organs and rules the structure makes are saved as the structure.
+    let (structure, derived) = structure_file(project, path)?;
+    let organs = flower.organs[derived.organs.len()..]
         .iter()
         .map(|organ| OrganFile {
             name: organ.name.clone(),
@@ -45,11 +48,14 @@ pub(super) fn plan_save(
             position: organ.placement.position.to_array(),
             azimuth_deg: organ.placement.azimuth_deg,
             joint_angle_deg: organ.placement.joint_angle_deg,
+            orientation: (organ.placement.orientation != glam::DQuat::IDENTITY)
+                .then(|| organ.placement.orientation.to_array()),
         })
         .collect();
     let overlaps = flower
         .overlaps
         .iter()
+        .filter(|overlap| !derived.overlaps.contains(overlap))
         .map(|overlap| OverlapFile {
             inner: flower.organs[overlap.inner].name.clone(),
             outer: flower.organs[overlap.outer].name.clone(),
@@ -63,6 +69,7 @@ pub(super) fn plan_save(
         templates,
         organs,
         overlaps,
+        structure,
     };
     let body = toml::to_string(&file).map_err(|error| ProjectError::Invalid {
         path: path.to_path_buf(),
@@ -78,11 +85,18 @@ pub(super) fn plan_save(
 /// The format version a file of `project` needs: the oldest that holds
 /// everything it sets, so a project that sets nothing new stays readable by
 /// older builds and saves byte for byte as before (version 3 added
-/// `mean_edge`).
+/// `mean_edge`, version 4 `[structure]` and organ orientations).
 fn file_version(project: &Project) -> u32 {
-    match project.settings.resolution {
-        Resolution::AsBuilt => 2,
-        Resolution::MeanEdge(_) => FORMAT_VERSION,
+    let flower = &project.flower;
+    let placed = flower.structure.is_some()
+        || flower
+            .organs
+            .iter()
+            .any(|o| o.placement.orientation != glam::DQuat::IDENTITY);
+    match (placed, project.settings.resolution) {
+        (true, _) => FORMAT_VERSION,
+        (false, Resolution::AsBuilt) => 2,
+        (false, Resolution::MeanEdge(_)) => 3,
     }
 }
 
@@ -223,6 +237,83 @@ pub(super) fn file_stems<'a>(names: impl Iterator<Item = &'a str>) -> Vec<String
 pub(super) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ProjectError> {
     anthesis_files::create_folder(&anthesis_files::folder_of(path), path)?;
     Ok(anthesis_files::write_atomic(path, bytes)?)
+}
+
+/// The `[structure]` entry of `project`, and what it makes (nothing when
+/// the project has no structure).
+fn structure_file(
+    project: &Project,
+    path: &Path,
+) -> Result<(Option<StructureFile>, Arrangement), ProjectError> {
+    let flower = &project.flower;
+    let Some(structure) = &flower.structure else {
+        return Ok((None, Arrangement::default()));
+    };
+    let derived = structure
+        .arrange(&flower.templates)
+        .map_err(|error| ProjectError::Invalid {
+            path: path.to_path_buf(),
+            message: error.to_string(),
+        })?;
+    let name = |t: usize| flower.templates[t].name.clone();
+    let file = match structure {
+        Structure::Whorls { whorls, contorted } => StructureFile {
+            kind: StructureKind::Whorls,
+            contorted: *contorted,
+            whorls: whorls
+                .iter()
+                .map(|w| WhorlFile {
+                    name: w.name.clone(),
+                    template: name(w.template),
+                    count: w.count,
+                    offset_deg: w.offset_deg,
+                    radius: w.radius,
+                    height: w.height,
+                    joint_angle_deg: w.joint_angle_deg,
+                    half_span_deg: w.half_span_deg,
+                })
+                .collect(),
+            spiral: None,
+            lsystem: None,
+        },
+        Structure::Spiral(s) => StructureFile {
+            kind: StructureKind::Spiral,
+            contorted: false,
+            whorls: Vec::new(),
+            spiral: Some(SpiralFile {
+                name: s.name.clone(),
+                template: name(s.template),
+                count: s.count,
+                divergence_deg: s.divergence_deg,
+                first_radius: s.first_radius,
+                first_height: s.first_height,
+                radius_step: s.radius_step,
+                height_step: s.height_step,
+                joint_angle_deg: s.joint_angle_deg,
+                half_span_deg: s.half_span_deg,
+            }),
+            lsystem: None,
+        },
+        Structure::LSystem {
+            text,
+            steps,
+            surfaces,
+        } => StructureFile {
+            kind: StructureKind::Lsystem,
+            contorted: false,
+            whorls: Vec::new(),
+            spiral: None,
+            lsystem: Some(LSystemFile {
+                steps: *steps,
+                text: text.clone(),
+                surfaces: surfaces
+                    .iter()
+                    .map(|(letter, &t)| (letter.to_string(), name(t)))
+                    .collect(),
+            }),
+        },
+    };
+    Ok((Some(file), derived))
 }
 
 #[cfg(test)]

@@ -24,6 +24,82 @@ pub(super) struct ProjectFile {
     pub(super) organs: Vec<OrganFile>,
     #[serde(default)]
     pub(super) overlaps: Vec<OverlapFile>,
+    /// Version 4: organs placed by whorls, a spiral or an L-system.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) structure: Option<StructureFile>,
+}
+
+/// `[structure]`: where the first organs come from.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct StructureFile {
+    pub(super) kind: StructureKind,
+    /// `kind = "whorls"`: one contorted whorl instead of nested ones.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub(super) contorted: bool,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) whorls: Vec<WhorlFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) spiral: Option<SpiralFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) lsystem: Option<LSystemFile>,
+}
+
+#[derive(Serialize, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum StructureKind {
+    Whorls,
+    Spiral,
+    Lsystem,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct WhorlFile {
+    pub(super) name: String,
+    pub(super) template: String,
+    pub(super) count: usize,
+    #[serde(default)]
+    pub(super) offset_deg: f64,
+    pub(super) radius: f64,
+    #[serde(default)]
+    pub(super) height: f64,
+    #[serde(default)]
+    pub(super) joint_angle_deg: f64,
+    pub(super) half_span_deg: f64,
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SpiralFile {
+    pub(super) name: String,
+    pub(super) template: String,
+    pub(super) count: usize,
+    #[serde(default = "golden_angle")]
+    pub(super) divergence_deg: f64,
+    pub(super) first_radius: f64,
+    #[serde(default)]
+    pub(super) first_height: f64,
+    #[serde(default)]
+    pub(super) radius_step: f64,
+    #[serde(default)]
+    pub(super) height_step: f64,
+    #[serde(default)]
+    pub(super) joint_angle_deg: f64,
+    pub(super) half_span_deg: f64,
+}
+
+fn golden_angle() -> f64 {
+    crate::structure::GOLDEN_ANGLE_DEG
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LSystemFile {
+    pub(super) steps: u32,
+    pub(super) text: String,
+    /// Surface letter → template name.
+    pub(super) surfaces: std::collections::BTreeMap<String, String>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -182,6 +258,9 @@ pub(super) struct OrganFile {
     pub(super) azimuth_deg: f64,
     #[serde(default)]
     pub(super) joint_angle_deg: f64,
+    /// Version 4: a unit quaternion `[x, y, z, w]`, absent for upright.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) orientation: Option<[f64; 4]>,
 }
 
 #[derive(Serialize, Deserialize)]

@@ -30,6 +30,9 @@ use thiserror::Error;
 /// is refused (a file from a stranger must not exhaust the memory).
 pub const MAX_MODULES: usize = 1_000_000;
 
+/// The most derivation steps asked for (real flowers need a handful).
+pub const MAX_STEPS: u32 = 100;
+
 /// A syntax error, or a word that grows too long.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum LSystemError {
@@ -72,6 +75,9 @@ pub enum LSystemError {
         /// 1-based line of the production.
         line: usize,
     },
+    /// More derivation steps than [`MAX_STEPS`] were asked for.
+    #[error("the L-system asks for {0} derivation steps; at most {MAX_STEPS} are allowed")]
+    TooManySteps(u32),
     /// The derived word became too long.
     #[error("the L-system grows past {MAX_MODULES} modules at derivation step {step}")]
     TooLong {
@@ -201,6 +207,9 @@ impl LSystem {
     /// replaced by its successor, evaluated with the module's parameters;
     /// the others are kept.
     pub fn derive(&self, steps: u32) -> Result<Vec<Module>, LSystemError> {
+        if steps > MAX_STEPS {
+            return Err(LSystemError::TooManySteps(steps));
+        }
         let mut word = self.axiom.clone();
         for step in 1..=steps {
             let mut next = Vec::with_capacity(word.len());

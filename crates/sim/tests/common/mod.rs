@@ -127,6 +127,7 @@ pub fn inner_driven_into_outer_by(keyframes: u32, overlap: bool, inner_drive_deg
                 position: DVec3::new(0.0, 0.0, distance_from_axis),
                 azimuth_deg: 0.0,
                 joint_angle_deg,
+                orientation: glam::DQuat::IDENTITY,
             },
         };
     Project {
@@ -139,6 +140,7 @@ pub fn inner_driven_into_outer_by(keyframes: u32, overlap: bool, inner_drive_deg
             } else {
                 Vec::new()
             },
+            structure: None,
         },
         settings: SimulationSettings {
             keyframes,

@@ -7,7 +7,7 @@
 //! ([`Whorl::half_span_deg`]); two organs are given an overlap rule only
 //! where those spans meet, so a rule always pairs organs that really touch.
 
-use anthesis_flower::{Organ, Overlap, Placement};
+use crate::{Organ, Overlap, Placement};
 use glam::DVec3;
 
 /// The golden divergence angle of spiral phyllotaxis, 360° (1 − 1/φ)
@@ -72,6 +72,7 @@ pub fn placement(azimuth_deg: f64, radius: f64, height: f64, joint_angle_deg: f6
         position: DVec3::new(radius * a.sin(), height, radius * a.cos()),
         azimuth_deg,
         joint_angle_deg,
+        orientation: glam::DQuat::IDENTITY,
     }
 }
 
