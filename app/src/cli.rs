@@ -99,6 +99,17 @@ pub enum Command {
     /// two-state blossom: per-triangle growth ellipses, G(t; g, T) and a
     /// spherical interpolation of directions), without a growth simulation.
     Blossom(blossom::BlossomArgs),
+    /// Write a starting point as a project folder: a flower built into the
+    /// binary (lily, eustoma-maite-lady, eustoma-mellow-yellow,
+    /// eustoma-pinocchio), to paint and change from there.
+    New {
+        /// The starting point's name.
+        #[arg(long = "from", value_name = "NAME")]
+        from: String,
+        /// The folder to write (created if missing; refused if it already
+        /// holds a project, so nothing is overwritten).
+        dir: PathBuf,
+    },
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -238,6 +249,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(args)) => render::render(&args),
         Some(Command::Bud(args)) => bud::bud(&args),
         Some(Command::Blossom(args)) => blossom::blossom(&args),
+        Some(Command::New { from, dir }) => new_project(&from, &dir),
     }
 }
 
@@ -257,6 +269,36 @@ fn load(path: &Path) -> Result<Project> {
     let project = load_project(path).context("cannot open project")?;
     check_units(&project)?;
     Ok(project)
+}
+
+/// `anthesis new --from NAME DIR`: the built-in flower NAME saved as
+/// `DIR/NAME.anthesis.toml` with its meshes and maps.
+fn new_project(from: &str, dir: &Path) -> Result<()> {
+    let project = load(Path::new(&format!("builtin:{from}")))?;
+    if dir.is_dir() {
+        let existing = std::fs::read_dir(dir)
+            .with_context(|| format!("cannot read the folder {}", dir.display()))?
+            .filter_map(Result::ok)
+            .any(|entry| {
+                entry
+                    .file_name()
+                    .to_string_lossy()
+                    .ends_with(anthesis_flower::project::PROJECT_EXTENSION)
+            });
+        if existing {
+            bail!(
+                "{} already holds a project; choose an empty or new folder",
+                dir.display()
+            );
+        }
+    }
+    let path = dir.join(format!(
+        "{from}{}",
+        anthesis_flower::project::PROJECT_EXTENSION
+    ));
+    anthesis_flower::project::save_project(&project, &path)?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
 }
 
 /// `--edge`: a positive length, or `as-built`.

@@ -832,3 +832,27 @@ fn organs_placed_by_whorls_or_an_lsystem_load_and_simulate() {
     let err = text(&one_line_error(&["info", broken.to_str().expect("utf-8")]).stderr);
     assert!(err.contains("L-system line 1, column 11"), "{err}");
 }
+
+#[test]
+fn new_writes_a_built_in_flower_as_a_project_folder_and_never_overwrites() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let folder = dir.path().join("my-lily");
+    let f = folder.to_str().expect("utf-8");
+    let out = anthesis(&["new", "--from", "lily", f]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let written = anthesis_flower::project::load_project(&folder).expect("the folder opens");
+    let builtin = anthesis_garden::builtin("lily")
+        .expect("lily")
+        .expect("loads");
+    assert_eq!(written, builtin);
+    // A second time into the same folder is refused, the project kept.
+    let before = std::fs::read(folder.join("lily.anthesis.toml")).expect("read");
+    let err = text(&one_line_error(&["new", "--from", "eustoma-pinocchio", f]).stderr);
+    assert!(err.contains("already holds a project"), "{err}");
+    assert_eq!(
+        std::fs::read(folder.join("lily.anthesis.toml")).expect("read"),
+        before
+    );
+    let err = text(&one_line_error(&["new", "--from", "tulip", f]).stderr);
+    assert!(err.contains("no built-in flower `tulip`"), "{err}");
+}
