@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+pub mod parts;
 pub mod project;
 mod receptacle;
 pub mod resolution;
@@ -189,6 +190,10 @@ pub struct Flower {
     /// `overlaps` start with what [`structure::Structure::arrange`] makes
     /// (saved as the structure, not one by one); the rest are listed.
     pub structure: Option<structure::Structure>,
+    /// The organs that do not grow (stamens, pistils, the pedicel, the
+    /// receptacle): shown, exported, and obstacles to the growing organs
+    /// (see [`parts`]).
+    pub parts: Vec<parts::Part>,
 }
 
 impl Flower {

@@ -136,6 +136,7 @@ mod tests {
             organs: vec![organ_at(1.0, 0.0), organ_at(-3.0, 4.0), organ_at(0.0, -4.5)],
             overlaps: Vec::new(),
             structure: None,
+            parts: Vec::new(),
         };
         // The farthest base is 5 from the axis (its height does not count).
         assert_eq!(

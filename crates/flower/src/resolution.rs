@@ -210,6 +210,7 @@ mod tests {
                 }],
                 overlaps: Vec::new(),
                 structure: None,
+                parts: Vec::new(),
             },
             settings: SimulationSettings {
                 resolution,

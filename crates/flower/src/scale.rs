@@ -457,6 +457,7 @@ mod tests {
             organs,
             overlaps: Vec::new(),
             structure: None,
+            parts: Vec::new(),
         }
     }
 

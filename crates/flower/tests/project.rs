@@ -156,6 +156,7 @@ fn lily() -> Project {
             ],
             overlaps: vec![Overlap { inner: 0, outer: 2 }],
             structure: None,
+            parts: Vec::new(),
         },
         settings: SimulationSettings {
             keyframes: 80,
@@ -428,21 +429,21 @@ fn a_newer_version_says_so() {
     // A newer version may have fields this build does not know: the version
     // error must win over the unknown field.
     edit(&path, |text| {
-        replace_once(text, "version = 2", "version = 5\nwind = \"strong\"")
+        replace_once(text, "version = 2", "version = 6\nwind = \"strong\"")
     });
     let error = load_project(&path).expect_err("newer");
     assert_eq!(
         error,
         ProjectError::NewerVersion {
             path: path.clone(),
-            found: 5,
+            found: 6,
             supported: FORMAT_VERSION,
         }
     );
     assert_eq!(
         error.to_string(),
         format!(
-            "{} was written by a newer Anthesis (format version 5; this build reads up to 4)",
+            "{} was written by a newer Anthesis (format version 6; this build reads up to 5)",
             path.display()
         )
     );
@@ -1563,6 +1564,138 @@ fn a_broken_structure_is_refused_naming_what_is_wrong() {
     let err = with(
         "[structure]\nkind = \"whorls\"\n[[structure.whorls]]\nname = \"petal\"\n\
                     template = \"Petal\"\ncount = 2\nradius = 1.0\nhalf_span_deg = 40.0\n",
+    );
+    assert!(err.contains("petal-1"), "{err}");
+}
+
+/// Stamens that spread, a three-lobed pistil with an ovary, a stem and a
+/// receptacle of its own.
+fn lily_parts() -> Vec<anthesis_flower::parts::Part> {
+    use anthesis_flower::parts::{Part, PartShape, Tube};
+    let part = |name: &str, shape: PartShape, count: u32| Part {
+        name: name.to_string(),
+        shape,
+        count,
+        ring_radius: 0.0,
+        height: 0.0,
+        offset_deg: 0.0,
+        angle_deg: 0.0,
+        schedule: Vec::new(),
+        color: [0.3, 0.5, 0.2, 1.0],
+        head_color: [0.3, 0.5, 0.2, 1.0],
+    };
+    let mut stamen = part(
+        "stamen",
+        PartShape::Stamen {
+            filament: Tube {
+                length: 8.0,
+                radius: 0.12,
+                curvature_deg: 20.0,
+            },
+            anther_length: 1.5,
+            anther_radius: 0.3,
+            anther_tilt_deg: 90.0,
+        },
+        6,
+    );
+    stamen.ring_radius = 0.6;
+    stamen.offset_deg = 30.0;
+    stamen.angle_deg = 5.0;
+    stamen.head_color = [0.6, 0.2, 0.05, 1.0];
+    stamen.schedule = vec![JointRamp {
+        from_step: 20,
+        to_step: 80,
+        angle_deg: 30.0,
+    }];
+    let mut pedicel = part(
+        "pedicel",
+        PartShape::Pedicel {
+            stalk: Tube {
+                length: 12.0,
+                radius: 0.4,
+                curvature_deg: -10.0,
+            },
+        },
+        1,
+    );
+    pedicel.height = -1.2;
+    vec![
+        part(
+            "receptacle",
+            PartShape::Receptacle {
+                radius: 2.2,
+                depth: 1.4,
+            },
+            1,
+        ),
+        stamen,
+        part(
+            "pistil",
+            PartShape::Pistil {
+                style: Tube {
+                    length: 9.0,
+                    radius: 0.15,
+                    curvature_deg: 0.0,
+                },
+                stigma_radius: 0.45,
+                stigma_lobes: 3,
+                ovary_length: 2.0,
+                ovary_radius: 0.5,
+            },
+            1,
+        ),
+        pedicel,
+    ]
+}
+
+#[test]
+fn parts_are_saved_as_readable_tables_and_load_back_equal() {
+    let mut project = lily();
+    project.flower.parts = lily_parts();
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains(&format!("version = {FORMAT_VERSION}")), "{text}");
+    assert_eq!(text.matches("[[parts]]").count(), 4, "{text}");
+    assert!(text.contains("kind = \"stamen\"") && text.contains("anther_tilt_deg = 90.0"));
+    assert!(text.contains("[[parts.schedule]]"), "{text}");
+    // Keys of other kinds are not written.
+    let pedicel = &text[text.find("name = \"pedicel\"").expect("pedicel")..];
+    assert!(!pedicel.contains("anther") && !pedicel.contains("depth"), "{pedicel}");
+    assert_eq!(load_project(&path).expect("loads"), project);
+    // Without parts the lily stays at its old version.
+    let (_f, plain) = saved_lily();
+    assert!(fs::read_to_string(plain).expect("read").contains("version = 2"));
+}
+
+#[test]
+fn broken_parts_are_refused_naming_the_part_and_the_key() {
+    let with = |part: &str| {
+        let (_f, path) = saved_lily();
+        edit(&path, |text| {
+            let text = replace_once(text, "version = 2", "version = 5");
+            format!("{text}\n[[parts]]\n{part}")
+        });
+        load_project(&path).expect_err("refused").to_string()
+    };
+    let err = with("name = \"s\"\nkind = \"stamen\"\nlength = 5.0\nradius = 0.1\n");
+    assert!(err.contains("stamen \"s\": `anther_length` is missing"), "{err}");
+    let err = with("name = \"s\"\nkind = \"petal\"\n");
+    assert!(err.contains("kind must be one of stamen, pistil, pedicel, receptacle"), "{err}");
+    let err = with("name = \"p\"\nkind = \"pedicel\"\nlength = 5.0\nradius = 0.1\ndepth = 1.0\n");
+    assert!(err.contains("`depth` is not a setting of a pedicel"), "{err}");
+    let err = with(
+        "name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\n\
+         stigma_lobes = 12\n",
+    );
+    assert!(err.contains("stigma_lobes must be 1 to 8, not 12"), "{err}");
+    let err = with("name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\nwidth = 2\n");
+    assert!(err.contains("width"), "{err}");
+    // An instance named like an organ.
+    let err = with(
+        "name = \"petal\"\nkind = \"stamen\"\ncount = 3\nlength = 5.0\nradius = 0.1\n\
+         anther_length = 1.0\nanther_radius = 0.2\n",
     );
     assert!(err.contains("petal-1"), "{err}");
 }

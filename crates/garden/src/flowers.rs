@@ -402,6 +402,7 @@ fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
             structure: None,
+            parts: Vec::new(),
         },
         settings: SimulationSettings::default(),
     })
@@ -706,6 +707,7 @@ pub fn eustoma_of(
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
             structure: None,
+            parts: Vec::new(),
         },
         settings: SimulationSettings::default(),
     })

@@ -172,6 +172,7 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
             organs: organs_list,
             overlaps,
             structure: None,
+            parts: Vec::new(),
         },
         settings: SimulationSettings {
             keyframes,

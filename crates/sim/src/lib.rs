@@ -15,6 +15,7 @@ pub mod collide;
 pub mod fault;
 pub mod fixtures;
 pub mod memory;
+mod obstacle;
 mod organ;
 pub mod resume;
 pub mod worker;
@@ -29,6 +30,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::collide::{Surface, Tracker, Violated, contacts_against, max_violation, push_back};
+use crate::obstacle::ObstacleSim;
 use crate::organ::{OrganSim, OrganState};
 use crate::resume::{Edit, edit_between};
 
@@ -241,6 +243,8 @@ pub struct Simulation {
     checkpoints: Option<Vec<Checkpoint>>,
     /// Overlaps between simulated organs, as indices into `organs`.
     overlaps: Vec<(usize, usize)>,
+    /// The parts every organ is kept out of.
+    obstacles: Vec<ObstacleSim>,
     settings: anthesis_flower::SimulationSettings,
     next_step: u32,
     /// Energy per organ at the previous keyframe, to spot blow-ups.
@@ -279,12 +283,17 @@ impl Simulation {
             })
             .collect();
         let previous_energy = vec![0.0; organs.len()];
+        let obstacles = anthesis_flower::parts::obstacles(flower)
+            .into_iter()
+            .map(ObstacleSim::new)
+            .collect();
         Ok(Simulation {
             organs,
             selection: selection.clone(),
             chosen,
             checkpoints: None,
             overlaps,
+            obstacles,
             settings: project.settings,
             next_step: 1,
             previous_energy,
@@ -496,6 +505,9 @@ impl Simulation {
             o.attach(step);
         });
 
+        for obstacle in &mut self.obstacles {
+            obstacle.move_to(step);
+        }
         let solver = self.settings.solver;
         let mut iterations = 0;
         let mut gradient = 0.0;
@@ -563,7 +575,7 @@ impl Simulation {
             for organ in &mut self.organs {
                 organ.attach(step);
             }
-            if self.overlaps.is_empty() {
+            if self.overlaps.is_empty() && self.obstacles.is_empty() {
                 break 0;
             }
             pressed = self.pressed(&contacts);
@@ -674,7 +686,9 @@ impl Simulation {
     /// current positions.
     fn contacts(&self, violated: Violated) -> Vec<Vec<Contact>> {
         let mut contacts = vec![Vec::new(); self.organs.len()];
+        self.obstacle_contacts(&mut contacts);
         if self.overlaps.is_empty() {
+            self.drop_base_contacts(&mut contacts);
             return contacts;
         }
         let normals: Vec<Vec<DVec3>> = self
@@ -715,12 +729,38 @@ impl Simulation {
                 &mut contacts[outer],
             );
         }
-        // Base particles sit on the receptacle, where organs meet by
-        // design; attachment, not collision, decides where they go.
-        for (organ, list) in self.organs.iter().zip(&mut contacts) {
+        self.drop_base_contacts(&mut contacts);
+        contacts
+    }
+
+    /// Base particles sit on the receptacle, where organs meet by design;
+    /// attachment, not collision, decides where they go.
+    fn drop_base_contacts(&self, contacts: &mut [Vec<Contact>]) {
+        for (organ, list) in self.organs.iter().zip(contacts) {
             list.retain(|c| !organ.is_base[c.particle as usize]);
         }
-        contacts
+    }
+
+    /// Contacts keeping every organ's particles outside the parts, each to
+    /// be put all the way out (a part does not move aside).
+    fn obstacle_contacts(&self, contacts: &mut [Vec<Contact>]) {
+        let offset = self.settings.collision_offset;
+        for (organ, list) in self.organs.iter().zip(contacts) {
+            let moving = organ.surface(&[]);
+            for obstacle in &self.obstacles {
+                if obstacle.near(&organ.positions) {
+                    contacts_against(
+                        &moving,
+                        &obstacle.surface(),
+                        obstacle.tracker(),
+                        1.0,
+                        offset,
+                        Violated::MoveAll,
+                        list,
+                    );
+                }
+            }
+        }
     }
 
     /// The paper's push-back: nobody ends on the wrong side. Organs are
@@ -739,6 +779,12 @@ impl Simulation {
         // pass again while that happens.
         for _ in 0..PUSH_BACK_PASSES {
             let mut pushed_in_pass = 0;
+            let mut outside = vec![Vec::new(); self.organs.len()];
+            self.obstacle_contacts(&mut outside);
+            self.drop_base_contacts(&mut outside);
+            for ((organ, list), moved) in self.organs.iter_mut().zip(&outside).zip(&mut moved) {
+                pushed_in_pass += push_back(&mut organ.positions, list, moved);
+            }
             for index in 0..self.overlaps.len() {
                 let (inner, outer) = self.overlaps[index];
                 for (moving, other, side) in [(inner, outer, 1.0), (outer, inner, -1.0)] {

@@ -6,8 +6,8 @@
 //! on what the step reads from the project: the time keys its blend weights
 //! name (with their maps and weights) and the joint angle at that step.
 //! Everything else a run reads (meshes, where organs sit, material
-//! constants, the model, the solver and collision settings) acts from the
-//! bud on; changing it starts the run over. Colours are not read at all.
+//! constants, the model, the solver and collision settings, the parts that
+//! are obstacles) acts from the bud on; changing it starts the run over. Colours are not read at all.
 
 use anthesis_flower::{Project, Template, joint_angle_after};
 
@@ -58,6 +58,8 @@ fn same_from_the_bud(before: &Project, after: &Project, organs: &[usize]) -> boo
     if settings(before) != settings(after)
         || before.flower.organs.len() != after.flower.organs.len()
         || before.flower.overlaps != after.flower.overlaps
+        || anthesis_flower::parts::obstacles(&before.flower)
+            != anthesis_flower::parts::obstacles(&after.flower)
     {
         return false;
     }

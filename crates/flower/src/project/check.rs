@@ -126,6 +126,26 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
         path,
     )?;
     check_unique(flower.organs.iter().map(|o| o.name.as_str()), "organ", path)?;
+    for part in &flower.parts {
+        if let Err(message) = part.check() {
+            return invalid(message);
+        }
+    }
+    // Exports name a node after every organ and part instance.
+    let instances: Vec<String> = flower
+        .parts
+        .iter()
+        .flat_map(|p| (0..p.count).map(|k| p.instance_name(k)))
+        .collect();
+    check_unique(
+        flower
+            .organs
+            .iter()
+            .map(|o| o.name.as_str())
+            .chain(instances.iter().map(String::as_str)),
+        "organ or part",
+        path,
+    )?;
 
     let settings = &project.settings;
     if settings.keyframes == 0 {

@@ -276,6 +276,11 @@ impl Loader<'_> {
                 overlaps.push(listed);
             }
         }
+        let parts = file
+            .parts
+            .iter()
+            .map(|part| part.part().map_err(|message| self.invalid(message)))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Project {
             name: file.name,
             flower: Flower {
@@ -283,6 +288,7 @@ impl Loader<'_> {
                 organs,
                 overlaps,
                 structure,
+                parts,
             },
             settings: file.simulation.settings(file.version),
         })

@@ -129,6 +129,7 @@
 mod check;
 mod error;
 mod load;
+mod parts;
 pub mod recovery;
 mod save;
 mod schema;
@@ -149,7 +150,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 
 /// Where saved meshes go, relative to the project file.
 pub const MESH_FOLDER: &str = "meshes";

@@ -203,6 +203,7 @@ mod tests {
                 }],
                 overlaps: Vec::new(),
                 structure: None,
+                parts: Vec::new(),
             },
             settings: SimulationSettings::default(),
         }

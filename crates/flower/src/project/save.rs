@@ -70,6 +70,7 @@ pub(super) fn plan_save(
         organs,
         overlaps,
         structure,
+        parts: flower.parts.iter().map(Into::into).collect(),
     };
     let body = toml::to_string(&file).map_err(|error| ProjectError::Invalid {
         path: path.to_path_buf(),
@@ -85,16 +86,20 @@ pub(super) fn plan_save(
 /// The format version a file of `project` needs: the oldest that holds
 /// everything it sets, so a project that sets nothing new stays readable by
 /// older builds and saves byte for byte as before (version 3 added
-/// `mean_edge`, version 4 `[structure]` and organ orientations).
+/// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
+/// `[[parts]]`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
+    if !flower.parts.is_empty() {
+        return FORMAT_VERSION;
+    }
     let placed = flower.structure.is_some()
         || flower
             .organs
             .iter()
             .any(|o| o.placement.orientation != glam::DQuat::IDENTITY);
     match (placed, project.settings.resolution) {
-        (true, _) => FORMAT_VERSION,
+        (true, _) => 4,
         (false, Resolution::AsBuilt) => 2,
         (false, Resolution::MeanEdge(_)) => 3,
     }

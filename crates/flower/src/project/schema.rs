@@ -27,6 +27,9 @@ pub(super) struct ProjectFile {
     /// Version 4: organs placed by whorls, a spiral or an L-system.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) structure: Option<StructureFile>,
+    /// Version 5: organs that do not grow.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) parts: Vec<super::parts::PartFile>,
 }
 
 /// `[structure]`: where the first organs come from.

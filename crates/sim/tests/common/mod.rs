@@ -141,6 +141,7 @@ pub fn inner_driven_into_outer_by(keyframes: u32, overlap: bool, inner_drive_deg
                 Vec::new()
             },
             structure: None,
+            parts: Vec::new(),
         },
         settings: SimulationSettings {
             keyframes,
