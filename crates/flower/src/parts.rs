@@ -481,13 +481,13 @@ pub fn part_pieces(flower: &Flower) -> Vec<PartPiece> {
     pieces
 }
 
-/// One obstacle: a part instance's whole surface (body and head) in its own
+/// One obstacle: a closed component of a part instance in the part's own
 /// frame, with where it sits and how it moves.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Obstacle {
     /// The instance's name.
     pub name: String,
-    /// Body and head in one closed mesh (outward normals).
+    /// One closed surface (outward normals).
     pub mesh: Mesh,
     /// Where the instance sits.
     pub placement: Placement,
@@ -507,32 +507,71 @@ impl Obstacle {
     }
 }
 
-/// The parts growing organs are kept out of, one per instance.
+/// The surfaces growing organs are kept out of: one per closed component
+/// of each part instance (a filament, its anther, each stigma lobe), so
+/// that where components overlap, "outside" of each is still its own
+/// surface's outside.
 pub fn obstacles(flower: &Flower) -> Vec<Obstacle> {
     let mut out = Vec::new();
     for part in flower.parts.iter().filter(|p| p.is_obstacle()) {
-        let mut mesh = Mesh::default();
-        for (piece, _, _) in part.meshes() {
-            append(&mut mesh, &piece);
-        }
+        let components: Vec<Mesh> = part
+            .meshes()
+            .iter()
+            .flat_map(|(mesh, _, _)| components(mesh))
+            .collect();
         for (k, placement) in part.placements().into_iter().enumerate() {
-            out.push(Obstacle {
-                name: part.instance_name(k as u32),
-                mesh: mesh.clone(),
-                placement,
-                schedule: part.schedule.clone(),
-            });
+            for mesh in &components {
+                out.push(Obstacle {
+                    name: part.instance_name(k as u32),
+                    mesh: mesh.clone(),
+                    placement,
+                    schedule: part.schedule.clone(),
+                });
+            }
         }
     }
     out
 }
 
-fn append(mesh: &mut Mesh, other: &Mesh) {
-    let offset = mesh.positions.len() as u32;
-    mesh.positions.extend_from_slice(&other.positions);
-    mesh.uvs.extend_from_slice(&other.uvs);
-    mesh.triangles
-        .extend(other.triangles.iter().map(|t| t.map(|i| i + offset)));
+/// The connected pieces of `mesh` (triangles sharing vertices), each with
+/// its own vertices, in the order of their first triangle.
+fn components(mesh: &Mesh) -> Vec<Mesh> {
+    let n = mesh.positions.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for t in &mesh.triangles {
+        for k in 1..3 {
+            let (a, b) = (root(&mut parent, t[0] as usize), root(&mut parent, t[k] as usize));
+            parent[a] = b;
+        }
+    }
+    let mut pieces: Vec<(usize, Mesh, Vec<Option<u32>>)> = Vec::new();
+    for t in &mesh.triangles {
+        let r = root(&mut parent, t[0] as usize);
+        let index = match pieces.iter().position(|(root, _, _)| *root == r) {
+            Some(i) => i,
+            None => {
+                pieces.push((r, Mesh::default(), vec![None; n]));
+                pieces.len() - 1
+            }
+        };
+        let (_, piece, map) = &mut pieces[index];
+        let tri = t.map(|v| {
+            *map[v as usize].get_or_insert_with(|| {
+                piece.positions.push(mesh.positions[v as usize]);
+                piece.uvs.push(mesh.uvs[v as usize]);
+                piece.positions.len() as u32 - 1
+            })
+        });
+        piece.triangles.push(tri);
+    }
+    pieces.into_iter().map(|(_, mesh, _)| mesh).collect()
 }
 
 /// A ring of a swept surface: its centre, two unit vectors spanning it

@@ -243,6 +243,28 @@ fn the_pedicel_points_down_and_a_receptacle_part_replaces_the_automatic_one() {
 }
 
 #[test]
+fn each_closed_component_is_an_obstacle_of_its_own() {
+    let flower = Flower {
+        templates: Vec::new(),
+        organs: Vec::new(),
+        overlaps: Vec::new(),
+        structure: None,
+        parts: vec![part(pistil(), 1), part(stamen(), 2)],
+    };
+    let obstacles = obstacles(&flower);
+    // Style, ovary and three lobes; filament and anther twice.
+    let names: Vec<&str> = obstacles.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["pistil", "pistil", "pistil", "pistil", "pistil", "stamen-1", "stamen-1", "stamen-2", "stamen-2"]
+    );
+    for o in &obstacles {
+        assert_closed_and_consistent(&o.mesh, &o.name);
+        assert!(volume(&o.mesh) > 0.0);
+    }
+}
+
+#[test]
 fn bad_parameters_are_refused_naming_the_part() {
     let mut p = part(stamen(), 6);
     assert_eq!(p.check(), Ok(()));
