@@ -150,6 +150,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             base_color: [0.95, 0.6, 0.3, 1.0],
             keyframes,
             base_color_png: None,
+            rigid: None,
         };
         write_tracks(out, OutputKind::of(out), &[track], &glb)?;
         eprintln!(

@@ -152,6 +152,21 @@ pub enum TrackProblem {
         /// The colour given.
         color: [f32; 4],
     },
+    #[error(
+        "its rigid motion does not match its keyframes ({local} local positions for {vertices} \
+         vertices, {poses} poses for {keyframes} keyframes, or a pose that is not finite)"
+    )]
+    /// A rigid track's local mesh or poses do not fit its keyframes.
+    RigidMotion {
+        /// Positions in the track's own frame.
+        local: usize,
+        /// Vertices of the keyframes.
+        vertices: usize,
+        /// Poses given.
+        poses: usize,
+        /// Keyframes given.
+        keyframes: usize,
+    },
     #[error("its base-colour texture is not a PNG file")]
     /// The base-colour texture is not a PNG.
     TextureNotPng,

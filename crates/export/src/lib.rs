@@ -68,7 +68,7 @@ mod usdc;
 
 use std::path::Path;
 
-use glam::{DVec2, DVec3};
+use glam::{DQuat, DVec2, DVec3};
 
 pub use between::KeyframeBlend;
 pub use error::{ExportError, TrackProblem};
@@ -76,7 +76,7 @@ pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
 pub use report::{GlbSize, GlbSizeReport, glb_size_report};
 pub use tracks::{
-    MAX_RENDER_POSITIONS, TrackLook, check_render_level, flower_tracks, organ_tracks,
+    MAX_RENDER_POSITIONS, TrackLook, check_render_level, flower_tracks, organ_tracks, part_track,
 };
 pub use usd::{
     USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, usdc_bytes, write_usd,
@@ -100,6 +100,41 @@ pub struct Track {
     /// Optional base-colour texture as the bytes of a PNG file, multiplied
     /// by `base_color` (so use white there to show the texture as it is).
     pub base_color_png: Option<Vec<u8>>,
+    /// Set when the track moves as a rigid body (a part turned by its
+    /// schedule): `keyframes[k][i]` is `poses[k]` applied to `local[i]`.
+    /// The .glb then animates the node's translation and rotation instead
+    /// of storing a morph target per keyframe; other formats use
+    /// `keyframes`.
+    pub rigid: Option<RigidMotion>,
+}
+
+/// A rigid track's mesh in its own frame and its pose at every keyframe.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RigidMotion {
+    /// Positions in the track's own frame.
+    pub local: Vec<DVec3>,
+    /// One pose per keyframe: world = translation + rotation · local.
+    pub poses: Vec<Pose>,
+}
+
+/// A rigid placement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// Where the local origin goes.
+    pub translation: DVec3,
+    /// A unit quaternion.
+    pub rotation: DQuat,
+}
+
+impl Pose {
+    /// The pose a fraction `t` of the way from `self` to `other` (linear
+    /// translation, spherical rotation, as glTF players interpolate).
+    pub fn towards(&self, other: &Pose, t: f64) -> Pose {
+        Pose {
+            translation: self.translation.lerp(other.translation, t),
+            rotation: self.rotation.slerp(other.rotation, t),
+        }
+    }
 }
 
 /// How keyframes map to animation time.

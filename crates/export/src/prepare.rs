@@ -74,6 +74,20 @@ fn check_track(track: &Track) -> Result<(), TrackProblem> {
     {
         return Err(TrackProblem::TextureNotPng);
     }
+    if let Some(rigid) = &track.rigid {
+        let finite = rigid.poses.iter().all(|p| {
+            p.translation.is_finite() && p.rotation.is_finite() && p.rotation.length() > 0.5
+        }) && rigid.local.iter().all(|p| p.is_finite());
+        if rigid.local.len() != vertex_count || rigid.poses.len() != track.keyframes.len() || !finite
+        {
+            return Err(TrackProblem::RigidMotion {
+                local: rigid.local.len(),
+                vertices: vertex_count,
+                poses: rigid.poses.len(),
+                keyframes: track.keyframes.len(),
+            });
+        }
+    }
     Ok(())
 }
 
@@ -231,6 +245,7 @@ mod tests {
             base_color: [1.0, 1.0, 1.0, 1.0],
             keyframes,
             base_color_png: None,
+            rigid: None,
         }
     }
 

@@ -5,13 +5,14 @@
 //! at the simulated resolution or as finer render meshes driven by the
 //! simulated ones (Loop subdivision, [`check_render_level`]).
 
-use anthesis_flower::{Flower, RECEPTACLE_COLOR, receptacle_for};
+use anthesis_flower::Flower;
+use anthesis_flower::parts::{PartPiece, part_pieces};
 use anthesis_mesh::Mesh;
 use anthesis_mesh::Subdivision;
 use anthesis_mesh::subdivide::subdivided_counts;
 use glam::{DVec2, DVec3};
 
-use crate::{ExportError, Track, TrackProblem};
+use crate::{ExportError, Pose, RigidMotion, Track, TrackProblem};
 
 /// What a [`Track`] keeps through a whole run: the name, the triangulation,
 /// the UV layout and the colour of one organ.
@@ -55,6 +56,7 @@ impl Track {
             base_color,
             keyframes: vec![mesh.positions],
             base_color_png: None,
+            rigid: None,
         }
     }
 }
@@ -77,6 +79,7 @@ pub fn organ_tracks<'a, 'k>(
             base_color: look.base_color,
             keyframes: Vec::new(),
             base_color_png: None,
+            rigid: None,
         })
         .collect();
     for organs in keyframes {
@@ -153,8 +156,10 @@ fn edge_count(triangles: &[[u32; 3]]) -> u64 {
 /// What an export of `flower` holds: one track per simulated organ (`organs`
 /// are indices into `flower.organs`, in the order the keyframes hold their
 /// positions), named after the organ and drawn with its template's mesh,
-/// UVs and colour, followed by the receptacle the organs sit on
-/// ([`receptacle_for`]) as a still track named `receptacle`.
+/// UVs and colour, followed by the flower's parts
+/// ([`anthesis_flower::parts::part_pieces`]: the receptacle the organs sit
+/// on, named `receptacle`, then every stamen, pistil and stem piece), each
+/// still or, where its schedule turns it, rigid ([`part_track`]).
 ///
 /// `keyframes` are as [`organ_tracks`] takes them: keyframe 0 (the bud)
 /// first. Without keyframes there is nothing to export: no tracks.
@@ -163,8 +168,8 @@ fn edge_count(triangles: &[[u32; 3]]) -> u64 {
 /// ([`Track::subdivided`]): the simulated mesh after that many levels of
 /// Loop subdivision, built once per organ and applied to every keyframe,
 /// about four times the vertices per level, with the template's UVs
-/// interpolated linearly so the painted maps land as on the simulated mesh. The receptacle, which is not simulated, is exported as
-/// it is. Fails when the level is too fine ([`check_render_level`]) or an
+/// interpolated linearly so the painted maps land as on the simulated mesh. The parts, which are not simulated, are exported as
+/// they are. Fails when the level is too fine ([`check_render_level`]) or an
 /// organ's mesh cannot be subdivided.
 pub fn flower_tracks<'k>(
     flower: &Flower,
@@ -186,6 +191,7 @@ pub fn flower_tracks<'k>(
             template.color,
         )
     });
+    let count = keyframes.len();
     let mut tracks = organ_tracks(looks, keyframes);
     if render_level > 0 {
         tracks = tracks
@@ -203,12 +209,53 @@ pub fn flower_tracks<'k>(
             })
             .collect::<Result<_, _>>()?;
     }
-    tracks.push(Track::still(
-        "receptacle",
-        receptacle_for(flower),
-        RECEPTACLE_COLOR,
-    ));
+    tracks.extend(part_pieces(flower).iter().map(|piece| part_track(piece, count)));
     Ok(tracks)
+}
+
+/// The track of a part's piece over `keyframe_count` keyframes: still
+/// where it does not move, rigid (its own mesh and a pose per keyframe)
+/// where its schedule turns it.
+pub fn part_track(piece: &PartPiece, keyframe_count: usize) -> Track {
+    if !piece.moves() || keyframe_count < 2 {
+        let mesh = Mesh {
+            positions: piece.positions_at(0),
+            ..piece.mesh.clone()
+        };
+        return Track::still(piece.name.clone(), mesh, piece.color);
+    }
+    let poses: Vec<Pose> = (0..keyframe_count as u32)
+        .map(|step| {
+            let (translation, rotation) = piece.pose(step);
+            Pose {
+                translation,
+                rotation,
+            }
+        })
+        .collect();
+    let keyframes = poses
+        .iter()
+        .map(|pose| {
+            piece
+                .mesh
+                .positions
+                .iter()
+                .map(|&p| pose.translation + pose.rotation * p)
+                .collect()
+        })
+        .collect();
+    Track {
+        name: piece.name.clone(),
+        triangles: piece.mesh.triangles.clone(),
+        uvs: piece.mesh.uvs.clone(),
+        base_color: piece.color,
+        keyframes,
+        base_color_png: None,
+        rigid: Some(RigidMotion {
+            local: piece.mesh.positions.clone(),
+            poses,
+        }),
+    }
 }
 
 impl Track {
@@ -257,6 +304,7 @@ impl Track {
             base_color: self.base_color,
             keyframes,
             base_color_png: self.base_color_png.clone(),
+            rigid: None,
         })
     }
 }
@@ -320,6 +368,7 @@ mod tests {
             base_color: [0.9, 0.8, 0.9, 1.0],
             keyframes,
             base_color_png: None,
+            rigid: None,
         }
     }
 

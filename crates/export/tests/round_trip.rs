@@ -674,6 +674,7 @@ fn meshopt_steps_do_not_accumulate_rounding() {
             })
             .collect(),
         base_color_png: None,
+        rigid: None,
     };
     let options = GlbOptions {
         encoding: Encoding::Meshopt,

@@ -465,6 +465,18 @@ impl GltfBuilder {
         self.accessor(element.accessor(Some(view), flat.len()))
     }
 
+    /// Animation output values, `N` floats per element (a translation or a
+    /// rotation quaternion per keyframe), stored as they are.
+    pub(super) fn animation_output<const N: usize>(&mut self, values: &[[f32; N]]) -> usize {
+        let kind = match N {
+            3 => "VEC3",
+            _ => "VEC4",
+        };
+        let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
+        let accessor = self.stored(&bytes, None, None, Element::plain(FLOAT, kind), values.len());
+        self.accessor(accessor)
+    }
+
     pub(super) fn times(&mut self, times: &[f32]) -> usize {
         let bytes = le_bytes(times.iter().copied(), f32::to_le_bytes);
         let mut accessor = self.stored(&bytes, None, None, SCALAR_F32, times.len());

@@ -14,7 +14,7 @@ use crate::prepare::{
     animation_times, sample_keyframes, sample_positions, target_name, validate_options,
     validate_tracks,
 };
-use crate::{ExportError, GlbOptions, Track};
+use crate::{ExportError, GlbOptions, Pose, Track};
 use builder::{
     CLAMP_TO_EDGE, GltfBuilder, KHR_MESH_QUANTIZATION, LINEAR, LINEAR_MIPMAP_LINEAR, TRIANGLES,
     f32_json,
@@ -70,9 +70,19 @@ pub fn glb_bytes(
     let mut images = Vec::new();
     let mut textures = Vec::new();
     let mut animated_nodes = Vec::new();
+    let mut top_nodes = Vec::with_capacity(tracks.len());
+    // Rigid tracks: the node that moves, and its pose at each exported
+    // keyframe.
+    let mut moving_nodes: Vec<(usize, Vec<Pose>)> = Vec::new();
 
     for (index, track) in tracks.iter().enumerate() {
-        let frames: Vec<Vec<DVec3>> = if track.keyframes.len() > 1 {
+        let rigid = track
+            .rigid
+            .as_ref()
+            .filter(|_| track.keyframes.len() > 1);
+        let frames: Vec<Vec<DVec3>> = if let Some(rigid) = rigid {
+            vec![rigid.local.clone()]
+        } else if track.keyframes.len() > 1 {
             sample_at
                 .iter()
                 .map(|&x| sample_keyframes(&track.keyframes, x))
@@ -119,11 +129,12 @@ pub fn glb_bytes(
             primitive["targets"] = Value::Array(encoded.targets);
             mesh["weights"] = Value::Array(vec![json!(0.0); target_count]);
             mesh["extras"] = json!({ "targetNames": target_names });
-            animated_nodes.push(index);
+            animated_nodes.push(nodes.len());
         }
         mesh["primitives"] = json!([primitive]);
         meshes.push(mesh);
 
+        let top = nodes.len();
         let mut node = json!({ "name": track.name, "mesh": index });
         if let Some(qbox) = encoded.dequantization {
             node["translation"] = json!(qbox.center.map(f32_json));
@@ -133,6 +144,21 @@ pub fn glb_bytes(
                 f32_json(qbox.scale)
             ]);
         }
+        if let Some(rigid) = rigid {
+            // The mesh (with its dequantisation) hangs below a node that
+            // carries the rigid motion.
+            let poses: Vec<Pose> = sample_at
+                .iter()
+                .map(|&x| sample_pose(&rigid.poses, x))
+                .collect();
+            let mover_index = nodes.len();
+            let mut mover = json!({ "name": track.name, "children": [mover_index + 1] });
+            set_pose(&mut mover, &poses[0]);
+            node["name"] = json!(format!("{} mesh", track.name));
+            nodes.push(mover);
+            moving_nodes.push((mover_index, poses));
+        }
+        top_nodes.push(top);
         nodes.push(node);
     }
 
@@ -142,34 +168,54 @@ pub fn glb_bytes(
             "generator": concat!("Anthesis (anthesis-export ", env!("CARGO_PKG_VERSION"), ")"),
         },
         "scene": 0,
-        "scenes": [{ "name": "flower", "nodes": (0..tracks.len()).collect::<Vec<_>>() }],
+        "scenes": [{ "name": "flower", "nodes": top_nodes }],
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
     });
 
-    if !animated_nodes.is_empty() {
+    if !animated_nodes.is_empty() || !moving_nodes.is_empty() {
         let sample_times = animation_times(options.timing, keyframe_count, &sample_at)?;
         let input = gltf.times(&sample_times);
-        let output = gltf.weights(
-            sample_at.len(),
-            target_count,
-            options.encoding,
-            TargetDeltas::of(options.encoding),
-        );
-        // All animated meshes share the keyframe times and the weights, so
-        // they share one sampler's accessors.
-        let samplers: Vec<Value> = animated_nodes
-            .iter()
-            .map(|_| json!({ "input": input, "output": output, "interpolation": "LINEAR" }))
-            .collect();
-        let channels: Vec<Value> = animated_nodes
-            .iter()
-            .enumerate()
-            .map(|(sampler, &node)| {
-                json!({ "sampler": sampler, "target": { "node": node, "path": "weights" } })
-            })
-            .collect();
+        let mut samplers = Vec::new();
+        let mut channels = Vec::new();
+        if !animated_nodes.is_empty() {
+            let output = gltf.weights(
+                sample_at.len(),
+                target_count,
+                options.encoding,
+                TargetDeltas::of(options.encoding),
+            );
+            // All animated meshes share the keyframe times and the weights,
+            // so they share one sampler's accessors.
+            for &node in &animated_nodes {
+                channels.push(json!({
+                    "sampler": samplers.len(),
+                    "target": { "node": node, "path": "weights" }
+                }));
+                samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
+            }
+        }
+        for (node, poses) in &moving_nodes {
+            let translations: Vec<[f32; 3]> = poses
+                .iter()
+                .map(|p| p.translation.as_vec3().to_array())
+                .collect();
+            let rotations: Vec<[f32; 4]> = poses
+                .iter()
+                .map(|p| p.rotation.normalize().as_quat().to_array())
+                .collect();
+            for (path, output) in [
+                ("translation", gltf.animation_output(&translations)),
+                ("rotation", gltf.animation_output(&rotations)),
+            ] {
+                channels.push(json!({
+                    "sampler": samplers.len(),
+                    "target": { "node": node, "path": path }
+                }));
+                samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
+            }
+        }
         root["animations"] =
             json!([{ "name": "opening", "samplers": samplers, "channels": channels }]);
     }
@@ -191,4 +237,19 @@ pub fn glb_bytes(
     let bytes = gltf.finish(root)?;
     progress(1.0);
     Ok(bytes)
+}
+
+/// The pose at `x` (in keyframes) of a sequence of poses: a keyframe's own,
+/// or the blend of its neighbours as [`crate::KeyframeBlend`] places it.
+fn sample_pose(poses: &[Pose], x: f64) -> Pose {
+    match crate::KeyframeBlend::at(poses.len(), x) {
+        Some(blend) => poses[blend.below].towards(&poses[blend.above], blend.fraction),
+        None => poses[0],
+    }
+}
+
+/// Writes `pose` as the node's translation and rotation.
+fn set_pose(node: &mut Value, pose: &Pose) {
+    node["translation"] = json!(pose.translation.as_vec3().to_array().map(f32_json));
+    node["rotation"] = json!(pose.rotation.normalize().as_quat().to_array().map(f32_json));
 }

@@ -65,6 +65,7 @@ pub fn organ_track(
             .map(|k| organ_at(template, placement, k as f64 / (keyframes - 1) as f64))
             .collect(),
         base_color_png: None,
+        rigid: None,
     }
 }
 
