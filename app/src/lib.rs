@@ -4,3 +4,4 @@
 pub mod animation;
 pub mod cli;
 pub mod desktop;
+pub mod parts;

@@ -309,14 +309,25 @@ fn simulate_scenes(
             .map(|((p, s), c)| OrganMesh::from_positions(&s.apply(p), s.triangles(), *c))
             .collect()
     };
+    let organs_at = |positions: &[Vec<glam::DVec3>], keyframe: u32| -> Vec<OrganMesh> {
+        let mut meshes = organs_at(positions);
+        meshes.extend(crate::parts::part_meshes(
+            &project.flower,
+            f64::from(keyframe),
+        ));
+        meshes
+    };
     let mut scenes: Vec<(u32, Vec<OrganMesh>)> = Vec::with_capacity(frames.len());
     if frames.first() == Some(&0) {
-        scenes.push((0, organs_at(&bud.positions_in_world)));
+        scenes.push((0, organs_at(&bud.positions_in_world, 0)));
     }
     let last_wanted = frames.last().copied().unwrap_or(0);
     run_keyframes(&mut sim, last_wanted, &mut |keyframe| {
         if frames.binary_search(&keyframe.index).is_ok() {
-            scenes.push((keyframe.index, organs_at(&keyframe.positions_in_world)));
+            scenes.push((
+                keyframe.index,
+                organs_at(&keyframe.positions_in_world, keyframe.index),
+            ));
         }
     })
     .into_result()?;

@@ -109,7 +109,12 @@ impl AnthesisApp {
         let (scene, meshes, revision) = self.scene.get(key, || {
             let scene =
                 viewport::build_scene(project, session, key.time_in_keyframes, key.show_others);
-            let meshes = viewport::scene_meshes(project, &scene, Some(key.selected_organ), overlay);
+            let mut meshes =
+                viewport::scene_meshes(project, &scene, Some(key.selected_organ), overlay);
+            meshes.extend(crate::parts::part_meshes(
+                &project.flower,
+                key.time_in_keyframes,
+            ));
             (scene, meshes)
         });
         if let Some(waited) = self.rerun.shown(

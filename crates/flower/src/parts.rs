@@ -25,8 +25,11 @@ use crate::{Flower, JointRamp, Placement, RECEPTACLE_COLOR, joint_angle_after, r
 const AROUND: usize = 10;
 /// Rings of a head between its poles.
 const HEAD_RINGS: usize = 7;
-/// The most rings along a tube.
-const MAX_TUBE_RINGS: usize = 96;
+/// The most rings along a tube: a gently curved tube needs few, and every
+/// vertex of a part is stored in every export (the lily's six stamens at
+/// one ring per 1.5 edges around took 6,000 vertices, a tenth of the
+/// .glb's size budget).
+const MAX_TUBE_RINGS: usize = 25;
 /// The most instances of one part.
 pub const MAX_PART_COUNT: u32 = 64;
 /// The most lobes of a stigma.

@@ -9,7 +9,6 @@
 
 use std::time::Instant;
 
-use anthesis_flower::{RECEPTACLE_COLOR, receptacle_mesh};
 use anthesis_garden::{flowers, shape};
 use anthesis_render::{Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
 use anthesis_sim::{Selection, run};
@@ -147,7 +146,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Err(e) = &result {
         println!("simulation stopped: {e}");
     }
-    let receptacle = receptacle_mesh(2.2, 1.5);
+    let pieces = anthesis_flower::parts::part_pieces(&project.flower);
     let mut renderer = OffscreenRenderer::new()?;
     let columns = kept.len() as u32;
     let rows = if only.is_some() {
@@ -158,17 +157,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut sheet = RgbaImage::new(tile * columns, tile * rows);
     let scenes: Vec<Vec<OrganMesh>> = kept
         .iter()
-        .map(|(_, positions)| {
+        .map(|(index, positions)| {
             let mut organs: Vec<OrganMesh> = positions
                 .iter()
                 .enumerate()
                 .map(|(i, p)| OrganMesh::from_positions(p, &meshes[i].triangles, colors[i]))
                 .collect();
-            organs.push(OrganMesh::from_positions(
-                &receptacle.positions,
-                &receptacle.triangles,
-                RECEPTACLE_COLOR,
-            ));
+            // The receptacle, stamens, pistil and stem, with the whole flower.
+            if only.is_none() {
+                organs.extend(pieces.iter().map(|piece| {
+                    OrganMesh::from_positions(
+                        &piece.positions_at(*index),
+                        &piece.mesh.triangles,
+                        piece.color,
+                    )
+                }));
+            }
             organs
         })
         .collect();

@@ -402,7 +402,7 @@ fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
             structure: None,
-            parts: Vec::new(),
+            parts: crate::parts::lily_parts(),
         },
         settings: SimulationSettings::default(),
     })
@@ -707,7 +707,7 @@ pub fn eustoma_of(
             organs: arrangement.organs,
             overlaps: arrangement.overlaps,
             structure: None,
-            parts: Vec::new(),
+            parts: crate::parts::eustoma_parts(),
         },
         settings: SimulationSettings::default(),
     })

@@ -24,6 +24,7 @@ pub use anthesis_flower::structure::whorl as arrangement;
 pub mod buds;
 pub mod flowers;
 pub mod paint;
+pub mod parts;
 pub mod shape;
 
 use std::io;

@@ -83,6 +83,22 @@ pub fn phong_point(corners: [DVec3; 3], normals: [DVec3; 3], weights: [f64; 3]) 
     0.5 * (flat + projected)
 }
 
+/// The winding number of a closed triangle surface around `x`: 1 inside
+/// a surface wound around its outward normals, 0 outside (−1 inside one
+/// wound inwards), from the solid angle of each triangle (Van Oosterom and
+/// Strackee's formula). The geometric inside test of the collision checks.
+pub fn winding_number(x: DVec3, positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let mut total = 0.0;
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize] - x);
+        let (la, lb, lc) = (a.length(), b.length(), c.length());
+        let numerator = a.dot(b.cross(c));
+        let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+        total += 2.0 * numerator.atan2(denominator);
+    }
+    total / (4.0 * std::f64::consts::PI)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,5 +180,31 @@ mod tests {
                 assert!(phong_point(corners, normals, at).distance(corners[k]) < 1e-15);
             }
         }
+    }
+
+    #[test]
+    fn the_winding_number_of_a_cube_is_one_inside_and_zero_outside() {
+        // A unit cube wound around its outward normals.
+        let positions: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let triangles: Vec<[u32; 3]> = quads
+            .iter()
+            .flat_map(|[a, b, c, d]| [[*a, *b, *c], [*a, *c, *d]])
+            .collect();
+        let inside = winding_number(DVec3::splat(0.3), &positions, &triangles);
+        let outside = winding_number(DVec3::new(1.4, 0.5, 0.5), &positions, &triangles);
+        assert!((inside - 1.0).abs() < 1e-12, "{inside}");
+        assert!(outside.abs() < 1e-12, "{outside}");
+        let flipped: Vec<[u32; 3]> = triangles.iter().map(|[a, b, c]| [*a, *c, *b]).collect();
+        assert!((winding_number(DVec3::splat(0.5), &positions, &flipped) + 1.0).abs() < 1e-12);
     }
 }

@@ -6,6 +6,7 @@ use anthesis_flower::JointRamp;
 use anthesis_flower::parts::{Part, PartShape, Tube, obstacles};
 use anthesis_flower::Project;
 use anthesis_sim::{Selection, fixtures, run};
+use anthesis_mesh::nearest::winding_number;
 use glam::DVec3;
 
 /// One petal of a one-organ whorl that tilts 40° inwards over the run, so
@@ -43,21 +44,6 @@ fn pistil() -> Part {
         color: [0.5, 0.7, 0.3, 1.0],
         head_color: [0.5, 0.7, 0.3, 1.0],
     }
-}
-
-/// The winding number of the closed surface around `x` (1 inside, 0
-/// outside), from the solid angles of its triangles (Van Oosterom and
-/// Strackee).
-fn winding_number(x: DVec3, positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
-    let mut total = 0.0;
-    for t in triangles {
-        let [a, b, c] = t.map(|i| positions[i as usize] - x);
-        let (la, lb, lc) = (a.length(), b.length(), c.length());
-        let numerator = a.dot(b.cross(c));
-        let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-        total += 2.0 * numerator.atan2(denominator);
-    }
-    total / (4.0 * std::f64::consts::PI)
 }
 
 /// The most particles inside the pistil (any of its closed components) at

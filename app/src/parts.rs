@@ -1,0 +1,76 @@
+//! What every view draws besides the growing organs: the flower's parts
+//! (the receptacle, stamens, pistils, the stem) at a keyframe time, the
+//! same pieces [`anthesis_export::flower_tracks`] exports.
+
+use anthesis_flower::Flower;
+use anthesis_flower::parts::part_pieces;
+use anthesis_render::OrganMesh;
+
+/// The parts of `flower` at `time_in_keyframes` (0 the bud; between two
+/// keyframes the positions blend linearly, as the timeline and the exports
+/// blend organs), each in its colour.
+pub fn part_meshes(flower: &Flower, time_in_keyframes: f64) -> Vec<OrganMesh> {
+    let time = if time_in_keyframes.is_finite() {
+        time_in_keyframes.max(0.0)
+    } else {
+        0.0
+    };
+    let below = time.floor();
+    let fraction = time - below;
+    let below = below.min(f64::from(u32::MAX - 1)) as u32;
+    part_pieces(flower)
+        .iter()
+        .map(|piece| {
+            let mut positions = piece.positions_at(below);
+            if fraction > 0.0 && piece.moves() {
+                let above = piece.positions_at(below + 1);
+                for (p, a) in positions.iter_mut().zip(above) {
+                    *p = p.lerp(a, fraction);
+                }
+            }
+            OrganMesh::from_positions(&positions, &piece.mesh.triangles, piece.color)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parts_blend_between_keyframes_and_the_receptacle_is_always_there() {
+        let mut project = anthesis_sim::fixtures::whorl(1, 4, 6, 10);
+        let meshes = part_meshes(&project.flower, 3.5);
+        assert_eq!(meshes.len(), 1, "the receptacle alone");
+        project.flower.parts = vec![anthesis_flower::parts::Part {
+            name: "pistil".into(),
+            shape: anthesis_flower::parts::PartShape::Pedicel {
+                stalk: anthesis_flower::parts::Tube {
+                    length: 5.0,
+                    radius: 0.2,
+                    curvature_deg: 0.0,
+                },
+            },
+            count: 1,
+            ring_radius: 0.0,
+            height: 0.0,
+            offset_deg: 0.0,
+            angle_deg: 0.0,
+            schedule: vec![anthesis_flower::JointRamp {
+                from_step: 0,
+                to_step: 10,
+                angle_deg: 20.0,
+            }],
+            color: [0.2, 0.5, 0.2, 1.0],
+            head_color: [0.2, 0.5, 0.2, 1.0],
+        }];
+        let at = |t: f64| part_meshes(&project.flower, t)[1].positions_in_world.clone();
+        let (three, four, between) = (at(3.0), at(4.0), at(3.5));
+        for ((a, b), m) in three.iter().zip(&four).zip(&between) {
+            for k in 0..3 {
+                assert!((0.5 * (a[k] + b[k]) - m[k]).abs() < 1e-5);
+            }
+        }
+        assert_ne!(three, four);
+    }
+}
