@@ -64,7 +64,11 @@ mod tests {
             color: [0.2, 0.5, 0.2, 1.0],
             head_color: [0.2, 0.5, 0.2, 1.0],
         }];
-        let at = |t: f64| part_meshes(&project.flower, t)[1].positions_in_world.clone();
+        let at = |t: f64| {
+            part_meshes(&project.flower, t)[1]
+                .positions_in_world
+                .clone()
+        };
         let (three, four, between) = (at(3.0), at(4.0), at(3.5));
         for ((a, b), m) in three.iter().zip(&four).zip(&between) {
             for k in 0..3 {

@@ -78,7 +78,9 @@ fn check_track(track: &Track) -> Result<(), TrackProblem> {
         let finite = rigid.poses.iter().all(|p| {
             p.translation.is_finite() && p.rotation.is_finite() && p.rotation.length() > 0.5
         }) && rigid.local.iter().all(|p| p.is_finite());
-        if rigid.local.len() != vertex_count || rigid.poses.len() != track.keyframes.len() || !finite
+        if rigid.local.len() != vertex_count
+            || rigid.poses.len() != track.keyframes.len()
+            || !finite
         {
             return Err(TrackProblem::RigidMotion {
                 local: rigid.local.len(),

@@ -209,7 +209,11 @@ pub fn flower_tracks<'k>(
             })
             .collect::<Result<_, _>>()?;
     }
-    tracks.extend(part_pieces(flower).iter().map(|piece| part_track(piece, count)));
+    tracks.extend(
+        part_pieces(flower)
+            .iter()
+            .map(|piece| part_track(piece, count)),
+    );
     Ok(tracks)
 }
 

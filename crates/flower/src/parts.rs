@@ -60,7 +60,11 @@ impl Tube {
             return (DVec3::new(0.0, s, 0.0), tangent);
         }
         let bend_radius = self.length / turn;
-        let point = DVec3::new(0.0, bend_radius * phi.sin(), bend_radius * (1.0 - phi.cos()));
+        let point = DVec3::new(
+            0.0,
+            bend_radius * phi.sin(),
+            bend_radius * (1.0 - phi.cos()),
+        );
         (point, tangent)
     }
 }
@@ -261,7 +265,14 @@ impl Part {
                 // The anther touches the filament's tip, sunk a little into it.
                 let centre = tip + tangent * (reach - 0.5 * filament.radius.min(reach));
                 let mut anther = Mesh::default();
-                head(&mut anther, centre, axis, half, anther_radius, (HEAD_V, 1.0));
+                head(
+                    &mut anther,
+                    centre,
+                    axis,
+                    half,
+                    anther_radius,
+                    (HEAD_V, 1.0),
+                );
                 vec![
                     (tube_mesh(&filament, (0.0, HEAD_V)), self.color, ""),
                     (anther, self.head_color, "-anther"),
@@ -305,7 +316,8 @@ impl Part {
                         let a = TAU * f64::from(k) / f64::from(stigma_lobes);
                         let out = side * a.cos() + other * a.sin();
                         let axis = (tangent + out).normalize();
-                        let centre = tip + tangent * (0.5 * stigma_radius) + out * (0.5 * stigma_radius);
+                        let centre =
+                            tip + tangent * (0.5 * stigma_radius) + out * (0.5 * stigma_radius);
                         head(
                             &mut stigma,
                             centre,
@@ -316,10 +328,7 @@ impl Part {
                         );
                     }
                 }
-                vec![
-                    (body, self.color, ""),
-                    (stigma, self.head_color, "-stigma"),
-                ]
+                vec![(body, self.color, ""), (stigma, self.head_color, "-stigma")]
             }
             PartShape::Pedicel { stalk } => vec![(tube_mesh(&stalk, (0.0, 1.0)), self.color, "")],
             PartShape::Receptacle { radius, depth } => {
@@ -336,14 +345,18 @@ impl Part {
             if x.is_finite() && x > 0.0 {
                 Ok(())
             } else {
-                Err(format!("{kind} \"{name}\": {what} must be a positive number, not {x}"))
+                Err(format!(
+                    "{kind} \"{name}\": {what} must be a positive number, not {x}"
+                ))
             }
         };
         let not_negative = |what: &str, x: f64| {
             if x.is_finite() && x >= 0.0 {
                 Ok(())
             } else {
-                Err(format!("{kind} \"{name}\": {what} must be 0 or more, not {x}"))
+                Err(format!(
+                    "{kind} \"{name}\": {what} must be 0 or more, not {x}"
+                ))
             }
         };
         let tube = |what: &str, tube: &Tube| -> Result<(), String> {
@@ -375,7 +388,9 @@ impl Part {
                 positive("anther_length", anther_length)?;
                 positive("anther_radius", anther_radius)?;
                 if !anther_tilt_deg.is_finite() {
-                    return Err(format!("{kind} \"{name}\": anther_tilt_deg must be a number"));
+                    return Err(format!(
+                        "{kind} \"{name}\": anther_tilt_deg must be a number"
+                    ));
                 }
             }
             PartShape::Pistil {
@@ -420,7 +435,9 @@ impl Part {
             ("angle_deg", self.angle_deg),
         ] {
             if !x.is_finite() {
-                return Err(format!("{kind} \"{name}\": {what} must be a number, not {x}"));
+                return Err(format!(
+                    "{kind} \"{name}\": {what} must be a number, not {x}"
+                ));
             }
         }
         for ramp in &self.schedule {
@@ -550,7 +567,10 @@ fn components(mesh: &Mesh) -> Vec<Mesh> {
     }
     for t in &mesh.triangles {
         for k in 1..3 {
-            let (a, b) = (root(&mut parent, t[0] as usize), root(&mut parent, t[k] as usize));
+            let (a, b) = (
+                root(&mut parent, t[0] as usize),
+                root(&mut parent, t[k] as usize),
+            );
             parent[a] = b;
         }
     }
@@ -640,7 +660,12 @@ fn tube_mesh(tube: &Tube, v_range: (f64, f64)) -> Mesh {
         .collect();
     let (tip, _) = tube.centre_at(tube.length);
     let mut mesh = Mesh::default();
-    sweep(&mut mesh, &rings, (DVec3::ZERO, v_range.0), (tip, v_range.1));
+    sweep(
+        &mut mesh,
+        &rings,
+        (DVec3::ZERO, v_range.0),
+        (tip, v_range.1),
+    );
     mesh
 }
 

@@ -1656,17 +1656,27 @@ fn parts_are_saved_as_readable_tables_and_load_back_equal() {
     let path = folder.path().join("lily.anthesis.toml");
     save_project(&project, &path).expect("saves");
     let text = fs::read_to_string(&path).expect("read");
-    assert!(text.contains(&format!("version = {FORMAT_VERSION}")), "{text}");
+    assert!(
+        text.contains(&format!("version = {FORMAT_VERSION}")),
+        "{text}"
+    );
     assert_eq!(text.matches("[[parts]]").count(), 4, "{text}");
     assert!(text.contains("kind = \"stamen\"") && text.contains("anther_tilt_deg = 90.0"));
     assert!(text.contains("[[parts.schedule]]"), "{text}");
     // Keys of other kinds are not written.
     let pedicel = &text[text.find("name = \"pedicel\"").expect("pedicel")..];
-    assert!(!pedicel.contains("anther") && !pedicel.contains("depth"), "{pedicel}");
+    assert!(
+        !pedicel.contains("anther") && !pedicel.contains("depth"),
+        "{pedicel}"
+    );
     assert_eq!(load_project(&path).expect("loads"), project);
     // Without parts the lily stays at its old version.
     let (_f, plain) = saved_lily();
-    assert!(fs::read_to_string(plain).expect("read").contains("version = 2"));
+    assert!(
+        fs::read_to_string(plain)
+            .expect("read")
+            .contains("version = 2")
+    );
 }
 
 #[test]
@@ -1680,17 +1690,28 @@ fn broken_parts_are_refused_naming_the_part_and_the_key() {
         load_project(&path).expect_err("refused").to_string()
     };
     let err = with("name = \"s\"\nkind = \"stamen\"\nlength = 5.0\nradius = 0.1\n");
-    assert!(err.contains("stamen \"s\": `anther_length` is missing"), "{err}");
+    assert!(
+        err.contains("stamen \"s\": `anther_length` is missing"),
+        "{err}"
+    );
     let err = with("name = \"s\"\nkind = \"petal\"\n");
-    assert!(err.contains("kind must be one of stamen, pistil, pedicel, receptacle"), "{err}");
+    assert!(
+        err.contains("kind must be one of stamen, pistil, pedicel, receptacle"),
+        "{err}"
+    );
     let err = with("name = \"p\"\nkind = \"pedicel\"\nlength = 5.0\nradius = 0.1\ndepth = 1.0\n");
-    assert!(err.contains("`depth` is not a setting of a pedicel"), "{err}");
+    assert!(
+        err.contains("`depth` is not a setting of a pedicel"),
+        "{err}"
+    );
     let err = with(
         "name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\n\
          stigma_lobes = 12\n",
     );
     assert!(err.contains("stigma_lobes must be 1 to 8, not 12"), "{err}");
-    let err = with("name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\nwidth = 2\n");
+    let err = with(
+        "name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\nwidth = 2\n",
+    );
     assert!(err.contains("width"), "{err}");
     // An instance named like an organ.
     let err = with(

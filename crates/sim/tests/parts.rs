@@ -3,10 +3,10 @@
 //! closed surface), not by trusting the solver.
 
 use anthesis_flower::JointRamp;
-use anthesis_flower::parts::{Part, PartShape, Tube, obstacles};
 use anthesis_flower::Project;
-use anthesis_sim::{Selection, fixtures, run};
+use anthesis_flower::parts::{Part, PartShape, Tube, obstacles};
 use anthesis_mesh::nearest::winding_number;
+use anthesis_sim::{Selection, fixtures, run};
 use glam::DVec3;
 
 /// One petal of a one-organ whorl that tilts 40° inwards over the run, so
@@ -78,7 +78,10 @@ fn a_petal_swung_into_a_pistil_stays_outside_it() {
     let without = petal_swinging_in();
     // Without the part the petal sweeps through where the pistil stands.
     let crossing = most_inside(&without, &pistil());
-    assert!(crossing > 5, "{crossing} particles: the petal never reached the pistil");
+    assert!(
+        crossing > 5,
+        "{crossing} particles: the petal never reached the pistil"
+    );
     let mut with = petal_swinging_in();
     with.flower.parts = vec![pistil()];
     assert_eq!(most_inside(&with, &pistil()), 0);
@@ -90,8 +93,16 @@ fn the_winding_number_tells_inside_from_outside() {
     flower.parts = vec![pistil()];
     let obstacle = obstacles(&flower).remove(0);
     let surface = obstacle.positions_at(0);
-    let inside = winding_number(DVec3::new(0.1, 5.0, 0.0), &surface, &obstacle.mesh.triangles);
-    let outside = winding_number(DVec3::new(1.5, 5.0, 0.0), &surface, &obstacle.mesh.triangles);
+    let inside = winding_number(
+        DVec3::new(0.1, 5.0, 0.0),
+        &surface,
+        &obstacle.mesh.triangles,
+    );
+    let outside = winding_number(
+        DVec3::new(1.5, 5.0, 0.0),
+        &surface,
+        &obstacle.mesh.triangles,
+    );
     assert!((inside - 1.0).abs() < 1e-9, "{inside}");
     assert!(outside.abs() < 1e-9, "{outside}");
 }

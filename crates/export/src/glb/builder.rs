@@ -473,7 +473,13 @@ impl GltfBuilder {
             _ => "VEC4",
         };
         let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
-        let accessor = self.stored(&bytes, None, None, Element::plain(FLOAT, kind), values.len());
+        let accessor = self.stored(
+            &bytes,
+            None,
+            None,
+            Element::plain(FLOAT, kind),
+            values.len(),
+        );
         self.accessor(accessor)
     }
 

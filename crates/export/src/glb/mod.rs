@@ -76,10 +76,7 @@ pub fn glb_bytes(
     let mut moving_nodes: Vec<(usize, Vec<Pose>)> = Vec::new();
 
     for (index, track) in tracks.iter().enumerate() {
-        let rigid = track
-            .rigid
-            .as_ref()
-            .filter(|_| track.keyframes.len() > 1);
+        let rigid = track.rigid.as_ref().filter(|_| track.keyframes.len() > 1);
         let frames: Vec<Vec<DVec3>> = if let Some(rigid) = rigid {
             vec![rigid.local.clone()]
         } else if track.keyframes.len() > 1 {
@@ -193,7 +190,8 @@ pub fn glb_bytes(
                     "sampler": samplers.len(),
                     "target": { "node": node, "path": "weights" }
                 }));
-                samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
+                samplers
+                    .push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
             }
         }
         for (node, poses) in &moving_nodes {
@@ -213,7 +211,8 @@ pub fn glb_bytes(
                     "sampler": samplers.len(),
                     "target": { "node": node, "path": path }
                 }));
-                samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
+                samplers
+                    .push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
             }
         }
         root["animations"] =

@@ -63,7 +63,10 @@ fn assert_closed_and_consistent(mesh: &Mesh, what: &str) {
     }
     assert_eq!(mesh.positions.len(), mesh.uvs.len());
     for uv in &mesh.uvs {
-        assert!((0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y), "{what}: uv {uv}");
+        assert!(
+            (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y),
+            "{what}: uv {uv}"
+        );
     }
 }
 
@@ -125,7 +128,11 @@ fn a_tube_bends_outwards_along_a_circular_arc() {
     assert!((tip - DVec3::new(0.0, 2.0, 2.0)).length() < 1e-12, "{tip}");
     assert!((tangent - DVec3::Z).length() < 1e-12);
     let (middle, _) = t.centre_at(0.5 * PI);
-    let expected = DVec3::new(0.0, 2.0 * (0.25 * PI).sin(), 2.0 * (1.0 - (0.25 * PI).cos()));
+    let expected = DVec3::new(
+        0.0,
+        2.0 * (0.25 * PI).sin(),
+        2.0 * (1.0 - (0.25 * PI).cos()),
+    );
     assert!((middle - expected).length() < 1e-12);
     // Inward curvature mirrors it.
     let (tip, _) = tube(PI, 0.05, -90.0).centre_at(PI);
@@ -150,9 +157,7 @@ fn the_anther_sits_on_the_filament_tip_across_it() {
     // across the filament's tip tangent.
     let axis = (anther.positions[anther.positions.len() - 1] - anther.positions[0]).normalize();
     assert!(axis.dot(tangent).abs() < 1e-9);
-    assert!(
-        (anther.positions[0].distance(*anther.positions.last().unwrap()) - 1.5).abs() < 1e-9
-    );
+    assert!((anther.positions[0].distance(*anther.positions.last().unwrap()) - 1.5).abs() < 1e-9);
 }
 
 #[test]
@@ -188,8 +193,8 @@ fn instances_go_around_the_axis_and_a_schedule_turns_them_outwards() {
     let lean = |step: u32| {
         let (_, rotation) = piece.pose(step);
         let up = rotation * DVec3::Y;
-        let outwards = DVec3::new(piece.placement.position.x, 0.0, piece.placement.position.z)
-            .normalize();
+        let outwards =
+            DVec3::new(piece.placement.position.x, 0.0, piece.placement.position.z).normalize();
         up.dot(outwards).atan2(up.y).to_degrees()
     };
     assert!((lean(0) - 10.0).abs() < 1e-9);
@@ -256,7 +261,10 @@ fn each_closed_component_is_an_obstacle_of_its_own() {
     let names: Vec<&str> = obstacles.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(
         names,
-        ["pistil", "pistil", "pistil", "pistil", "pistil", "stamen-1", "stamen-1", "stamen-2", "stamen-2"]
+        [
+            "pistil", "pistil", "pistil", "pistil", "pistil", "stamen-1", "stamen-1", "stamen-2",
+            "stamen-2"
+        ]
     );
     for o in &obstacles {
         assert_closed_and_consistent(&o.mesh, &o.name);
@@ -292,7 +300,12 @@ fn bad_parameters_are_refused_naming_the_part() {
         ovary_length: 0.0,
         ovary_radius: 0.0,
     };
-    assert!(pistil.check().unwrap_err().contains("stigma_lobes must be 1 to 8"));
+    assert!(
+        pistil
+            .check()
+            .unwrap_err()
+            .contains("stigma_lobes must be 1 to 8")
+    );
     let mut receptacle = part(
         PartShape::Receptacle {
             radius: 1.0,

@@ -83,6 +83,31 @@
 //! # kind = "lsystem": [structure.lsystem] with steps, text (the L-system,
 //! # see `structure::lsystem`) and surfaces = { p = "petal", c = "sepal" }:
 //! # each ~X places an organ of that template in the turtle's frame.
+//!
+//! # Version 5: organs that do not grow (see `crate::parts`).
+//! [[parts]]
+//! name = "stamen"              # instances stamen-1, stamen-2, ... (count > 1)
+//! kind = "stamen"              # or "pistil", "pedicel", "receptacle"
+//! count = 6                    # optional, default 1
+//! ring_radius = 0.9            # optional: bases this far from the axis
+//! height = 0.4                 # optional
+//! offset_deg = 30.0            # optional: azimuth of the first
+//! angle_deg = 3.0              # optional: initial tilt outwards
+//! length = 27.0                # stamen, pistil, pedicel: the tube
+//! radius = 0.22                # (receptacle: its radius, with depth)
+//! curvature_deg = 6.0          # optional: the tube turns outwards
+//! anther_length = 4.0          # stamen
+//! anther_radius = 0.55         # stamen
+//! anther_tilt_deg = 90.0       # stamen, optional: 90 lies across the tip
+//! # pistil: stigma_radius, stigma_lobes (default 1), ovary_length and
+//! # ovary_radius (default 0: none); receptacle: radius, depth.
+//! color = [0.9, 0.62, 0.3, 1.0]        # optional, a default per kind
+//! head_color = [0.3, 0.06, 0.02, 1.0]  # stamen, pistil: anther or stigma
+//!
+//! [[parts.schedule]]           # optional: turns it like a joint schedule
+//! from_step = 20
+//! to_step = 80
+//! degrees = 30.0
 //! ```
 //!
 //! # Rules

@@ -78,12 +78,24 @@ impl PartFile {
             ));
         }
         let optional: [(&str, bool, &[&str]); 11] = [
-            ("length", self.length.is_some(), &["stamen", "pistil", "pedicel"]),
+            (
+                "length",
+                self.length.is_some(),
+                &["stamen", "pistil", "pedicel"],
+            ),
             ("radius", self.radius.is_some(), &KINDS),
-            ("curvature_deg", self.curvature_deg.is_some(), &["stamen", "pistil", "pedicel"]),
+            (
+                "curvature_deg",
+                self.curvature_deg.is_some(),
+                &["stamen", "pistil", "pedicel"],
+            ),
             ("anther_length", self.anther_length.is_some(), &["stamen"]),
             ("anther_radius", self.anther_radius.is_some(), &["stamen"]),
-            ("anther_tilt_deg", self.anther_tilt_deg.is_some(), &["stamen"]),
+            (
+                "anther_tilt_deg",
+                self.anther_tilt_deg.is_some(),
+                &["stamen"],
+            ),
             ("stigma_radius", self.stigma_radius.is_some(), &["pistil"]),
             ("stigma_lobes", self.stigma_lobes.is_some(), &["pistil"]),
             ("ovary_length", self.ovary_length.is_some(), &["pistil"]),
@@ -92,7 +104,9 @@ impl PartFile {
         ];
         for (key, given, kinds) in optional {
             if given && !kinds.contains(&kind) {
-                return Err(format!("{kind} \"{name}\": `{key}` is not a setting of a {kind}"));
+                return Err(format!(
+                    "{kind} \"{name}\": `{key}` is not a setting of a {kind}"
+                ));
             }
         }
         if self.head_color.is_some() && !matches!(kind, "stamen" | "pistil") {
