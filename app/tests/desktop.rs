@@ -1926,3 +1926,63 @@ fn the_in_app_file_browser_navigates_filters_and_opens_saves_and_exports() {
     );
     let _ = std::fs::remove_dir_all(root);
 }
+
+/// Scrolls the widget labelled `label` into view and clicks it (the
+/// parameters panel is taller than the window).
+fn click_in_view(harness: &mut Harness<'_, AnthesisApp>, label: &str) {
+    harness.get_by_label(label).scroll_to_me();
+    harness.run();
+    harness.get_by_label(label).click();
+    harness.run();
+}
+
+#[test]
+fn parts_are_added_edited_and_removed_from_the_parameters_panel_with_undo() {
+    let mut harness = opened_small_flower();
+    let first_run = harness.state().session().run();
+    assert!(harness.state().project().flower.parts.is_empty());
+
+    click_in_view(&mut harness, "Add stamens");
+    let app = harness.state();
+    let parts = &app.project().flower.parts;
+    assert_eq!(parts.len(), 1);
+    assert_eq!(parts[0].name, "stamen");
+    assert_eq!(parts[0].count, 5);
+    assert!(app.session().run() > first_run, "a part restarts the run");
+    let after_add = app.session().run();
+
+    click_in_view(&mut harness, "Add pistil");
+    assert_eq!(harness.state().project().flower.parts.len(), 2);
+    // The new part's parameters: open it and change its count.
+    click_in_view(&mut harness, "stamen “stamen” × 5");
+    click_in_view(&mut harness, "count");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("count").type_text("7");
+    harness.run();
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.project().flower.parts[0].count, 7);
+    assert!(app.session().run() > after_add);
+    assert!(
+        app.document()
+            .undo_label()
+            .is_some_and(|l| l.contains("count of stamen")),
+        "{:?}",
+        app.document().undo_label()
+    );
+
+    harness.snapshot("parts_panel");
+
+    // Undo the count and the pistil; the stamens stay.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    let parts = &harness.state().project().flower.parts;
+    assert_eq!(parts.len(), 1);
+    assert_eq!(parts[0].count, 5);
+
+    click_in_view(&mut harness, "Remove part");
+    assert!(harness.state().project().flower.parts.is_empty());
+}

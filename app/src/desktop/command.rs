@@ -128,6 +128,9 @@ pub enum ProjectEdit {
     /// The resolution every template is simulated at (the parameters
     /// panel); the meshes as built stay in the project.
     Resolution(Resolution),
+    /// The flower's parts (stamens, pistils, stem, receptacle), all of
+    /// them: the parts section of the parameters panel.
+    Parts(Vec<anthesis_flower::parts::Part>),
     /// Replace one map of a time key.
     Map {
         template: usize,
@@ -202,6 +205,7 @@ impl ProjectEdit {
                 }
             }
             ProjectEdit::Resolution(resolution) => project.settings.resolution = resolution,
+            ProjectEdit::Parts(parts) => project.flower.parts = parts,
             ProjectEdit::Map { template, key, map } => {
                 let Some(k) = templates
                     .get_mut(template)
@@ -457,6 +461,9 @@ mod tests {
                 )),
             },
             ProjectEdit::Resolution(Resolution::MeanEdge(0.5)),
+            ProjectEdit::Parts(vec![crate::desktop::parts_panel::new_part(
+                project, "pistil",
+            )]),
         ]
     }
 

@@ -21,6 +21,7 @@ mod menus;
 pub mod paint;
 mod panels;
 pub mod params;
+pub mod parts_panel;
 mod project_io;
 mod prompts;
 pub mod rerun;

@@ -7,6 +7,7 @@ use eframe::egui;
 use super::AnthesisApp;
 use super::command::Command;
 use super::params;
+use super::parts_panel;
 use super::timeline;
 use super::viewport;
 
@@ -52,6 +53,8 @@ impl AnthesisApp {
                     &resolved,
                     template,
                 ));
+                ui.separator();
+                chosen.extend(parts_panel::parts_ui(ui, self.doc.project()));
             });
         self.queued.extend(chosen);
     }

@@ -153,6 +153,32 @@ pub struct Part {
     pub head_color: [f32; 4],
 }
 
+/// The name of instance `k` (from 0) of a part named `name` repeated
+/// `count` times: `NAME-1`, `NAME-2`, …, or just `NAME` alone.
+pub fn instance_name(name: &str, count: u32, k: u32) -> String {
+    if count == 1 {
+        name.to_string()
+    } else {
+        format!("{name}-{}", k + 1)
+    }
+}
+
+/// The colours a part of this shape gets unless told otherwise (linear
+/// RGBA, body and head): a pale filament with a pollen-orange anther, a
+/// pale green style and stigma, a stem green.
+pub fn default_colors(shape: &PartShape) -> ([f32; 4], [f32; 4]) {
+    const PALE: [f32; 4] = [0.80, 0.82, 0.60, 1.0];
+    const POLLEN: [f32; 4] = [0.55, 0.18, 0.03, 1.0];
+    const STYLE: [f32; 4] = [0.62, 0.72, 0.40, 1.0];
+    match shape {
+        PartShape::Stamen { .. } => (PALE, POLLEN),
+        PartShape::Pistil { .. } => (STYLE, STYLE),
+        PartShape::Pedicel { .. } | PartShape::Receptacle { .. } => {
+            (RECEPTACLE_COLOR, RECEPTACLE_COLOR)
+        }
+    }
+}
+
 /// One mesh of a part instance as views and exports draw it: the body
 /// (tube, ovary) or the head (anther, stigma).
 #[derive(Debug, Clone, PartialEq)]
@@ -231,11 +257,7 @@ impl Part {
 
     /// The name of instance `k` (from 0).
     pub fn instance_name(&self, k: u32) -> String {
-        if self.count == 1 {
-            self.name.clone()
-        } else {
-            format!("{}-{}", self.name, k + 1)
-        }
+        instance_name(&self.name, self.count, k)
     }
 
     /// Whether growing organs are kept out of it (every part but the

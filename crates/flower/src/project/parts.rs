@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::schema::JointRampFile;
-use crate::parts::{Part, PartShape, Tube};
+use crate::parts::{Part, PartShape, Tube, default_colors};
 
 /// One `[[parts]]` entry.
 #[derive(Serialize, Deserialize, Default)]
@@ -58,12 +58,6 @@ fn one() -> u32 {
 
 /// The kinds a file may name.
 pub(super) const KINDS: [&str; 4] = ["stamen", "pistil", "pedicel", "receptacle"];
-
-/// Default colours (linear RGBA): a pale filament, a pollen-orange anther,
-/// a pale green style and stigma, a stem green.
-const PALE: [f32; 4] = [0.80, 0.82, 0.60, 1.0];
-const POLLEN: [f32; 4] = [0.55, 0.18, 0.03, 1.0];
-const STYLE: [f32; 4] = [0.62, 0.72, 0.40, 1.0];
 
 impl PartFile {
     /// The part this entry describes, or a message naming the part and
@@ -167,17 +161,6 @@ impl PartFile {
         };
         part.check()?;
         Ok(part)
-    }
-}
-
-/// The colours a part gets when its entry names none.
-pub(crate) fn default_colors(shape: &PartShape) -> ([f32; 4], [f32; 4]) {
-    match shape {
-        PartShape::Stamen { .. } => (PALE, POLLEN),
-        PartShape::Pistil { .. } => (STYLE, STYLE),
-        PartShape::Pedicel { .. } | PartShape::Receptacle { .. } => {
-            (crate::RECEPTACLE_COLOR, crate::RECEPTACLE_COLOR)
-        }
     }
 }
 
