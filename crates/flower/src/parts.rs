@@ -520,7 +520,42 @@ pub fn part_pieces(flower: &Flower) -> Vec<PartPiece> {
             }
         }
     }
+    pieces.extend(segment_pieces(flower));
     pieces
+}
+
+/// The tubes the flower's L-system draws with `F` (see
+/// [`crate::structure::Structure::segments`]), named `segment-1`, … in the
+/// word's order, in the stem's colour; they do not move.
+fn segment_pieces(flower: &Flower) -> Vec<PartPiece> {
+    let Some(structure) = &flower.structure else {
+        return Vec::new();
+    };
+    structure
+        .segments()
+        .iter()
+        .enumerate()
+        .map(|(k, segment)| {
+            let along = segment.end - segment.start;
+            let tube = Tube {
+                length: along.length(),
+                radius: 0.5 * segment.width,
+                curvature_deg: 0.0,
+            };
+            PartPiece {
+                name: format!("segment-{}", k + 1),
+                mesh: tube_mesh(&tube, (0.0, 1.0)),
+                color: RECEPTACLE_COLOR,
+                placement: Placement {
+                    position: segment.start,
+                    azimuth_deg: 0.0,
+                    joint_angle_deg: 0.0,
+                    orientation: DQuat::from_rotation_arc(DVec3::Y, along / tube.length),
+                },
+                schedule: Vec::new(),
+            }
+        })
+        .collect()
 }
 
 /// One obstacle: a closed component of a part instance in the part's own
@@ -550,7 +585,8 @@ impl Obstacle {
 }
 
 /// The surfaces growing organs are kept out of: one per closed component
-/// of each part instance (a filament, its anther, each stigma lobe), so
+/// of each part instance (a filament, its anther, each stigma lobe) and
+/// one per tube an L-system's `F` draws, so
 /// that where components overlap, "outside" of each is still its own
 /// surface's outside.
 pub fn obstacles(flower: &Flower) -> Vec<Obstacle> {
@@ -572,6 +608,12 @@ pub fn obstacles(flower: &Flower) -> Vec<Obstacle> {
             }
         }
     }
+    out.extend(segment_pieces(flower).into_iter().map(|piece| Obstacle {
+        name: piece.name,
+        mesh: piece.mesh,
+        placement: piece.placement,
+        schedule: piece.schedule,
+    }));
     out
 }
 

@@ -318,3 +318,54 @@ fn bad_parameters_are_refused_naming_the_part() {
     receptacle.color = [1.5, 0.0, 0.0, 1.0];
     assert!(receptacle.check().unwrap_err().contains("color components"));
 }
+
+#[test]
+fn an_lsystems_f_segments_are_tubes_of_its_width_from_start_to_end() {
+    use crate::structure::Structure;
+    let flower = Flower {
+        templates: Vec::new(),
+        organs: Vec::new(),
+        overlaps: Vec::new(),
+        structure: Some(Structure::LSystem {
+            text: "axiom: #(0.4) F(2) [ +(90) F(1) ] !(0) F(3) #(0.2) f(1) F(1)".to_string(),
+            steps: 0,
+            surfaces: Default::default(),
+        }),
+        parts: Vec::new(),
+    };
+    let pieces = part_pieces(&flower);
+    let names: Vec<&str> = pieces.iter().map(|p| p.name.as_str()).collect();
+    // The width-0 segment draws nothing.
+    assert_eq!(names, ["receptacle", "segment-1", "segment-2", "segment-3"]);
+    // Each tube's end caps are centred on the segment's ends: the pole
+    // vertices of the sweep are its first and last.
+    let ends = |piece: &PartPiece| {
+        let p = piece.positions_at(0);
+        (p[0], p[p.len() - 1])
+    };
+    let close = |a: DVec3, b: DVec3| (a - b).length() < 1e-12;
+    let (start, end) = ends(&pieces[1]);
+    assert!(
+        close(start, DVec3::ZERO) && close(end, DVec3::new(0.0, 2.0, 0.0)),
+        "{start} {end}"
+    );
+    // +(90) turns the heading H = +Y about U = +Z (R_U, eq. 1.2).
+    let (start, end) = ends(&pieces[2]);
+    assert!(close(start, DVec3::new(0.0, 2.0, 0.0)));
+    assert!(
+        ((end - start).length() - 1.0).abs() < 1e-12 && (end.y - 2.0).abs() < 1e-12,
+        "{end}"
+    );
+    let (start, end) = ends(&pieces[3]);
+    assert!(close(start, DVec3::new(0.0, 6.0, 0.0)) && close(end, DVec3::new(0.0, 7.0, 0.0)));
+    // Radius: half the width.
+    let radius = pieces[3].mesh.positions[1]
+        .x
+        .hypot(pieces[3].mesh.positions[1].z);
+    assert!((radius - 0.1).abs() < 1e-12, "{radius}");
+    for piece in &pieces[1..] {
+        assert!(volume(&piece.mesh) > 0.0);
+        assert!(!piece.moves());
+    }
+    assert_eq!(obstacles(&flower).len(), 3, "the tubes keep organs out");
+}

@@ -130,6 +130,29 @@ impl Structure {
     }
 }
 
+impl Structure {
+    /// The tubes an L-system's `F` segments draw (the stem, branches,
+    /// filaments): one per segment of positive length and width, the width
+    /// its diameter. None for whorls and spirals, or an L-system that does
+    /// not derive (loading refuses those).
+    pub fn segments(&self) -> Vec<turtle::Segment> {
+        let Structure::LSystem { text, steps, .. } = self else {
+            return Vec::new();
+        };
+        let Ok(system) = LSystem::parse(text) else {
+            return Vec::new();
+        };
+        let Ok(word) = system.derive(*steps) else {
+            return Vec::new();
+        };
+        interpret(&word, &Defaults::of(&system))
+            .segments
+            .into_iter()
+            .filter(|s| s.width > 0.0 && s.width.is_finite() && s.start.distance(s.end) > 1e-9)
+            .collect()
+    }
+}
+
 /// The organs an L-system places, and their overlap rules.
 ///
 /// Decided (the seed gives none): organs of one template form a ring; the
