@@ -4,6 +4,7 @@
 
 #![warn(missing_docs)]
 
+mod colour;
 pub mod parts;
 pub mod project;
 mod receptacle;
@@ -11,6 +12,7 @@ pub mod resolution;
 pub mod scale;
 pub mod structure;
 
+pub use colour::{Colouring, MAX_BAKED_SIDE, srgb8, srgb8_to_linear};
 pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
 pub use resolution::Resolution;
 
@@ -46,8 +48,12 @@ pub struct Template {
     pub base_region: BaseRegion,
     /// How the joint angle changes over the steps.
     pub joint_schedule: Vec<JointRamp>,
-    /// Display and export colour, linear RGBA in [0, 1].
+    /// Display and export colour, linear RGBA in [0, 1]: the base colour
+    /// when the template has a [`Colouring`].
     pub color: [f32; 4],
+    /// A second colour painted over `color` with a mix map ([`Colouring`]);
+    /// `None`: the organ is `color` all over.
+    pub colouring: Option<Colouring>,
 }
 
 /// The base particles: those whose UV lies in this region.

@@ -190,6 +190,7 @@ mod tests {
             base_region: BaseRegion::default(),
             joint_schedule: Vec::new(),
             color: [1.0; 4],
+            colouring: None,
         }
     }
 

@@ -430,6 +430,7 @@ mod tests {
             base_region: Default::default(),
             joint_schedule: Vec::new(),
             color: [1.0; 4],
+            colouring: None,
         }
     }
 

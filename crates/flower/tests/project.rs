@@ -12,7 +12,7 @@ use anthesis_flower::project::{
 };
 use anthesis_flower::structure::{Spiral, Structure, Whorl};
 use anthesis_flower::{
-    BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, Resolution,
+    BaseRegion, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project, Resolution,
     SimulationSettings, Template,
 };
 use anthesis_maps::{
@@ -105,6 +105,7 @@ fn petal_template() -> Template {
             },
         ],
         color: [0.98, 0.62, 0.32, 1.0],
+        colouring: None,
     }
 }
 
@@ -127,6 +128,7 @@ fn sepal_template() -> Template {
         base_region: BaseRegion::default(),
         joint_schedule: Vec::new(),
         color: [0.3, 0.55, 0.2, 0.9],
+        colouring: None,
     }
 }
 
@@ -1676,6 +1678,42 @@ fn parts_are_saved_as_readable_tables_and_load_back_equal() {
         fs::read_to_string(plain)
             .expect("read")
             .contains("version = 2")
+/// The lily with a crimson blush painted from the petal's base (a colour map
+/// of its own size, 16x16 against the growth maps' 8x6).
+fn coloured_lily() -> Project {
+    let mut project = lily();
+    project.flower.templates[0].colouring = Some(Colouring {
+        second_color: [0.6, 0.02, 0.08, 1.0],
+        mix: exact_raster(16, 16, |uv| 1.0 - uv.y),
+    });
+    project
+}
+
+#[test]
+fn a_colour_map_survives_saving_and_loading() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    let project = coloured_lily();
+    save_project(&project, &path).expect("save");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(
+        text.contains("second_color = [0.6, 0.02, 0.08, 1.0]")
+            && text.contains("colour_map = \"maps/petal-colour.png\""),
+        "{text}"
+    );
+    assert!(text.contains(&format!("version = {FORMAT_VERSION}")), "{text}");
+    // Only the template that has one names a colour map.
+    assert_eq!(text.matches("colour_map").count(), 1, "{text}");
+    assert!(folder.path().join("maps/petal-colour.png").is_file());
+    let loaded = load_project(&path).expect("load");
+    assert_eq!(loaded, project);
+    let base = loaded.flower.templates[0].colour_at(DVec2::new(0.5, 0.0));
+    let tip = loaded.flower.templates[0].colour_at(DVec2::new(0.5, 1.0));
+    assert!(base[0] < 0.7 && base[1] < 0.1, "crimson at the base: {base:?}");
+    let color = loaded.flower.templates[0].color;
+    assert!(
+        (0..4).all(|i| (tip[i] - color[i]).abs() < 0.05),
+        "nearly the base colour at the tip: {tip:?}"
     );
 }
 
@@ -1719,4 +1757,71 @@ fn broken_parts_are_refused_naming_the_part_and_the_key() {
          anther_length = 1.0\nanther_radius = 0.2\n",
     );
     assert!(err.contains("petal-1"), "{err}");
+fn a_project_without_colour_maps_saves_as_before() {
+    let (_folder, path) = saved_lily();
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(!text.contains("second_color") && !text.contains("colour_map"));
+    assert!(text.contains("version = 2"), "{text}");
+    assert_eq!(load_project(&path).expect("load").flower.templates[0].colouring, None);
+}
+
+#[test]
+fn a_constant_colour_map_is_a_number() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    let mut project = lily();
+    project.flower.templates[1].colouring = Some(Colouring {
+        second_color: [0.1, 0.2, 0.3, 1.0],
+        mix: ScalarMap::constant(0.5),
+    });
+    save_project(&project, &path).expect("save");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("colour_map = 0.5"), "{text}");
+    assert_eq!(load_project(&path).expect("load"), project);
+}
+
+#[test]
+fn a_bad_colour_map_png_is_a_map_error_naming_it() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    save_project(&coloured_lily(), &path).expect("save");
+    let png = folder.path().join("maps/petal-colour.png");
+    fs::write(&png, b"not a png at all").expect("write");
+    let error = load_project(&path).expect_err("bad png");
+    match &error {
+        ProjectError::Map { path, error } => {
+            assert_eq!(*path, png);
+            assert!(matches!(error, MapError::NotPng { .. }), "{error:?}");
+        }
+        other => panic!("expected a map error, got {other:?}"),
+    }
+    assert!(error.to_string().contains("petal-colour.png"), "{error}");
+    fs::remove_file(&png).expect("remove");
+    let error = load_project(&path).expect_err("missing png");
+    assert!(
+        matches!(&error, ProjectError::Io { path, .. } if *path == png),
+        "{error:?}"
+    );
+}
+
+#[test]
+fn half_a_colour_map_or_colours_out_of_range_are_refused() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    save_project(&coloured_lily(), &path).expect("save");
+    edit(&path, |text| {
+        replace_once(text, "second_color = [0.6, 0.02, 0.08, 1.0]\n", "")
+    });
+    let error = load_project(&path).expect_err("colour map without its colour");
+    assert!(
+        matches!(&error, ProjectError::Invalid { message, .. }
+            if message.contains("second_color") && message.contains("\"Petal\"")),
+        "{error:?}"
+    );
+    let mut project = coloured_lily();
+    if let Some(colouring) = &mut project.flower.templates[0].colouring {
+        colouring.second_color = [1.5, 0.0, 0.0, 1.0];
+    }
+    let error = save_project(&project, &path).expect_err("second colour out of range");
+    assert!(error.to_string().contains("second_color"), "{error}");
 }

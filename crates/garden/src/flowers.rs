@@ -301,6 +301,7 @@ fn template(
         bend_stiffness: spec.stiffness,
         joint_schedule: vec![spec.joint],
         color: spec.color,
+        colouring: None,
     })
 }
 

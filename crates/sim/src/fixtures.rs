@@ -111,6 +111,7 @@ fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
             angle_deg: 23.0,
         }],
         color: [0.95, 0.55, 0.35, 1.0],
+        colouring: None,
     }
 }
 

@@ -292,6 +292,26 @@ fn template_problem(template: &Template) -> Option<String> {
             template.color
         ));
     }
+    if let Some(colouring) = &template.colouring {
+        if colouring.second_color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+            return Some(format!(
+                "second_color components must lie in [0, 1], found {:?}",
+                colouring.second_color
+            ));
+        }
+        if let Some(value) = colouring
+            .mix
+            .values()
+            .iter()
+            .find(|v| !(0.0..=1.0).contains(*v))
+        {
+            return Some(format!(
+                "the colour map holds {}; its values must lie in [0, 1] (0 = color, 1 = \
+                 second_color)",
+                short_number(f64::from(*value))
+            ));
+        }
+    }
     for ramp in &template.joint_schedule {
         if ramp.from_step > ramp.to_step || !ramp.angle_deg.is_finite() {
             return Some(format!(

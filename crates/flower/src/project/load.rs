@@ -17,7 +17,7 @@ use super::schema::{
 };
 use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::structure::{Arrangement, Spiral, Structure, Whorl};
-use crate::{BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, Template};
+use crate::{BaseRegion, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project, Template};
 
 /// The largest project file read, in bytes; a project file names its
 /// meshes and maps, so even a garden of templates is a few kilobytes.
@@ -336,6 +336,24 @@ impl Loader<'_> {
         size.finish()?;
         let maps = KeyedMaps::new(keys, Blend::from(&file.blend))
             .map_err(|error| self.invalid(format!("template \"{name}\": {error}")))?;
+        let colouring = match (file.second_color, file.colour_map) {
+            (None, None) => None,
+            (Some(second_color), Some(entry)) => {
+                // The colour map has a size of its own (it is not simulated).
+                let mix = self.scalar_map(
+                    entry,
+                    &format!("template \"{name}\": colour_map"),
+                    &mut SizeCheck::default(),
+                )?;
+                Some(Colouring { second_color, mix })
+            }
+            (Some(_), None) | (None, Some(_)) => {
+                return Err(self.invalid(format!(
+                    "template \"{name}\" has one of second_color and colour_map; a colour map \
+                     needs both (the colour it paints, and where)"
+                )));
+            }
+        };
         Ok(Template {
             name: file.name,
             mesh,
@@ -351,6 +369,7 @@ impl Loader<'_> {
             },
             joint_schedule: file.joint_schedule.iter().map(JointRamp::from).collect(),
             color: file.color,
+            colouring,
         })
     }
 

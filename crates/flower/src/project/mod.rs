@@ -31,6 +31,11 @@
 //! stretch_stiffness = 20.0
 //! bend_stiffness = 20.0
 //! color = [0.98, 0.62, 0.32, 1.0]          # optional, default opaque white
+//! second_color = [0.6, 0.02, 0.08, 1.0]    # optional (version 5), with colour_map:
+//! colour_map = "maps/petal-colour.png"     # where second_color shows over color
+//!                                           # (0 = color, 1 = second_color; a
+//!                                           # PNG like the growth maps, of any
+//!                                           # size, or a number)
 //! blend = "linear"                          # optional: "linear" (default),
 //!                                           # "smooth" or
 //!                                           # { logistic = { steepness = 10.0 } }

@@ -186,6 +186,7 @@ mod tests {
             },
             joint_schedule: Vec::new(),
             color: [1.0, 0.5, 0.5, 1.0],
+            colouring: None,
         };
         Project {
             name: name.into(),

@@ -3,7 +3,7 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use anthesis_maps::{BitDepth, MapKind};
+use anthesis_maps::{BitDepth, MapKind, ScalarMap};
 
 use super::check::{SizeCheck, check_project};
 use super::error::{ProjectError, map_error};
@@ -87,7 +87,7 @@ pub(super) fn plan_save(
 /// everything it sets, so a project that sets nothing new stays readable by
 /// older builds and saves byte for byte as before (version 3 added
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
-/// `[[parts]]`).
+/// `[[parts]]`, colour maps).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
     if !flower.parts.is_empty() {
@@ -98,6 +98,9 @@ fn file_version(project: &Project) -> u32 {
             .organs
             .iter()
             .any(|o| o.placement.orientation != glam::DQuat::IDENTITY);
+    if flower.templates.iter().any(|t| t.colouring.is_some()) {
+        return FORMAT_VERSION;
+    }
     match (placed, project.settings.resolution) {
         (true, _) => 4,
         (false, Resolution::AsBuilt) => 2,
@@ -171,6 +174,13 @@ pub(super) fn template_file(
         keys.push(key_file);
     }
     size.finish()?;
+    let (second_color, colour_map) = match &template.colouring {
+        None => (None, None),
+        Some(colouring) => (
+            Some(colouring.second_color),
+            Some(colour_map_entry(&colouring.mix, stem, folder, files)?),
+        ),
+    };
 
     let region = &template.base_region;
     Ok(TemplateFile {
@@ -181,6 +191,8 @@ pub(super) fn template_file(
         stretch_stiffness: template.stretch_stiffness,
         bend_stiffness: template.bend_stiffness,
         color: template.color,
+        second_color,
+        colour_map,
         blend: BlendFile::from(template.maps.blend),
         base_region: BaseRegionFile {
             v_max: region.v_max,
@@ -194,6 +206,30 @@ pub(super) fn template_file(
             .collect(),
         keys,
     })
+}
+
+/// The `colour_map` entry of a template whose file stem is `stem`: a
+/// number for a constant, else `maps/<stem>-colour.png` (16-bit, as the
+/// growth maps), added to `files`.
+fn colour_map_entry(
+    mix: &ScalarMap,
+    stem: &str,
+    folder: &Path,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> Result<ScalarEntry, ProjectError> {
+    if mix.size() == (1, 1) {
+        return Ok(ScalarEntry::Constant(mix.values()[0]));
+    }
+    let relative = format!("{MAP_FOLDER}/{stem}-colour.png");
+    let path = folder.join(&relative);
+    if let Some(value) = mix.values().iter().find(|v| !(0.0..=1.0).contains(*v)) {
+        return Err(out_of_range(&path, "colour", *value, "0 to 1"));
+    }
+    let bytes = mix
+        .to_png_bytes(BitDepth::Sixteen)
+        .map_err(|error| map_error(&path, error))?;
+    files.push((relative.clone(), bytes));
+    Ok(ScalarEntry::File(relative))
 }
 
 pub(super) fn out_of_range(path: &Path, map_name: &str, value: f32, range: &str) -> ProjectError {

@@ -159,6 +159,14 @@ pub(super) struct TemplateFile {
     pub(super) bend_stiffness: f64,
     #[serde(default = "opaque_white")]
     pub(super) color: [f32; 4],
+    /// Version 5: the colour a colour map paints over `color`; with
+    /// `colour_map`, or neither.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) second_color: Option<[f32; 4]>,
+    /// Version 5: how much of `second_color` shows (a PNG like the growth
+    /// maps, or a number).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) colour_map: Option<ScalarEntry>,
     #[serde(default)]
     pub(super) blend: BlendFile,
     #[serde(default)]

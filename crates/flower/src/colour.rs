@@ -1,0 +1,153 @@
+//! What a template looks like: its base colour and, optionally, a second
+//! colour painted over it with a mix map, as growth maps are painted (the
+//! same rasters, brushes and PNG files). The viewport, `anthesis render`
+//! and the exports all take a template's colour from here.
+
+use anthesis_maps::ScalarMap;
+use glam::DVec2;
+
+use crate::Template;
+
+/// A second colour painted over a template's base colour
+/// ([`Template::color`]): where the mix map is 0 the organ shows the base
+/// colour, where it is 1 the second colour, linearly blended between.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Colouring {
+    /// Linear RGBA in `[0, 1]` (as [`Template::color`]).
+    pub second_color: [f32; 4],
+    /// How much of the second colour shows, over the mesh's UV square
+    /// (`v = 0` on the bottom row, as growth maps); values in `[0, 1]`.
+    /// Its size is its own: it need not match the growth maps'.
+    pub mix: ScalarMap,
+}
+
+/// The largest side of an image [`Template::colour_image`] bakes by
+/// default: a 1x1 (constant) mix map bakes to 1x1, a painted one at its
+/// own size up to this.
+pub const MAX_BAKED_SIDE: u32 = 1024;
+
+impl Template {
+    /// The linear RGBA colour at `uv` on the organ: the base colour blended
+    /// towards the second colour by the mix map's (bilinear) value there,
+    /// or the base colour when the template has no colouring.
+    pub fn colour_at(&self, uv: DVec2) -> [f32; 4] {
+        match &self.colouring {
+            None => self.color,
+            Some(colouring) => {
+                let t = colouring.mix.sample(uv).clamp(0.0, 1.0) as f32;
+                std::array::from_fn(|i| {
+                    self.color[i] + (colouring.second_color[i] - self.color[i]) * t
+                })
+            }
+        }
+    }
+
+    /// The size [`Template::colour_image`] bakes at when asked for the
+    /// template's own: the mix map's size (each side at most
+    /// [`MAX_BAKED_SIDE`]), 1x1 without colouring.
+    pub fn colour_image_size(&self) -> (u32, u32) {
+        match &self.colouring {
+            None => (1, 1),
+            Some(colouring) => {
+                let (w, h) = colouring.mix.size();
+                (w.clamp(1, MAX_BAKED_SIDE), h.clamp(1, MAX_BAKED_SIDE))
+            }
+        }
+    }
+
+    /// The template's colour over its UV square as an 8-bit sRGB-encoded
+    /// RGBA image of `width` x `height` pixels (each at least 1), each pixel
+    /// [`Template::colour_at`] its centre. Row 0 of the image is the top
+    /// (`v` near 1), so `v = 0` is the bottom row, as map images are; alpha
+    /// is stored linearly.
+    pub fn colour_image(&self, width: u32, height: u32) -> image::RgbaImage {
+        let (width, height) = (width.max(1), height.max(1));
+        image::RgbaImage::from_fn(width, height, |x, y| {
+            let uv = DVec2::new(
+                (f64::from(x) + 0.5) / f64::from(width),
+                1.0 - (f64::from(y) + 0.5) / f64::from(height),
+            );
+            image::Rgba(srgb8(self.colour_at(uv)))
+        })
+    }
+}
+
+/// A linear RGBA colour as 8-bit sRGB-encoded RGB and linear alpha.
+pub fn srgb8(linear: [f32; 4]) -> [u8; 4] {
+    let encode = |c: f32| {
+        let c = c.clamp(0.0, 1.0);
+        let s = if c <= 0.003_130_8 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0).round() as u8
+    };
+    [
+        encode(linear[0]),
+        encode(linear[1]),
+        encode(linear[2]),
+        (linear[3].clamp(0.0, 1.0) * 255.0).round() as u8,
+    ]
+}
+
+/// The linear value of an 8-bit sRGB-encoded channel.
+pub fn srgb8_to_linear(code: u8) -> f32 {
+    let s = f32::from(code) / 255.0;
+    if s <= 0.040_45 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn template(colouring: Option<Colouring>) -> Template {
+        let mesh = anthesis_mesh::generate::test_petal(1.0, 0.5, 4, 4);
+        Template {
+            name: "petal".into(),
+            mesh,
+            maps: anthesis_maps::KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
+            dg: 0.0,
+            thickness: 0.1,
+            stretch_stiffness: 1.0,
+            bend_stiffness: 1.0,
+            base_region: crate::BaseRegion::default(),
+            joint_schedule: Vec::new(),
+            color: [1.0, 0.0, 0.0, 1.0],
+            colouring,
+        }
+    }
+
+    #[test]
+    fn without_colouring_the_base_colour_is_everywhere() {
+        let t = template(None);
+        assert_eq!(t.colour_at(DVec2::new(0.3, 0.9)), [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(t.colour_image_size(), (1, 1));
+        assert_eq!(t.colour_image(1, 1).get_pixel(0, 0).0, [255, 0, 0, 255]);
+    }
+
+    #[test]
+    fn the_mix_map_blends_linearly_and_v_0_is_the_bottom_row() {
+        // Mix 0 at the base (v = 0), 1 at the tip: red to blue.
+        let mix = ScalarMap::from_fn(8, 8, |uv| uv.y as f32);
+        let t = template(Some(Colouring {
+            second_color: [0.0, 0.0, 1.0, 1.0],
+            mix,
+        }));
+        let middle = t.colour_at(DVec2::new(0.5, 0.5));
+        assert!((middle[0] - 0.5).abs() < 1e-6 && (middle[2] - 0.5).abs() < 1e-6);
+        assert_eq!(t.colour_image_size(), (8, 8));
+        let image = t.colour_image(8, 8);
+        let top = image.get_pixel(4, 0).0;
+        let bottom = image.get_pixel(4, 7).0;
+        assert!(top[2] > 240 && top[0] < 90, "top row is the tip: {top:?}");
+        assert!(bottom[0] > 240 && bottom[2] < 90, "bottom row is the base: {bottom:?}");
+        // Halfway in linear light is 0.5, which sRGB encodes as 188.
+        assert_eq!(srgb8([0.5, 0.5, 0.5, 0.5]), [188, 188, 188, 128]);
+        assert!((srgb8_to_linear(188) - 0.5).abs() < 0.003);
+    }
+}
