@@ -19,7 +19,35 @@ pub struct Colouring {
     /// (`v = 0` on the bottom row, as growth maps); values in `[0, 1]`.
     /// Its size is its own: it need not match the growth maps'.
     pub mix: ScalarMap,
+    /// Further colours painted over the second one in order, as layers in
+    /// a paint program (the lily's crimson spots over its green-yellow
+    /// throat); usually none. The app paints `mix` only.
+    pub layers: Vec<ColourLayer>,
 }
+
+/// A colour painted over what lies under it where its mix map says (0:
+/// what is under it, 1: this colour).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColourLayer {
+    /// Linear RGBA in `[0, 1]`.
+    pub color: [f32; 4],
+    /// How much of `color` shows, values in `[0, 1]`, any size.
+    pub mix: ScalarMap,
+}
+
+/// `under` blended towards `over` by `t` in `[0, 1]`.
+fn blend(under: [f32; 4], over: [f32; 4], t: f64) -> [f32; 4] {
+    let t = t.clamp(0.0, 1.0) as f32;
+    std::array::from_fn(|i| under[i] + (over[i] - under[i]) * t)
+}
+
+/// The second colour a template gets when its colour map is first painted
+/// or its second colour first picked (a deep crimson, linear RGBA).
+pub const DEFAULT_SECOND_COLOR: [f32; 4] = [0.45, 0.02, 0.06, 1.0];
+
+/// The size a colour map is painted at when it is first painted (finer than
+/// growth maps: spots and veins are small).
+pub const COLOUR_PAINT_SIZE: u32 = 256;
 
 /// The largest side of an image [`Template::colour_image`] bakes by
 /// default: a 1x1 (constant) mix map bakes to 1x1, a painted one at its
@@ -28,28 +56,47 @@ pub const MAX_BAKED_SIDE: u32 = 1024;
 
 impl Template {
     /// The linear RGBA colour at `uv` on the organ: the base colour blended
-    /// towards the second colour by the mix map's (bilinear) value there,
-    /// or the base colour when the template has no colouring.
+    /// towards the second colour by the mix map's (bilinear) value there
+    /// (then towards each further layer's colour by its map), or the base
+    /// colour when the template has no colouring.
     pub fn colour_at(&self, uv: DVec2) -> [f32; 4] {
         match &self.colouring {
             None => self.color,
             Some(colouring) => {
-                let t = colouring.mix.sample(uv).clamp(0.0, 1.0) as f32;
-                std::array::from_fn(|i| {
-                    self.color[i] + (colouring.second_color[i] - self.color[i]) * t
+                let second = blend(self.color, colouring.second_color, colouring.mix.sample(uv));
+                colouring.layers.iter().fold(second, |under, layer| {
+                    blend(under, layer.color, layer.mix.sample(uv))
                 })
             }
         }
     }
 
+    /// The template's colouring, ready to paint: made when missing (the
+    /// [`DEFAULT_SECOND_COLOR`], nothing painted yet) and a constant mix map
+    /// made a raster of [`COLOUR_PAINT_SIZE`] holding the same value.
+    pub fn colouring_to_paint(&mut self) -> &mut Colouring {
+        let colouring = self.colouring.get_or_insert_with(|| Colouring {
+            second_color: DEFAULT_SECOND_COLOR,
+            mix: ScalarMap::constant(0.0),
+            layers: Vec::new(),
+        });
+        anthesis_maps::brush::ensure_scalar_raster(
+            &mut colouring.mix,
+            (COLOUR_PAINT_SIZE, COLOUR_PAINT_SIZE),
+        );
+        colouring
+    }
+
     /// The size [`Template::colour_image`] bakes at when asked for the
-    /// template's own: the mix map's size (each side at most
-    /// [`MAX_BAKED_SIDE`]), 1x1 without colouring.
+    /// template's own: the largest of its mix maps' sizes (each side at
+    /// most [`MAX_BAKED_SIDE`]), 1x1 without colouring.
     pub fn colour_image_size(&self) -> (u32, u32) {
         match &self.colouring {
             None => (1, 1),
             Some(colouring) => {
-                let (w, h) = colouring.mix.size();
+                let sizes = std::iter::once(colouring.mix.size())
+                    .chain(colouring.layers.iter().map(|l| l.mix.size()));
+                let (w, h) = sizes.fold((1, 1), |(w, h), (a, b)| (w.max(a), h.max(b)));
                 (w.clamp(1, MAX_BAKED_SIDE), h.clamp(1, MAX_BAKED_SIDE))
             }
         }
@@ -137,6 +184,7 @@ mod tests {
         let t = template(Some(Colouring {
             second_color: [0.0, 0.0, 1.0, 1.0],
             mix,
+            layers: Vec::new(),
         }));
         let middle = t.colour_at(DVec2::new(0.5, 0.5));
         assert!((middle[0] - 0.5).abs() < 1e-6 && (middle[2] - 0.5).abs() < 1e-6);
@@ -145,9 +193,31 @@ mod tests {
         let top = image.get_pixel(4, 0).0;
         let bottom = image.get_pixel(4, 7).0;
         assert!(top[2] > 240 && top[0] < 90, "top row is the tip: {top:?}");
-        assert!(bottom[0] > 240 && bottom[2] < 90, "bottom row is the base: {bottom:?}");
+        assert!(
+            bottom[0] > 240 && bottom[2] < 90,
+            "bottom row is the base: {bottom:?}"
+        );
         // Halfway in linear light is 0.5, which sRGB encodes as 188.
         assert_eq!(srgb8([0.5, 0.5, 0.5, 0.5]), [188, 188, 188, 128]);
         assert!((srgb8_to_linear(188) - 0.5).abs() < 0.003);
+    }
+
+    #[test]
+    fn further_layers_paint_over_in_order() {
+        // Green over the left half of the red base, then blue over the
+        // bottom half of everything.
+        let t = template(Some(Colouring {
+            second_color: [0.0, 1.0, 0.0, 1.0],
+            mix: ScalarMap::from_fn(8, 8, |uv| if uv.x < 0.5 { 1.0 } else { 0.0 }),
+            layers: vec![ColourLayer {
+                color: [0.0, 0.0, 1.0, 1.0],
+                mix: ScalarMap::from_fn(4, 16, |uv| if uv.y < 0.5 { 1.0 } else { 0.0 }),
+            }],
+        }));
+        assert_eq!(t.colour_at(DVec2::new(0.1, 0.9)), [0.0, 1.0, 0.0, 1.0]);
+        assert_eq!(t.colour_at(DVec2::new(0.9, 0.9)), [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(t.colour_at(DVec2::new(0.1, 0.1)), [0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(t.colour_at(DVec2::new(0.9, 0.1)), [0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(t.colour_image_size(), (8, 16));
     }
 }

@@ -12,7 +12,10 @@ pub mod resolution;
 pub mod scale;
 pub mod structure;
 
-pub use colour::{Colouring, MAX_BAKED_SIDE, srgb8, srgb8_to_linear};
+pub use colour::{
+    COLOUR_PAINT_SIZE, ColourLayer, Colouring, DEFAULT_SECOND_COLOR, MAX_BAKED_SIDE, srgb8,
+    srgb8_to_linear,
+};
 pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
 pub use resolution::Resolution;
 

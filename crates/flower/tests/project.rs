@@ -12,8 +12,8 @@ use anthesis_flower::project::{
 };
 use anthesis_flower::structure::{Spiral, Structure, Whorl};
 use anthesis_flower::{
-    BaseRegion, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project, Resolution,
-    SimulationSettings, Template,
+    BaseRegion, ColourLayer, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project,
+    Resolution, SimulationSettings, Template,
 };
 use anthesis_maps::{
     BitDepth, Blend, DirectionMap, GrowthMaps, KeyedMaps, MapError, MapKey, MapKind, ScalarMap,
@@ -1685,6 +1685,7 @@ fn coloured_lily() -> Project {
     project.flower.templates[0].colouring = Some(Colouring {
         second_color: [0.6, 0.02, 0.08, 1.0],
         mix: exact_raster(16, 16, |uv| 1.0 - uv.y),
+        layers: Vec::new(),
     });
     project
 }
@@ -1701,7 +1702,10 @@ fn a_colour_map_survives_saving_and_loading() {
             && text.contains("colour_map = \"maps/petal-colour.png\""),
         "{text}"
     );
-    assert!(text.contains(&format!("version = {FORMAT_VERSION}")), "{text}");
+    assert!(
+        text.contains(&format!("version = {FORMAT_VERSION}")),
+        "{text}"
+    );
     // Only the template that has one names a colour map.
     assert_eq!(text.matches("colour_map").count(), 1, "{text}");
     assert!(folder.path().join("maps/petal-colour.png").is_file());
@@ -1709,7 +1713,10 @@ fn a_colour_map_survives_saving_and_loading() {
     assert_eq!(loaded, project);
     let base = loaded.flower.templates[0].colour_at(DVec2::new(0.5, 0.0));
     let tip = loaded.flower.templates[0].colour_at(DVec2::new(0.5, 1.0));
-    assert!(base[0] < 0.7 && base[1] < 0.1, "crimson at the base: {base:?}");
+    assert!(
+        base[0] < 0.7 && base[1] < 0.1,
+        "crimson at the base: {base:?}"
+    );
     let color = loaded.flower.templates[0].color;
     assert!(
         (0..4).all(|i| (tip[i] - color[i]).abs() < 0.05),
@@ -1762,21 +1769,32 @@ fn a_project_without_colour_maps_saves_as_before() {
     let text = fs::read_to_string(&path).expect("read");
     assert!(!text.contains("second_color") && !text.contains("colour_map"));
     assert!(text.contains("version = 2"), "{text}");
-    assert_eq!(load_project(&path).expect("load").flower.templates[0].colouring, None);
+    assert_eq!(
+        load_project(&path).expect("load").flower.templates[0].colouring,
+        None
+    );
 }
 
 #[test]
-fn a_constant_colour_map_is_a_number() {
+fn a_constant_colour_map_is_a_number_and_layers_are_saved() {
     let folder = tempfile::tempdir().expect("temp dir");
     let path = folder.path().join("lily.anthesis.toml");
     let mut project = lily();
     project.flower.templates[1].colouring = Some(Colouring {
         second_color: [0.1, 0.2, 0.3, 1.0],
         mix: ScalarMap::constant(0.5),
+        layers: vec![ColourLayer {
+            color: [0.9, 0.9, 0.1, 1.0],
+            mix: exact_raster(4, 4, |uv| uv.x),
+        }],
     });
     save_project(&project, &path).expect("save");
     let text = fs::read_to_string(&path).expect("read");
     assert!(text.contains("colour_map = 0.5"), "{text}");
+    assert!(
+        text.contains("map = \"maps/outer_sepal-colour-2.png\""),
+        "{text}"
+    );
     assert_eq!(load_project(&path).expect("load"), project);
 }
 

@@ -278,6 +278,11 @@ pub enum PaintTarget {
     /// The growth direction map: `Set` and `Add` dabs paint the stroke
     /// direction (see [`dab_direction`]).
     Direction,
+    /// A template's colour map: how much of its second colour shows (0 to
+    /// 1). It is one map, not one per time key, and it is not simulated, so
+    /// [`dab_keyed`] leaves it alone: the template holds it
+    /// (`anthesis_flower::Colouring`), painted with [`dab_scalar`].
+    Colour,
 }
 
 impl PaintTarget {
@@ -286,6 +291,7 @@ impl PaintTarget {
         match self {
             PaintTarget::Scalar(kind) => kind.label(),
             PaintTarget::Direction => "direction",
+            PaintTarget::Colour => "colour",
         }
     }
 }
@@ -320,6 +326,7 @@ pub fn dab_keyed(
             ensure_direction_raster(map, size);
             dab_direction(map, brush, centre_in_uv, direction_in_uv);
         }
+        PaintTarget::Colour => {}
     }
 }
 

@@ -293,16 +293,29 @@ fn template_problem(template: &Template) -> Option<String> {
         ));
     }
     if let Some(colouring) = &template.colouring {
-        if colouring.second_color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+        if colouring
+            .second_color
+            .iter()
+            .any(|c| !(0.0..=1.0).contains(c))
+        {
             return Some(format!(
                 "second_color components must lie in [0, 1], found {:?}",
                 colouring.second_color
             ));
         }
-        if let Some(value) = colouring
-            .mix
-            .values()
+        if let Some(layer) = colouring
+            .layers
             .iter()
+            .find(|l| l.color.iter().any(|c| !(0.0..=1.0).contains(c)))
+        {
+            return Some(format!(
+                "colour layer components must lie in [0, 1], found {:?}",
+                layer.color
+            ));
+        }
+        let maps = std::iter::once(&colouring.mix).chain(colouring.layers.iter().map(|l| &l.mix));
+        if let Some(value) = maps
+            .flat_map(|m| m.values())
             .find(|v| !(0.0..=1.0).contains(*v))
         {
             return Some(format!(

@@ -17,7 +17,10 @@ use super::schema::{
 };
 use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::structure::{Arrangement, Spiral, Structure, Whorl};
-use crate::{BaseRegion, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project, Template};
+use crate::{
+    BaseRegion, ColourLayer, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project,
+    Template,
+};
 
 /// The largest project file read, in bytes; a project file names its
 /// meshes and maps, so even a garden of templates is a few kilobytes.
@@ -337,20 +340,36 @@ impl Loader<'_> {
         let maps = KeyedMaps::new(keys, Blend::from(&file.blend))
             .map_err(|error| self.invalid(format!("template \"{name}\": {error}")))?;
         let colouring = match (file.second_color, file.colour_map) {
-            (None, None) => None,
+            (None, None) if file.colour_layers.is_empty() => None,
             (Some(second_color), Some(entry)) => {
-                // The colour map has a size of its own (it is not simulated).
+                // Colour maps have sizes of their own (they are not simulated).
                 let mix = self.scalar_map(
                     entry,
                     &format!("template \"{name}\": colour_map"),
                     &mut SizeCheck::default(),
                 )?;
-                Some(Colouring { second_color, mix })
+                let mut layers = Vec::with_capacity(file.colour_layers.len());
+                for (i, layer) in file.colour_layers.into_iter().enumerate() {
+                    layers.push(ColourLayer {
+                        color: layer.color,
+                        mix: self.scalar_map(
+                            layer.map,
+                            &format!("template \"{name}\": colour layer {}", i + 1),
+                            &mut SizeCheck::default(),
+                        )?,
+                    });
+                }
+                Some(Colouring {
+                    second_color,
+                    mix,
+                    layers,
+                })
             }
-            (Some(_), None) | (None, Some(_)) => {
+            _ => {
                 return Err(self.invalid(format!(
-                    "template \"{name}\" has one of second_color and colour_map; a colour map \
-                     needs both (the colour it paints, and where)"
+                    "template \"{name}\" has one of second_color and colour_map (or colour \
+                     layers without them); a colour map needs both (the colour it paints, \
+                     and where)"
                 )));
             }
         };

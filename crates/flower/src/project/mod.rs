@@ -36,6 +36,9 @@
 //!                                           # (0 = color, 1 = second_color; a
 //!                                           # PNG like the growth maps, of any
 //!                                           # size, or a number)
+//! [[templates.colour_layers]]               # optional (version 5): more colours
+//! color = [0.5, 0.02, 0.05, 1.0]            # painted over, in order
+//! map = "maps/petal-colour-2.png"
 //! blend = "linear"                          # optional: "linear" (default),
 //!                                           # "smooth" or
 //!                                           # { logistic = { steepness = 10.0 } }

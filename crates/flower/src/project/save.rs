@@ -8,9 +8,9 @@ use anthesis_maps::{BitDepth, MapKind, ScalarMap};
 use super::check::{SizeCheck, check_project};
 use super::error::{ProjectError, map_error};
 use super::schema::{
-    BaseRegionFile, BlendFile, DirectionEntry, JointRampFile, KeyFile, LSystemFile, OrganFile,
-    OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SpiralFile, StructureFile,
-    StructureKind, TemplateFile, WhorlFile,
+    BaseRegionFile, BlendFile, ColourLayerFile, DirectionEntry, JointRampFile, KeyFile,
+    LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SpiralFile,
+    StructureFile, StructureKind, TemplateFile, WhorlFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
 use crate::structure::{Arrangement, Structure};
@@ -174,12 +174,32 @@ pub(super) fn template_file(
         keys.push(key_file);
     }
     size.finish()?;
-    let (second_color, colour_map) = match &template.colouring {
-        None => (None, None),
-        Some(colouring) => (
-            Some(colouring.second_color),
-            Some(colour_map_entry(&colouring.mix, stem, folder, files)?),
-        ),
+    let (second_color, colour_map, colour_layers) = match &template.colouring {
+        None => (None, None, Vec::new()),
+        Some(colouring) => {
+            let mut layers = Vec::with_capacity(colouring.layers.len());
+            for (i, layer) in colouring.layers.iter().enumerate() {
+                layers.push(ColourLayerFile {
+                    color: layer.color,
+                    map: colour_map_entry(
+                        &layer.mix,
+                        &format!("{stem}-colour-{}", i + 2),
+                        folder,
+                        files,
+                    )?,
+                });
+            }
+            (
+                Some(colouring.second_color),
+                Some(colour_map_entry(
+                    &colouring.mix,
+                    &format!("{stem}-colour"),
+                    folder,
+                    files,
+                )?),
+                layers,
+            )
+        }
     };
 
     let region = &template.base_region;
@@ -193,6 +213,7 @@ pub(super) fn template_file(
         color: template.color,
         second_color,
         colour_map,
+        colour_layers,
         blend: BlendFile::from(template.maps.blend),
         base_region: BaseRegionFile {
             v_max: region.v_max,
@@ -208,19 +229,18 @@ pub(super) fn template_file(
     })
 }
 
-/// The `colour_map` entry of a template whose file stem is `stem`: a
-/// number for a constant, else `maps/<stem>-colour.png` (16-bit, as the
-/// growth maps), added to `files`.
+/// The entry of a colour map saved as `maps/<name>.png` (16-bit, as the
+/// growth maps, added to `files`), or a number for a constant.
 fn colour_map_entry(
     mix: &ScalarMap,
-    stem: &str,
+    name: &str,
     folder: &Path,
     files: &mut Vec<(String, Vec<u8>)>,
 ) -> Result<ScalarEntry, ProjectError> {
     if mix.size() == (1, 1) {
         return Ok(ScalarEntry::Constant(mix.values()[0]));
     }
-    let relative = format!("{MAP_FOLDER}/{stem}-colour.png");
+    let relative = format!("{MAP_FOLDER}/{name}.png");
     let path = folder.join(&relative);
     if let Some(value) = mix.values().iter().find(|v| !(0.0..=1.0).contains(*v)) {
         return Err(out_of_range(&path, "colour", *value, "0 to 1"));

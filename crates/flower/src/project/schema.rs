@@ -167,6 +167,10 @@ pub(super) struct TemplateFile {
     /// maps, or a number).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) colour_map: Option<ScalarEntry>,
+    /// Version 5: further colours painted over, in order (needs the two
+    /// above).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) colour_layers: Vec<ColourLayerFile>,
     #[serde(default)]
     pub(super) blend: BlendFile,
     #[serde(default)]
@@ -174,6 +178,14 @@ pub(super) struct TemplateFile {
     #[serde(default)]
     pub(super) joint_schedule: Vec<JointRampFile>,
     pub(super) keys: Vec<KeyFile>,
+}
+
+/// `[[templates.colour_layers]]`: a colour and where it shows.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ColourLayerFile {
+    pub(super) color: [f32; 4],
+    pub(super) map: ScalarEntry,
 }
 
 fn opaque_white() -> [f32; 4] {
