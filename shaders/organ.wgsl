@@ -47,12 +47,19 @@ struct Organ {
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(1) @binding(0) var<uniform> organ: Organ;
+// The organ's colour over its UVs (a template's baked colour map; 1x1
+// white when it has none), multiplied with organ.color_linear. An sRGB
+// texture, so samples are linear. Row 0 is the top (v near 1).
+@group(2) @binding(0) var colour_texture: texture_2d<f32>;
+@group(2) @binding(1) var colour_sampler: sampler;
 
 struct VertexIn {
     @location(0) position_in_world: vec3<f32>,
     @location(1) normal_in_world: vec3<f32>,
     // A scalar map value per vertex, expected in [0, 1].
     @location(2) overlay: f32,
+    // The vertex's UV (v = 0 at the organ's base).
+    @location(3) uv: vec2<f32>,
 }
 
 struct VertexOut {
@@ -60,6 +67,7 @@ struct VertexOut {
     @location(0) position_in_world: vec3<f32>,
     @location(1) normal_in_world: vec3<f32>,
     @location(2) overlay: f32,
+    @location(3) uv: vec2<f32>,
 }
 
 @vertex
@@ -69,6 +77,7 @@ fn vs_organ(in: VertexIn) -> VertexOut {
     out.position_in_world = in.position_in_world;
     out.normal_in_world = in.normal_in_world;
     out.overlay = in.overlay;
+    out.uv = in.uv;
     return out;
 }
 
@@ -112,6 +121,8 @@ fn to_target(linear: vec3<f32>) -> vec3<f32> {
 // in the petal's colour instead of going dark and muddy.
 @fragment
 fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
+    // Sampled first, in uniform control flow.
+    let painted = textureSample(colour_texture, colour_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
     var normal = normalize(in.normal_in_world);
     var side_brightness = 1.0;
     if !is_front {
@@ -137,7 +148,7 @@ fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0
     let halfway = normalize(light + to_eye);
     let sheen = 0.04 * pow(max(dot(normal, halfway), 0.0), 16.0);
 
-    var base = organ.color_linear.rgb;
+    var base = organ.color_linear.rgb * painted.rgb;
     base = mix(base, overlay_ramp(in.overlay), clamp(organ.overlay_mix.x, 0.0, 1.0));
 
     let reflected = base * (0.42 * ambient + 0.6 * key);
@@ -145,7 +156,7 @@ fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0
     // squared): more saturated than the reflected colour.
     let transmitted = 0.5 * through * base * base;
     let lit = (reflected + transmitted + vec3<f32>(sheen)) * side_brightness;
-    return vec4<f32>(to_target(lit), organ.color_linear.a);
+    return vec4<f32>(to_target(lit), organ.color_linear.a * painted.a);
 }
 
 struct BackgroundOut {

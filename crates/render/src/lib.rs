@@ -34,7 +34,7 @@ mod target;
 pub use blit::{BLIT_SHADER_SOURCE, BLIT_SOURCE_FORMAT, BlitPipeline};
 pub use camera::Camera;
 pub use error::RenderError;
-pub use mesh::{OrganMesh, organs_bounds_in_world};
+pub use mesh::{OrganMesh, OrganTexture, organs_bounds_in_world};
 pub use offscreen::OffscreenRenderer;
 pub use orbit::{ORBIT_FOV_DEG, OrbitCamera};
 pub use pipeline::{Background, DEPTH_CLEAR_VALUE, OrganPipeline, SHADER_SOURCE, TargetFormat};

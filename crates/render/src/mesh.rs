@@ -1,7 +1,10 @@
+use std::sync::Arc;
+
 use glam::DVec3;
 
 /// One organ ready to draw: `f32` world-space vertices with normals, its
-/// triangles and a colour.
+/// triangles and a colour, optionally painted by a texture over its UVs
+/// (a template's colour map, baked).
 ///
 /// Normals point to the organ's inner side (the Anthesis winding
 /// convention); the side they point at is shaded as the front, the other
@@ -20,6 +23,22 @@ pub struct OrganMesh {
     /// An optional scalar per vertex in `[0, 1]` (e.g. a growth-map value)
     /// shown with a blue–yellow–red ramp instead of the organ colour.
     pub overlay: Option<Vec<f32>>,
+    /// An optional colour texture multiplied with `color_linear`: its
+    /// texture coordinate per vertex and an 8-bit sRGB-encoded RGBA image
+    /// whose bottom row is `v = 0` (as map images and
+    /// `Template::colour_image` are). `None` draws as a 1x1 white texture
+    /// would: `color_linear` alone. The renderer keeps the image uploaded
+    /// while the same `Arc` comes back.
+    pub texture: Option<OrganTexture>,
+}
+
+/// A colour texture over an organ's UVs (see [`OrganMesh::texture`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrganTexture {
+    /// One `[u, v]` per vertex (`v = 0` at the organ's base).
+    pub uvs: Vec<[f32; 2]>,
+    /// 8-bit sRGB-encoded RGBA, row 0 at the top (`v` near 1).
+    pub image: Arc<image::RgbaImage>,
 }
 
 impl OrganMesh {
@@ -40,7 +59,16 @@ impl OrganMesh {
             triangles: triangles.to_vec(),
             color_linear,
             overlay: None,
+            texture: None,
         }
+    }
+
+    /// Paints the organ with `image` over its `uvs` (one per vertex),
+    /// multiplied with its colour (so use white to show the image as it
+    /// is).
+    pub fn with_texture(mut self, uvs: Vec<[f32; 2]>, image: Arc<image::RgbaImage>) -> OrganMesh {
+        self.texture = Some(OrganTexture { uvs, image });
+        self
     }
 
     /// Adds a per-vertex overlay (values in `[0, 1]`).
@@ -71,6 +99,17 @@ impl OrganMesh {
                 "{} overlay values for {n} positions",
                 overlay.len()
             ));
+        }
+        if let Some(texture) = &self.texture {
+            if texture.uvs.len() != n {
+                return Err(format!(
+                    "{} texture coordinates for {n} positions",
+                    texture.uvs.len()
+                ));
+            }
+            if texture.image.width() == 0 || texture.image.height() == 0 {
+                return Err("the texture image is empty".to_string());
+            }
         }
         if n > u32::MAX as usize {
             return Err(format!("{n} vertices do not fit u32 indices"));

@@ -83,7 +83,7 @@ impl OffscreenRenderer {
         if !(supports(format.color) && supports(format.depth)) {
             format.sample_count = 1;
         }
-        let pipeline = OrganPipeline::new(&device, format);
+        let pipeline = OrganPipeline::new(&device, &queue, format);
         Ok(OffscreenRenderer {
             _instance: instance,
             adapter_info,

@@ -1,3 +1,5 @@
+use std::sync::Arc;
+
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -115,10 +117,11 @@ struct Vertex {
     position_in_world: [f32; 3],
     normal_in_world: [f32; 3],
     overlay: f32,
+    uv: [f32; 2],
 }
 
-const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
-    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32];
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 4] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32, 3 => Float32x2];
 
 /// One organ's GPU buffers. Buffers are kept and rewritten while the new
 /// data fits, so streaming animation frames does not reallocate.
@@ -126,6 +129,9 @@ struct GpuOrgan {
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,
+    /// The organ's colour texture and the image it was uploaded from (kept
+    /// while the same image comes back); `None`: the white texture.
+    texture: Option<(Arc<image::RgbaImage>, wgpu::BindGroup)>,
 }
 
 /// The organ and background pipelines with their buffers, usable with any
@@ -141,6 +147,10 @@ pub struct OrganPipeline {
     organ_uniform_capacity: usize,
     organ_uniform_buffer: wgpu::Buffer,
     organ_bind_group: wgpu::BindGroup,
+    texture_layout: wgpu::BindGroupLayout,
+    texture_sampler: wgpu::Sampler,
+    /// A 1x1 white texture: what an organ without a texture is drawn with.
+    white_texture: wgpu::BindGroup,
     organs: Vec<GpuOrgan>,
     background: Background,
     /// The ground shadow's place, as `Frame.ground` in organ.wgsl: set from
@@ -153,8 +163,9 @@ fn round_up(value: u64, alignment: u64) -> u64 {
 }
 
 impl OrganPipeline {
-    /// Builds the pipelines for passes with attachments of `format`.
-    pub fn new(device: &wgpu::Device, format: TargetFormat) -> OrganPipeline {
+    /// Builds the pipelines for passes with attachments of `format`
+    /// (`queue` uploads the white texture untextured organs are drawn with).
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, format: TargetFormat) -> OrganPipeline {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("anthesis organ.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER_SOURCE.into()),
@@ -177,9 +188,34 @@ impl OrganPipeline {
             label: Some("anthesis organ uniforms"),
             entries: &[uniform_entry(true, size_of::<OrganUniform>())],
         });
+        let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("anthesis organ texture"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("anthesis organs"),
-            bind_group_layouts: &[Some(&frame_layout), Some(&organ_layout)],
+            bind_group_layouts: &[
+                Some(&frame_layout),
+                Some(&organ_layout),
+                Some(&texture_layout),
+            ],
             immediate_size: 0,
         });
 
@@ -279,6 +315,17 @@ impl OrganPipeline {
         );
         let (organ_uniform_buffer, organ_bind_group) =
             Self::create_organ_uniforms(device, &organ_layout, organ_uniform_stride, 1);
+        // Bilinear within the image, clamped at its edges (the UV square's
+        // rim is the organ's rim).
+        let texture_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("anthesis organ texture"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let white = image::RgbaImage::from_pixel(1, 1, image::Rgba([255; 4]));
+        let white_texture =
+            Self::create_texture(device, queue, &texture_layout, &texture_sampler, &white);
         OrganPipeline {
             format,
             organ_pipeline,
@@ -290,10 +337,58 @@ impl OrganPipeline {
             organ_uniform_capacity: 1,
             organ_uniform_buffer,
             organ_bind_group,
+            texture_layout,
+            texture_sampler,
+            white_texture,
             organs: Vec::new(),
             ground: [0.0; 4],
             background: Background::default(),
         }
+    }
+
+    /// Uploads `image` (sRGB-encoded RGBA8: sampled as linear colours) and
+    /// binds it with `sampler` as `layout` describes.
+    fn create_texture(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        layout: &wgpu::BindGroupLayout,
+        sampler: &wgpu::Sampler,
+        image: &image::RgbaImage,
+    ) -> wgpu::BindGroup {
+        let texture = device.create_texture_with_data(
+            queue,
+            &wgpu::TextureDescriptor {
+                label: Some("anthesis organ texture"),
+                size: wgpu::Extent3d {
+                    width: image.width(),
+                    height: image.height(),
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba8UnormSrgb,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            image.as_raw(),
+        );
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("anthesis organ texture"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+            ],
+        })
     }
 
     fn create_organ_uniforms(
@@ -396,8 +491,24 @@ impl OrganPipeline {
                     position_in_world: mesh.positions_in_world[v],
                     normal_in_world: mesh.normals_in_world[v],
                     overlay: mesh.overlay.as_ref().map_or(0.0, |o| o[v]),
+                    uv: mesh.texture.as_ref().map_or([0.0; 2], |t| t.uvs[v]),
                 })
                 .collect();
+            // The texture: kept while the same image comes back.
+            let previous = self.organs.get_mut(i).and_then(|gpu| gpu.texture.take());
+            let texture = mesh.texture.as_ref().map(|t| match previous {
+                Some((image, bind_group)) if Arc::ptr_eq(&image, &t.image) => (image, bind_group),
+                _ => {
+                    let bind_group = Self::create_texture(
+                        device,
+                        queue,
+                        &self.texture_layout,
+                        &self.texture_sampler,
+                        &t.image,
+                    );
+                    (Arc::clone(&t.image), bind_group)
+                }
+            });
             let vertex_bytes: &[u8] = bytemuck::cast_slice(&vertices);
             let index_bytes: &[u8] = bytemuck::cast_slice(&mesh.triangles);
             let index_count = (mesh.triangles.len() * 3) as u32;
@@ -414,6 +525,7 @@ impl OrganPipeline {
                     queue.write_buffer(&gpu.indices, 0, index_bytes);
                 }
                 gpu.index_count = index_count;
+                gpu.texture = texture;
             } else {
                 let create = |label, contents: &[u8], usage| {
                     // Zero-sized buffers cannot be bound: keep at least one word.
@@ -442,6 +554,7 @@ impl OrganPipeline {
                         wgpu::BufferUsages::INDEX,
                     ),
                     index_count,
+                    texture,
                 };
                 if i < self.organs.len() {
                     self.organs[i] = gpu;
@@ -496,6 +609,7 @@ impl OrganPipeline {
         pass.set_pipeline(&self.background_pipeline);
         pass.set_bind_group(0, &self.frame_bind_group, &[]);
         pass.set_bind_group(1, &self.organ_bind_group, &[0]);
+        pass.set_bind_group(2, &self.white_texture, &[]);
         pass.draw(0..3, 0..1);
     }
 
@@ -509,6 +623,8 @@ impl OrganPipeline {
             }
             let offset = (i as u64 * self.organ_uniform_stride) as u32;
             pass.set_bind_group(1, &self.organ_bind_group, &[offset]);
+            let texture = organ.texture.as_ref().map_or(&self.white_texture, |t| &t.1);
+            pass.set_bind_group(2, texture, &[]);
             pass.set_vertex_buffer(0, organ.vertices.slice(..));
             pass.set_index_buffer(organ.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..organ.index_count, 0, 0..1);
@@ -608,6 +724,6 @@ mod tests {
         };
         assert_eq!(size_of_struct("Frame"), size_of::<FrameUniform>());
         assert_eq!(size_of_struct("Organ"), size_of::<OrganUniform>());
-        assert_eq!(size_of::<Vertex>(), 28);
+        assert_eq!(size_of::<Vertex>(), 36);
     }
 }

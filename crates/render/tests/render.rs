@@ -2,6 +2,8 @@
 //! tests fail, never skip, when no adapter is available.
 
 use anthesis_render::{Background, Camera, OffscreenRenderer, OrganMesh, RenderError};
+use std::sync::Arc;
+
 use glam::DVec3;
 use image::{Rgba, RgbaImage};
 
@@ -232,6 +234,58 @@ fn overlay_replaces_the_organ_colour_with_the_ramp() {
         "low end should be blue: {low:?}"
     );
     assert!(is_reddish(high), "high end should be red: {high:?}");
+}
+
+/// The square's UVs: `u` along +X, `v` along +Y (0 at the bottom edge).
+const SQUARE_UVS: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+
+#[test]
+fn a_texture_paints_the_organ_by_its_uvs() {
+    let mut renderer = renderer();
+    // 2 x 2 pixels, row 0 the top (v = 1): red bottom-left, green
+    // bottom-right and top-right, red top-left. sRGB codes.
+    let (red, green) = ([230, 25, 25, 255], [25, 204, 25, 255]);
+    let painted = image::RgbaImage::from_fn(2, 2, |x, _| Rgba(if x == 0 { red } else { green }));
+    let organ = square(1.0, 0.0, [1.0; 4]).with_texture(SQUARE_UVS.to_vec(), Arc::new(painted));
+    let image = renderer
+        .render(std::slice::from_ref(&organ), &camera(true), SIZE, SIZE)
+        .expect("render");
+    let left = pixel_of(&camera(true), DVec3::new(-0.6, 0.0, 0.0));
+    let right = pixel_of(&camera(true), DVec3::new(0.6, 0.0, 0.0));
+    let left = *image.get_pixel(left.0, left.1);
+    let right = *image.get_pixel(right.0, right.1);
+    assert!(is_reddish(left), "u < 0.5 is red: {left:?}");
+    assert!(is_greenish(right), "u > 0.5 is green: {right:?}");
+    // The texture is multiplied with the organ's colour: white over red
+    // is the flat red of an untextured square.
+    let white = image::RgbaImage::from_pixel(1, 1, Rgba([255; 4]));
+    let textured = square(1.0, 0.0, RED).with_texture(SQUARE_UVS.to_vec(), Arc::new(white));
+    let flat = centre(
+        &renderer
+            .render(&[square(1.0, 0.0, RED)], &camera(true), SIZE, SIZE)
+            .expect("flat"),
+    );
+    let through_white = centre(
+        &renderer
+            .render(&[textured], &camera(true), SIZE, SIZE)
+            .expect("white texture"),
+    );
+    assert_eq!(flat, through_white);
+    // Drawn again with the same image (kept uploaded) and then another.
+    let again = renderer
+        .render(std::slice::from_ref(&organ), &camera(true), SIZE, SIZE)
+        .expect("again");
+    assert_eq!(again, image);
+    // A texture with the wrong number of coordinates is refused.
+    let mut broken = organ.clone();
+    if let Some(texture) = &mut broken.texture {
+        texture.uvs.pop();
+    }
+    assert!(
+        renderer
+            .render(&[broken], &camera(true), SIZE, SIZE)
+            .is_err()
+    );
 }
 
 #[test]

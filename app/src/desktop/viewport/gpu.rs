@@ -34,9 +34,13 @@ pub struct ViewportGpu {
 impl ViewportGpu {
     /// Creates the pipelines for egui's pass of `egui_target_format`
     /// (single-sampled, no depth: eframe's and egui_kittest's defaults).
-    pub fn new(device: &wgpu::Device, egui_target_format: wgpu::TextureFormat) -> ViewportGpu {
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        egui_target_format: wgpu::TextureFormat,
+    ) -> ViewportGpu {
         ViewportGpu {
-            organs: OrganPipeline::new(device, BLIT_SOURCE_FORMAT),
+            organs: OrganPipeline::new(device, queue, BLIT_SOURCE_FORMAT),
             target: None,
             uploaded_revision: None,
             blit: BlitPipeline::new(device, egui_target_format),
@@ -46,7 +50,11 @@ impl ViewportGpu {
 
     /// Registers the viewport's GPU state with eframe's renderer.
     pub fn install(render_state: &egui_wgpu::RenderState) {
-        let gpu = ViewportGpu::new(&render_state.device, render_state.target_format);
+        let gpu = ViewportGpu::new(
+            &render_state.device,
+            &render_state.queue,
+            render_state.target_format,
+        );
         render_state.renderer.write().callback_resources.insert(gpu);
     }
 }
