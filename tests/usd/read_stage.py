@@ -75,6 +75,16 @@ def mesh_report(mesh):
             "diffuse_color": list(shader.GetInput("diffuseColor").Get()) if shader else None,
             "opacity": shader.GetInput("opacity").Get() if shader else None,
         }
+        # Where the diffuse colour comes from when it is connected: the
+        # source shader's id and the primvar it reads.
+        if shader and shader.GetInput("diffuseColor").HasConnectedSource():
+            source = shader.GetInput("diffuseColor").GetConnectedSources()[0][0]
+            reader = UsdShade.Shader(source.source.GetPrim())
+            report["material"]["diffuse_source"] = {
+                "shader_id": reader.GetIdAttr().Get(),
+                "varname": reader.GetInput("varname").Get(),
+                "output": source.sourceName,
+            }
     return report
 
 

@@ -81,6 +81,14 @@ pub enum ExportError {
     #[error("cannot build the USD layer: {0}")]
     /// The USD layer could not be built.
     Usd(String),
+    #[error("cannot encode the colour map of template {template:?} as a PNG: {message}")]
+    /// A template's baked colour map could not be encoded.
+    Texture {
+        /// The template's name.
+        template: String,
+        /// The encoder's message.
+        message: String,
+    },
 }
 
 fn finest_hint(finest: Option<u32>) -> String {
@@ -170,4 +178,11 @@ pub enum TrackProblem {
     #[error("its base-colour texture is not a PNG file")]
     /// The base-colour texture is not a PNG.
     TextureNotPng,
+    #[error("its base-colour texture cannot be read: {message}")]
+    /// The base-colour texture starts like a PNG but does not decode (USD
+    /// samples it for the vertex colours).
+    TextureUnreadable {
+        /// The decoder's message.
+        message: String,
+    },
 }

@@ -57,6 +57,7 @@
 #![warn(missing_docs)]
 
 mod between;
+mod colour;
 mod error;
 mod glb;
 mod obj;
@@ -71,6 +72,7 @@ use std::path::Path;
 use glam::{DQuat, DVec2, DVec3};
 
 pub use between::KeyframeBlend;
+pub use colour::colour_png;
 pub use error::{ExportError, TrackProblem};
 pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};

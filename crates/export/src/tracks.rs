@@ -156,7 +156,9 @@ fn edge_count(triangles: &[[u32; 3]]) -> u64 {
 /// What an export of `flower` holds: one track per simulated organ (`organs`
 /// are indices into `flower.organs`, in the order the keyframes hold their
 /// positions), named after the organ and drawn with its template's mesh,
-/// UVs and colour, followed by the flower's parts
+/// UVs and colour (a template with a colour map: its baked PNG as the
+/// base-colour texture, [`crate::colour_png`], and a white base colour),
+/// followed by the flower's parts
 /// ([`anthesis_flower::parts::part_pieces`]: the receptacle the organs sit
 /// on, named `receptacle`, then every stamen, pistil and stem piece), each
 /// still or, where its schedule turns it, rigid ([`part_track`]).
@@ -193,6 +195,7 @@ pub fn flower_tracks<'k>(
     });
     let count = keyframes.len();
     let mut tracks = organ_tracks(looks, keyframes);
+    crate::colour::paint_tracks(&mut tracks, flower, organs)?;
     if render_level > 0 {
         tracks = tracks
             .iter()

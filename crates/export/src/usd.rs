@@ -27,7 +27,10 @@
 //!   `faceVertexCounts` (all 3) and `faceVertexIndices`; `primvars:st`
 //!   (vertex interpolation, `v = 0` at the organ's base, which is also the
 //!   bottom row of a map image as USD expects); `primvars:displayColor` and
-//!   `primvars:displayOpacity` (constant, the track's linear base colour);
+//!   `primvars:displayOpacity` (constant, the track's linear base colour;
+//!   per vertex, `vertex` interpolation, when the track has a base-colour
+//!   texture: the base colour times the texture sampled at the vertex's
+//!   UV, bilinear in linear light, as a template's colour map);
 //!   `doubleSided = true`, `orientation = "rightHanded"` (triangles wind
 //!   counter-clockwise around the inner side's normal) and
 //!   `subdivisionScheme = "none"` (the triangles are the surface, not a
@@ -36,7 +39,9 @@
 //!   `Material` whose `UsdPreviewSurface` has the base colour as
 //!   `diffuseColor`, its alpha as `opacity`, roughness 0.7 and metallic 0,
 //!   like the .glb's material. Base-colour textures are not written (a USD
-//!   texture is a separate file next to the layer).
+//!   texture is a separate file next to the layer): with one, the
+//!   `diffuseColor` is connected to a `UsdPrimvarReader_float3` shader
+//!   (`displayColor` under the material) reading `displayColor`.
 
 use std::path::Path;
 
@@ -161,14 +166,27 @@ fn build_layer(
         .sum::<usize>()
         .max(1) as f32;
     let mut work_done = 0usize;
-    for (track, name) in tracks.iter().zip(&names) {
-        let material = write_material(&mut layer, &materials, name, track.base_color)?;
+    for (index, (track, name)) in tracks.iter().zip(&names).enumerate() {
+        let colours =
+            crate::colour::vertex_colours(track).map_err(|problem| ExportError::InvalidTrack {
+                track: index,
+                name: track.name.clone(),
+                problem,
+            })?;
+        let material = write_material(
+            &mut layer,
+            &materials,
+            name,
+            track.base_color,
+            colours.is_some(),
+        )?;
         let mesh = layer.prim(&flower, name, "Mesh")?;
         write_mesh(
             &mut layer,
             &mesh,
             &material,
             track,
+            colours.as_deref(),
             options.normals,
             &mut || {
                 work_done += 1;
@@ -281,6 +299,7 @@ fn write_mesh(
     mesh: &sdf::Path,
     material: &sdf::Path,
     track: &Track,
+    colours: Option<&[[f32; 4]]>,
     normals: bool,
     tick: &mut dyn FnMut(),
 ) -> Result<(), ExportError> {
@@ -356,35 +375,57 @@ fn write_mesh(
     )?;
     layer.set_field(&st, "interpolation", Value::Token("vertex".into()))?;
 
-    let [r, g, b, a] = track.base_color;
+    // One colour, or one per vertex from the colour map.
+    let (rgb, alpha, interpolation) = match colours {
+        None => {
+            let [r, g, b, a] = track.base_color;
+            (vec![gf::vec3f(r, g, b)], vec![a], "constant")
+        }
+        Some(colours) => (
+            colours
+                .iter()
+                .map(|c| gf::vec3f(c[0], c[1], c[2]))
+                .collect(),
+            colours.iter().map(|c| c[3]).collect(),
+            "vertex",
+        ),
+    };
     let color = layer.attribute(
         mesh,
         "primvars:displayColor",
         "color3f[]",
         None,
-        Value::Vec3fVec(vec![gf::vec3f(r, g, b)]),
+        Value::Vec3fVec(rgb),
     )?;
-    layer.set_field(&color, "interpolation", Value::Token("constant".into()))?;
+    layer.set_field(&color, "interpolation", Value::Token(interpolation.into()))?;
     let opacity = layer.attribute(
         mesh,
         "primvars:displayOpacity",
         "float[]",
         None,
-        Value::FloatVec(vec![a]),
+        Value::FloatVec(alpha),
     )?;
-    layer.set_field(&opacity, "interpolation", Value::Token("constant".into()))?;
+    layer.set_field(
+        &opacity,
+        "interpolation",
+        Value::Token(interpolation.into()),
+    )?;
 
     layer.relationship(mesh, "material:binding", material)?;
     Ok(())
 }
 
 /// A `Material` with a `UsdPreviewSurface` of `color` under `scope`;
-/// returns the material's path.
+/// returns the material's path. With `vertex_colours`, its `diffuseColor`
+/// is connected to a `UsdPrimvarReader_float3` of the mesh's
+/// `displayColor` (`color` stays its value where readers are not
+/// followed).
 fn write_material(
     layer: &mut LayerBuilder,
     scope: &sdf::Path,
     name: &str,
     color: [f32; 4],
+    vertex_colours: bool,
 ) -> Result<sdf::Path, ExportError> {
     let material = layer.prim(scope, name, "Material")?;
     let shader = layer.prim(&material, "surface", "Shader")?;
@@ -396,13 +437,36 @@ fn write_material(
         Value::Token("UsdPreviewSurface".into()),
     )?;
     let [r, g, b, a] = color;
-    layer.attribute(
+    let diffuse = layer.attribute(
         &shader,
         "inputs:diffuseColor",
         "color3f",
         None,
         Value::Vec3f(gf::vec3f(r, g, b)),
     )?;
+    if vertex_colours {
+        let reader = layer.prim(&material, "displayColor", "Shader")?;
+        layer.attribute(
+            &reader,
+            "info:id",
+            "token",
+            Some(Variability::Uniform),
+            Value::Token("UsdPrimvarReader_float3".into()),
+        )?;
+        layer.attribute(
+            &reader,
+            "inputs:varname",
+            "string",
+            None,
+            Value::String("displayColor".into()),
+        )?;
+        let result = layer.declared_attribute(&reader, "outputs:result", "float3")?;
+        layer.set_field(
+            &diffuse,
+            FieldKey::ConnectionPaths,
+            Value::PathListOp(ListOp::explicit([result])),
+        )?;
+    }
     layer.attribute(&shader, "inputs:opacity", "float", None, Value::Float(a))?;
     layer.attribute(
         &shader,

@@ -360,3 +360,66 @@ fn usd_paths_are_told_by_their_extension() {
         assert!(!is_usd_path(Path::new(other)), "{other}");
     }
 }
+
+/// sRGB code to linear, as the exporter decodes a texture.
+fn srgb_to_linear(code: u8) -> f32 {
+    let s = f32::from(code) / 255.0;
+    if s <= 0.04045 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[test]
+fn a_textured_track_gets_its_colours_per_vertex() {
+    let mut tracks = fixture(3);
+    // 2 x 2 pixels, row 0 the top: the left column red, the right blue.
+    let (red, blue) = ([230u8, 20, 20, 255], [20u8, 40, 220, 255]);
+    let image =
+        image::RgbaImage::from_fn(2, 2, |x, _| image::Rgba(if x == 0 { red } else { blue }));
+    let mut png = Vec::new();
+    image::DynamicImage::ImageRgba8(image)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("encode");
+    tracks[0].base_color_png = Some(png);
+    tracks[0].base_color = [1.0; 4];
+    let report = write_and_read(&tracks, &UsdOptions::default(), "coloured.usda");
+    assert_eq!(report["validation_findings"], serde_json::json!([]));
+    let mesh = &report["meshes"][0];
+    let colours = &mesh["display_color"];
+    assert_eq!(colours["interpolation"], "vertex");
+    let values = vec3s_of(&colours["value"]);
+    assert_eq!(values.len(), tracks[0].uvs.len());
+    let linear = |c: [u8; 4]| {
+        DVec3::new(
+            f64::from(srgb_to_linear(c[0])),
+            f64::from(srgb_to_linear(c[1])),
+            f64::from(srgb_to_linear(c[2])),
+        )
+    };
+    for (uv, colour) in tracks[0].uvs.iter().zip(&values) {
+        // Left of the first pixel centre all red, right of the second all
+        // blue, linear in between.
+        let t = ((uv.x - 0.25) / 0.5).clamp(0.0, 1.0);
+        let expected = linear(red).lerp(linear(blue), t);
+        assert!(
+            (*colour - expected).abs().max_element() < 1e-4,
+            "at {uv}: {colour} against {expected}"
+        );
+    }
+    assert_eq!(mesh["display_opacity"]["interpolation"], "vertex");
+    let source = &mesh["material"]["diffuse_source"];
+    assert_eq!(source["shader_id"], "UsdPrimvarReader_float3");
+    assert_eq!(source["varname"], "displayColor");
+    // Untextured tracks keep one constant colour and no reader.
+    assert_eq!(
+        report["meshes"][1]["display_color"]["interpolation"],
+        "constant"
+    );
+    assert!(
+        report["meshes"][1]["material"]
+            .get("diffuse_source")
+            .is_none()
+    );
+}
