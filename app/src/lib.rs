@@ -4,4 +4,5 @@
 pub mod animation;
 pub mod cli;
 pub mod desktop;
+pub mod look;
 pub mod parts;

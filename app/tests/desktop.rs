@@ -1985,4 +1985,97 @@ fn parts_are_added_edited_and_removed_from_the_parameters_panel_with_undo() {
 
     click_in_view(&mut harness, "Remove part");
     assert!(harness.state().project().flower.parts.is_empty());
+
+#[test]
+fn painting_the_colour_target_paints_the_colour_map_shows_its_colours_and_undoes() {
+    use anthesis_maps::brush::{Brush, BrushMode, PaintTarget};
+    let mut harness = opened_small_flower();
+    let before = harness.state().project().clone();
+    assert_eq!(before.flower.templates[0].colouring, None);
+    let paint = harness.state_mut().paint_mut();
+    paint.target = PaintTarget::Colour;
+    paint.brush = Brush {
+        mode: BrushMode::Set,
+        radius_in_uv: 0.08,
+        strength: 1.0,
+        hardness: 1.0,
+        value: 1.0,
+        mirror: false,
+    };
+    harness.run();
+    stroke_on_canvas(&mut harness, egui::vec2(0.3, 0.3), egui::vec2(0.3, 0.7));
+    let app = harness.state();
+    let colouring = app.project().flower.templates[0]
+        .colouring
+        .as_ref()
+        .expect("the stroke made a colour map");
+    assert_eq!(
+        colouring.second_color,
+        anthesis_flower::DEFAULT_SECOND_COLOR
+    );
+    assert_eq!(
+        colouring.mix.size(),
+        (
+            anthesis_flower::COLOUR_PAINT_SIZE,
+            anthesis_flower::COLOUR_PAINT_SIZE
+        )
+    );
+    // Canvas (0.3, 0.5) is u 0.3, v 0.5: painted; the other side is not.
+    assert!(colouring.mix.sample(glam::DVec2::new(0.3, 0.5)) > 0.9);
+    assert_eq!(colouring.mix.sample(glam::DVec2::new(0.8, 0.5)), 0.0);
+    // The growth maps are untouched (and `anthesis_sim::resume` keeps
+    // every computed keyframe: colours are not simulated).
+    assert_eq!(
+        app.project().flower.templates[0].maps,
+        before.flower.templates[0].maps
+    );
+    assert!(
+        harness
+            .query_by_label_contains("0 = the base colour, 1 = the second colour")
+            .is_some()
+    );
+    harness.get_by_label("Clear").click();
+    harness.hover_at(egui::pos2(600.0, 300.0));
+    harness.run();
+    harness.snapshot("paint_colour_target");
+
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().project(), &before, "one stroke, one undo");
+}
+
+#[test]
+fn the_parameters_panel_picks_the_base_and_second_colours() {
+    let mut project = small_flower();
+    project.flower.templates[0].colouring = Some(anthesis_flower::Colouring {
+        second_color: [0.45, 0.02, 0.06, 1.0],
+        mix: anthesis_maps::ScalarMap::from_fn(16, 16, |uv| uv.y as f32),
+        layers: Vec::new(),
+    });
+    let resolved = project.clone();
+    let chosen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let sink = std::rc::Rc::clone(&chosen);
+    let mut harness = Harness::builder()
+        .with_size(egui::vec2(300.0, 760.0))
+        .wgpu()
+        .build_ui(move |ui| {
+            sink.borrow_mut()
+                .extend(anthesis_app::desktop::params::parameters_ui(
+                    ui, &project, &resolved, 0,
+                ));
+        });
+    harness.run();
+    assert!(harness.query_by_label("base colour").is_some());
+    assert!(harness.query_by_label("second colour").is_some());
+    harness.snapshot("parameters_colours");
+    // Removing the colour map is one undoable edit of the template.
+    harness.get_by_label("Remove colour map").click();
+    harness.run();
+    let edits: Vec<String> = chosen.borrow().iter().map(|c| format!("{c:?}")).collect();
+    assert!(
+        edits
+            .iter()
+            .any(|e| e.contains("colour map of") && e.contains("colouring: None")),
+        "{edits:?}"
+    );
 }

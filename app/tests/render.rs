@@ -344,3 +344,92 @@ fn render_subdivide_draws_the_smooth_render_meshes_in_the_same_place() {
         .count();
     assert!(changed > 20, "only {changed} pixels changed");
 }
+
+/// The colour of `picture` around `(x, y)`: the mean of the 3x3 pixels.
+fn colour_around(picture: &RgbaImage, x: f64, y: f64) -> [f64; 3] {
+    let (x, y) = (x.round() as i64, y.round() as i64);
+    let mut sum = [0.0; 3];
+    for dy in -1..=1 {
+        for dx in -1..=1 {
+            let p = picture.get_pixel((x + dx) as u32, (y + dy) as u32);
+            for (s, c) in sum.iter_mut().zip(p.0) {
+                *s += f64::from(c) / 9.0;
+            }
+        }
+    }
+    sum
+}
+
+#[test]
+fn render_shows_a_two_colour_template_in_both_colours_where_its_mix_map_says() {
+    use anthesis_flower::Colouring;
+    use glam::DVec2;
+    // A red organ painted blue over its right half (u > 0.5).
+    let mut project = anthesis_sim::fixtures::whorl(1, 8, 14, 2);
+    let template = &mut project.flower.templates[0];
+    template.color = [0.8, 0.05, 0.03, 1.0];
+    template.colouring = Some(Colouring {
+        second_color: [0.03, 0.08, 0.8, 1.0],
+        mix: anthesis_maps::ScalarMap::from_fn(32, 32, |uv| if uv.x > 0.5 { 1.0 } else { 0.0 }),
+        layers: Vec::new(),
+    });
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("two-colour.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let (azimuth_deg, elevation_deg) = (project.flower.organs[0].placement.azimuth_deg, 10.0);
+    let out = anthesis(&[
+        "render",
+        utf8(&path),
+        "--frames",
+        "0",
+        "--out",
+        utf8(dir.path()),
+        "--size",
+        "320x240",
+        "--azimuth",
+        &azimuth_deg.to_string(),
+        "--elevation",
+        &elevation_deg.to_string(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let picture = load_png(&dir.path().join("frame-000.png"));
+
+    // Where the organ's points at u = 0.25 and u = 0.75 (half way up) land.
+    let bud = anthesis_sim::Simulation::new(&project, &anthesis_sim::Selection::All)
+        .expect("simulation")
+        .bud();
+    let positions = &bud.positions_in_world[0];
+    let (low, high) = positions
+        .iter()
+        .fold((positions[0], positions[0]), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    let camera = anthesis_render::Camera::framing(low, high, azimuth_deg, elevation_deg);
+    let mesh = &project.flower.templates[0].mesh;
+    let at_uv = |uv: DVec2| {
+        let nearest = (0..mesh.vertex_count())
+            .min_by(|&a, &b| {
+                mesh.uvs[a]
+                    .distance(uv)
+                    .total_cmp(&mesh.uvs[b].distance(uv))
+            })
+            .expect("vertices");
+        let clip = camera.view_projection(320.0 / 240.0) * positions[nearest].as_vec3().extend(1.0);
+        let ndc = clip.truncate() / clip.w;
+        colour_around(
+            &picture,
+            (f64::from(ndc.x) + 1.0) * 0.5 * 320.0,
+            (1.0 - f64::from(ndc.y)) * 0.5 * 240.0,
+        )
+    };
+    let base_side = at_uv(DVec2::new(0.25, 0.5));
+    let second_side = at_uv(DVec2::new(0.75, 0.5));
+    assert!(
+        base_side[0] > base_side[2] + 80.0,
+        "u = 0.25 shows the red base colour: {base_side:?}"
+    );
+    assert!(
+        second_side[2] > second_side[0] + 80.0,
+        "u = 0.75 shows the blue second colour: {second_side:?}"
+    );
+}

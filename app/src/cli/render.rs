@@ -278,7 +278,13 @@ fn simulate_scenes(
 ) -> Result<Vec<(u32, Vec<OrganMesh>)>> {
     anthesis_sim::memory::check_run(project, selection, KeyframeCost::Kept)?;
     let mut sim = Simulation::new(project, selection)?;
-    let colors: Vec<[f32; 4]> = (0..sim.organs().len()).map(|i| sim.color(i)).collect();
+    // Each organ's colour, or its template's colour map (white times the
+    // baked image), as the viewport draws it.
+    let looks: Vec<_> = selection
+        .organs(project.flower.organs.len())
+        .iter()
+        .map(|&organ| crate::look::template_look(project.flower.template_of(organ)))
+        .collect();
     // The same render meshes as `simulate --subdivide` exports
     // (`anthesis_export::Track::subdivided`): each organ's subdivision built
     // once, its corners found in the bud.
@@ -305,8 +311,11 @@ fn simulate_scenes(
         positions
             .iter()
             .zip(&subdivisions)
-            .zip(&colors)
-            .map(|((p, s), c)| OrganMesh::from_positions(&s.apply(p), s.triangles(), *c))
+            .zip(&looks)
+            .map(|((p, s), (color, texture))| {
+                let mesh = OrganMesh::from_positions(&s.apply(p), s.triangles(), *color);
+                crate::look::with_texture(mesh, s.uvs(), texture.as_ref())
+            })
             .collect()
     };
     let organs_at = |positions: &[Vec<glam::DVec3>], keyframe: u32| -> Vec<OrganMesh> {

@@ -20,7 +20,7 @@ use super::log::Topic;
 use super::prompts::Pending;
 use super::viewport::ViewOptions;
 use super::{AnthesisApp, Document};
-use anthesis_maps::brush::{Brush, PaintTarget, StrokeDab, dab_keyed};
+use anthesis_maps::brush::{Brush, PaintTarget, StrokeDab, dab_keyed, dab_scalar};
 
 /// One user action.
 #[derive(Debug, Clone, PartialEq)]
@@ -144,6 +144,8 @@ pub enum ProjectEdit {
 pub enum LoadedMap {
     Scalar(MapKind, ScalarMap),
     Direction(DirectionMap),
+    /// The template's colour map (any size: it is not simulated).
+    Colour(ScalarMap),
 }
 
 impl ProjectEdit {
@@ -169,6 +171,14 @@ impl ProjectEdit {
                 dabs,
             } => {
                 if let Some(t) = templates.get_mut(template) {
+                    if target == PaintTarget::Colour {
+                        // The colour map: one for the template, not keyed.
+                        let colouring = t.colouring_to_paint();
+                        for dab in dabs {
+                            dab_scalar(&mut colouring.mix, &brush, dab.centre_in_uv, 0.0);
+                        }
+                        return;
+                    }
                     for dab in dabs {
                         dab_keyed(
                             &mut t.maps,
@@ -206,6 +216,15 @@ impl ProjectEdit {
             }
             ProjectEdit::Resolution(resolution) => project.settings.resolution = resolution,
             ProjectEdit::Parts(parts) => project.flower.parts = parts,
+            ProjectEdit::Map {
+                template,
+                key: _,
+                map,
+            } if matches!(*map, LoadedMap::Colour(_)) => {
+                if let (Some(t), LoadedMap::Colour(mix)) = (templates.get_mut(template), *map) {
+                    t.colouring_to_paint().mix = mix;
+                }
+            }
             ProjectEdit::Map { template, key, map } => {
                 let Some(k) = templates
                     .get_mut(template)
@@ -216,6 +235,7 @@ impl ProjectEdit {
                 match *map {
                     LoadedMap::Scalar(kind, map) => *k.maps.scalar_mut(kind) = map,
                     LoadedMap::Direction(map) => k.maps.direction = map,
+                    LoadedMap::Colour(_) => {}
                 }
             }
         }

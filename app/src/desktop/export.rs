@@ -119,19 +119,22 @@ fn write_gif(
         anyhow::bail!("there are no keyframes to render yet");
     };
     let keyframes = animation::keyframes_every(step, last as u32);
+    // Each track's colour map, decoded once.
+    let textures: Vec<_> = tracks
+        .iter()
+        .map(|t| crate::look::png_texture(t.base_color_png.as_deref()))
+        .collect();
     let scenes: Vec<Vec<OrganMesh>> = keyframes
         .iter()
         .map(|&k| {
             tracks
                 .iter()
-                .filter_map(|t| {
+                .zip(&textures)
+                .filter_map(|(t, texture)| {
                     // A still track (one keyframe) shows it throughout.
                     let positions = t.keyframes.get(k as usize).or(t.keyframes.last())?;
-                    Some(OrganMesh::from_positions(
-                        positions,
-                        &t.triangles,
-                        t.base_color,
-                    ))
+                    let mesh = OrganMesh::from_positions(positions, &t.triangles, t.base_color);
+                    Some(crate::look::with_texture(mesh, &t.uvs, texture.as_ref()))
                 })
                 .collect()
         })

@@ -78,10 +78,16 @@ pub fn ramp(value: f32) -> Color32 {
 }
 
 /// The picture of `target` in key `key`: scalar maps through [`ramp`],
-/// directions as grey (their arrows are drawn on top).
+/// directions as grey (their arrows are drawn on top), the colour map as
+/// the organ's actual colours.
 fn map_image(template: &Template, key: usize, target: PaintTarget) -> egui::ColorImage {
     let maps = &template.maps.key_clamped(key).maps;
     match target {
+        PaintTarget::Colour => {
+            let (w, h) = template.colour_image_size();
+            let image = template.colour_image(w, h);
+            egui::ColorImage::from_rgba_unmultiplied([w as usize, h as usize], image.as_raw())
+        }
         PaintTarget::Scalar(kind) => {
             let map = maps.scalar(kind);
             let (w, h) = map.size();
@@ -205,6 +211,12 @@ impl PaintState {
                     .sample(point_in_uv) as f32,
             ),
             PaintTarget::Direction => None,
+            PaintTarget::Colour => Some(
+                template
+                    .colouring
+                    .as_ref()
+                    .map_or(0.0, |c| c.mix.sample(point_in_uv) as f32),
+            ),
         }
     }
 
@@ -270,13 +282,15 @@ impl PaintState {
                             );
                         }
                         ui.selectable_value(&mut self.target, PaintTarget::Direction, "direction");
+                        ui.selectable_value(&mut self.target, PaintTarget::Colour, "colour");
                     })
                     .response
                     .labelled_by(label)
                     .on_hover_text(
                         "e/w-growth: growth along/across the growth direction of the base layer; \
                      -in: of the inner layer (inner > base bends the petal outwards); stretch, \
-                     bend: stiffness multipliers; direction: drag to paint the growth direction.",
+                     bend: stiffness multipliers; direction: drag to paint the growth direction; \
+                     colour: where the second colour shows over the base colour (not simulated).",
                     );
                 ui.end_row();
 
@@ -645,8 +659,15 @@ impl PaintState {
             .small()
             .weak(),
         );
+        let colours = (self.target == PaintTarget::Colour).then(|| {
+            let second = current
+                .colouring
+                .as_ref()
+                .map_or(anthesis_flower::DEFAULT_SECOND_COLOR, |c| c.second_color);
+            (current.color, second)
+        });
         match self.target {
-            PaintTarget::Scalar(kind) => {
+            PaintTarget::Scalar(_) | PaintTarget::Colour => {
                 let (area, _) =
                     ui.allocate_exact_size(Vec2::new(ui.available_width(), 26.0), Sense::hover());
                 let bar = Rect::from_min_size(area.min, Vec2::new(area.width(), 12.0));
@@ -661,7 +682,10 @@ impl PaintState {
                             bar.y_range(),
                         ),
                         0.0,
-                        ramp((t0 + t1) / 2.0),
+                        match colours {
+                            Some((base, second)) => blend_colour(base, second, (t0 + t1) / 2.0),
+                            None => ramp((t0 + t1) / 2.0),
+                        },
                     );
                 }
                 let value_under = hovered.and_then(|uv| self.value_at(current, uv));
@@ -694,13 +718,26 @@ impl PaintState {
                         ui.visuals().text_color(),
                     );
                 }
-                ui.label(egui::RichText::new(legend(kind, current.dg)).small());
+                let (text, meant) = match self.target {
+                    PaintTarget::Scalar(kind) => (
+                        legend(kind, current.dg),
+                        value_under.map(|v| meaning(kind, current.dg, v)),
+                    ),
+                    _ => (
+                        "colour: how much of the second colour shows over the base colour \
+                         (both picked in the parameters panel). 0 = the base colour, 1 = the \
+                         second colour; not simulated, so painting it recomputes no keyframe."
+                            .to_string(),
+                        value_under.map(|v| format!(" = {:.0} % second colour", 100.0 * v)),
+                    ),
+                };
+                ui.label(egui::RichText::new(text).small());
                 ui.label(match (hovered, value_under) {
                     (Some(uv), Some(value)) => format!(
                         "under the pointer (u {:.2}, v {:.2}): {value:.3}{}",
                         uv.x,
                         uv.y,
-                        meaning(kind, current.dg, value)
+                        meant.unwrap_or_default()
                     ),
                     _ => "under the pointer: –".to_string(),
                 });
@@ -725,6 +762,13 @@ impl PaintState {
             }
         }
     }
+}
+
+/// The base colour blended towards the second by `t` (linear colours, as
+/// the renderer blends them), for the screen.
+fn blend_colour(base: [f32; 4], second: [f32; 4], t: f32) -> Color32 {
+    let c = |i: usize| base[i] + (second[i] - base[i]) * t;
+    egui::Rgba::from_rgb(c(0), c(1), c(2)).into()
 }
 
 /// What 0 and 1 mean for map `kind` of a template growing at most `dg` per

@@ -1,11 +1,12 @@
 //! The parameters panel: the selected organ's template (dg, thickness,
-//! Ks, Kb, joint schedule, base region), the project's keyframe count and
+//! Ks, Kb, joint schedule, base region, base and second colour), the
+//! project's keyframe count and
 //! its resolution (with the particles each organ gets), each with a tooltip
 //! saying what it does. An edit becomes a [`Command::Edit`], so each is
 //! undoable and restarts the simulation.
 
 use anthesis_flower::resolution::predicted_size;
-use anthesis_flower::{JointRamp, Project, Resolution, Template};
+use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOR, JointRamp, Project, Resolution, Template};
 use eframe::egui::{self, DragValue};
 
 use super::command::{Command, ProjectEdit};
@@ -242,6 +243,57 @@ pub fn parameters_ui(
     if let Some(edit) = resolution_ui(ui, project, resolved, template) {
         return Some(edit);
     }
+    ui.separator();
+    ui.strong("Colour").on_hover_text(
+        "What the organ looks like (not simulated): the base colour, and a second colour \
+         painted over it with the paint panel's colour map.",
+    );
+    egui::Grid::new("template colours")
+        .num_columns(2)
+        .show(ui, |ui| {
+            let (base, changed) = colour_row(
+                ui,
+                "base colour",
+                "The organ's colour where the colour map is 0 (everywhere without one).",
+                draft.color,
+            );
+            if changed {
+                draft.color = base;
+                mark(true, "base colour");
+            }
+            let second = draft
+                .colouring
+                .as_ref()
+                .map_or(DEFAULT_SECOND_COLOR, |c| c.second_color);
+            let (second, changed) = colour_row(
+                ui,
+                "second colour",
+                "The colour painted over the base colour where the colour map is 1 (paint it \
+                 with the paint panel's target “colour”).",
+                second,
+            );
+            if changed {
+                draft
+                    .colouring
+                    .get_or_insert_with(|| Colouring {
+                        second_color: second,
+                        mix: anthesis_maps::ScalarMap::constant(0.0),
+                        layers: Vec::new(),
+                    })
+                    .second_color = second;
+                mark(true, "second colour");
+            }
+        });
+    if draft.colouring.is_some()
+        && ui
+            .button("Remove colour map")
+            .on_hover_text("The organ goes back to its base colour all over")
+            .clicked()
+    {
+        draft.colouring = None;
+        mark(true, "colour map");
+    }
+
     let field = changed_field?;
     Some(Command::Edit {
         label: edit_label(field, &name),
@@ -251,6 +303,27 @@ pub fn parameters_ui(
             keyframes,
         },
     })
+}
+
+/// A labelled colour button (linear RGBA, alpha kept); returns the colour
+/// and whether it changed.
+fn colour_row(ui: &mut egui::Ui, label: &str, tooltip: &str, linear: [f32; 4]) -> ([f32; 4], bool) {
+    let label = ui.label(label).on_hover_text(tooltip);
+    let mut rgba = egui::Rgba::from_rgb(linear[0], linear[1], linear[2]);
+    let changed = egui::color_picker::color_edit_button_rgba(
+        ui,
+        &mut rgba,
+        egui::color_picker::Alpha::Opaque,
+    )
+    .labelled_by(label.id)
+    .on_hover_text(tooltip)
+    .changed();
+    ui.end_row();
+    let clamp = |c: f32| c.clamp(0.0, 1.0);
+    (
+        [clamp(rgba.r()), clamp(rgba.g()), clamp(rgba.b()), linear[3]],
+        changed,
+    )
 }
 
 /// The undo step's name for a changed parameter: what changed and whose it

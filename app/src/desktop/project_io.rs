@@ -131,6 +131,9 @@ impl AnthesisApp {
             PaintTarget::Direction => anthesis_maps::DirectionMap::load_png(path)
                 .map_err(|e| e.to_string())
                 .and_then(|map| fits(map.size()).map(|()| LoadedMap::Direction(map))),
+            PaintTarget::Colour => anthesis_maps::ScalarMap::load_png(path)
+                .map(LoadedMap::Colour)
+                .map_err(|e| e.to_string()),
         };
         match loaded {
             Ok(map) => {

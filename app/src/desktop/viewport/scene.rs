@@ -81,7 +81,8 @@ pub fn scene_bounds(scene: &[SceneOrgan]) -> Option<(DVec3, DVec3)> {
 const HIGHLIGHT_LINEAR: [f32; 3] = [1.0, 0.71, 0.17];
 
 /// Meshes for the renderer: each organ in its template colour (linear, as
-/// the renderer takes it); the selected one tinted towards a warm
+/// the renderer takes it) or its colour map (`crate::look`, baked once per
+/// template); the selected one tinted towards a warm
 /// highlight; organs not simulated (bud placeholders in preview) washed out
 /// towards grey; the overlay map as a ramp.
 pub fn scene_meshes(
@@ -90,11 +91,16 @@ pub fn scene_meshes(
     selected: Option<usize>,
     overlay: Option<(MapKind, usize)>,
 ) -> Vec<OrganMesh> {
+    let mut looks: Vec<Option<([f32; 4], Option<Arc<image::RgbaImage>>)>> =
+        vec![None; project.flower.templates.len()];
     scene
         .iter()
         .map(|o| {
             let template = project.flower.template_of(o.organ);
-            let mut color_linear = template.color;
+            let index = project.flower.organs[o.organ].template;
+            let (mut color_linear, texture) = looks[index]
+                .get_or_insert_with(|| crate::look::template_look(template))
+                .clone();
             if selected == Some(o.organ) {
                 for (c, h) in color_linear.iter_mut().zip(HIGHLIGHT_LINEAR) {
                     *c += 0.45 * (h - *c);
@@ -105,6 +111,7 @@ pub fn scene_meshes(
                 }
             }
             let mesh = OrganMesh::from_positions(&o.positions_in_world, &o.triangles, color_linear);
+            let mesh = crate::look::with_texture(mesh, &o.uvs, texture.as_ref());
             match overlay {
                 Some((kind, key)) => {
                     let map = template.maps.key_clamped(key).maps.scalar(kind);
