@@ -3,14 +3,16 @@
 //! parameters of Table 1.
 
 use anthesis_bud::BudError;
-use anthesis_flower::{BaseRegion, Flower, JointRamp, Project, SimulationSettings, Template};
+use anthesis_flower::{
+    BaseRegion, ColourLayer, Colouring, Flower, JointRamp, Project, SimulationSettings, Template,
+};
 use anthesis_maps::{Blend, GrowthMaps, KeyedMaps, MapError, MapKey};
 use anthesis_mesh::Mesh;
 use glam::DVec2;
 
 use crate::arrangement::{Whorl, contorted_whorl, nested_whorls};
 use crate::buds::RingOrgan;
-use crate::paint::{Painting, above_base, midrib_band, smoothstep};
+use crate::paint::{Painting, above_base, colour_map, midrib_band, smoothstep, spots};
 
 /// Why a default flower could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -338,9 +340,46 @@ fn lily_petal_template_at(edge_scale: f64) -> Result<Template, GardenError> {
         "lily petal",
         lily_petal_bud(),
         LILY_PETAL_EDGE * edge_scale,
-        [0.98, 0.55, 0.22, 1.0],
+        LILY_WHITE,
     );
-    template("petal", &spec, lily_maps(LilyExcess::PETAL))
+    let mut petal = template("petal", &spec, lily_maps(LilyExcess::PETAL))?;
+    petal.colouring = Some(lily_colouring(7, 26));
+    Ok(petal)
+}
+
+/// The lily's tepals: a warm white (linear RGBA; sRGB about 247, 245, 238).
+pub const LILY_WHITE: [f32; 4] = [0.93, 0.91, 0.855, 1.0];
+/// The lily's throat: a greenish yellow (sRGB about 190, 205, 90).
+pub const LILY_THROAT: [f32; 4] = [0.515, 0.61, 0.1, 1.0];
+/// The lily's spots: crimson (sRGB about 150, 15, 40).
+pub const LILY_CRIMSON: [f32; 4] = [0.305, 0.005, 0.021, 1.0];
+
+/// How much of the throat colour shows on a lily tepal: all of it at the
+/// base, along the midrib (wider at the base), fading out by a third of
+/// the length, and a faint streak up the midrib to about half way.
+pub fn lily_throat(uv: DVec2) -> f64 {
+    let (u, v) = (uv.x, uv.y);
+    let base = (1.0 - smoothstep(0.04, 0.34, v)) * midrib_band(u, 0.16 + 0.22 * (1.0 - v));
+    let streak = 0.45 * midrib_band(u, 0.035) * (1.0 - smoothstep(0.25, 0.55, v));
+    base.max(streak)
+}
+
+/// A lily tepal's colours: [`LILY_WHITE`], the greenish-yellow throat
+/// ([`lily_throat`]) and `count` small crimson spots (pseudo-random from
+/// `seed`) on the inner half, between the throat and the middle, nearer
+/// the midrib than the margins.
+fn lily_colouring(seed: u64, count: usize) -> Colouring {
+    // The tepal is about three times longer than wide: spots three times
+    // wider in u than in v are round on it.
+    let spotted = spots(seed, count, (0.14, 0.5), 0.2, 0.011, 3.0);
+    Colouring {
+        second_color: LILY_THROAT,
+        mix: colour_map(lily_throat),
+        layers: vec![ColourLayer {
+            color: LILY_CRIMSON,
+            mix: colour_map(spotted),
+        }],
+    }
 }
 
 /// The lily sepal template: [`lily_sepal_bud`] meshed at [`EDGE_SCALE`]
@@ -355,9 +394,12 @@ fn lily_sepal_template_at(edge_scale: f64) -> Result<Template, GardenError> {
         "lily sepal",
         lily_sepal_bud(),
         LILY_SEPAL_EDGE * edge_scale,
-        [0.96, 0.5, 0.2, 1.0],
+        LILY_WHITE,
     );
-    template("sepal", &spec, lily_maps(LilyExcess::SEPAL))
+    let mut sepal = template("sepal", &spec, lily_maps(LilyExcess::SEPAL))?;
+    // The outer tepals: the same colours, fewer spots.
+    sepal.colouring = Some(lily_colouring(11, 18));
+    Ok(sepal)
 }
 
 /// The whorls of a bud of `organs` of shape `bud`, `count` of them from
@@ -453,10 +495,49 @@ impl Cultivar {
     fn color(self) -> [f32; 4] {
         match self {
             Cultivar::MellowYellow => [0.97, 0.9, 0.5, 1.0],
-            Cultivar::MaiteLady => [0.93, 0.7, 0.86, 1.0],
+            // White with a purple picotee rim.
+            Cultivar::MaiteLady => [0.9, 0.88, 0.91, 1.0],
             Cultivar::Pinocchio => [0.62, 0.42, 0.82, 1.0],
         }
     }
+
+    /// The cultivar's colour map: Mellow Yellow's cream-yellow petals turn
+    /// lime green towards the base; Maite Lady's white petals have a purple
+    /// picotee margin over their upper half; Pinocchio's violet petals
+    /// deepen to a dark purple blush from the base.
+    pub fn colouring(self) -> Colouring {
+        match self {
+            Cultivar::MellowYellow => Colouring {
+                // sRGB about 165, 200, 60.
+                second_color: [0.376, 0.578, 0.045, 1.0],
+                mix: colour_map(|uv| 0.85 * (1.0 - smoothstep(0.05, 0.4, uv.y))),
+                layers: Vec::new(),
+            },
+            Cultivar::MaiteLady => Colouring {
+                // sRGB about 150, 40, 140.
+                second_color: [0.305, 0.021, 0.262, 1.0],
+                mix: colour_map(eustoma_picotee),
+                layers: Vec::new(),
+            },
+            Cultivar::Pinocchio => Colouring {
+                // sRGB about 80, 20, 110.
+                second_color: [0.08, 0.007, 0.155, 1.0],
+                mix: colour_map(|uv| 1.0 - smoothstep(0.04, 0.45, uv.y)),
+                layers: Vec::new(),
+            },
+        }
+    }
+}
+
+/// A picotee rim on an Eustoma petal: the margin (`u` near 0 or 1) and the
+/// rounded top (`v` near 1) of the upper half, about a tenth of the half
+/// width wide, with a soft inner edge that feathers along the veins.
+pub fn eustoma_picotee(uv: DVec2) -> f64 {
+    let (u, v) = (uv.x, uv.y);
+    let to_margin = u.min(1.0 - u).min(0.5 * (1.0 - v));
+    let feather = 0.012 * (1.0 + (u * 60.0).sin());
+    let rim = 1.0 - smoothstep(0.035, 0.075 + feather, to_margin);
+    rim * smoothstep(0.35, 0.6, v)
 }
 
 /// Table 1: Eustoma's growth scale, thickness, stiffness and mean edge.
@@ -664,7 +745,9 @@ fn eustoma_petal_template_of(
         joint: EUSTOMA_JOINT,
         color: cultivar.color(),
     };
-    template("petal", &spec, eustoma_maps_of(growth))
+    let mut petal = template("petal", &spec, eustoma_maps_of(growth))?;
+    petal.colouring = Some(cultivar.colouring());
+    Ok(petal)
 }
 
 /// One Eustoma cultivar: five contorted petals, each one's right side

@@ -63,6 +63,66 @@ pub fn direction_map(direction_at: impl Fn(DVec2) -> DVec2) -> DirectionMap {
     }
 }
 
+/// The resolution of the painted colour maps: finer than the growth maps,
+/// since spots and picotee rims are small.
+pub const COLOUR_MAP_SIZE: u32 = 256;
+
+/// A colour mix map of `value_at(uv)` at [`COLOUR_MAP_SIZE`], clamped and
+/// quantised like [`scalar_map`]; a constant when uniform.
+pub fn colour_map(value_at: impl Fn(DVec2) -> f64) -> ScalarMap {
+    let map = ScalarMap::from_fn(COLOUR_MAP_SIZE, COLOUR_MAP_SIZE, |uv| {
+        quantise_unit(value_at(uv).clamp(0.0, 1.0))
+    });
+    let first = map.values()[0];
+    if map.values().iter().all(|&v| v == first) {
+        ScalarMap::constant(first)
+    } else {
+        map
+    }
+}
+
+/// Round spots on the organ (soft-edged discs, 1 inside): `count` of them
+/// scattered by a fixed pseudo-random sequence from `seed` over `v` in
+/// `v_range`, at most `spread` in `u` from the midrib, `radius_v` tall in
+/// `v` and `aspect` times that wide in `u` (an organ `aspect` times longer
+/// than wide has round spots then). The same seed paints the same spots.
+pub fn spots(
+    seed: u64,
+    count: usize,
+    v_range: (f64, f64),
+    spread: f64,
+    radius_v: f64,
+    aspect: f64,
+) -> impl Fn(DVec2) -> f64 {
+    // A 64-bit linear congruential generator (Knuth's MMIX constants),
+    // its top 53 bits as a number in [0, 1).
+    let mut state = seed;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let centres: Vec<(DVec2, f64)> = (0..count)
+        .map(|_| {
+            // More spots towards the throat: v drawn with a square.
+            let v = v_range.0 + (v_range.1 - v_range.0) * next().powf(1.5);
+            let u = 0.5 + spread * (2.0 * next() - 1.0);
+            let size = 0.6 + 0.8 * next();
+            (DVec2::new(u, v), radius_v * size)
+        })
+        .collect();
+    move |uv: DVec2| {
+        centres
+            .iter()
+            .map(|(centre, r)| {
+                let d = (uv - *centre) / DVec2::new(r * aspect, *r);
+                1.0 - smoothstep(0.7, 1.0, d.length())
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
 /// The value a 16-bit scalar PNG gives back for `value` in `[0, 1]`.
 fn quantise_unit(value: f64) -> f32 {
     let max = f64::from(BitDepth::Sixteen.max_code());
