@@ -67,6 +67,18 @@ fn three_mask(ids: &RgbaImage) -> Vec<bool> {
     ids.pixels().map(|p| p.0[1] == 255).collect()
 }
 
+/// Pixels three.js drew a tepal on in the ids picture: the first meshes of
+/// the file are the organs (`ORGANS`), mesh `i` drawn as red `32 (i + 1)`,
+/// full green, no blue (page.html's `idColor`).
+fn tepal_mask(ids: &RgbaImage) -> Vec<bool> {
+    ids.pixels()
+        .map(|p| {
+            let [r, g, b, _] = p.0;
+            g == 255 && b == 0 && r % 32 == 0 && (1..=ORGANS.len()).contains(&usize::from(r / 32))
+        })
+        .collect()
+}
+
 /// Intersection over union of two masks.
 fn overlap(a: &[bool], b: &[bool]) -> f64 {
     let both = a.iter().zip(b).filter(|(x, y)| **x && **y).count();
@@ -276,4 +288,65 @@ fn every_encoding_of_the_lily_plays_in_three_js_like_anthesis_renders_it() {
             assert!(pixels > 100, "{encoding}: {organ} covers {pixels} pixels");
         }
     }
+
+    // The tepals' colour side by side: the lily's colour maps (white, a
+    // greenish-yellow throat, crimson spots) reach three.js as base-colour
+    // textures and look as `anthesis render` paints them. The lights
+    // differ (three.js: a hemisphere and a key light on a PBR material;
+    // anthesis: its petal shading), so brightness is compared loosely and
+    // the colour itself (chromaticity) tightly, over the pixels both draw
+    // a tepal on, at every compared keyframe.
+    let dense = &reports[0]["frames"];
+    for (i, keyframe) in KEYFRAMES.iter().enumerate() {
+        let ours = image_at(&format!("{renders}/frame-{keyframe:03}.png"));
+        let ids = image_at(dense[i]["ids"].as_str().expect("ids"));
+        let theirs = image_at(dense[i]["shaded"].as_str().expect("shaded"));
+        let both: Vec<bool> = anthesis_mask(&ours)
+            .iter()
+            .zip(tepal_mask(&ids))
+            .map(|(a, b)| *a && b)
+            .collect();
+        let (ours, theirs) = (mean_colour(&ours, &both), mean_colour(&theirs, &both));
+        let (c_ours, c_theirs) = (chromaticity(ours), chromaticity(theirs));
+        let brightness = (theirs.iter().sum::<f64>()) / (ours.iter().sum::<f64>());
+        eprintln!(
+            "keyframe {keyframe}: mean tepal colour (sRGB) anthesis {:.0?}, three.js {:.0?}; \
+             chromaticity {:.3?} vs {:.3?}; brightness ratio {brightness:.2}",
+            ours, theirs, c_ours, c_theirs
+        );
+        for channel in 0..3 {
+            assert!(
+                (c_ours[channel] - c_theirs[channel]).abs() <= COLOUR_TOLERANCE,
+                "keyframe {keyframe}: three.js's tepals {theirs:.0?} are another colour than \
+                 anthesis render's {ours:.0?}"
+            );
+        }
+        assert!(
+            (0.6..=1.6).contains(&brightness),
+            "keyframe {keyframe}: three.js's tepals {theirs:.0?} against {ours:.0?}"
+        );
+    }
+}
+
+/// How far the chromaticities (each channel's share of the sum) of the two
+/// pictures' mean tepal colours may differ.
+const COLOUR_TOLERANCE: f64 = 0.03;
+
+/// The mean sRGB colour of `picture` over the pixels `mask` holds.
+fn mean_colour(picture: &RgbaImage, mask: &[bool]) -> [f64; 3] {
+    let mut sum = [0.0; 3];
+    let mut count = 0.0;
+    for (p, _) in picture.pixels().zip(mask).filter(|(_, m)| **m) {
+        for (s, c) in sum.iter_mut().zip(p.0) {
+            *s += f64::from(c);
+        }
+        count += 1.0;
+    }
+    sum.map(|s| s / f64::max(count, 1.0))
+}
+
+/// Each channel's share of the sum of the three.
+fn chromaticity(colour: [f64; 3]) -> [f64; 3] {
+    let sum = colour.iter().sum::<f64>().max(1e-9);
+    colour.map(|c| c / sum)
 }
