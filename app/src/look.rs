@@ -8,11 +8,15 @@ use anthesis_flower::Template;
 use anthesis_render::OrganMesh;
 use glam::DVec2;
 
+/// What the renderer draws an organ with: the colour it multiplies the
+/// texture with, and the texture (`None`: the colour alone).
+pub type Look = ([f32; 4], Option<Arc<image::RgbaImage>>);
+
 /// The colour the renderer multiplies the texture with, and the texture:
 /// a template with a colour map draws white times its baked colour image
 /// ([`Template::colour_image`] at its own size); one without draws its
 /// colour.
-pub fn template_look(template: &Template) -> ([f32; 4], Option<Arc<image::RgbaImage>>) {
+pub fn template_look(template: &Template) -> Look {
     if template.colouring.is_none() {
         return (template.color, None);
     }

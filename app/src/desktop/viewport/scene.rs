@@ -91,8 +91,7 @@ pub fn scene_meshes(
     selected: Option<usize>,
     overlay: Option<(MapKind, usize)>,
 ) -> Vec<OrganMesh> {
-    let mut looks: Vec<Option<([f32; 4], Option<Arc<image::RgbaImage>>)>> =
-        vec![None; project.flower.templates.len()];
+    let mut looks: Vec<Option<crate::look::Look>> = vec![None; project.flower.templates.len()];
     scene
         .iter()
         .map(|o| {
