@@ -61,6 +61,7 @@ fn flower() -> Flower {
         organs: vec![organ("petal-1", 0, 0.0), organ("sepal-1", 1, 180.0)],
         overlaps: Vec::new(),
         structure: None,
+        parts: Vec::new(),
     }
 }
 
@@ -140,5 +141,19 @@ fn a_coloured_flower_passes_the_validator_with_a_base_colour_texture() {
         let sepal = &materials[1]["pbrMetallicRoughness"];
         assert!(sepal.get("baseColorTexture").is_none(), "{encoding}");
         assert_eq!(glb.json["images"].as_array().map(Vec::len), Some(1));
+    }
+    // Organs of one template share its image.
+    let mut tracks = tracks;
+    tracks.insert(1, tracks[0].clone());
+    tracks[1].name = "petal-2".into();
+    let bytes = glb_bytes(&tracks, &GlbOptions::default(), &mut |_| {}).expect("export");
+    assert_valid_glb(&bytes, "coloured-shared");
+    let glb = parse_glb(&bytes);
+    assert_eq!(glb.json["images"].as_array().map(Vec::len), Some(1));
+    for material in 0..2 {
+        assert_eq!(
+            glb.json["materials"][material]["pbrMetallicRoughness"]["baseColorTexture"]["index"],
+            0
+        );
     }
 }

@@ -69,6 +69,7 @@ pub fn glb_bytes(
     let mut materials = Vec::with_capacity(tracks.len());
     let mut images = Vec::new();
     let mut textures = Vec::new();
+    let mut stored_pngs: Vec<&Vec<u8>> = Vec::new();
     let mut animated_nodes = Vec::new();
     let mut top_nodes = Vec::with_capacity(tracks.len());
     // Rigid tracks: the node that moves, and its pose at each exported
@@ -101,15 +102,23 @@ pub fn glb_bytes(
             material["alphaMode"] = json!("BLEND");
         }
         if let Some(png) = &track.base_color_png {
-            let view = gltf.view(png, None, None);
-            images.push(json!({
-                "name": track.name,
-                "bufferView": view,
-                "mimeType": "image/png",
-            }));
-            textures.push(json!({ "sampler": 0, "source": images.len() - 1 }));
-            material["pbrMetallicRoughness"]["baseColorTexture"] =
-                json!({ "index": textures.len() - 1 });
+            // Organs of one template share its colour map: one image and
+            // texture for each distinct PNG.
+            let texture = match stored_pngs.iter().position(|stored| *stored == png) {
+                Some(texture) => texture,
+                None => {
+                    let view = gltf.view(png, None, None);
+                    images.push(json!({
+                        "name": track.name,
+                        "bufferView": view,
+                        "mimeType": "image/png",
+                    }));
+                    textures.push(json!({ "sampler": 0, "source": images.len() - 1 }));
+                    stored_pngs.push(png);
+                    textures.len() - 1
+                }
+            };
+            material["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": texture });
         }
         materials.push(material);
 
