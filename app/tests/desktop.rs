@@ -1985,6 +1985,7 @@ fn parts_are_added_edited_and_removed_from_the_parameters_panel_with_undo() {
 
     click_in_view(&mut harness, "Remove part");
     assert!(harness.state().project().flower.parts.is_empty());
+}
 
 #[test]
 fn painting_the_colour_target_paints_the_colour_map_shows_its_colours_and_undoes() {

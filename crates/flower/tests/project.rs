@@ -1678,6 +1678,51 @@ fn parts_are_saved_as_readable_tables_and_load_back_equal() {
         fs::read_to_string(plain)
             .expect("read")
             .contains("version = 2")
+    );
+}
+
+#[test]
+fn broken_parts_are_refused_naming_the_part_and_the_key() {
+    let with = |part: &str| {
+        let (_f, path) = saved_lily();
+        edit(&path, |text| {
+            let text = replace_once(text, "version = 2", "version = 5");
+            format!("{text}\n[[parts]]\n{part}")
+        });
+        load_project(&path).expect_err("refused").to_string()
+    };
+    let err = with("name = \"s\"\nkind = \"stamen\"\nlength = 5.0\nradius = 0.1\n");
+    assert!(
+        err.contains("stamen \"s\": `anther_length` is missing"),
+        "{err}"
+    );
+    let err = with("name = \"s\"\nkind = \"petal\"\n");
+    assert!(
+        err.contains("kind must be one of stamen, pistil, pedicel, receptacle"),
+        "{err}"
+    );
+    let err = with("name = \"p\"\nkind = \"pedicel\"\nlength = 5.0\nradius = 0.1\ndepth = 1.0\n");
+    assert!(
+        err.contains("`depth` is not a setting of a pedicel"),
+        "{err}"
+    );
+    let err = with(
+        "name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\n\
+         stigma_lobes = 12\n",
+    );
+    assert!(err.contains("stigma_lobes must be 1 to 8, not 12"), "{err}");
+    let err = with(
+        "name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\nwidth = 2\n",
+    );
+    assert!(err.contains("width"), "{err}");
+    // An instance named like an organ.
+    let err = with(
+        "name = \"petal\"\nkind = \"stamen\"\ncount = 3\nlength = 5.0\nradius = 0.1\n\
+         anther_length = 1.0\nanther_radius = 0.2\n",
+    );
+    assert!(err.contains("petal-1"), "{err}");
+}
+
 /// The lily with a crimson blush painted from the petal's base (a colour map
 /// of its own size, 16x16 against the growth maps' 8x6).
 fn coloured_lily() -> Project {
@@ -1725,45 +1770,6 @@ fn a_colour_map_survives_saving_and_loading() {
 }
 
 #[test]
-fn broken_parts_are_refused_naming_the_part_and_the_key() {
-    let with = |part: &str| {
-        let (_f, path) = saved_lily();
-        edit(&path, |text| {
-            let text = replace_once(text, "version = 2", "version = 5");
-            format!("{text}\n[[parts]]\n{part}")
-        });
-        load_project(&path).expect_err("refused").to_string()
-    };
-    let err = with("name = \"s\"\nkind = \"stamen\"\nlength = 5.0\nradius = 0.1\n");
-    assert!(
-        err.contains("stamen \"s\": `anther_length` is missing"),
-        "{err}"
-    );
-    let err = with("name = \"s\"\nkind = \"petal\"\n");
-    assert!(
-        err.contains("kind must be one of stamen, pistil, pedicel, receptacle"),
-        "{err}"
-    );
-    let err = with("name = \"p\"\nkind = \"pedicel\"\nlength = 5.0\nradius = 0.1\ndepth = 1.0\n");
-    assert!(
-        err.contains("`depth` is not a setting of a pedicel"),
-        "{err}"
-    );
-    let err = with(
-        "name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\n\
-         stigma_lobes = 12\n",
-    );
-    assert!(err.contains("stigma_lobes must be 1 to 8, not 12"), "{err}");
-    let err = with(
-        "name = \"s\"\nkind = \"pistil\"\nlength = 5.0\nradius = 0.1\nstigma_radius = 0.3\nwidth = 2\n",
-    );
-    assert!(err.contains("width"), "{err}");
-    // An instance named like an organ.
-    let err = with(
-        "name = \"petal\"\nkind = \"stamen\"\ncount = 3\nlength = 5.0\nradius = 0.1\n\
-         anther_length = 1.0\nanther_radius = 0.2\n",
-    );
-    assert!(err.contains("petal-1"), "{err}");
 fn a_project_without_colour_maps_saves_as_before() {
     let (_folder, path) = saved_lily();
     let text = fs::read_to_string(&path).expect("read");
