@@ -95,9 +95,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .map(|&i| project.flower.template_of(i).mesh.clone())
         .collect();
-    let colors: Vec<_> = simulated
+    // Each organ's colour, or white times its template's colour map (as the
+    // app and `anthesis render` draw it).
+    let looks: Vec<_> = simulated
         .iter()
-        .map(|&i| project.flower.template_of(i).color)
+        .map(|&i| {
+            let template = project.flower.template_of(i);
+            match &template.colouring {
+                None => (template.color, None),
+                Some(_) => {
+                    let (w, h) = template.colour_image_size();
+                    let uvs: Vec<[f32; 2]> = template
+                        .mesh
+                        .uvs
+                        .iter()
+                        .map(|uv| uv.as_vec2().to_array())
+                        .collect();
+                    (
+                        [1.0; 4],
+                        Some((uvs, std::sync::Arc::new(template.colour_image(w, h)))),
+                    )
+                }
+            }
+        })
         .collect();
     let result = run(&project, &selection, &mut |_, keyframe| {
         if frames.contains(&keyframe.index) {
@@ -161,7 +181,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut organs: Vec<OrganMesh> = positions
                 .iter()
                 .enumerate()
-                .map(|(i, p)| OrganMesh::from_positions(p, &meshes[i].triangles, colors[i]))
+                .map(|(i, p)| {
+                    let (color, texture) = &looks[i];
+                    let mesh = OrganMesh::from_positions(p, &meshes[i].triangles, *color);
+                    match texture {
+                        Some((uvs, image)) => mesh.with_texture(uvs.clone(), image.clone()),
+                        None => mesh,
+                    }
+                })
                 .collect();
             // The receptacle, stamens, pistil and stem, with the whole flower.
             if only.is_none() {
