@@ -1029,9 +1029,9 @@ fn the_last_project_and_view_are_remembered_between_launches() {
     assert!(app.view_options().wireframe);
 }
 
-#[test]
-fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
-    let mut harness = opened_small_flower();
+/// Paint on the 3D organ, the bend map, with the camera aimed at the middle
+/// of petal-1 as it is shown now (the viewport's centre).
+fn aimed_at_the_middle_of_petal_1(harness: &mut Harness<'_, AnthesisApp>) {
     // Aim the camera at the middle of petal-1 as it is shown now.
     let app = harness.state_mut();
     let template = &app.project().flower.templates[0];
@@ -1066,6 +1066,12 @@ fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
         (40.0, shown),
         "the camera stays where the test put it"
     );
+}
+
+#[test]
+fn dragging_on_the_3d_organ_in_paint_mode_paints_its_map() {
+    let mut harness = opened_small_flower();
+    aimed_at_the_middle_of_petal_1(&mut harness);
     let before = harness.state().project().clone();
     let centre = harness.get_by_label("3D viewport").rect().center();
     harness.hover_at(centre);
@@ -2079,4 +2085,42 @@ fn the_parameters_panel_picks_the_base_and_second_colours() {
             .any(|e| e.contains("colour map of") && e.contains("colouring: None")),
         "{edits:?}"
     );
+}
+
+#[test]
+fn alt_click_on_the_3d_organ_picks_the_value_under_the_pointer() {
+    use anthesis_maps::brush::BrushMode;
+    // A bend map of 0.37 everywhere on petal-1's template.
+    let mut project = small_flower();
+    project.flower.templates[0].maps.keys_mut()[0].maps.bend =
+        anthesis_maps::ScalarMap::constant(0.37);
+    let mut harness = harness(project);
+    harness.run();
+    feed(&mut harness, None);
+    harness.run();
+    aimed_at_the_middle_of_petal_1(&mut harness);
+    let paint = harness.state_mut().paint_mut();
+    paint.brush.mode = BrushMode::Add;
+    paint.brush.value = 0.9;
+    let before = harness.state().project().clone();
+    let centre = harness.get_by_label("3D viewport").rect().center();
+    harness.hover_at(centre);
+    harness.run();
+    for pressed in [true, false] {
+        harness.event_modifiers(
+            egui::Event::PointerButton {
+                pos: centre,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: egui::Modifiers::ALT,
+            },
+            egui::Modifiers::ALT,
+        );
+        harness.step();
+    }
+    harness.run();
+    let brush = harness.state_mut().paint_mut().brush;
+    assert_eq!(brush.mode, BrushMode::Set);
+    assert!((brush.value - 0.37).abs() < 1e-6, "picked {}", brush.value);
+    assert_eq!(harness.state().project(), &before, "picking paints nothing");
 }

@@ -443,13 +443,14 @@ impl PaintState {
         });
         ui.toggle_value(&mut self.eyedropper, "Eyedropper")
             .on_hover_text(
-                "Click the canvas to pick the value under the pointer as a set brush \
-                 (Alt+click always picks)",
+                "Click the canvas (or the organ, when painting on the 3D organ) to pick the \
+                 value under the pointer as a set brush (Alt+click always picks)",
             );
         ui.checkbox(&mut self.brush.mirror, "Mirror about the midrib (u = 0.5)");
         ui.checkbox(&mut self.on_3d, "Paint on the 3D organ (drag on it)")
             .on_hover_text(
-                "Dragging on the selected organ in the viewport paints; Shift+drag orbits",
+                "Dragging on the selected organ in the viewport paints; Alt+click picks the \
+                 value there; Shift+drag orbits",
             );
     }
 

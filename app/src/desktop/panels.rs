@@ -158,7 +158,17 @@ impl AnthesisApp {
             self.paint.brush.radius_in_uv,
         );
         let template = self.selected_template();
+        // Alt, or the eyedropper, picks the value under the pointer on the
+        // organ as on the canvas, instead of painting.
+        let picking = ui.input(|i| i.modifiers.alt) || self.paint.eyedropper;
         match response.painting {
+            Some(hit)
+                if picking && self.project().flower.organs[hit.organ].template == template =>
+            {
+                let current = &self.doc.project().flower.templates[template];
+                self.paint.pick(current, hit.point_in_uv);
+                self.paint.end_stroke();
+            }
             Some(hit) if self.project().flower.organs[hit.organ].template == template => {
                 // The same spacing as on the canvas, in UV along the
                 // picked path.
