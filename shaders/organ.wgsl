@@ -81,16 +81,16 @@ fn vs_organ(in: VertexIn) -> VertexOut {
     return out;
 }
 
-// Blue (low) through pale yellow (middle) to red (high), linear RGB.
+// Blue (low) through pale yellow (middle) to red (high), linear RGB. The
+// stops RAMP_LOW, RAMP_MIDDLE and RAMP_HIGH are written before this file
+// from `anthesis_render::OVERLAY_RAMP_LINEAR` (the one definition, which
+// the app's canvas and legend use too).
 fn overlay_ramp(value: f32) -> vec3<f32> {
     let t = clamp(value, 0.0, 1.0);
-    let low = vec3<f32>(0.02, 0.10, 0.55);
-    let middle = vec3<f32>(0.95, 0.90, 0.60);
-    let high = vec3<f32>(0.65, 0.02, 0.02);
     if t < 0.5 {
-        return mix(low, middle, t * 2.0);
+        return mix(RAMP_LOW, RAMP_MIDDLE, t * 2.0);
     }
-    return mix(middle, high, t * 2.0 - 1.0);
+    return mix(RAMP_MIDDLE, RAMP_HIGH, t * 2.0 - 1.0);
 }
 
 fn linear_to_srgb(linear: vec3<f32>) -> vec3<f32> {

@@ -65,16 +65,12 @@ impl Default for PaintState {
     }
 }
 
-/// Blue (0) – pale yellow (0.5) – red (1), as the viewport's overlay ramp.
+/// Blue (0) – pale yellow (0.5) – red (1): the viewport's overlay ramp
+/// (`anthesis_render::overlay_ramp_linear`, the one definition), encoded
+/// to sRGB as the renderer does.
 pub fn ramp(value: f32) -> Color32 {
-    let t = value.clamp(0.0, 1.0);
-    let (a, b, s) = if t < 0.5 {
-        ([10.0, 60.0, 190.0], [250.0, 240.0, 200.0], t * 2.0)
-    } else {
-        ([250.0, 240.0, 200.0], [170.0, 10.0, 10.0], t * 2.0 - 1.0)
-    };
-    let c = |i: usize| (a[i] + (b[i] - a[i]) * s) as u8;
-    Color32::from_rgb(c(0), c(1), c(2))
+    let [r, g, b] = anthesis_render::overlay_ramp_linear(value);
+    Color32::from(egui::Rgba::from_rgb(r, g, b))
 }
 
 /// The picture of `target` in key `key`: scalar maps through [`ramp`],

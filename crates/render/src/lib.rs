@@ -37,7 +37,10 @@ pub use error::RenderError;
 pub use mesh::{OrganMesh, OrganTexture, organs_bounds_in_world};
 pub use offscreen::OffscreenRenderer;
 pub use orbit::{ORBIT_FOV_DEG, OrbitCamera};
-pub use pipeline::{Background, DEPTH_CLEAR_VALUE, OrganPipeline, SHADER_SOURCE, TargetFormat};
+pub use pipeline::{
+    Background, DEPTH_CLEAR_VALUE, OVERLAY_RAMP_LINEAR, OrganPipeline, SHADER_SOURCE, TargetFormat,
+    organ_shader_source, overlay_ramp_linear,
+};
 pub use target::RenderTarget;
 
 /// The wgpu this crate is built against, for callers that must name its

@@ -5,8 +5,45 @@ use wgpu::util::DeviceExt;
 
 use crate::{Camera, OrganMesh, RenderError};
 
-/// The WGSL source of `shaders/organ.wgsl`, compiled into the crate.
+/// The WGSL source of `shaders/organ.wgsl`, compiled into the crate; the
+/// shader the pipeline builds is [`organ_shader_source`], which adds the
+/// overlay ramp's stops in front of it.
 pub const SHADER_SOURCE: &str = include_str!("../../../shaders/organ.wgsl");
+
+/// The map overlay's colour ramp, linear RGB, at 0 (blue), 0.5 (pale
+/// yellow) and 1 (red), blended linearly in between: the one definition
+/// the viewport's shader and the app's canvas and legend share.
+pub const OVERLAY_RAMP_LINEAR: [[f32; 3]; 3] =
+    [[0.02, 0.10, 0.55], [0.95, 0.90, 0.60], [0.65, 0.02, 0.02]];
+
+/// The overlay ramp at `value` (clamped to `[0, 1]`), linear RGB, computed
+/// as the shader's `overlay_ramp` does.
+pub fn overlay_ramp_linear(value: f32) -> [f32; 3] {
+    let t = if value.is_nan() {
+        0.0
+    } else {
+        value.clamp(0.0, 1.0)
+    };
+    let [low, middle, high] = OVERLAY_RAMP_LINEAR;
+    let (a, b, s) = if t < 0.5 {
+        (low, middle, t * 2.0)
+    } else {
+        (middle, high, t * 2.0 - 1.0)
+    };
+    // As WGSL's mix: exactly a at s = 0 and b at s = 1.
+    [0, 1, 2].map(|i| a[i] * (1.0 - s) + b[i] * s)
+}
+
+/// The organ shader as compiled: the overlay ramp's stops
+/// ([`OVERLAY_RAMP_LINEAR`]) as WGSL constants, then `shaders/organ.wgsl`.
+pub fn organ_shader_source() -> String {
+    let [low, middle, high] =
+        OVERLAY_RAMP_LINEAR.map(|[r, g, b]| format!("vec3<f32>({r:?}, {g:?}, {b:?})"));
+    format!(
+        "const RAMP_LOW: vec3<f32> = {low};\nconst RAMP_MIDDLE: vec3<f32> = {middle};\n\
+         const RAMP_HIGH: vec3<f32> = {high};\n{SHADER_SOURCE}"
+    )
+}
 
 /// The depth a pass must clear to before drawing organs (reversed depth:
 /// 0 is infinitely far).
@@ -168,7 +205,7 @@ impl OrganPipeline {
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, format: TargetFormat) -> OrganPipeline {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("anthesis organ.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER_SOURCE.into()),
+            source: wgpu::ShaderSource::Wgsl(organ_shader_source().into()),
         });
         let uniform_entry = |has_dynamic_offset: bool, size: usize| wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -710,7 +747,8 @@ mod tests {
 
     #[test]
     fn uniform_layouts_match_the_wgsl_structs() {
-        let module = naga::front::wgsl::parse_str(SHADER_SOURCE).expect("organ.wgsl parses");
+        let module =
+            naga::front::wgsl::parse_str(&organ_shader_source()).expect("organ.wgsl parses");
         let size_of_struct = |name: &str| {
             let (_, ty) = module
                 .types
@@ -725,5 +763,25 @@ mod tests {
         assert_eq!(size_of_struct("Frame"), size_of::<FrameUniform>());
         assert_eq!(size_of_struct("Organ"), size_of::<OrganUniform>());
         assert_eq!(size_of::<Vertex>(), 36);
+    }
+
+    #[test]
+    fn the_shader_gets_the_ramp_stops_the_crate_defines() {
+        let source = organ_shader_source();
+        assert!(source.starts_with("const RAMP_LOW: vec3<f32> = vec3<f32>(0.02, 0.1, 0.55);"));
+        assert!(source.contains("const RAMP_HIGH: vec3<f32> = vec3<f32>(0.65, 0.02, 0.02);"));
+        // The file itself names the stops and defines no colours of its own.
+        assert!(
+            !SHADER_SOURCE.contains("0.55"),
+            "a ramp stop is hard-coded in organ.wgsl"
+        );
+        assert_eq!(overlay_ramp_linear(0.0), OVERLAY_RAMP_LINEAR[0]);
+        assert_eq!(overlay_ramp_linear(0.5), OVERLAY_RAMP_LINEAR[1]);
+        assert_eq!(overlay_ramp_linear(7.0), OVERLAY_RAMP_LINEAR[2]);
+        let quarter = overlay_ramp_linear(0.25);
+        for i in 0..3 {
+            let halfway = 0.5 * (OVERLAY_RAMP_LINEAR[0][i] + OVERLAY_RAMP_LINEAR[1][i]);
+            assert!((quarter[i] - halfway).abs() < 1e-6);
+        }
     }
 }
