@@ -177,16 +177,39 @@ pub fn contacts_against(
     violated: Violated,
     out: &mut Vec<Contact>,
 ) {
-    for (i, x) in moving.positions.iter().enumerate() {
-        let Some(q) = tracker.nearest(*x, other.positions) else {
+    contacts_of(
+        moving.positions.iter().copied().enumerate(),
+        other,
+        tracker,
+        side,
+        offset,
+        violated,
+        out,
+    );
+}
+
+/// [`contacts_against`] for the particles `particles` (index, position)
+/// only: those farther than the tracker's reach from `other` get no
+/// contact anyway, so leaving them out changes nothing.
+pub fn contacts_of(
+    particles: impl Iterator<Item = (usize, DVec3)>,
+    other: &Surface,
+    tracker: &Tracker,
+    side: f64,
+    offset: f64,
+    violated: Violated,
+    out: &mut Vec<Contact>,
+) {
+    for (i, x) in particles {
+        let Some(q) = tracker.nearest(x, other.positions) else {
             continue;
         };
-        let Some(nearest) = nearest_on_surface(*x, other, q) else {
+        let Some(nearest) = nearest_on_surface(x, other, q) else {
             continue;
         };
         let normal = nearest.normal * side;
         if nearest.on_rim {
-            let d = *x - nearest.point;
+            let d = x - nearest.point;
             let beside = (d - normal * d.dot(normal)).length();
             if beside > offset {
                 continue;
@@ -198,7 +221,7 @@ pub fn contacts_against(
             normal,
             offset,
         };
-        let violation = contact.violation(*x);
+        let violation = contact.violation(x);
         if violation > 0.0 && violated == Violated::MoveHalf {
             contact.point -= normal * (0.5 * violation);
         }

@@ -29,7 +29,9 @@ use anthesis_physics::{Contact, SolverError};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::collide::{Surface, Tracker, Violated, contacts_against, max_violation, push_back};
+use crate::collide::{
+    Surface, Tracker, Violated, contacts_against, contacts_of, max_violation, push_back,
+};
 use crate::obstacle::ObstacleSim;
 use crate::organ::{OrganSim, OrganState};
 use crate::resume::{Edit, edit_between};
@@ -746,19 +748,22 @@ impl Simulation {
     fn obstacle_contacts(&self, contacts: &mut [Vec<Contact>]) {
         let offset = self.settings.collision_offset;
         for (organ, list) in self.organs.iter().zip(contacts) {
-            let moving = organ.surface(&[]);
             for obstacle in &self.obstacles {
-                if obstacle.near(&organ.positions) {
-                    contacts_against(
-                        &moving,
-                        &obstacle.surface(),
-                        obstacle.tracker(),
-                        1.0,
-                        offset,
-                        Violated::MoveAll,
-                        list,
-                    );
-                }
+                let near = organ
+                    .positions
+                    .iter()
+                    .copied()
+                    .enumerate()
+                    .filter(|&(_, p)| obstacle.reaches(p));
+                contacts_of(
+                    near,
+                    &obstacle.surface(),
+                    obstacle.tracker(),
+                    1.0,
+                    offset,
+                    Violated::MoveAll,
+                    list,
+                );
             }
         }
     }

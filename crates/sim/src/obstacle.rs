@@ -80,11 +80,10 @@ impl ObstacleSim {
         2.0 * self.mean_edge
     }
 
-    /// Whether any of `positions` is within reach of the obstacle's box.
-    pub(crate) fn near(&self, positions: &[DVec3]) -> bool {
-        positions
-            .iter()
-            .any(|p| p.cmpge(self.lo).all() && p.cmple(self.hi).all())
+    /// Whether `p` lies in the obstacle's box grown by the reach: only
+    /// such particles can get a contact.
+    pub(crate) fn reaches(&self, p: DVec3) -> bool {
+        p.cmpge(self.lo).all() && p.cmple(self.hi).all()
     }
 
     pub(crate) fn surface(&self) -> Surface<'_> {
