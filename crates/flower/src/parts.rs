@@ -558,38 +558,12 @@ fn segment_pieces(flower: &Flower) -> Vec<PartPiece> {
         .collect()
 }
 
-/// One obstacle: a closed component of a part instance in the part's own
-/// frame, with where it sits and how it moves.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Obstacle {
-    /// The instance's name.
-    pub name: String,
-    /// One closed surface (outward normals).
-    pub mesh: Mesh,
-    /// Where the instance sits.
-    pub placement: Placement,
-    /// How it turns.
-    pub schedule: Vec<JointRamp>,
-}
-
-impl Obstacle {
-    /// The mesh's positions in the world frame at `step`.
-    pub fn positions_at(&self, step: u32) -> Vec<DVec3> {
-        let (translation, rotation) = pose(&self.placement, &self.schedule, step);
-        self.mesh
-            .positions
-            .iter()
-            .map(|&p| translation + rotation * p)
-            .collect()
-    }
-}
-
 /// The surfaces growing organs are kept out of: one per closed component
 /// of each part instance (a filament, its anther, each stigma lobe) and
 /// one per tube an L-system's `F` draws, so
 /// that where components overlap, "outside" of each is still its own
 /// surface's outside.
-pub fn obstacles(flower: &Flower) -> Vec<Obstacle> {
+pub fn obstacles(flower: &Flower) -> Vec<PartPiece> {
     let mut out = Vec::new();
     for part in flower.parts.iter().filter(|p| p.is_obstacle()) {
         let components: Vec<Mesh> = part
@@ -599,21 +573,17 @@ pub fn obstacles(flower: &Flower) -> Vec<Obstacle> {
             .collect();
         for (k, placement) in part.placements().into_iter().enumerate() {
             for mesh in &components {
-                out.push(Obstacle {
+                out.push(PartPiece {
                     name: part.instance_name(k as u32),
                     mesh: mesh.clone(),
+                    color: part.color,
                     placement,
                     schedule: part.schedule.clone(),
                 });
             }
         }
     }
-    out.extend(segment_pieces(flower).into_iter().map(|piece| Obstacle {
-        name: piece.name,
-        mesh: piece.mesh,
-        placement: piece.placement,
-        schedule: piece.schedule,
-    }));
+    out.extend(segment_pieces(flower));
     out
 }
 

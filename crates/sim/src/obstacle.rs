@@ -6,14 +6,14 @@
 //! needed). Like organ contacts they act on particles: a part thinner
 //! than an organ's edges can pass between its particles.
 
-use anthesis_flower::parts::Obstacle;
+use anthesis_flower::parts::PartPiece;
 use glam::DVec3;
 
 use crate::collide::{Surface, Tracker};
 
 /// One obstacle at the pose of one step.
 pub(crate) struct ObstacleSim {
-    source: Obstacle,
+    source: PartPiece,
     /// Which step the positions are for.
     step: Option<u32>,
     positions: Vec<DVec3>,
@@ -29,7 +29,7 @@ pub(crate) struct ObstacleSim {
 }
 
 impl ObstacleSim {
-    pub(crate) fn new(source: Obstacle) -> ObstacleSim {
+    pub(crate) fn new(source: PartPiece) -> ObstacleSim {
         let mesh = &source.mesh;
         let triangles_around =
             anthesis_mesh::nearest::triangles_around(&mesh.triangles, mesh.vertex_count());
