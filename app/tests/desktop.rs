@@ -1524,17 +1524,21 @@ fn the_resolution_control_remeshes_reruns_and_undoes() {
     );
 }
 
-#[test]
-fn the_parameters_panel_with_a_resolution() {
-    use anthesis_flower::Resolution;
-    let mut project = small_flower();
-    let edge = anthesis_bud::quality(&project.flower.templates[0].mesh).mean_edge;
-    project.settings.resolution = Resolution::MeanEdge((edge * 0.6 * 100.0).round() / 100.0);
-    let resolved = anthesis_flower::resolution::resolve(&project).expect("remeshes");
+/// The parameters panel alone for template 0 of `project`, `height`
+/// points tall, and the commands it queues.
+#[allow(clippy::type_complexity)]
+fn parameters_panel(
+    project: Project,
+    resolved: Project,
+    height: f32,
+) -> (
+    Harness<'static>,
+    std::rc::Rc<std::cell::RefCell<Vec<anthesis_app::desktop::command::Command>>>,
+) {
     let chosen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
     let sink = std::rc::Rc::clone(&chosen);
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(300.0, 560.0))
+    let harness = Harness::builder()
+        .with_size(egui::vec2(300.0, height))
         .wgpu()
         .build_ui(move |ui| {
             sink.borrow_mut()
@@ -1542,6 +1546,17 @@ fn the_parameters_panel_with_a_resolution() {
                     ui, &project, &resolved, 0,
                 ));
         });
+    (harness, chosen)
+}
+
+#[test]
+fn the_parameters_panel_with_a_resolution() {
+    use anthesis_flower::Resolution;
+    let mut project = small_flower();
+    let edge = anthesis_bud::quality(&project.flower.templates[0].mesh).mean_edge;
+    project.settings.resolution = Resolution::MeanEdge((edge * 0.6 * 100.0).round() / 100.0);
+    let resolved = anthesis_flower::resolution::resolve(&project).expect("remeshes");
+    let (mut harness, chosen) = parameters_panel(project, resolved, 560.0);
     harness.run();
     let particles = harness.query_all_by_label_contains(" particles").count();
     assert_eq!(particles, 2, "one row per template");
@@ -2060,17 +2075,7 @@ fn the_parameters_panel_picks_the_base_and_second_colours() {
         layers: Vec::new(),
     });
     let resolved = project.clone();
-    let chosen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
-    let sink = std::rc::Rc::clone(&chosen);
-    let mut harness = Harness::builder()
-        .with_size(egui::vec2(300.0, 760.0))
-        .wgpu()
-        .build_ui(move |ui| {
-            sink.borrow_mut()
-                .extend(anthesis_app::desktop::params::parameters_ui(
-                    ui, &project, &resolved, 0,
-                ));
-        });
+    let (mut harness, chosen) = parameters_panel(project, resolved, 760.0);
     harness.run();
     assert!(harness.query_by_label("base colour").is_some());
     assert!(harness.query_by_label("second colour").is_some());
