@@ -1425,6 +1425,8 @@ fn organs_placed_by_a_structure_are_saved_as_the_structure() {
                 text: "axiom: f(0.1) B\nB -> D/(120)D/(120)D\nD -> [&(5)~s][~p]".into(),
                 steps: 2,
                 surfaces: [('p', 0), ('s', 1)].into_iter().collect(),
+                // Not the default, so the round trip shows it is kept.
+                units: 2.0,
             },
         ),
     ] {
@@ -1454,6 +1456,7 @@ fn an_lsystem_places_organs_in_the_turtle_frame_and_layers_templates_in_order() 
         text: "axiom: f(0.1) B\nB -> D/(120)D/(120)D\nD -> [&(5)~s][~p]".into(),
         steps: 2,
         surfaces: [('p', 0), ('s', 1)].into_iter().collect(),
+        units: 1.0,
     });
     let flower = &project.flower;
     let names: Vec<&str> = flower.organs.iter().map(|o| o.name.as_str()).collect();
@@ -1492,6 +1495,64 @@ fn an_lsystem_places_organs_in_the_turtle_frame_and_layers_templates_in_order() 
             Overlap { inner: 3, outer: 2 },
             Overlap { inner: 5, outer: 4 },
         ]
+    );
+}
+
+#[test]
+fn lsystem_units_scale_every_position_and_line_width_but_not_the_organs() {
+    let text = "width = 4\naxiom: F(10) [ +(90) F(5) ] ~p";
+    let at = |units: f64| {
+        lily_by(Structure::LSystem {
+            text: text.into(),
+            steps: 0,
+            surfaces: [('p', 0)].into_iter().collect(),
+            units,
+        })
+    };
+    let (one, tenth) = (at(1.0), at(0.1));
+    let organ = |p: &anthesis_flower::Project| p.flower.organs[0].placement;
+    assert!((organ(&one).position - DVec3::new(0.0, 10.0, 0.0)).length() < 1e-12);
+    assert!((organ(&tenth).position - DVec3::new(0.0, 1.0, 0.0)).length() < 1e-12);
+    assert_eq!(organ(&one).orientation, organ(&tenth).orientation);
+    let segments = |p: &anthesis_flower::Project| p.flower.structure.as_ref().unwrap().segments();
+    let (s1, s10) = (segments(&one), segments(&tenth));
+    assert_eq!(s1.len(), 2);
+    for (a, b) in s1.iter().zip(&s10) {
+        assert!((a.start * 0.1 - b.start).length() < 1e-12);
+        assert!((a.end * 0.1 - b.end).length() < 1e-12);
+        assert!(
+            (a.width * 0.1 - b.width).abs() < 1e-12,
+            "{} {}",
+            a.width,
+            b.width
+        );
+    }
+    // The branch ends 5 units to the side of the stem's top, in either unit.
+    assert!(((s10[1].end - DVec3::new(0.0, 1.0, 0.0)).length() - 0.5).abs() < 1e-12);
+    // Organ meshes are the template's, unscaled.
+    assert_eq!(one.flower.templates[0].mesh, tenth.flower.templates[0].mesh);
+}
+
+#[test]
+fn lsystem_units_that_are_not_a_positive_number_are_refused() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("flower.anthesis.toml");
+    let mut project = lily_by(Structure::LSystem {
+        text: "axiom: ~p".into(),
+        steps: 0,
+        surfaces: [('p', 0)].into_iter().collect(),
+        units: 0.5,
+    });
+    project.name = "units".into();
+    save_project(&project, &path).expect("saves");
+    edit(&path, |text| {
+        replace_once(text, "units = 0.5", "units = -2.0")
+    });
+    let err = load_project(&path).expect_err("negative units");
+    assert!(
+        err.to_string()
+            .contains("units must be a positive number, got -2"),
+        "{err}"
     );
 }
 

@@ -330,6 +330,7 @@ fn an_lsystems_f_segments_are_tubes_of_its_width_from_start_to_end() {
             text: "axiom: #(0.4) F(2) [ +(90) F(1) ] !(0) F(3) #(0.2) f(1) F(1)".to_string(),
             steps: 0,
             surfaces: Default::default(),
+            units: 1.0,
         }),
         parts: Vec::new(),
     };

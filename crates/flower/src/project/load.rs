@@ -163,10 +163,17 @@ impl Loader<'_> {
                     };
                     surfaces.insert(c, template(name, &format!("surface `{letter}`"))?);
                 }
+                let units = l.units.unwrap_or(1.0);
+                if !(units.is_finite() && units > 0.0) {
+                    return Err(self.invalid(format!(
+                        "[structure.lsystem] units must be a positive number, got {units}"
+                    )));
+                }
                 Ok(Structure::LSystem {
                     text: l.text.clone(),
                     steps: l.steps,
                     surfaces,
+                    units,
                 })
             }
         }

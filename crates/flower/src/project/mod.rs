@@ -90,7 +90,9 @@
 //! #
 //! # kind = "lsystem": [structure.lsystem] with steps, text (the L-system,
 //! # see `structure::lsystem`) and surfaces = { p = "petal", c = "sepal" }:
-//! # each ~X places an organ of that template in the turtle's frame.
+//! # each ~X places an organ of that template in the turtle's frame;
+//! # optional units = 0.05 (project units per turtle unit, default 1)
+//! # scales every position and line width the turtle draws.
 //!
 //! # Version 5: organs that do not grow (see `crate::parts`).
 //! [[parts]]

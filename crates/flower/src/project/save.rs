@@ -359,6 +359,7 @@ fn structure_file(
             text,
             steps,
             surfaces,
+            units,
         } => StructureFile {
             kind: StructureKind::Lsystem,
             contorted: false,
@@ -371,6 +372,7 @@ fn structure_file(
                     .iter()
                     .map(|(letter, &t)| (letter.to_string(), name(t)))
                     .collect(),
+                units: (*units != 1.0).then_some(*units),
             }),
         },
     };

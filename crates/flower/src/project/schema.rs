@@ -103,6 +103,9 @@ pub(super) struct LSystemFile {
     pub(super) text: String,
     /// Surface letter → template name.
     pub(super) surfaces: std::collections::BTreeMap<String, String>,
+    /// Project length units per turtle unit; absent means 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) units: Option<f64>,
 }
 
 #[derive(Serialize, Deserialize)]

@@ -43,6 +43,13 @@ pub enum Structure {
         steps: u32,
         /// The template (index) each surface letter places.
         surfaces: BTreeMap<char, usize>,
+        /// Project length units per turtle unit (1 by default): every
+        /// position and line width the turtle draws is multiplied by it,
+        /// so an L-system written in its author's units (the seed's apple
+        /// flower: a stem of 500, lines 20 wide) places organs made in the
+        /// project's. Organ shapes are not scaled; a `~X(s)` scale is
+        /// still refused.
+        units: f64,
     },
 }
 
@@ -120,11 +127,12 @@ impl Structure {
                 text,
                 steps,
                 surfaces,
+                units,
             } => {
                 for &t in surfaces.values() {
                     check(t)?;
                 }
-                lsystem_arrangement(text, *steps, surfaces, templates)
+                lsystem_arrangement(text, *steps, surfaces, *units, templates)
             }
         }
     }
@@ -136,7 +144,10 @@ impl Structure {
     /// its diameter. None for whorls and spirals, or an L-system that does
     /// not derive (loading refuses those).
     pub fn segments(&self) -> Vec<turtle::Segment> {
-        let Structure::LSystem { text, steps, .. } = self else {
+        let Structure::LSystem {
+            text, steps, units, ..
+        } = self
+        else {
             return Vec::new();
         };
         let Ok(system) = LSystem::parse(text) else {
@@ -148,6 +159,11 @@ impl Structure {
         interpret(&word, &Defaults::of(&system))
             .segments
             .into_iter()
+            .map(|s| turtle::Segment {
+                start: s.start * *units,
+                end: s.end * *units,
+                width: s.width * *units,
+            })
             .filter(|s| s.width > 0.0 && s.width.is_finite() && s.start.distance(s.end) > 1e-9)
             .collect()
     }
@@ -167,6 +183,7 @@ fn lsystem_arrangement(
     text: &str,
     steps: u32,
     surfaces: &BTreeMap<char, usize>,
+    units: f64,
     templates: &[Template],
 ) -> Result<Arrangement, StructureError> {
     let system = LSystem::parse(text)?;
@@ -197,7 +214,7 @@ fn lsystem_arrangement(
             name: format!("{}-{}", templates[template].name, counts[template]),
             template,
             placement: Placement {
-                position: placed.position,
+                position: placed.position * units,
                 azimuth_deg: 0.0,
                 joint_angle_deg: 0.0,
                 orientation: DQuat::from_mat3(&rotation).normalize(),
