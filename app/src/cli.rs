@@ -1,9 +1,10 @@
-//! `anthesis info|simulate|render|bud`: the engine without a window, for
+//! `anthesis info|simulate|render|bud|blossom|fit`: the engine without a window, for
 //! batch work, CI and benchmarks. Errors print as one line and exit
 //! non-zero. Each subcommand lives in a module of `cli/`.
 
 mod blossom;
 mod bud;
+mod fit;
 mod render;
 mod simulate;
 
@@ -99,6 +100,9 @@ pub enum Command {
     /// two-state blossom: per-triangle growth ellipses, G(t; g, T) and a
     /// spherical interpolation of directions), without a growth simulation.
     Blossom(blossom::BlossomArgs),
+    /// Fit growth maps to a target open shape of one organ ("which maps make
+    /// it open like this?") and write the project with the fitted maps.
+    Fit(fit::FitArgs),
     /// Write a starting point as a project folder: a flower built into the
     /// binary (lily, eustoma-maite-lady, eustoma-mellow-yellow,
     /// eustoma-pinocchio), to paint and change from there.
@@ -249,6 +253,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(args)) => render::render(&args),
         Some(Command::Bud(args)) => bud::bud(&args),
         Some(Command::Blossom(args)) => blossom::blossom(&args),
+        Some(Command::Fit(args)) => fit::fit(&args),
         Some(Command::New { from, dir }) => new_project(&from, &dir),
     }
 }

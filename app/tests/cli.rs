@@ -856,3 +856,146 @@ fn new_writes_a_built_in_flower_as_a_project_folder_and_never_overwrites() {
     let err = text(&one_line_error(&["new", "--from", "tulip", f]).stderr);
     assert!(err.contains("no built-in flower `tulip`"), "{err}");
 }
+
+#[test]
+fn fit_finds_maps_for_a_simulated_open_shape_and_refuses_bad_targets() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // One small petal that grows visibly in eight keyframes.
+    let mut project = anthesis_sim::fixtures::whorl(1, 6, 10, 8);
+    project.flower.templates[0].dg = 0.03;
+    let path = dir.path().join("petal.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let path = path.to_str().expect("utf-8");
+    let frames = dir.path().join("frames");
+    let frames_arg = frames.to_str().expect("utf-8");
+    let out = anthesis(&["simulate", path, "--organ", "petal-1", "--out", frames_arg]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let open = frames.join("keyframe_0008.obj");
+    let open = open.to_str().expect("utf-8");
+
+    let fitted = dir.path().join("fitted");
+    let report = dir.path().join("fit.json");
+    let fit_args = |target: &str, out: &str| -> Vec<String> {
+        [
+            "fit",
+            path,
+            "--organ",
+            "petal-1",
+            "--target",
+            target,
+            "--nodes",
+            "1x3",
+            "--direction-nodes",
+            "0x0",
+            "--out",
+            out,
+            "--report",
+            report.to_str().expect("utf-8"),
+        ]
+        .map(str::to_owned)
+        .to_vec()
+    };
+    let args = fit_args(open, fitted.to_str().expect("utf-8"));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = anthesis(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).starts_with("fitted: RMS"),
+        "{}",
+        text(&out.stdout)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let rms = json["rms"].as_f64().expect("rms");
+    let max = json["max"].as_f64().expect("max");
+    assert!(
+        rms > 0.0 && rms < 0.02 && max >= rms && max < 0.05,
+        "{json}"
+    );
+    assert!(json["guess_rms"].as_f64().expect("guess") > rms, "{json}");
+    assert_eq!(json["parameters"], 12);
+    assert!(json["iterations"].as_u64().expect("iterations") >= 1);
+    assert!(json["seconds"].as_f64().expect("seconds") > 0.0);
+    assert_eq!(json["reached"], true);
+
+    // The fitted project simulates like any other, to the reported shape.
+    let refit = dir.path().join("refit");
+    let out = anthesis(&[
+        "simulate",
+        fitted.to_str().expect("utf-8"),
+        "--organ",
+        "petal-1",
+        "--out",
+        refit.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let points = |file: &Path| -> Vec<glam::DVec3> {
+        let obj = std::fs::read_to_string(file).expect("read");
+        let petal = anthesis_mesh::obj::object_text(&obj, Some("petal-1")).expect("petal-1");
+        anthesis_mesh::parse_obj(&petal).expect("parses").positions
+    };
+    let (got, want) = (
+        points(&refit.join("keyframe_0008.obj")),
+        points(&frames.join("keyframe_0008.obj")),
+    );
+    let length = json["organ_length"].as_f64().expect("length");
+    let mean_square = got
+        .iter()
+        .zip(&want)
+        .map(|(a, b)| a.distance_squared(*b))
+        .sum::<f64>()
+        / got.len() as f64;
+    // The OBJ files round positions to their printed digits.
+    assert!(
+        (mean_square.sqrt() / length - rms).abs() < 1e-6 * (1.0 + rms),
+        "{json}"
+    );
+
+    // An existing fit is not overwritten.
+    let err = text(&one_line_error(&args).stderr);
+    assert!(err.contains("already holds a project"), "{err}");
+    // Another mesh, a NaN, a missing organ: one clear line each.
+    let other = dir.path().join("other.obj");
+    let sheet = anthesis_mesh::generate::flat_sheet(1.0, 1.0, 3, 3);
+    std::fs::write(&other, anthesis_mesh::obj_string(&sheet)).expect("write");
+    let new_out = dir.path().join("fitted-2");
+    let args = fit_args(
+        other.to_str().expect("utf-8"),
+        new_out.to_str().expect("utf-8"),
+    );
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let err = text(&one_line_error(&args).stderr);
+    let wrong = format!(
+        "the target has {} vertices but organ `petal-1` has {}",
+        sheet.vertex_count(),
+        project.flower.template_of(0).mesh.vertex_count()
+    );
+    assert!(err.contains(&wrong), "{err}");
+    let nan = dir.path().join("nan.obj");
+    let text_obj = std::fs::read_to_string(frames.join("keyframe_0008.obj")).expect("read");
+    let mut replaced = false;
+    let with_nan: String = text_obj
+        .lines()
+        .map(|line| {
+            if !replaced && line.starts_with("v ") {
+                replaced = true;
+                "v 0 nan 0".to_owned()
+            } else {
+                line.to_owned()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&nan, with_nan).expect("write");
+    let args = fit_args(
+        nan.to_str().expect("utf-8"),
+        new_out.to_str().expect("utf-8"),
+    );
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let err = text(&one_line_error(&args).stderr);
+    assert!(
+        err.contains("target vertex 1 (from 1) has a coordinate that is not a finite number"),
+        "{err}"
+    );
+    assert!(!new_out.exists());
+}
