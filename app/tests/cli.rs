@@ -855,6 +855,18 @@ fn new_writes_a_built_in_flower_as_a_project_folder_and_never_overwrites() {
     );
     let err = text(&one_line_error(&["new", "--from", "tulip", f]).stderr);
     assert!(err.contains("no built-in flower `tulip`"), "{err}");
+    // The empty starting point: one whorl of five simple petals.
+    let five = dir.path().join("five");
+    let out = anthesis(&["new", "--from", "five-petal", five.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let written = anthesis_flower::project::load_project(&five).expect("the folder opens");
+    assert_eq!(written.flower.organs.len(), 5);
+    assert_eq!(
+        written,
+        anthesis_garden::builtin("five-petal")
+            .expect("built in")
+            .expect("loads")
+    );
 }
 
 #[test]

@@ -5,6 +5,7 @@
 #![warn(missing_docs)]
 
 mod colour;
+pub mod edit;
 pub mod parts;
 pub mod project;
 mod receptacle;

@@ -1,4 +1,4 @@
-//! The four default projects: the Asiatic lily (paper §6.1) and three
+//! The default projects: the Asiatic lily (paper §6.1) and three
 //! cultivars of *Eustoma grandiflorum* grown from one bud (§6.2), with the
 //! parameters of Table 1.
 
@@ -42,11 +42,12 @@ pub enum GardenError {
 }
 
 /// The names of the default flowers (folder names under `assets/flowers/`).
-pub const FLOWER_NAMES: [&str; 4] = [
+pub const FLOWER_NAMES: [&str; 5] = [
     "lily",
     "eustoma-mellow-yellow",
     "eustoma-maite-lady",
     "eustoma-pinocchio",
+    crate::five_petal::FIVE_PETAL_NAME,
 ];
 
 /// Builds the default flower called `name` (one of [`FLOWER_NAMES`]).
@@ -73,6 +74,7 @@ pub fn flower_at_resolution(name: &str, edge_scale: f64) -> Option<Result<Projec
         "eustoma-mellow-yellow" => eustoma_at(Cultivar::MellowYellow, edge_scale),
         "eustoma-maite-lady" => eustoma_at(Cultivar::MaiteLady, edge_scale),
         "eustoma-pinocchio" => eustoma_at(Cultivar::Pinocchio, edge_scale),
+        crate::five_petal::FIVE_PETAL_NAME => crate::five_petal::five_petal_at(edge_scale),
         _ => return None,
     })
 }
@@ -256,7 +258,7 @@ fn keyed(keys: Vec<(u32, GrowthMaps)>) -> Result<KeyedMaps, MapError> {
 /// A base region of `v <= v_max`, widened to hold at least two rows of
 /// particles of `mesh` (one row lies along the joint axis and could not
 /// hold the joint angle).
-fn base_region(mesh: &Mesh, v_max: f64) -> BaseRegion {
+pub(crate) fn base_region(mesh: &Mesh, v_max: f64) -> BaseRegion {
     let mut vs: Vec<f64> = mesh.uvs.iter().map(|uv| uv.y).collect();
     vs.sort_by(f64::total_cmp);
     vs.dedup_by(|a, b| (*a - *b).abs() < 1e-9);

@@ -7,7 +7,9 @@
 //! - [`arrangement`]: whorls, contorted whorls and phyllotactic spirals on
 //!   the receptacle, with the overlap rules collisions need;
 //! - [`paint`]: growth maps painted as functions of UV;
-//! - [`flowers`]: the four projects ([`flowers::lily`], [`flowers::eustoma`]);
+//! - [`flowers`]: the projects ([`flowers::lily`], [`flowers::eustoma`]);
+//! - [`five_petal`]: the empty starting point, one whorl of five simple
+//!   petals with uniform maps;
 //! - [`shape`]: numeric shape descriptors (opening angles, turning,
 //!   cupping, corolla profile) that tests use to check each flower's
 //!   character;
@@ -22,6 +24,7 @@
 
 pub use anthesis_flower::structure::whorl as arrangement;
 pub mod buds;
+pub mod five_petal;
 pub mod flowers;
 pub mod paint;
 pub mod parts;

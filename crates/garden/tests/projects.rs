@@ -20,6 +20,14 @@ fn committed(name: &str) -> PathBuf {
         .join(project_file_name(name))
 }
 
+/// The folder names of the three Eustoma cultivars.
+fn eustomas() -> Vec<&'static str> {
+    anthesis_garden::Cultivar::ALL
+        .iter()
+        .map(|c| c.folder_name())
+        .collect()
+}
+
 fn built(name: &str) -> Project {
     match flowers::flower(name) {
         Some(Ok(project)) => project,
@@ -114,7 +122,7 @@ fn buds_meshed_at_the_papers_edge_have_about_its_particle_counts() {
         assert!((q.mean_edge - edge).abs() < 0.05 * edge, "{q:?}");
         assert!(q.min_angle_deg > 30.0, "{q:?}");
     }
-    for name in &FLOWER_NAMES[1..] {
+    for name in eustomas() {
         let q = quality(&built_at(name, 1.0).flower.templates[0].mesh);
         assert!(near(q.vertices, 261), "{name}: {q:?}");
         assert!(near(q.triangles, 458), "{name}: {q:?}");
@@ -147,7 +155,7 @@ fn the_default_flowers_are_meshed_finer_than_the_paper_for_converged_shapes() {
 
 #[test]
 fn the_three_cultivars_share_one_bud_and_differ_in_their_maps() {
-    let projects: Vec<Project> = FLOWER_NAMES[1..].iter().map(|n| built(n)).collect();
+    let projects: Vec<Project> = eustomas().iter().map(|n| built(n)).collect();
     for other in &projects[1..] {
         assert_eq!(
             other.flower.templates[0].mesh,
@@ -256,8 +264,11 @@ fn overlap_rules_pair_exactly_the_organs_whose_margins_overlap() {
             // Petals (0–2) inside sepals (3–5), each petal under two sepals.
             assert_eq!(inner_outer.len(), 6);
             assert!(inner_outer.iter().all(|&(i, o)| i < 3 && o >= 3));
-        } else {
+        } else if eustomas().contains(&name) {
             assert_eq!(inner_outer, [(0, 1), (1, 2), (2, 3), (3, 4), (4, 0)]);
+        } else if name == anthesis_garden::five_petal::FIVE_PETAL_NAME {
+            // Five petals side by side: none lies over another.
+            assert!(inner_outer.is_empty(), "{inner_outer:?}");
         }
     }
 }
@@ -294,4 +305,34 @@ fn inner_organs_lie_inside_outer_ones_where_they_overlap() {
             assert!(checked > 0, "{name}: {overlap:?} never meet");
         }
     }
+}
+
+#[test]
+fn the_five_petal_start_is_one_whorl_of_five_petals_as_structure() {
+    use anthesis_flower::structure::Structure;
+    let project = built(anthesis_garden::five_petal::FIVE_PETAL_NAME);
+    assert_eq!(project.flower.templates.len(), 1);
+    assert_eq!(project.flower.organs.len(), 5);
+    let Some(Structure::Whorls { whorls, contorted }) = &project.flower.structure else {
+        panic!("made by a whorl: {:?}", project.flower.structure);
+    };
+    assert!(!contorted);
+    assert_eq!(whorls.len(), 1);
+    assert_eq!(whorls[0].count, 5);
+    // Narrower than the gap between neighbours: no overlap rules needed.
+    assert!(
+        whorls[0].half_span_deg < 36.0,
+        "{}",
+        whorls[0].half_span_deg
+    );
+    // Uniform maps: one key of constant maps.
+    let maps = &project.flower.templates[0].maps;
+    assert_eq!(maps.keys().len(), 1);
+    assert_eq!(maps.raster_size(), None);
+    let q = quality(&project.flower.templates[0].mesh);
+    assert!(
+        (100..=600).contains(&q.vertices),
+        "a petal of a few hundred particles: {q:?}"
+    );
+    assert!(q.min_angle_deg > 20.0, "{q:?}");
 }

@@ -187,6 +187,13 @@ pub const FORMAT_NAME: &str = "anthesis-project";
 /// The newest file format version this build reads, and the one it writes.
 pub const FORMAT_VERSION: u32 = 5;
 
+/// Checks `project` by the rules every loaded or saved project obeys
+/// (names, counts, numbers, parts), as the app does before it takes an
+/// edit of the flower; errors name [`UNNAMED_PROJECT`] as the file.
+pub fn check(project: &Project) -> Result<(), ProjectError> {
+    check::check_project(project, Path::new(UNNAMED_PROJECT))
+}
+
 /// Where saved meshes go, relative to the project file.
 pub const MESH_FOLDER: &str = "meshes";
 

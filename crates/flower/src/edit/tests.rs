@@ -1,0 +1,312 @@
+use glam::DVec3;
+
+use super::*;
+use crate::structure::lsystem::LSystemError;
+use crate::{BaseRegion, Placement};
+use anthesis_maps::KeyedMaps;
+use anthesis_mesh::generate::test_petal;
+
+fn template(name: &str) -> Template {
+    Template {
+        name: name.to_string(),
+        mesh: test_petal(4.0, 2.0, 4, 6),
+        maps: KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
+        dg: 0.01,
+        thickness: 0.2,
+        stretch_stiffness: 20.0,
+        bend_stiffness: 20.0,
+        base_region: BaseRegion::default(),
+        joint_schedule: Vec::new(),
+        color: [1.0; 4],
+        colouring: None,
+    }
+}
+
+fn whorl(name: &str, template: usize, count: usize, offset_deg: f64, radius: f64) -> Whorl {
+    Whorl {
+        name: name.to_string(),
+        template,
+        count,
+        offset_deg,
+        radius,
+        height: 0.1 * radius,
+        joint_angle_deg: 5.0,
+        half_span_deg: 40.0,
+    }
+}
+
+/// A lily-like flower: three petals inside three sepals (whorls), and one
+/// listed organ, a bract, with a listed rule.
+fn flower() -> Flower {
+    let whorls = vec![
+        whorl("petal", 0, 3, 0.0, 1.0),
+        whorl("sepal", 1, 3, 60.0, 1.5),
+    ];
+    let made = Structure::Whorls {
+        whorls: whorls.clone(),
+        contorted: false,
+    }
+    .arrange(&[template("petal"), template("sepal")])
+    .unwrap();
+    let mut organs = made.organs;
+    organs.push(Organ {
+        name: "bract".to_string(),
+        template: 1,
+        placement: placement(0.0, 3.0, -1.0, 10.0),
+    });
+    let mut overlaps = made.overlaps;
+    overlaps.push(Overlap { inner: 3, outer: 6 });
+    Flower {
+        templates: vec![template("petal"), template("sepal")],
+        organs,
+        overlaps,
+        structure: Some(Structure::Whorls {
+            whorls,
+            contorted: false,
+        }),
+        parts: Vec::new(),
+    }
+}
+
+fn names(flower: &Flower) -> Vec<&str> {
+    flower.organs.iter().map(|o| o.name.as_str()).collect()
+}
+
+fn rule_names(flower: &Flower) -> Vec<(String, String)> {
+    flower
+        .overlaps
+        .iter()
+        .map(|o| {
+            (
+                flower.organs[o.inner].name.clone(),
+                flower.organs[o.outer].name.clone(),
+            )
+        })
+        .collect()
+}
+
+fn whorls_of(flower: &Flower) -> Vec<Whorl> {
+    match &flower.structure {
+        Some(Structure::Whorls { whorls, .. }) => whorls.clone(),
+        other => panic!("whorls expected: {other:?}"),
+    }
+}
+
+#[test]
+fn a_new_whorl_count_remakes_the_made_organs_and_keeps_the_listed_ones() {
+    let flower = flower();
+    assert_eq!(flower.made_organ_count(), 6);
+    let mut whorls = whorls_of(&flower);
+    whorls[0].count = 5;
+    let edited = flower
+        .with_structure(Some(Structure::Whorls {
+            whorls,
+            contorted: false,
+        }))
+        .unwrap();
+    assert_eq!(
+        names(&edited),
+        [
+            "petal-1", "petal-2", "petal-3", "petal-4", "petal-5", "sepal-1", "sepal-2", "sepal-3",
+            "bract"
+        ]
+    );
+    assert_eq!(edited.made_organ_count(), 8);
+    // The listed rule follows its organs' names to their new indices.
+    assert!(rule_names(&edited).contains(&("sepal-1".into(), "bract".into())));
+    let origins = edited.rule_origins();
+    assert_eq!(
+        origins.iter().filter(|o| **o == RuleOrigin::Listed).count(),
+        1
+    );
+    // Every other rule is a petal inside a sepal.
+    for (rule, origin) in edited.overlaps.iter().zip(&origins) {
+        if *origin == RuleOrigin::Made {
+            assert!(rule.inner < 5 && (5..8).contains(&rule.outer), "{rule:?}");
+        }
+    }
+    // The listed organ keeps its place.
+    assert_eq!(edited.organs[8], flower.organs[6]);
+}
+
+#[test]
+fn a_bad_l_system_is_refused_with_its_line_and_column_and_the_flower_stays() {
+    let flower = flower();
+    let bad = Structure::LSystem {
+        text: "axiom: A\nA -> [/(0 B".to_string(),
+        steps: 1,
+        surfaces: BTreeMap::from([('a', 0)]),
+    };
+    let err = flower.with_structure(Some(bad)).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            EditError::Structure(StructureError::LSystem(LSystemError::Syntax {
+                line: 2,
+                column: 11,
+                ..
+            }))
+        ),
+        "{err:?}"
+    );
+    // A surface no template is given for.
+    let unknown = Structure::LSystem {
+        text: "axiom: ~q".to_string(),
+        steps: 0,
+        surfaces: BTreeMap::from([('a', 0)]),
+    };
+    assert_eq!(
+        flower.arranged_by(unknown).unwrap_err(),
+        EditError::Structure(StructureError::UnknownSurface('q'))
+    );
+}
+
+#[test]
+fn the_l_system_like_the_whorls_places_the_same_organs_in_the_same_order_of_layers() {
+    let flower = flower();
+    let whorls = whorls_of(&flower);
+    let (text, steps, surfaces) = lsystem_like(&whorls);
+    let by_lsystem = flower
+        .arranged_by(Structure::LSystem {
+            text: text.clone(),
+            steps,
+            surfaces,
+        })
+        .unwrap_or_else(|e| panic!("{e}\n{text}"));
+    assert_eq!(by_lsystem.organs.len(), 6, "the listed bract is dropped");
+    // Outermost first: the sepals, then the petals; each organ's points
+    // land where the whorl puts them.
+    let points = [
+        DVec3::ZERO,
+        DVec3::new(0.5, 3.0, 0.0),
+        DVec3::new(-0.3, 1.0, 0.2),
+    ];
+    let sepals_then_petals = [3, 4, 5, 0, 1, 2];
+    for (organ, &whorl_organ) in by_lsystem.organs.iter().zip(&sepals_then_petals) {
+        let expected = &flower.organs[whorl_organ];
+        assert_eq!(organ.template, expected.template);
+        for p in points {
+            let (a, b) = (
+                organ.placement.world_from_template(p, 0.0),
+                expected.placement.world_from_template(p, 0.0),
+            );
+            assert!(
+                a.distance(b) < 1e-9,
+                "{} vs {}: {a} {b}\n{text}",
+                organ.name,
+                expected.name
+            );
+        }
+    }
+    // Petals inside sepals, as the whorls have it (the L-system pairs
+    // every petal with the sepals facing its way).
+    for rule in &by_lsystem.overlaps {
+        assert_eq!(by_lsystem.organs[rule.inner].template, 0);
+        assert_eq!(by_lsystem.organs[rule.outer].template, 1);
+    }
+    assert!(!by_lsystem.overlaps.is_empty());
+}
+
+#[test]
+fn swapping_a_rule_overrides_it_and_swapping_back_restores_the_made_one() {
+    let flower = flower();
+    let made = flower
+        .rule_origins()
+        .iter()
+        .position(|o| *o == RuleOrigin::Made)
+        .unwrap();
+    let swapped = flower.with_rule_swapped(made).unwrap();
+    assert_eq!(swapped.rule_origins()[made], RuleOrigin::Overridden);
+    assert_eq!(
+        (swapped.overlaps[made].inner, swapped.overlaps[made].outer),
+        (flower.overlaps[made].outer, flower.overlaps[made].inner)
+    );
+    // The override survives remaking the organs (a new whorl offset).
+    let mut whorls = whorls_of(&swapped);
+    whorls[1].offset_deg = 61.0;
+    let remade = swapped
+        .with_structure(Some(Structure::Whorls {
+            whorls,
+            contorted: false,
+        }))
+        .unwrap();
+    let inner = &flower.organs[flower.overlaps[made].outer].name;
+    let outer = &flower.organs[flower.overlaps[made].inner].name;
+    assert!(rule_names(&remade).contains(&(inner.clone(), outer.clone())));
+    let back = swapped.with_rule_swapped(made).unwrap();
+    assert_eq!(back, flower);
+    assert!(flower.with_rule_swapped(99).is_err());
+}
+
+#[test]
+fn templates_and_organs_are_added_and_removed_with_their_whorls_and_rules() {
+    let flower = flower();
+    // A third template, its name made unique; an organ of it, listed.
+    let added = flower.with_template(template("petal"));
+    assert_eq!(added.templates[2].name, "petal 2");
+    let organ = added.new_organ(2).unwrap();
+    assert_eq!(organ.name, "petal 2-1");
+    let with_organ = added.with_organ(organ).unwrap();
+    assert_eq!(with_organ.organs.len(), 8);
+    // Removing the sepal template removes its whorl and the bract (and
+    // the bract's rule), and the third template becomes the second.
+    let without = with_organ.without_template(1).unwrap();
+    assert_eq!(
+        names(&without),
+        ["petal-1", "petal-2", "petal-3", "petal 2-1"]
+    );
+    assert_eq!(without.organs[3].template, 1);
+    assert!(without.overlaps.is_empty());
+    assert_eq!(whorls_of(&without).len(), 1);
+    // A made organ cannot be removed on its own; a listed one can.
+    assert_eq!(
+        without.without_organ(0).unwrap_err(),
+        EditError::MadeByStructure("petal-1".into())
+    );
+    let fewer = without.without_organ(3).unwrap();
+    assert_eq!(names(&fewer), ["petal-1", "petal-2", "petal-3"]);
+    // The template of the last organs, or the last template, cannot go.
+    assert_eq!(fewer.without_template(0).unwrap_err(), EditError::NoOrgans);
+    let one = fewer.without_template(1).unwrap();
+    assert_eq!(one.templates.len(), 1);
+    assert_eq!(one.organs, fewer.organs);
+    assert_eq!(one.without_template(0).unwrap_err(), EditError::NoTemplates);
+    let only_bract = flower.with_structure(None).unwrap();
+    assert_eq!(only_bract.made_organ_count(), 0);
+    assert_eq!(only_bract.organs, flower.organs, "all organs kept, listed");
+    assert_eq!(only_bract.overlaps, flower.overlaps);
+    // Two organs of one name are refused.
+    let mut whorls = whorls_of(&flower);
+    whorls[1].name = "petal".into();
+    assert!(matches!(
+        flower.with_structure(Some(Structure::Whorls {
+            whorls,
+            contorted: false
+        })),
+        Err(EditError::DuplicateOrgan(_))
+    ));
+}
+
+#[test]
+fn a_listed_organ_moved_keeps_its_rules() {
+    let flower = flower();
+    let mut bract = flower.organs[6].clone();
+    bract.placement = Placement {
+        joint_angle_deg: 30.0,
+        ..bract.placement
+    };
+    bract.name = "bract A".into();
+    let moved = flower.with_organ_changed(6, bract.clone()).unwrap();
+    assert_eq!(moved.organs[6], bract);
+    assert!(rule_names(&moved).contains(&("sepal-1".into(), "bract A".into())));
+    assert!(flower.with_organ_changed(0, bract).is_err());
+}
+
+#[test]
+fn a_spiral_like_the_whorls_holds_all_their_organs() {
+    let flower = flower();
+    let spiral = spiral_like(&whorls_of(&flower)).unwrap();
+    let arranged = flower.arranged_by(Structure::Spiral(spiral)).unwrap();
+    assert_eq!(arranged.organs.len(), 6);
+    assert!(arranged.organs.iter().all(|o| o.template == 1));
+}

@@ -1,0 +1,139 @@
+//! The empty starting point of a new flower: one whorl of five simple
+//! petals, each a slightly cupped, rounded blade with uniform growth maps
+//! (the whole petal lengthens and broadens alike, its inner side a little
+//! more along it, so it opens outwards), arranged by a `[structure]` whorl
+//! so that the app's Flower panel can change the count, add whorls or
+//! replace it by a spiral or an L-system. Nothing about it is tuned to a
+//! real species: it is there to be painted.
+
+use anthesis_flower::structure::{Structure, Whorl};
+use anthesis_flower::{Flower, JointRamp, Project, SimulationSettings, Template};
+use anthesis_maps::{DirectionMap, GrowthMaps, KeyedMaps, ScalarMap};
+use glam::DVec2;
+
+use crate::arrangement::nested_whorls;
+use crate::buds::RingOrgan;
+use crate::flowers::{EDGE_SCALE, GardenError, base_region};
+
+/// The folder name of the five-petal flower under `assets/flowers/`.
+pub const FIVE_PETAL_NAME: &str = "five-petal";
+
+/// Mean edge of the simple petal's mesh, in project units, before any
+/// `edge_scale` (Eustoma's: some 150 particles per petal at the
+/// default [`EDGE_SCALE`]).
+pub const SIMPLE_PETAL_EDGE: f64 = 2.0;
+
+/// The simple petal in the bud: a blade 22 long leaning out at about 23°
+/// from the axis, widest a little above the middle, with a rounded top;
+/// narrow enough that five of them side by side do not overlap (each
+/// spans less than ±36° about the axis).
+pub fn simple_petal_bud() -> RingOrgan {
+    RingOrgan {
+        midrib: [
+            DVec2::new(4.0, 0.0),
+            DVec2::new(6.5, 6.5),
+            DVec2::new(9.5, 13.5),
+            DVec2::new(12.5, 20.0),
+        ],
+        half_width: [1.3, 3.4, 4.2, 2.4],
+        offset: 0.0,
+        contortion: 0.0,
+        top_rounding: 0.35,
+    }
+}
+
+/// The simple petal's growth, the same everywhere on it: along the growth
+/// direction (`e`), across it (`w`), and how much the inner side outgrows
+/// the base along it (the petal bends outwards as it grows).
+const SIMPLE_E: f32 = 0.5;
+const SIMPLE_W: f32 = 0.4;
+const SIMPLE_E_IN_EXCESS: f32 = 0.06;
+
+/// The simple petal's joint: +20° over steps 1–50.
+pub const SIMPLE_JOINT: JointRamp = JointRamp {
+    from_step: 0,
+    to_step: 50,
+    angle_deg: 20.0,
+};
+
+/// A soft pink (linear RGBA; sRGB about 240, 190, 205).
+pub const SIMPLE_PINK: [f32; 4] = [0.87, 0.52, 0.61, 1.0];
+
+/// Uniform growth maps: one key, constant maps (the brush turns a constant
+/// map into a raster when it is first painted).
+pub fn simple_petal_maps() -> KeyedMaps {
+    let maps = GrowthMaps {
+        e_growth: ScalarMap::constant(SIMPLE_E),
+        w_growth: ScalarMap::constant(SIMPLE_W),
+        e_growth_in: ScalarMap::constant(SIMPLE_E + SIMPLE_E_IN_EXCESS),
+        w_growth_in: ScalarMap::constant(SIMPLE_W),
+        stretch: ScalarMap::constant(1.0),
+        bend: ScalarMap::constant(1.0),
+        direction: DirectionMap::constant(DVec2::Y),
+    };
+    KeyedMaps::single(maps)
+}
+
+/// The simple petal template named `name`, meshed at `edge_scale` times
+/// [`SIMPLE_PETAL_EDGE`], with Eustoma's material (Table 1) and
+/// [`simple_petal_maps`].
+pub fn simple_petal_template(name: &str, edge_scale: f64) -> Result<Template, GardenError> {
+    let organ = "simple petal";
+    let mesh = simple_petal_bud()
+        .build(SIMPLE_PETAL_EDGE * edge_scale)
+        .map_err(|error| GardenError::Bud { organ, error })?;
+    Ok(Template {
+        name: name.to_string(),
+        base_region: base_region(&mesh, 0.05),
+        mesh,
+        maps: simple_petal_maps(),
+        dg: crate::flowers::EUSTOMA_DG,
+        thickness: crate::flowers::EUSTOMA_THICKNESS,
+        stretch_stiffness: crate::flowers::EUSTOMA_STIFFNESS,
+        bend_stiffness: crate::flowers::EUSTOMA_STIFFNESS,
+        joint_schedule: vec![SIMPLE_JOINT],
+        color: SIMPLE_PINK,
+        colouring: None,
+    })
+}
+
+/// The whorl of `count` simple petals of template `template`, from azimuth
+/// `offset_deg`.
+pub fn simple_whorl(name: &str, template: usize, count: usize, offset_deg: f64) -> Whorl {
+    let bud = simple_petal_bud();
+    let base = bud.base_in_meridian();
+    Whorl {
+        name: name.to_string(),
+        template,
+        count,
+        offset_deg,
+        radius: base.x,
+        height: base.y,
+        joint_angle_deg: 0.0,
+        half_span_deg: bud.half_span_deg(),
+    }
+}
+
+/// The empty flower: one whorl of five simple petals, no parts.
+pub fn five_petal() -> Result<Project, GardenError> {
+    five_petal_at(EDGE_SCALE)
+}
+
+pub(crate) fn five_petal_at(edge_scale: f64) -> Result<Project, GardenError> {
+    let whorls = vec![simple_whorl("petal", 0, 5, 0.0)];
+    let arrangement = nested_whorls(&whorls);
+    Ok(Project {
+        name: "Five petals".to_string(),
+        flower: Flower {
+            templates: vec![simple_petal_template("petal", edge_scale)?],
+            organs: arrangement.organs,
+            overlaps: arrangement.overlaps,
+            structure: Some(Structure::Whorls {
+                whorls,
+                contorted: false,
+            }),
+            parts: Vec::new(),
+        },
+        settings: SimulationSettings::default(),
+    })
+}
