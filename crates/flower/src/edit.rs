@@ -252,9 +252,11 @@ impl Flower {
                 text,
                 steps,
                 surfaces,
+                units,
             }) => Some(Structure::LSystem {
                 text: text.clone(),
                 steps: *steps,
+                units: *units,
                 surfaces: surfaces
                     .iter()
                     .filter(|(_, t)| **t != index)

@@ -136,6 +136,7 @@ fn a_bad_l_system_is_refused_with_its_line_and_column_and_the_flower_stays() {
         text: "axiom: A\nA -> [/(0 B".to_string(),
         steps: 1,
         surfaces: BTreeMap::from([('a', 0)]),
+        units: 1.0,
     };
     let err = flower.with_structure(Some(bad)).unwrap_err();
     assert!(
@@ -154,6 +155,7 @@ fn a_bad_l_system_is_refused_with_its_line_and_column_and_the_flower_stays() {
         text: "axiom: ~q".to_string(),
         steps: 0,
         surfaces: BTreeMap::from([('a', 0)]),
+        units: 1.0,
     };
     assert_eq!(
         flower.arranged_by(unknown).unwrap_err(),
@@ -171,6 +173,7 @@ fn the_l_system_like_the_whorls_places_the_same_organs_in_the_same_order_of_laye
             text: text.clone(),
             steps,
             surfaces,
+            units: 1.0,
         })
         .unwrap_or_else(|e| panic!("{e}\n{text}"));
     assert_eq!(by_lsystem.organs.len(), 6, "the listed bract is dropped");
