@@ -41,12 +41,15 @@ pub enum GardenError {
     Arrangement(String),
 }
 
-/// The names of the default flowers (folder names under `assets/flowers/`).
-pub const FLOWER_NAMES: [&str; 5] = [
+/// The names of the default flowers (folder names under `assets/flowers/`):
+/// the paper's four, the seed's apple flower and the empty five-petal
+/// starting point.
+pub const FLOWER_NAMES: [&str; 6] = [
     "lily",
     "eustoma-mellow-yellow",
     "eustoma-maite-lady",
     "eustoma-pinocchio",
+    "apple",
     crate::five_petal::FIVE_PETAL_NAME,
 ];
 
@@ -75,6 +78,7 @@ pub fn flower_at_resolution(name: &str, edge_scale: f64) -> Option<Result<Projec
         "eustoma-maite-lady" => eustoma_at(Cultivar::MaiteLady, edge_scale),
         "eustoma-pinocchio" => eustoma_at(Cultivar::Pinocchio, edge_scale),
         crate::five_petal::FIVE_PETAL_NAME => crate::five_petal::five_petal_at(edge_scale),
+        "apple" => crate::apple::apple_at(edge_scale / EDGE_SCALE),
         _ => return None,
     })
 }
@@ -246,7 +250,7 @@ pub fn lily_maps(excess: LilyExcess) -> Result<KeyedMaps, MapError> {
     keyed(vec![(40, key(&e_in_early)), (50, key(&e_in_late))])
 }
 
-fn keyed(keys: Vec<(u32, GrowthMaps)>) -> Result<KeyedMaps, MapError> {
+pub(crate) fn keyed(keys: Vec<(u32, GrowthMaps)>) -> Result<KeyedMaps, MapError> {
     KeyedMaps::new(
         keys.into_iter()
             .map(|(step, maps)| MapKey { step, maps })

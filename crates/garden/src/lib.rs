@@ -7,7 +7,10 @@
 //! - [`arrangement`]: whorls, contorted whorls and phyllotactic spirals on
 //!   the receptacle, with the overlap rules collisions need;
 //! - [`paint`]: growth maps painted as functions of UV;
-//! - [`flowers`]: the projects ([`flowers::lily`], [`flowers::eustoma`]);
+//! - [`flowers`]: the four projects of the paper ([`flowers::lily`],
+//!   [`flowers::eustoma`]);
+//! - [`apple`]: the apple flower of `lsystem-bezier-flower.txt` §3–§4, placed
+//!   by the seed's own L-system;
 //! - [`five_petal`]: the empty starting point, one whorl of five simple
 //!   petals with uniform maps;
 //! - [`shape`]: numeric shape descriptors (opening angles, turning,
@@ -23,6 +26,7 @@
 #![warn(missing_docs)]
 
 pub use anthesis_flower::structure::whorl as arrangement;
+pub mod apple;
 pub mod buds;
 pub mod five_petal;
 pub mod flowers;

@@ -155,3 +155,22 @@ pub fn eustoma_parts() -> Vec<Part> {
     pistil.height = 0.3;
     vec![receptacle, pedicel, stamens, pistil]
 }
+
+/// The apple flower's: only a receptacle at the top of its stem (`height`),
+/// since the seed's L-system draws the stem and the stamens itself (its
+/// `F` lines become tubes).
+pub fn apple_parts(height: f64) -> Vec<Part> {
+    const GREEN: [f32; 4] = [0.30, 0.45, 0.16, 1.0];
+    let mut receptacle = part(
+        "receptacle",
+        PartShape::Receptacle {
+            radius: 2.2,
+            depth: 2.6,
+        },
+        1,
+        GREEN,
+        GREEN,
+    );
+    receptacle.height = height;
+    vec![receptacle]
+}
