@@ -526,7 +526,8 @@ pub fn part_pieces(flower: &Flower) -> Vec<PartPiece> {
 
 /// The tubes the flower's L-system draws with `F` (see
 /// [`crate::structure::Structure::segments`]), named `segment-1`, … in the
-/// word's order, in the stem's colour; they do not move.
+/// word's order, in the colour `;` set (the stem's colour by default);
+/// they do not move.
 fn segment_pieces(flower: &Flower) -> Vec<PartPiece> {
     let Some(structure) = &flower.structure else {
         return Vec::new();
@@ -545,7 +546,7 @@ fn segment_pieces(flower: &Flower) -> Vec<PartPiece> {
             PartPiece {
                 name: format!("segment-{}", k + 1),
                 mesh: tube_mesh(&tube, (0.0, 1.0)),
-                color: RECEPTACLE_COLOR,
+                color: segment.color.unwrap_or(RECEPTACLE_COLOR),
                 placement: Placement {
                     position: segment.start,
                     azimuth_deg: 0.0,

@@ -12,7 +12,10 @@
 //!   flower's axis stays the world's +Y. `units` = 0.08 maps the seed's
 //!   lengths (a stem of `lenA` = 500, lines 20 wide) onto the scale the
 //!   growth parameters are tuned at (the paper's petals are about 45 long):
-//!   a stem 40 long, stamens of two lines 8 long and 1.6 wide.
+//!   a stem 40 long, stamens of two lines 8 long and 1.6 wide. The axiom
+//!   also sets the colour of the lines B draws (`;(r, g, b)`, an L-Py
+//!   symbol the seed does not use): the stamens are a pale yellow, the stem
+//!   keeps the default green. The productions are the seed's, line for line.
 //! - **The surfaces** are drawn in the turtle's frame, as the seed's `~c`
 //!   and `~p` are: their control nets start a little out from the turtle
 //!   (which stands on the axis at the stem's end), so the six petals and six
@@ -35,14 +38,15 @@ use glam::{DVec2, DVec3};
 use crate::flowers::{GardenError, base_region, keyed};
 use crate::paint::{Painting, above_base, colour_map, midrib_band, smoothstep};
 
-/// The seed's L-system (3), without the axiom's viewing turns (see the
-/// module documentation).
+/// The seed's L-system (3), without the axiom's viewing turns and with a
+/// colour for the lines drawn after the stem (see the module
+/// documentation).
 pub const APPLE_LSYSTEM: &str = "\
 initial line width = 20
 line width increment = 5
 lenA = 500
 lenF = 100
-ω : #A!B
+ω : #A!;(0.93, 0.82, 0.45)B
 p1: B → D/(60)D/(60)D/(60)D/(60)D/(60)D
 p2: D → [C][P][S]
 p3: A → F(lenA)

@@ -327,7 +327,8 @@ fn an_lsystems_f_segments_are_tubes_of_its_width_from_start_to_end() {
         organs: Vec::new(),
         overlaps: Vec::new(),
         structure: Some(Structure::LSystem {
-            text: "axiom: #(0.4) F(2) [ +(90) F(1) ] !(0) F(3) #(0.2) f(1) F(1)".to_string(),
+            text: "axiom: #(0.4) F(2) [ +(90) ;(1, 1, 0) F(1) ] !(0) F(3) #(0.2) f(1) F(1)"
+                .to_string(),
             steps: 0,
             surfaces: Default::default(),
             units: 1.0,
@@ -368,5 +369,11 @@ fn an_lsystems_f_segments_are_tubes_of_its_width_from_start_to_end() {
         assert!(volume(&piece.mesh) > 0.0);
         assert!(!piece.moves());
     }
+    // The branch is drawn in the colour `;` set, the others in the stem's.
+    let colours: Vec<[f32; 4]> = pieces[1..].iter().map(|p| p.color).collect();
+    assert_eq!(
+        colours,
+        [RECEPTACLE_COLOR, [1.0, 1.0, 0.0, 1.0], RECEPTACLE_COLOR]
+    );
     assert_eq!(obstacles(&flower).len(), 3, "the tubes keep organs out");
 }

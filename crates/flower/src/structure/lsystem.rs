@@ -13,7 +13,7 @@
 //! ```
 //!
 //! A module is one character (a letter, or a turtle symbol
-//! `F f + - & ^ / \ [ ] # !`), `~` followed by the letter of a surface, each
+//! `F f + - & ^ / \ [ ] # ! ;`), `~` followed by the letter of a surface, each
 //! optionally followed by parameters in parentheses: arithmetic expressions
 //! (`+ - * /`, unary minus, parentheses, numbers, constants and, in a
 //! production's successor, its formal parameters). Spaces between modules
@@ -364,7 +364,7 @@ fn parse_production(
 }
 
 /// The characters a module symbol may be, besides letters.
-const TURTLE_SYMBOLS: &str = "+-&^/\\[]#!";
+const TURTLE_SYMBOLS: &str = "+-&^/\\[]#!;";
 
 /// One level of the expression grammar: parses an operand.
 type Operand = fn(&mut Parser, &BTreeMap<String, f64>, &[String]) -> Result<Expr, LSystemError>;
@@ -426,7 +426,7 @@ impl Parser {
                 Ok(c.to_string())
             }
             other => Err(self.error(
-                "a module (a letter or one of + - & ^ / \\ [ ] # ! ~)",
+                "a module (a letter or one of + - & ^ / \\ [ ] # ! ; ~)",
                 other,
             )),
         }

@@ -163,6 +163,7 @@ impl Structure {
                 start: s.start * *units,
                 end: s.end * *units,
                 width: s.width * *units,
+                color: s.color,
             })
             .filter(|s| s.width > 0.0 && s.width.is_finite() && s.start.distance(s.end) > 1e-9)
             .collect()

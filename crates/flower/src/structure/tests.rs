@@ -133,6 +133,28 @@ fn brackets_nest_and_restore_position_frame_and_width() {
     assert_eq!(widths, [1.0, 4.0, 4.0, 4.0, 1.0]);
 }
 
+#[test]
+fn a_semicolon_sets_the_line_colour_and_brackets_restore_it() {
+    let d = draw(
+        "red = 1\naxiom: F ;(red, 0, 0) F [ ;(0, 2, -1) F ] F ; F ;(0.5) F",
+        0,
+    );
+    let colours: Vec<Option<[f32; 4]>> = d.segments.iter().map(|s| s.color).collect();
+    assert_eq!(
+        colours,
+        [
+            None,
+            Some([1.0, 0.0, 0.0, 1.0]),
+            // Clamped to [0, 1]; the bracket's colour ends with it.
+            Some([0.0, 1.0, 0.0, 1.0]),
+            Some([1.0, 0.0, 0.0, 1.0]),
+            // `;` alone and `;` with fewer than three values: the default.
+            None,
+            None,
+        ]
+    );
+}
+
 /// The seed's apple flower, L-system (3), as written there.
 const APPLE: &str = "\
 initial line width = 20

@@ -2,6 +2,12 @@
 //! word read from left to right moves a turtle (position P, heading H,
 //! left L, up U with H × L = U), draws `F` segments as tubes of the current
 //! width and places the surfaces `~X` at its position and frame.
+//!
+//! One symbol beyond the seed's §2, since its lines are all one colour: as
+//! in L-Py and cpfg, `;` sets the colour the following lines are drawn in
+//! (part of the turtle's state, so `[` and `]` save and restore it):
+//! `;(r, g, b)` a linear RGB colour with components in `[0, 1]`, `;` alone
+//! the default (the stem's green).
 
 use glam::{DMat3, DVec3};
 
@@ -40,6 +46,9 @@ pub struct Segment {
     pub end: DVec3,
     /// The line width when it was drawn.
     pub width: f64,
+    /// The colour `;(r, g, b)` set (linear RGBA, opaque), or `None` for the
+    /// default.
+    pub color: Option<[f32; 4]>,
 }
 
 /// What a word draws.
@@ -125,6 +134,23 @@ struct State {
     /// Columns H, L, U.
     frame: DMat3,
     width: f64,
+    color: Option<[f32; 4]>,
+}
+
+/// The colour `;(r, g, b)` sets: the three components clamped to `[0, 1]`
+/// (a NaN to 0), opaque; `None` (the default colour) with fewer than three.
+fn line_color(params: &[f64]) -> Option<[f32; 4]> {
+    let channel = |x: f64| {
+        if x.is_nan() {
+            0.0
+        } else {
+            x.clamp(0.0, 1.0) as f32
+        }
+    };
+    match params {
+        [r, g, b, ..] => Some([channel(*r), channel(*g), channel(*b), 1.0]),
+        _ => None,
+    }
 }
 
 /// Interprets `word`: the turtle starts at the origin with H = +Y,
@@ -137,6 +163,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
         position: DVec3::ZERO,
         frame: DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z),
         width: defaults.width,
+        color: None,
     };
     let mut stack = Vec::new();
     let mut drawing = Drawing::default();
@@ -152,6 +179,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
                     start: state.position,
                     end,
                     width: state.width,
+                    color: state.color,
                 });
                 state.position = end;
             }
@@ -174,6 +202,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
             "!" => {
                 state.width = first.unwrap_or(state.width - defaults.width_increment);
             }
+            ";" => state.color = line_color(&module.params),
             symbol => {
                 if let Some(letter) = symbol.strip_prefix('~').and_then(|l| l.chars().next()) {
                     drawing.surfaces.push(PlacedSurface {
