@@ -4,19 +4,28 @@
 //! and run, the fit's RMS and largest distance (fractions of the petal's
 //! length), iterations, simulations and seconds, then the medians.
 //!
-//! `cargo run --release -p anthesis-fit --example eustoma_round_trip [RUNS]`
+//! `cargo run --release -p anthesis-fit --example eustoma_round_trip [RUNS] [CULTIVAR]
+//! [--uniform-stiffness]`: RUNS per cultivar (default 1), CULTIVAR a part
+//! of one cultivar's name (e.g. `maite`, default all three); the fit keeps
+//! the template's stretch and bend maps (material, not growth) unless
+//! `--uniform-stiffness` resets them to 1 too.
 
 use anthesis_fit::{FitSettings, fit, simulate_final};
 use anthesis_garden::Cultivar;
 use anthesis_maps::{GrowthMaps, KeyedMaps};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let runs: usize = std::env::args()
-        .nth(1)
+    let uniform_stiffness = std::env::args().any(|a| a == "--uniform-stiffness");
+    let positional: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let runs: usize = positional
+        .first()
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or(1);
-    let only: Option<String> = std::env::args().nth(2);
+    let only: Option<String> = positional.get(1).map(|s| s.to_lowercase());
     let settings = FitSettings::default();
     for cultivar in [
         Cultivar::MellowYellow,
@@ -36,13 +45,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let organ = 0;
         let template = project.flower.template_of(organ);
         let target = simulate_final(&project, organ, template.maps.clone(), &|| false)?;
-        // The shared bud with uniform growth maps (stiffness kept).
+        // The shared bud with uniform growth maps (stiffness kept unless
+        // asked).
         let mut start = project.clone();
         let t = start.flower.organs[organ].template;
         let mut uniform = GrowthMaps::uniform();
-        let first = &template.maps.keys()[0].maps;
-        uniform.stretch = first.stretch.clone();
-        uniform.bend = first.bend.clone();
+        if !uniform_stiffness {
+            let first = &template.maps.keys()[0].maps;
+            uniform.stretch = first.stretch.clone();
+            uniform.bend = first.bend.clone();
+        }
         start.flower.templates[t].maps = KeyedMaps::single(uniform);
         let mut rms = Vec::new();
         let mut max = Vec::new();

@@ -21,14 +21,17 @@
 //!   *simulated final positions − target positions*, all particles, in the
 //!   world frame (the base is attached to the receptacle by the simulation
 //!   itself, so no rigid alignment is made). The Jacobian is by forward
-//!   finite differences, one full simulation per parameter, run in
-//!   parallel (rayon); between full Jacobians it is kept current by
-//!   Broyden's rank-one updates from the steps taken, and recomputed when a
-//!   step fails to reduce the residual well. Each iteration tries two
-//!   damping values at once (one per core).
-//! - The simulation is the project's own (its keyframe count, resolution,
-//!   solver, parts): the final shape depends on the number of keyframes,
-//!   so the fit does not shorten the run.
+//!   forward finite differences (step 0.001), one simulation per
+//!   parameter, run in parallel (rayon), on a run of half the keyframes at
+//!   twice the growth per step ([`FitSettings::coarse`]: half the cost,
+//!   derivatives of a shape 0.6 % of the length from the full run's);
+//!   between Jacobians it is kept current by Broyden's rank-one updates
+//!   from the full run's residuals, and taken afresh when a step gains
+//!   little, if it can end within the time allowed. Each iteration tries
+//!   two damping values at once (one per core).
+//! - Residuals are always those of the project's own run (its keyframe
+//!   count, resolution, solver, parts): the final shape depends on the
+//!   number of keyframes, so the result is judged on the full run.
 
 #![warn(missing_docs)]
 
@@ -67,7 +70,19 @@ pub struct FitSettings {
     /// The finite-difference step of a growth map value (the angle's is
     /// the same in radians).
     pub step: f64,
+    /// The Jacobian is taken on a run of 1/`coarse` the keyframes with
+    /// `coarse` times the growth per step (the joint schedule and the time
+    /// keys at 1/`coarse` their steps), when that leaves at least
+    /// [`MIN_COARSE_KEYFRAMES`]: about `coarse` times cheaper, and near
+    /// enough the full run's derivatives (Eustoma, halved: final shapes
+    /// 0.6 % of the length apart). Residuals are always the full run's,
+    /// and Broyden's updates carry the Jacobian towards the full run's.
+    /// 1: the full run throughout.
+    pub coarse: u32,
 }
+
+/// The fewest keyframes a coarse Jacobian run may have.
+pub const MIN_COARSE_KEYFRAMES: u32 = 20;
 
 impl Default for FitSettings {
     fn default() -> Self {
@@ -85,6 +100,7 @@ impl Default for FitSettings {
             goal_rms: 0.002,
             max_seconds: 50.0,
             step: 0.001,
+            coarse: 2,
         }
     }
 }
@@ -303,6 +319,9 @@ pub fn distances(shape: &[DVec3], target: &[DVec3], length: f64) -> (f64, f64) {
 /// What a fit works on.
 struct Problem<'a> {
     project: &'a Project,
+    /// The coarse run the Jacobian is taken on, and its layout (the same
+    /// parameters, keys at its steps).
+    coarse: Option<(Project, Layout)>,
     organ: usize,
     layout: Layout,
     size: (u32, u32),
@@ -321,8 +340,19 @@ impl Problem<'_> {
     /// particle; `None` when the simulation fails (a blow-up counts as a
     /// step too far, not as an error of the fit).
     fn residual(&self, p: &[f64]) -> Result<Option<Vec<f64>>, FitError> {
-        let maps = self.maps(p)?;
-        match simulate_final(self.project, self.organ, maps, self.cancel) {
+        self.residual_of(p, false)
+    }
+
+    /// [`Problem::residual`] of the full run, or of the coarse run when
+    /// `coarse` and there is one.
+    fn residual_of(&self, p: &[f64], coarse: bool) -> Result<Option<Vec<f64>>, FitError> {
+        let (project, layout) = match &self.coarse {
+            Some((project, layout)) if coarse => (project, layout),
+            _ => (self.project, &self.layout),
+        };
+        let template = project.flower.template_of(self.organ);
+        let maps = layout.maps(p, self.size, &template.maps)?;
+        match simulate_final(project, self.organ, maps, self.cancel) {
             Ok(shape) => Ok(Some(
                 shape
                     .iter()
@@ -401,8 +431,10 @@ pub fn fit(
         key_steps: basis::key_steps(settings.keys, project.settings.keyframes),
     };
     let size = template.maps.raster_size().unwrap_or((64, 64));
+    let coarse = coarse_run(project, organ, &layout, settings.coarse);
     let problem = Problem {
         project,
+        coarse,
         organ,
         layout,
         size,
@@ -594,7 +626,7 @@ pub fn fit(
 }
 
 /// The Jacobian of the residual at `p` (residual `r`) by forward
-/// differences, column-major; a column whose step leaves the bounds steps
+/// differences, on the coarse run if there is one, column-major; a column whose step leaves the bounds steps
 /// the other way, and one whose simulation fails is left zero. Returns the
 /// simulations run.
 fn finite_differences(
@@ -604,6 +636,16 @@ fn finite_differences(
     step: f64,
 ) -> Result<(Vec<f64>, usize), FitError> {
     let n = p.len();
+    let coarse = problem.coarse.is_some();
+    // The differences are taken from the run they are made with.
+    let base = if coarse {
+        problem.residual_of(p, true)?
+    } else {
+        Some(r.to_vec())
+    };
+    let Some(base) = base else {
+        return Ok((vec![0.0; n * r.len()], 1));
+    };
     let columns: Vec<Vec<f64>> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -611,11 +653,92 @@ fn finite_differences(
             let h = if p[i] + step > hi { -step } else { step };
             let mut q = p.to_vec();
             q[i] += h;
-            Ok(match problem.residual(&q)? {
-                Some(res) => res.iter().zip(r).map(|(a, b)| (a - b) / h).collect(),
+            Ok(match problem.residual_of(&q, coarse)? {
+                Some(res) => res.iter().zip(&base).map(|(a, b)| (a - b) / h).collect(),
                 None => vec![0.0; r.len()],
             })
         })
         .collect::<Result<_, FitError>>()?;
-    Ok((columns.concat(), n))
+    Ok((columns.concat(), n + usize::from(coarse)))
+}
+
+/// The coarse run of `project` for the Jacobian (see
+/// [`FitSettings::coarse`]): `None` when `factor` is 1 or would leave too
+/// few keyframes.
+fn coarse_run(
+    project: &Project,
+    organ: usize,
+    layout: &Layout,
+    factor: u32,
+) -> Option<(Project, Layout)> {
+    let keyframes = project.settings.keyframes;
+    if factor <= 1 || keyframes / factor < MIN_COARSE_KEYFRAMES {
+        return None;
+    }
+    let shrink = |step: u32| (f64::from(step) / f64::from(factor)).round() as u32;
+    let mut coarse = project.clone();
+    coarse.settings.keyframes = keyframes / factor;
+    let index = coarse.flower.organs[organ].template;
+    let template = &mut coarse.flower.templates[index];
+    template.dg *= f64::from(factor);
+    for ramp in &mut template.joint_schedule {
+        ramp.from_step = shrink(ramp.from_step);
+        ramp.to_step = shrink(ramp.to_step);
+    }
+    // The template's own keys only lend their stiffness maps; keys that
+    // would share a step keep the first.
+    let mut keys = template.maps.keys().to_vec();
+    for key in &mut keys {
+        key.step = shrink(key.step);
+    }
+    keys.dedup_by_key(|key| key.step);
+    template.maps = KeyedMaps::new(keys, template.maps.blend).ok()?;
+    let mut steps: Vec<u32> = layout.key_steps.iter().map(|&s| shrink(s)).collect();
+    steps.dedup();
+    if steps.len() != layout.key_steps.len() {
+        return None;
+    }
+    let layout = Layout {
+        key_steps: steps,
+        ..layout.clone()
+    };
+    Some((coarse, layout))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_coarse_run_takes_half_the_steps_at_twice_the_growth() {
+        let project = anthesis_sim::fixtures::whorl(1, 6, 10, 40);
+        let layout = Layout {
+            growth: Grid {
+                nodes_u: 1,
+                nodes_v: 2,
+            },
+            direction: Grid {
+                nodes_u: 0,
+                nodes_v: 0,
+            },
+            key_steps: basis::key_steps(3, 40),
+        };
+        let (coarse, coarse_layout) = coarse_run(&project, 0, &layout, 2).expect("40 halve to 20");
+        assert_eq!(coarse.settings.keyframes, 20);
+        let (before, after) = (&project.flower.templates[0], &coarse.flower.templates[0]);
+        assert_eq!(after.dg, 2.0 * before.dg);
+        assert_eq!(coarse_layout.key_steps, vec![0, 10, 20]);
+        let steps = |t: &anthesis_flower::Template| -> Vec<u32> {
+            t.maps.keys().iter().map(|k| k.step).collect()
+        };
+        assert_eq!(steps(before), vec![40, 50]);
+        assert_eq!(steps(after), vec![20, 25]);
+        assert_eq!(
+            after.joint_schedule[0].to_step,
+            before.joint_schedule[0].to_step / 2
+        );
+        // Too few keyframes left: the full run throughout.
+        assert!(coarse_run(&project, 0, &layout, 4).is_none());
+        assert!(coarse_run(&project, 0, &layout, 1).is_none());
+    }
 }
