@@ -6,3 +6,4 @@ pub mod cli;
 pub mod desktop;
 pub mod look;
 pub mod parts;
+pub mod thumbnail;

@@ -387,7 +387,15 @@ fn new_with_unsaved_changes_asks_first_and_dont_save_discards() {
     harness.run();
     harness.get_by_label("New").click();
     harness.run();
-    assert_eq!(harness.state().pending(), Some(&Pending::New));
+    // The gallery of starting points; the lily asks first.
+    harness.get_by_label("New flower");
+    wait_for_gallery(&mut harness);
+    harness.get_by_label("Asiatic lily").click();
+    harness.run();
+    assert_eq!(
+        harness.state().pending(),
+        Some(&Pending::New("lily".into()))
+    );
     harness.get_by_label("Unsaved changes");
     harness.get_by_label("Cancel").click();
     harness.run();
@@ -397,7 +405,7 @@ fn new_with_unsaved_changes_asks_first_and_dont_save_discards() {
         "cancel keeps the work"
     );
 
-    harness.state_mut().request(Pending::New);
+    harness.state_mut().request(Pending::New("lily".into()));
     harness.run();
     harness.get_by_label("Don't save").click();
     harness.run();
@@ -1811,11 +1819,11 @@ fn the_camera_frames_the_flower_at_launch_on_a_preview_switch_and_on_new() {
     harness.run();
     let reach = reach_of_shown_flower(&mut harness);
     assert!((0.6..=0.9).contains(&reach), "whole flower again: {reach}");
-    // File → New: the default lily, framed.
+    // File → New, the lily: framed.
     harness.state_mut().camera_mut().distance *= 7.0;
     harness
         .state_mut()
-        .apply(anthesis_app::desktop::Command::NewProject);
+        .apply(anthesis_app::desktop::Command::NewFrom("lily".into()));
     harness.run();
     feed(&mut harness, Some(0));
     harness.run();
@@ -1958,8 +1966,10 @@ fn click_in_view(harness: &mut Harness<'_, AnthesisApp>, label: &str) {
 }
 
 #[test]
-fn parts_are_added_edited_and_removed_from_the_parameters_panel_with_undo() {
+fn parts_are_added_edited_and_removed_from_the_flower_panel_with_undo() {
     let mut harness = opened_small_flower();
+    harness.get_by_label("Flower").click();
+    harness.run();
     let first_run = harness.state().session().run();
     assert!(harness.state().project().flower.parts.is_empty());
 
@@ -2128,4 +2138,316 @@ fn alt_click_on_the_3d_organ_picks_the_value_under_the_pointer() {
     assert_eq!(brush.mode, BrushMode::Set);
     assert!((brush.value - 0.37).abs() < 1e-6, "picked {}", brush.value);
     assert_eq!(harness.state().project(), &before, "picking paints nothing");
+}
+
+/// The built-in starting point `name`.
+fn builtin(name: &str) -> Project {
+    anthesis_garden::builtin(name)
+        .expect("built in")
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+/// Steps until the New gallery has rendered every picture.
+fn wait_for_gallery(harness: &mut Harness<'_, AnthesisApp>) {
+    let start = Instant::now();
+    while !harness.state().gallery_pictures_done() {
+        assert!(
+            start.elapsed() < Duration::from_secs(180),
+            "the gallery's pictures were not rendered in 3 minutes"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+        harness.step();
+    }
+    harness.run();
+}
+
+#[test]
+fn file_new_shows_every_built_in_starting_point_as_its_bud_and_opens_the_one_chosen() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.get_by_label("File").click();
+    harness.run();
+    harness.get_by_label("New").click();
+    harness.run();
+    harness.get_by_label("New flower");
+    wait_for_gallery(&mut harness);
+    // Every flower the garden builds in, under its project's name, with
+    // its picture (a button with an image: no "rendering…" left).
+    for name in anthesis_garden::FLOWER_NAMES {
+        let title = builtin(name).name;
+        harness.get_by_label(&title);
+        harness.get_by_label(&format!("bud of {title}"));
+    }
+    assert!(harness.query_by_label_contains("rendering").is_none());
+    assert!(harness.query_by_label_contains("no picture").is_none());
+    harness.snapshot("new_gallery");
+    harness.get_by_label("Five petals").click();
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.project(), &builtin("five-petal"));
+    assert!(!app.document().is_dirty(), "a new project is not an edit");
+    assert!(
+        harness.query_by_label("New flower").is_none(),
+        "the gallery closes"
+    );
+}
+
+#[test]
+fn the_gallery_pictures_are_renders_of_the_buds() {
+    let mut renderer = anthesis_render::OffscreenRenderer::new().expect("a renderer");
+    let five = builtin("five-petal");
+    let picture =
+        anthesis_app::thumbnail::bud_picture(&mut renderer, &five, 96, 96).expect("renders");
+    // The petals' pink covers a good part of the picture; the background
+    // has none of it.
+    let pink = anthesis_flower::srgb8(anthesis_garden::five_petal::SIMPLE_PINK);
+    let pinkish = picture
+        .pixels()
+        .filter(|p| {
+            let [r, g, b, _] = p.0;
+            r > g && r > b && i32::from(r) - i32::from(g) > 25 && r > 90
+        })
+        .count();
+    let share = pinkish as f64 / (96.0 * 96.0);
+    assert!(
+        share > 0.08,
+        "{share} of the picture is petal (pink {pink:?})"
+    );
+    // Another flower is another picture.
+    let lily = anthesis_app::thumbnail::bud_picture(&mut renderer, &builtin("lily"), 96, 96)
+        .expect("renders");
+    assert_ne!(lily, picture);
+}
+
+/// Selects the text in the focused widget and types `text` over it.
+fn replace_text(harness: &mut Harness<'_, AnthesisApp>, text: &str) {
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.run();
+    harness
+        .get_by_role(egui::accesskit::Role::MultilineTextInput)
+        .type_text(text);
+    harness.step();
+}
+
+/// Simulates the app's project for `keyframes` keyframes with the engine
+/// and gives them to the current run.
+fn feed_simulated(harness: &mut Harness<'_, AnthesisApp>, keyframes: u32) {
+    let app = harness.state_mut();
+    let project = app.project().clone();
+    let selection = app.selection();
+    let run = app.session().run();
+    let mut sim = anthesis_sim::Simulation::new(&project, &selection).expect("simulates");
+    let mut computed = vec![sim.bud()];
+    for _ in 0..keyframes {
+        computed.push(sim.step(&|| false, &mut |_| {}).expect("converges"));
+    }
+    let mut failures = Vec::new();
+    let session = app.session_mut();
+    session.accept(
+        Event::Started {
+            run,
+            organs: Vec::new(),
+            keyframes: project.settings.keyframes,
+            first_computed: 1,
+        },
+        &mut failures,
+    );
+    for keyframe in computed {
+        session.accept(
+            Event::Keyframe {
+                run,
+                keyframe: Arc::new(keyframe),
+            },
+            &mut failures,
+        );
+    }
+    assert!(failures.is_empty());
+    harness.run();
+}
+
+#[test]
+fn a_five_petal_flower_is_built_from_the_empty_start_in_the_flower_panel_and_simulated() {
+    let mut harness = harness(builtin("five-petal"));
+    harness.run();
+    harness.get_by_label("Flower").click();
+    harness.run();
+    let runs = harness.state().session().run();
+
+    // The whorl: tilt its petals out by typing a joint angle.
+    click_in_view(&mut harness, "joint angle");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("joint angle").type_text("8");
+    harness.run();
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    let app = harness.state();
+    assert!(
+        app.project()
+            .flower
+            .organs
+            .iter()
+            .all(|o| o.placement.joint_angle_deg == 8.0)
+    );
+    assert_eq!(
+        app.document().undo_label(),
+        Some("joint angle of whorl petal")
+    );
+    assert!(app.session().run() > runs, "the edit re-simulates");
+
+    // The centre: stamens and a pistil.
+    click_in_view(&mut harness, "Add stamens");
+    click_in_view(&mut harness, "Add pistil");
+    assert_eq!(harness.state().project().flower.parts.len(), 2);
+
+    // The arrangement as an L-system: the same five petals.
+    let before = harness.state().project().flower.organs.clone();
+    click_in_view(&mut harness, "arrange by");
+    harness.get_by_label("L-system").click();
+    harness.run();
+    let flower = &harness.state().project().flower;
+    assert!(matches!(
+        flower.structure,
+        Some(anthesis_flower::structure::Structure::LSystem { .. })
+    ));
+    assert_eq!(flower.organs.len(), 5);
+    for (a, b) in flower.organs.iter().zip(&before) {
+        let tip = glam::DVec3::new(0.0, 20.0, 0.0);
+        let (a, b) = (
+            a.placement.world_from_template(tip, 0.0),
+            b.placement.world_from_template(tip, 0.0),
+        );
+        assert!(a.distance(b) < 1e-9, "{a} {b}");
+    }
+
+    // A typo: its place is named, and the flower stays as it was.
+    harness
+        .get_by_role(egui::accesskit::Role::MultilineTextInput)
+        .click();
+    harness.run();
+    let good = harness.state().project().clone();
+    replace_text(
+        &mut harness,
+        "axiom: A\nA -> [/(0) B] [/(72) B] [/(144 B] [/(216) B] [/(288) B]\n\
+         B -> &(90) f(4) ^(90) &(12) ~a\n",
+    );
+    // Column 32 is the `B` where `)` belongs.
+    harness.get_by_label_contains("L-system line 2, column 32");
+    for _ in 0..4 {
+        harness.step();
+    }
+    assert_eq!(
+        harness.state().project(),
+        &good,
+        "an invalid text applies nothing"
+    );
+    let error = harness
+        .state()
+        .flower_panel()
+        .text_error()
+        .map(str::to_owned);
+    assert!(
+        error.as_deref().is_some_and(|e| e.contains("expected")),
+        "{error:?}"
+    );
+    harness.snapshot("flower_panel_lsystem_error");
+
+    // Fixed: applied when typing pauses, as one undo step.
+    let fixed = "axiom: A\nA -> [/(0) B] [/(72) B] [/(144) B] [/(216) B] [/(288) B]\n\
+                 B -> &(90) f(4) ^(90) &(12) ~a\n";
+    replace_text(&mut harness, fixed);
+    assert!(harness.state().flower_panel().text_error().is_none());
+    assert_eq!(harness.state().project(), &good, "not while typing");
+    for _ in 0..4 {
+        harness.step();
+    }
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.document().undo_label(), Some("L-system text"));
+    let flower = &app.project().flower;
+    assert_eq!(flower.organs.len(), 5);
+    assert!(matches!(
+        &flower.structure,
+        Some(anthesis_flower::structure::Structure::LSystem { text, .. }) if text == fixed
+    ));
+    // The petals lean out 12° in the bud now, where the whorl had 8°.
+    let lean = |organ: &anthesis_flower::Organ| {
+        let tip = organ
+            .placement
+            .world_from_template(glam::DVec3::new(0.0, 1.0, 0.0), 0.0)
+            - organ.placement.world_from_template(glam::DVec3::ZERO, 0.0);
+        tip.y.acos().to_degrees()
+    };
+    assert!((lean(&flower.organs[0]) - 12.0).abs() < 1e-6);
+    assert!((lean(&before[0]) - 8.0).abs() < 1e-6);
+
+    // Simulated by the engine: the petals open.
+    feed_simulated(&mut harness, 30);
+    let session = harness.state().session();
+    let keyframes = session.keyframes();
+    let tip_distance = |k: usize| {
+        keyframes[k].positions_in_world[0]
+            .iter()
+            .map(|p| p.x.hypot(p.z))
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        tip_distance(30) > tip_distance(0) + 0.5,
+        "opened: {} -> {}",
+        tip_distance(0),
+        tip_distance(30)
+    );
+    harness.snapshot("flower_panel_five_petals");
+}
+
+#[test]
+fn whorls_and_the_overlap_order_are_edited_in_the_flower_panel_and_undone() {
+    let mut harness = harness(builtin("five-petal"));
+    harness.run();
+    harness.get_by_label("Flower").click();
+    harness.run();
+    harness.get_by_label("Overlap order (0 pairs)");
+
+    // A second ring outside the first, its petals between theirs: each
+    // inner petal lies inside the two outer ones it meets.
+    click_in_view(&mut harness, "Add whorl");
+    let flower = &harness.state().project().flower;
+    assert_eq!(flower.organs.len(), 10);
+    assert_eq!(flower.overlaps.len(), 10);
+    assert!(flower.overlaps.iter().all(|o| o.inner < 5 && o.outer >= 5));
+    click_in_view(&mut harness, "Overlap order (10 pairs)");
+    let first = harness.state().project().flower.overlaps[0];
+    let swap = harness
+        .get_all_by_label("Swap")
+        .next()
+        .expect("a swap button");
+    swap.scroll_to_me();
+    harness.run();
+    harness
+        .get_all_by_label("Swap")
+        .next()
+        .expect("a swap button")
+        .click();
+    harness.run();
+    let app = harness.state();
+    let swapped = app.project().flower.overlaps[0];
+    assert_eq!((swapped.inner, swapped.outer), (first.outer, first.inner));
+    assert!(
+        app.document()
+            .undo_label()
+            .is_some_and(|l| l.starts_with("swap petal-1")),
+        "{:?}",
+        app.document().undo_label()
+    );
+    harness.get_by_label("swapped");
+    harness.snapshot("flower_panel_overlap_order");
+
+    // A listed organ of a new template, then undo all the way back.
+    click_in_view(&mut harness, "Add simple petal");
+    assert_eq!(harness.state().project().flower.templates.len(), 2);
+    for _ in 0..3 {
+        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+        harness.run();
+    }
+    assert_eq!(harness.state().project(), &builtin("five-petal"));
+    assert_eq!(harness.state().selected_organ(), 0);
 }

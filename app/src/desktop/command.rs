@@ -25,8 +25,11 @@ use anthesis_maps::brush::{Brush, PaintTarget, StrokeDab, dab_keyed, dab_scalar}
 /// One user action.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
-    /// A new project from the default flower (asks about unsaved changes).
+    /// Show the gallery of starting points for a new project.
     NewProject,
+    /// A new project from the built-in flower of this name (asks about
+    /// unsaved changes).
+    NewFrom(String),
     /// Open a project: this file, or ask for one (asks about unsaved
     /// changes first).
     OpenProject(Option<PathBuf>),
@@ -129,8 +132,11 @@ pub enum ProjectEdit {
     /// panel); the meshes as built stay in the project.
     Resolution(Resolution),
     /// The flower's parts (stamens, pistils, stem, receptacle), all of
-    /// them: the parts section of the parameters panel.
+    /// them: the parts section of the Flower panel.
     Parts(Vec<anthesis_flower::parts::Part>),
+    /// The whole flower as the Flower panel edited it (templates, organs,
+    /// arrangement, overlap order; made by `anthesis_flower::edit`).
+    Flower(Box<anthesis_flower::Flower>),
     /// Replace one map of a time key.
     Map {
         template: usize,
@@ -216,6 +222,7 @@ impl ProjectEdit {
             }
             ProjectEdit::Resolution(resolution) => project.settings.resolution = resolution,
             ProjectEdit::Parts(parts) => project.flower.parts = parts,
+            ProjectEdit::Flower(flower) => project.flower = *flower,
             ProjectEdit::Map {
                 template,
                 key: _,
@@ -246,7 +253,8 @@ impl AnthesisApp {
     /// Carries out `command`.
     pub fn apply(&mut self, command: Command) {
         match command {
-            Command::NewProject => self.request(Pending::New),
+            Command::NewProject => self.gallery.show(&self.ctx),
+            Command::NewFrom(name) => self.request(Pending::New(name)),
             Command::OpenProject(path) => self.request(Pending::Open(path)),
             Command::Save => {
                 self.save();
@@ -330,6 +338,19 @@ impl AnthesisApp {
             }
             self.log.succeeded(Topic::Resolution);
         }
+        if let ProjectEdit::Flower(flower) = &edit {
+            // Checked as a loaded project is: a flower the panel made
+            // wrongly never reaches the simulation.
+            let mut trial = self.doc.project().clone();
+            trial.flower = (**flower).clone();
+            if let Err(error) = anthesis_flower::project::check(&trial) {
+                self.log.error_about(
+                    Topic::Project,
+                    format!("the flower stays as it was: {error}"),
+                );
+                return false;
+            }
+        }
         let added_step = match &edit {
             ProjectEdit::AddKey { template, key } => Some((*template, key.step)),
             _ => None,
@@ -337,6 +358,8 @@ impl AnthesisApp {
         let changed = self.doc.edit(label, |project| edit.apply(project));
         if changed {
             self.needs_run = true;
+            let organs = self.project().flower.organs.len();
+            self.selected_organ = self.selected_organ.min(organs.saturating_sub(1));
         }
         if let Some((template, step)) = added_step
             && let Some(index) = self
@@ -484,6 +507,12 @@ mod tests {
             ProjectEdit::Parts(vec![crate::desktop::parts_panel::new_part(
                 project, "pistil",
             )]),
+            ProjectEdit::Flower(Box::new(
+                project
+                    .flower
+                    .with_organ(project.flower.new_organ(0).expect("template 0"))
+                    .expect("an organ is added"),
+            )),
         ]
     }
 

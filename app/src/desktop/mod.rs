@@ -15,7 +15,9 @@ pub mod command;
 pub mod document;
 pub mod export;
 pub mod files;
+pub mod flower_panel;
 mod framing;
+mod gallery;
 pub mod log;
 mod menus;
 pub mod paint;
@@ -135,6 +137,16 @@ impl Default for Startup {
 
 pub use prompts::Pending;
 
+/// What the left panel shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LeftTab {
+    /// The selected organ's template: parameters and resolution.
+    Organ,
+    /// The whole flower: templates, arrangement, organs, overlap order,
+    /// parts.
+    Flower,
+}
+
 /// The application state.
 pub struct AnthesisApp {
     doc: Document,
@@ -181,6 +193,13 @@ pub struct AnthesisApp {
     queued: Vec<Command>,
     /// The Help → Shortcuts window is open.
     show_shortcuts: bool,
+    /// What the left panel shows: the selected organ's parameters or the
+    /// whole flower.
+    left_tab: LeftTab,
+    /// The Flower panel's L-system text and choices.
+    flower_panel: flower_panel::FlowerPanelState,
+    /// File → New: the starting points and their pictures.
+    gallery: gallery::Gallery,
     /// Writes unsaved work for recovery (off until enabled).
     autosave: Option<autosave::Autosave>,
     /// Work recovered after a crash, waiting for "recover or discard?".
@@ -269,6 +288,9 @@ impl AnthesisApp {
             resolved: resolution::Resolved::default(),
             queued: Vec::new(),
             show_shortcuts: false,
+            left_tab: LeftTab::Organ,
+            flower_panel: flower_panel::FlowerPanelState::default(),
+            gallery: gallery::Gallery::default(),
             autosave: None,
             recovery_offer: None,
             title: String::new(),
@@ -321,6 +343,11 @@ impl AnthesisApp {
 
     pub fn log(&self) -> &Log {
         &self.log
+    }
+
+    /// The Flower panel's state (its L-system text, for tests).
+    pub fn flower_panel(&self) -> &flower_panel::FlowerPanelState {
+        &self.flower_panel
     }
 
     pub fn selected_organ(&self) -> usize {
@@ -531,6 +558,7 @@ impl eframe::App for AnthesisApp {
         self.export_window(&ctx);
         self.history_window(&ctx);
         self.shortcuts_window(&ctx);
+        self.gallery_window(&ctx);
         self.file_browser(&ctx);
         self.apply_queued();
         self.unsaved_prompt(&ctx);

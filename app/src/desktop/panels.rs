@@ -4,17 +4,27 @@
 
 use eframe::egui;
 
-use super::AnthesisApp;
 use super::command::Command;
 use super::params;
-use super::parts_panel;
 use super::timeline;
 use super::viewport;
+use super::{AnthesisApp, LeftTab, flower_panel};
 
 impl AnthesisApp {
-    /// The left panel: organs, preview switch and the parameters.
+    /// The left panel: organs, preview switch, and the selected organ's
+    /// parameters or the Flower panel.
     pub(super) fn organs_panel(&mut self, ui: &mut egui::Ui) {
-        ui.heading("Organs");
+        ui.horizontal(|ui| {
+            ui.heading("Organs");
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                ui.selectable_value(&mut self.left_tab, LeftTab::Flower, "Flower")
+                    .on_hover_text(
+                        "The whole flower: templates, arrangement, organs, overlap order, parts",
+                    );
+                ui.selectable_value(&mut self.left_tab, LeftTab::Organ, "Organ")
+                    .on_hover_text("The selected organ's template: parameters and resolution");
+            });
+        });
         let mut chosen = Vec::new();
         egui::ScrollArea::vertical()
             .id_salt("organ list")
@@ -42,6 +52,21 @@ impl AnthesisApp {
             chosen.push(Command::SetSingleOrganPreview(preview));
         }
         ui.separator();
+        if self.left_tab == LeftTab::Flower {
+            let now = ui.input(|i| i.time);
+            egui::ScrollArea::vertical()
+                .id_salt("flower panel")
+                .show(ui, |ui| {
+                    chosen.extend(flower_panel::flower_ui(
+                        ui,
+                        self.doc.project(),
+                        &mut self.flower_panel,
+                        now,
+                    ));
+                });
+            self.queued.extend(chosen);
+            return;
+        }
         let template = self.selected_template();
         let resolved = self.resolved_project();
         egui::ScrollArea::vertical()
@@ -53,8 +78,6 @@ impl AnthesisApp {
                     &resolved,
                     template,
                 ));
-                ui.separator();
-                chosen.extend(parts_panel::parts_ui(ui, self.doc.project()));
             });
         self.queued.extend(chosen);
     }

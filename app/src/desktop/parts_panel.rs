@@ -12,7 +12,7 @@ use eframe::egui::{self, DragValue, Rgba};
 use super::command::{Command, ProjectEdit};
 
 /// A labelled number row; returns whether it changed.
-fn row(
+pub(super) fn row(
     ui: &mut egui::Ui,
     label: &str,
     tooltip: &str,

@@ -13,7 +13,8 @@ use super::log::Topic;
 /// Something that would lose unsaved changes, waiting for the user's answer.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Pending {
-    New,
+    /// A new project from the built-in flower of this name.
+    New(String),
     Open(Option<std::path::PathBuf>),
     Quit,
 }
@@ -31,7 +32,7 @@ impl AnthesisApp {
     /// Carries out `action` without asking.
     pub(super) fn perform(&mut self, action: Pending) {
         match action {
-            Pending::New => match default_project() {
+            Pending::New(name) => match new_project(&name) {
                 Ok(project) => {
                     self.discard_recovery();
                     self.replace_document(Document::new(project, None));
@@ -59,7 +60,7 @@ impl AnthesisApp {
             return;
         }
         let verb = match action {
-            Pending::New => "starting a new project",
+            Pending::New(_) => "starting a new project",
             Pending::Open(_) => "opening another project",
             Pending::Quit => "quitting",
         };
@@ -110,6 +111,18 @@ impl AnthesisApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::CancelClose);
             self.pending = Some(Pending::Quit);
         }
+    }
+}
+
+/// The built-in flower `name` as a new project (the lily falls back on
+/// [`default_project`], which also builds it).
+fn new_project(name: &str) -> anyhow::Result<anthesis_flower::Project> {
+    if name == "lily" {
+        return default_project();
+    }
+    match anthesis_garden::builtin(name) {
+        Some(loaded) => Ok(loaded?),
+        None => Err(anyhow::anyhow!("no built-in flower `{name}`")),
     }
 }
 

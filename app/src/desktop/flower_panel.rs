@@ -1,0 +1,880 @@
+//! The Flower panel: the flower as a whole. Its templates (add a simple
+//! petal or a copy, remove one), its arrangement (listed organs, whorls,
+//! a golden-angle spiral or an L-system, whose text is checked as it is
+//! typed and applied when typing pauses), its organs (add and remove the
+//! listed ones), the overlap order (which organ lies inside which, each
+//! pair swappable) and the parts that do not grow.
+//!
+//! The panel only edits data: what an edit does to the organs and rules
+//! is `anthesis_flower::edit`'s, and every change is one
+//! [`ProjectEdit::Flower`] (or [`ProjectEdit::Parts`]), undoable and
+//! re-simulated like a stroke.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+use anthesis_flower::edit::{RuleOrigin, lsystem_like, spiral_like, whorls_like};
+use anthesis_flower::structure::lsystem::LSystemError;
+use anthesis_flower::structure::{Spiral, Structure, StructureError, Whorl};
+use anthesis_flower::{Flower, Project};
+use eframe::egui::{self, Color32, DragValue, RichText};
+
+use super::command::{Command, ProjectEdit};
+use super::parts_panel;
+
+/// How long typing must pause before the L-system text is applied.
+pub const TYPING_PAUSE_SECONDS: f64 = 0.5;
+
+/// The panel's own state: the L-system text being typed.
+#[derive(Debug, Default)]
+pub struct FlowerPanelState {
+    /// The L-system text as shown (the project's, or what is being typed).
+    text: String,
+    /// The project's text when `text` was last taken from it.
+    source: Option<String>,
+    /// When the text was last typed in, while it waits to be applied.
+    typed_at: Option<f64>,
+    /// What is wrong with `text`, if anything.
+    error: Option<TextError>,
+    /// Why the last edit was refused.
+    refused: Option<String>,
+    /// The template a new organ is made of.
+    new_organ_template: usize,
+    /// The L-system's units (project units per turtle unit), kept as the
+    /// project has them.
+    units: f64,
+}
+
+/// An error of the L-system text and where it is.
+#[derive(Debug, Clone, PartialEq)]
+struct TextError {
+    message: String,
+    /// Bytes of the text to highlight.
+    at: Option<Range<usize>>,
+}
+
+impl FlowerPanelState {
+    /// The L-system text shown (for tests).
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// The error shown under the L-system text, if any.
+    pub fn text_error(&self) -> Option<&str> {
+        self.error.as_ref().map(|e| e.message.as_str())
+    }
+}
+
+/// Which kind of arrangement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Listed,
+    Whorls,
+    Spiral,
+    LSystem,
+}
+
+impl Kind {
+    fn of(structure: Option<&Structure>) -> Kind {
+        match structure {
+            None => Kind::Listed,
+            Some(Structure::Whorls { .. }) => Kind::Whorls,
+            Some(Structure::Spiral(_)) => Kind::Spiral,
+            Some(Structure::LSystem { .. }) => Kind::LSystem,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Listed => "Listed organs",
+            Kind::Whorls => "Whorls",
+            Kind::Spiral => "Spiral",
+            Kind::LSystem => "L-system",
+        }
+    }
+}
+
+/// The byte range of the text an L-system error points at: the character
+/// at its line and column (the end of the line when the column is past
+/// it), or its whole line.
+fn error_range(text: &str, error: &LSystemError) -> Option<Range<usize>> {
+    let (line, column) = match error {
+        LSystemError::Syntax { line, column, .. } => (*line, Some(*column)),
+        LSystemError::UnknownName { line, .. } | LSystemError::Arity { line, .. } => (*line, None),
+        _ => return None,
+    };
+    let mut start = 0;
+    for (n, l) in text.split('\n').enumerate() {
+        let end = start + l.len();
+        if n + 1 == line {
+            return Some(match column {
+                None => start..end,
+                Some(column) => match l.char_indices().nth(column.saturating_sub(1)) {
+                    Some((at, c)) => start + at..start + at + c.len_utf8(),
+                    // Past the end: the line's last character, if any.
+                    None => match l.char_indices().last() {
+                        Some((at, c)) => start + at..start + at + c.len_utf8(),
+                        None => start..end,
+                    },
+                },
+            });
+        }
+        start = end + 1;
+    }
+    None
+}
+
+/// The text laid out with the error's characters on red.
+fn highlighted(
+    ui: &egui::Ui,
+    text: &str,
+    at: Option<&Range<usize>>,
+    wrap: f32,
+) -> egui::text::LayoutJob {
+    let font = egui::TextStyle::Monospace.resolve(ui.style());
+    let normal = egui::TextFormat::simple(font.clone(), ui.visuals().text_color());
+    let mut job = egui::text::LayoutJob {
+        wrap: egui::text::TextWrapping {
+            max_width: wrap,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    match at.filter(|r| r.end <= text.len() && text.is_char_boundary(r.start)) {
+        Some(range) if !range.is_empty() => {
+            job.append(&text[..range.start], 0.0, normal.clone());
+            let mut marked = egui::TextFormat::simple(font, Color32::WHITE);
+            marked.background = Color32::from_rgb(200, 40, 40);
+            job.append(&text[range.clone()], 0.0, marked);
+            job.append(&text[range.end..], 0.0, normal);
+        }
+        _ => job.append(text, 0.0, normal),
+    }
+    job
+}
+
+/// The surface letters `~X` of an L-system's text, in order.
+fn surface_letters(text: &str) -> Vec<char> {
+    let mut letters = Vec::new();
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        if c == '~'
+            && let Some(&letter) = chars.peek()
+            && letter.is_alphabetic()
+            && !letters.contains(&letter)
+        {
+            letters.push(letter);
+        }
+    }
+    letters
+}
+
+/// What the panel asks for: an edited flower with its label, or a message.
+enum Outcome {
+    Edit(String, Flower),
+    Refused(String),
+}
+
+fn outcome(
+    label: impl Into<String>,
+    result: Result<Flower, anthesis_flower::edit::EditError>,
+) -> Outcome {
+    match result {
+        Ok(flower) => Outcome::Edit(label.into(), flower),
+        Err(error) => Outcome::Refused(error.to_string()),
+    }
+}
+
+/// A labelled number row (see `parts_panel`).
+fn number(
+    ui: &mut egui::Ui,
+    label: &str,
+    tooltip: &str,
+    value: &mut f64,
+    range: std::ops::RangeInclusive<f64>,
+) -> bool {
+    parts_panel::row(ui, label, tooltip, value, range)
+}
+
+/// A template chooser; returns whether it changed.
+fn template_combo(
+    ui: &mut egui::Ui,
+    id: impl std::hash::Hash + std::fmt::Debug,
+    label: egui::Id,
+    flower: &Flower,
+    template: &mut usize,
+) -> bool {
+    let before = *template;
+    let selected = flower
+        .templates
+        .get(*template)
+        .map_or("(none)", |t| t.name.as_str());
+    egui::ComboBox::from_id_salt(id)
+        .selected_text(selected)
+        .show_ui(ui, |ui| {
+            for (i, t) in flower.templates.iter().enumerate() {
+                ui.selectable_value(template, i, &t.name);
+            }
+        })
+        .response
+        .labelled_by(label);
+    *template != before
+}
+
+/// The rows of one whorl; returns the field that changed.
+fn whorl_rows(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    whorl: &mut Whorl,
+    id: usize,
+) -> Option<&'static str> {
+    let mut changed = None;
+    let mut mark = |c: bool, field: &'static str| {
+        if c && changed.is_none() {
+            changed = Some(field);
+        }
+    };
+    egui::Grid::new(("whorl rows", id))
+        .num_columns(2)
+        .spacing([12.0, 4.0])
+        .show(ui, |ui| {
+            let label = ui.label("template").id;
+            mark(
+                template_combo(ui, ("whorl template", id), label, flower, &mut whorl.template),
+                "template",
+            );
+            ui.end_row();
+            let label = ui.label("count").on_hover_text("How many organs around the axis.");
+            let mut count = whorl.count as u32;
+            mark(
+                ui.add(DragValue::new(&mut count).range(1..=64))
+                    .labelled_by(label.id)
+                    .changed(),
+                "count",
+            );
+            whorl.count = count as usize;
+            ui.end_row();
+            mark(
+                number(ui, "offset", "Azimuth of the first organ, in degrees (0 faces +Z).", &mut whorl.offset_deg, -360.0..=360.0),
+                "offset",
+            );
+            mark(
+                number(ui, "radius", "Distance of the organs' bases from the axis.", &mut whorl.radius, 0.0..=1000.0),
+                "radius",
+            );
+            mark(
+                number(ui, "height", "Height of the organs' bases.", &mut whorl.height, -1000.0..=1000.0),
+                "height",
+            );
+            mark(
+                number(ui, "joint angle", "Initial tilt outwards, in degrees.", &mut whorl.joint_angle_deg, -180.0..=180.0),
+                "joint angle",
+            );
+            mark(
+                number(
+                    ui,
+                    "half span",
+                    "Half the angle about the axis an organ covers at its widest: organs of two whorls \
+                     whose spans meet get an overlap rule.",
+                    &mut whorl.half_span_deg,
+                    0.0..=180.0,
+                ),
+                "half span",
+            );
+        });
+    changed
+}
+
+/// The rows of the spiral; returns the field that changed.
+fn spiral_rows(ui: &mut egui::Ui, flower: &Flower, spiral: &mut Spiral) -> Option<&'static str> {
+    let mut changed = None;
+    let mut mark = |c: bool, field: &'static str| {
+        if c && changed.is_none() {
+            changed = Some(field);
+        }
+    };
+    egui::Grid::new("spiral rows")
+        .num_columns(2)
+        .spacing([12.0, 4.0])
+        .show(ui, |ui| {
+            let label = ui.label("template").id;
+            mark(
+                template_combo(ui, "spiral template", label, flower, &mut spiral.template),
+                "template",
+            );
+            ui.end_row();
+            let label = ui
+                .label("count")
+                .on_hover_text("How many organs along the spiral.");
+            let mut count = spiral.count as u32;
+            mark(
+                ui.add(DragValue::new(&mut count).range(1..=256))
+                    .labelled_by(label.id)
+                    .changed(),
+                "count",
+            );
+            spiral.count = count as usize;
+            ui.end_row();
+            mark(
+                number(
+                    ui,
+                    "divergence",
+                    "Angle between consecutive organs (the golden angle: 137.5°).",
+                    &mut spiral.divergence_deg,
+                    -360.0..=360.0,
+                ),
+                "divergence",
+            );
+            mark(
+                number(
+                    ui,
+                    "first radius",
+                    "Distance of the first (outermost) organ from the axis.",
+                    &mut spiral.first_radius,
+                    0.0..=1000.0,
+                ),
+                "first radius",
+            );
+            mark(
+                number(
+                    ui,
+                    "first height",
+                    "Height of the first organ's base.",
+                    &mut spiral.first_height,
+                    -1000.0..=1000.0,
+                ),
+                "first height",
+            );
+            mark(
+                number(
+                    ui,
+                    "radius step",
+                    "Each later organ sits this much nearer the axis.",
+                    &mut spiral.radius_step,
+                    -100.0..=100.0,
+                ),
+                "radius step",
+            );
+            mark(
+                number(
+                    ui,
+                    "height step",
+                    "Each later organ sits this much higher.",
+                    &mut spiral.height_step,
+                    -100.0..=100.0,
+                ),
+                "height step",
+            );
+            mark(
+                number(
+                    ui,
+                    "joint angle",
+                    "Initial tilt outwards, in degrees.",
+                    &mut spiral.joint_angle_deg,
+                    -180.0..=180.0,
+                ),
+                "joint angle",
+            );
+            mark(
+                number(
+                    ui,
+                    "half span",
+                    "Half the angle an organ covers about the axis.",
+                    &mut spiral.half_span_deg,
+                    0.0..=180.0,
+                ),
+                "half span",
+            );
+        });
+    changed
+}
+
+impl FlowerPanelState {
+    /// Checks `text` as the flower's L-system: the flower it makes, or the
+    /// error to show.
+    fn check(
+        &mut self,
+        flower: &Flower,
+        text: &str,
+        steps: u32,
+        surfaces: &BTreeMap<char, usize>,
+    ) -> Option<Flower> {
+        let structure = Structure::LSystem {
+            text: text.to_string(),
+            steps,
+            surfaces: surfaces.clone(),
+            units: self.units,
+        };
+        match flower.with_structure(Some(structure)) {
+            Ok(made) => {
+                self.error = None;
+                Some(made)
+            }
+            Err(error) => {
+                let at = match &error {
+                    anthesis_flower::edit::EditError::Structure(StructureError::LSystem(e)) => {
+                        error_range(text, e)
+                    }
+                    _ => None,
+                };
+                self.error = Some(TextError {
+                    message: error.to_string(),
+                    at,
+                });
+                None
+            }
+        }
+    }
+
+    /// The L-system editor; `now` is the input time in seconds.
+    fn lsystem_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        flower: &Flower,
+        (text, steps, surfaces): (&str, u32, &BTreeMap<char, usize>),
+        now: f64,
+    ) -> Option<Outcome> {
+        // Follow the project (an undo, another project) unless typing.
+        if self.typed_at.is_none() && self.source.as_deref() != Some(text) {
+            self.text = text.to_string();
+            self.source = Some(text.to_string());
+            self.error = None;
+        }
+        let mut out = None;
+        let error_at = self.error.as_ref().and_then(|e| e.at.clone());
+        let mut layouter = |ui: &egui::Ui, buffer: &dyn egui::TextBuffer, wrap: f32| {
+            let job = highlighted(ui, buffer.as_str(), error_at.as_ref(), wrap);
+            ui.fonts_mut(|f| f.layout_job(job))
+        };
+        let edit = ui.add(
+            egui::TextEdit::multiline(&mut self.text)
+                .id_salt("lsystem text")
+                .code_editor()
+                .desired_rows(6)
+                .desired_width(f32::INFINITY)
+                .layouter(&mut layouter),
+        );
+        let edit = edit.on_hover_text(
+            "One statement a line: constants (angle = 30), axiom: …, productions A(x) -> … . \
+             ~X places an organ of the template chosen for surface X below.",
+        );
+        if edit.changed() {
+            self.typed_at = Some(now);
+            let typed = self.text.clone();
+            self.check(flower, &typed, steps, surfaces);
+        }
+        if let Some(error) = &self.error {
+            ui.label(RichText::new(&error.message).color(ui.visuals().error_fg_color));
+        }
+        if let Some(at) = self.typed_at {
+            let waited = now - at;
+            if waited >= TYPING_PAUSE_SECONDS {
+                self.typed_at = None;
+                let typed = self.text.clone();
+                if typed != text
+                    && let Some(made) = self.check(flower, &typed, steps, surfaces)
+                {
+                    self.source = Some(typed);
+                    out = Some(Outcome::Edit("L-system text".to_string(), made));
+                } else if self.error.is_none() {
+                    self.source = Some(typed);
+                }
+            } else {
+                ui.ctx()
+                    .request_repaint_after(std::time::Duration::from_secs_f64(
+                        TYPING_PAUSE_SECONDS - waited + 0.01,
+                    ));
+            }
+        }
+        // Steps and surfaces apply at once (with the text as it is, when
+        // it is valid).
+        let mut steps_now = steps;
+        let mut surfaces_now = surfaces.clone();
+        let mut label = None;
+        ui.horizontal(|ui| {
+            let l = ui.label("derivation steps");
+            if ui
+                .add(
+                    DragValue::new(&mut steps_now)
+                        .range(0..=anthesis_flower::structure::lsystem::MAX_STEPS),
+                )
+                .labelled_by(l.id)
+                .changed()
+            {
+                label = Some("derivation steps".to_string());
+            }
+        });
+        for letter in surface_letters(&self.text) {
+            ui.horizontal(|ui| {
+                let name = ui.label(format!("surface ~{letter}")).id;
+                let mut template = surfaces_now.get(&letter).copied().unwrap_or(usize::MAX);
+                if template_combo(ui, ("surface", letter), name, flower, &mut template) {
+                    surfaces_now.insert(letter, template);
+                    label = Some(format!("surface ~{letter}"));
+                }
+            });
+        }
+        if let Some(label) = label {
+            let typed = self.text.clone();
+            if let Some(made) = self.check(flower, &typed, steps_now, &surfaces_now) {
+                self.typed_at = None;
+                self.source = Some(typed);
+                out = Some(Outcome::Edit(label, made));
+            }
+        }
+        out
+    }
+}
+
+/// Shows the Flower panel for `project`; returns the edits the user made.
+/// `now` is the input time in seconds (typing pauses are measured in it).
+pub fn flower_ui(
+    ui: &mut egui::Ui,
+    project: &Project,
+    state: &mut FlowerPanelState,
+    now: f64,
+) -> Vec<Command> {
+    let flower = &project.flower;
+    let mut outcomes: Vec<Outcome> = Vec::new();
+
+    // Templates.
+    ui.strong("Templates")
+        .on_hover_text("The organ types: a mesh, growth maps and material each.");
+    for (i, template) in flower.templates.iter().enumerate() {
+        let organs = flower.organs.iter().filter(|o| o.template == i).count();
+        ui.horizontal(|ui| {
+            ui.label(format!(
+                "{} — {organs} organ{}",
+                template.name,
+                if organs == 1 { "" } else { "s" }
+            ));
+            let remove = ui
+                .add_enabled(
+                    flower.templates.len() > 1,
+                    egui::Button::new("Remove").small(),
+                )
+                .on_hover_text("Remove the template, its organs and the whorls that use it");
+            if remove.clicked() {
+                outcomes.push(outcome(
+                    format!("remove template {}", template.name),
+                    flower.without_template(i),
+                ));
+            }
+        });
+    }
+    ui.horizontal_wrapped(|ui| {
+        if ui
+            .button("Add simple petal")
+            .on_hover_text("A flat, slightly cupped petal with uniform growth maps, to paint")
+            .clicked()
+        {
+            match anthesis_garden::five_petal::simple_petal_template(
+                "petal",
+                anthesis_garden::flowers::EDGE_SCALE,
+            ) {
+                Ok(template) => {
+                    let added = flower.with_template(template);
+                    let name = added
+                        .templates
+                        .last()
+                        .map_or(String::new(), |t| t.name.clone());
+                    outcomes.push(Outcome::Edit(format!("add template {name}"), added));
+                }
+                Err(error) => outcomes.push(Outcome::Refused(error.to_string())),
+            }
+        }
+        let source = state
+            .new_organ_template
+            .min(flower.templates.len().saturating_sub(1));
+        if let Some(template) = flower.templates.get(source)
+            && ui
+                .button("Duplicate template")
+                .on_hover_text("A copy of the template chosen under Organs, to change on its own")
+                .clicked()
+        {
+            let added = flower.with_template(template.clone());
+            let name = added
+                .templates
+                .last()
+                .map_or(String::new(), |t| t.name.clone());
+            outcomes.push(Outcome::Edit(format!("add template {name}"), added));
+        }
+    });
+    ui.separator();
+
+    // Arrangement.
+    ui.strong("Arrangement").on_hover_text(
+        "Where the organs go: listed one by one, whorls (rings, innermost first), a golden-angle \
+         spiral or an L-system whose ~X places an organ.",
+    );
+    let kind = Kind::of(flower.structure.as_ref());
+    let mut chosen = kind;
+    ui.horizontal(|ui| {
+        let label = ui.label("arrange by").id;
+        egui::ComboBox::from_id_salt("arrangement kind")
+            .selected_text(kind.name())
+            .show_ui(ui, |ui| {
+                for k in [Kind::Listed, Kind::Whorls, Kind::Spiral, Kind::LSystem] {
+                    ui.selectable_value(&mut chosen, k, k.name());
+                }
+            })
+            .response
+            .labelled_by(label);
+    });
+    if chosen != kind {
+        let whorls = whorls_like(flower);
+        let result = match chosen {
+            Kind::Listed => flower.with_structure(None),
+            Kind::Whorls => flower.arranged_by(Structure::Whorls {
+                whorls,
+                contorted: false,
+            }),
+            Kind::Spiral => match spiral_like(&whorls) {
+                Some(spiral) => flower.arranged_by(Structure::Spiral(spiral)),
+                None => Err(anthesis_flower::edit::EditError::NoOrgans),
+            },
+            Kind::LSystem => {
+                let (text, steps, surfaces) = lsystem_like(&whorls);
+                flower.arranged_by(Structure::LSystem {
+                    text,
+                    steps,
+                    surfaces,
+                    units: 1.0,
+                })
+            }
+        };
+        outcomes.push(outcome(
+            format!("arrange by {}", chosen.name().to_lowercase()),
+            result,
+        ));
+    }
+    match &flower.structure {
+        None => {
+            ui.label("Each organ is placed on its own (see Organs).");
+        }
+        Some(Structure::Whorls { whorls, contorted }) => {
+            let mut draft = whorls.clone();
+            let mut contorted_now = *contorted;
+            let mut label = None;
+            if ui
+                .checkbox(&mut contorted_now, "contorted")
+                .on_hover_text(
+                    "One ring whose organs each lie beneath their right-hand neighbour (Eustoma)",
+                )
+                .changed()
+            {
+                label = Some("contorted".to_string());
+            }
+            let mut remove = None;
+            for (i, whorl) in draft.iter_mut().enumerate() {
+                egui::CollapsingHeader::new(format!("whorl “{}” × {}", whorl.name, whorl.count))
+                    .id_salt(("whorl", i))
+                    .default_open(draft_len_is_small(whorls.len()))
+                    .show(ui, |ui| {
+                        if let Some(field) = whorl_rows(ui, flower, whorl, i) {
+                            label = Some(format!("{field} of whorl {}", whorl.name));
+                        }
+                        if ui
+                            .add_enabled(whorls.len() > 1, egui::Button::new("Remove whorl"))
+                            .clicked()
+                        {
+                            remove = Some(i);
+                        }
+                    });
+            }
+            if let Some(i) = remove {
+                label = Some(format!("remove whorl {}", draft[i].name));
+                draft.remove(i);
+            }
+            if ui
+                .button("Add whorl")
+                .on_hover_text("A ring outside the others, its organs between theirs")
+                .clicked()
+                && let Some(last) = draft.last()
+            {
+                let name =
+                    anthesis_flower::edit::unique_name(&format!("{} outer", last.name), |n| {
+                        draft.iter().any(|w| w.name == n)
+                    });
+                let step = 360.0 / last.count.max(1) as f64;
+                let added = Whorl {
+                    name,
+                    offset_deg: last.offset_deg + 0.5 * step,
+                    radius: last.radius * 1.15 + 0.1,
+                    ..last.clone()
+                };
+                label = Some(format!("add whorl {}", added.name));
+                draft.push(added);
+            }
+            if let Some(label) = label {
+                outcomes.push(outcome(
+                    label,
+                    flower.with_structure(Some(Structure::Whorls {
+                        whorls: draft,
+                        contorted: contorted_now,
+                    })),
+                ));
+            }
+        }
+        Some(Structure::Spiral(spiral)) => {
+            let mut draft = spiral.clone();
+            if let Some(field) = spiral_rows(ui, flower, &mut draft) {
+                outcomes.push(outcome(
+                    format!("{field} of the spiral"),
+                    flower.with_structure(Some(Structure::Spiral(draft))),
+                ));
+            }
+        }
+        Some(Structure::LSystem {
+            text,
+            steps,
+            surfaces,
+            units,
+        }) => {
+            state.units = *units;
+            let now_text = text.clone();
+            if let Some(out) = state.lsystem_ui(ui, flower, (&now_text, *steps, surfaces), now) {
+                outcomes.push(out);
+            }
+        }
+    }
+    if let Some(refused) = &state.refused {
+        ui.label(RichText::new(refused).color(ui.visuals().error_fg_color));
+    }
+    ui.separator();
+
+    // Organs.
+    let made = flower.made_organ_count();
+    egui::CollapsingHeader::new(format!("Organs ({})", flower.organs.len()))
+        .id_salt("flower organs")
+        .show(ui, |ui| {
+            for (i, organ) in flower.organs.iter().enumerate() {
+                ui.horizontal(|ui| {
+                    let template = flower
+                        .templates
+                        .get(organ.template)
+                        .map_or("?", |t| t.name.as_str());
+                    ui.label(format!("{} ({template})", organ.name));
+                    if i < made {
+                        ui.weak("arranged");
+                    } else if ui
+                        .small_button("Remove organ")
+                        .on_hover_text("Remove this listed organ and its overlap rules")
+                        .clicked()
+                    {
+                        outcomes.push(outcome(
+                            format!("remove organ {}", organ.name),
+                            flower.without_organ(i),
+                        ));
+                    }
+                });
+            }
+        });
+    ui.horizontal(|ui| {
+        let mut template = state
+            .new_organ_template
+            .min(flower.templates.len().saturating_sub(1));
+        let label = ui.label("new organ of").id;
+        template_combo(ui, "new organ template", label, flower, &mut template);
+        state.new_organ_template = template;
+        if ui
+            .button("Add organ")
+            .on_hover_text("One more organ of this template, listed after the arranged ones")
+            .clicked()
+            && let Some(organ) = flower.new_organ(template)
+        {
+            let name = organ.name.clone();
+            outcomes.push(outcome(
+                format!("add organ {name}"),
+                flower.with_organ(organ),
+            ));
+        }
+    });
+    ui.separator();
+
+    // Overlap order.
+    let origins = flower.rule_origins();
+    egui::CollapsingHeader::new(format!("Overlap order ({} pairs)", flower.overlaps.len()))
+        .id_salt("overlap order")
+        .show(ui, |ui| {
+            if flower.overlaps.is_empty() {
+                ui.label("No organs overlap: none lies inside another.");
+            }
+            for (i, (rule, origin)) in flower.overlaps.iter().zip(&origins).enumerate() {
+                let (Some(inner), Some(outer)) =
+                    (flower.organs.get(rule.inner), flower.organs.get(rule.outer))
+                else {
+                    continue;
+                };
+                ui.horizontal(|ui| {
+                    ui.label(format!("{} inside {}", inner.name, outer.name));
+                    match origin {
+                        RuleOrigin::Made => ui.weak("arranged"),
+                        RuleOrigin::Overridden => ui.label(RichText::new("swapped").italics()),
+                        RuleOrigin::Listed => ui.weak("listed"),
+                    };
+                    if ui
+                        .small_button("Swap")
+                        .on_hover_text("The other way round: the outer one lies inside")
+                        .clicked()
+                    {
+                        outcomes.push(outcome(
+                            format!("swap {} and {}", inner.name, outer.name),
+                            flower.with_rule_swapped(i),
+                        ));
+                    }
+                });
+            }
+        });
+    ui.separator();
+
+    let mut commands = Vec::new();
+    for out in outcomes {
+        match out {
+            Outcome::Edit(label, flower) => {
+                state.refused = None;
+                commands.push(Command::Edit {
+                    label,
+                    edit: ProjectEdit::Flower(Box::new(flower)),
+                });
+            }
+            Outcome::Refused(message) => state.refused = Some(message),
+        }
+    }
+    // Parts.
+    commands.extend(parts_panel::parts_ui(ui, project));
+    commands
+}
+
+/// Whorls start open when there are few of them.
+fn draft_len_is_small(n: usize) -> bool {
+    n <= 2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use anthesis_flower::structure::lsystem::LSystem;
+
+    #[test]
+    fn the_error_range_is_the_character_at_the_line_and_column() {
+        let text = "axiom: A\nA -> F(1 B";
+        let error = LSystem::parse(text).unwrap_err();
+        let range = error_range(text, &error).unwrap();
+        assert_eq!(&text[range], "B");
+        // Past the end of the line: its last character.
+        let text = "axiom: A\nA -> F(1";
+        let error = LSystem::parse(text).unwrap_err();
+        let range = error_range(text, &error).unwrap();
+        assert_eq!(&text[range], "1");
+        // An unknown name: its line.
+        let text = "axiom: A\nA -> F(len)";
+        let error = LSystem::parse(text).unwrap_err();
+        assert_eq!(&text[error_range(text, &error).unwrap()], "A -> F(len)");
+    }
+
+    #[test]
+    fn surface_letters_are_found_once_in_order() {
+        assert_eq!(surface_letters("axiom: [~p] ~c ~p F ~"), vec!['p', 'c']);
+    }
+}
