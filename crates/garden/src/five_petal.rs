@@ -47,7 +47,7 @@ pub fn simple_petal_bud() -> RingOrgan {
 /// the base along it (the petal bends outwards as it grows).
 const SIMPLE_E: f32 = 0.5;
 const SIMPLE_W: f32 = 0.4;
-const SIMPLE_E_IN_EXCESS: f32 = 0.06;
+const SIMPLE_E_IN_EXCESS: f32 = 0.015;
 
 /// The simple petal's joint: +20° over steps 1–50.
 pub const SIMPLE_JOINT: JointRamp = JointRamp {
