@@ -2229,16 +2229,17 @@ fn replace_text(harness: &mut Harness<'_, AnthesisApp>, text: &str) {
     harness.step();
 }
 
-/// Simulates the app's project for `keyframes` keyframes with the engine
-/// and gives them to the current run.
-fn feed_simulated(harness: &mut Harness<'_, AnthesisApp>, keyframes: u32) {
+/// Simulates the app's project to its end with the engine and gives the
+/// keyframes to the current run (its time said to be one second, so that
+/// snapshots do not depend on the machine).
+fn feed_simulated(harness: &mut Harness<'_, AnthesisApp>) {
     let app = harness.state_mut();
     let project = app.project().clone();
     let selection = app.selection();
     let run = app.session().run();
     let mut sim = anthesis_sim::Simulation::new(&project, &selection).expect("simulates");
     let mut computed = vec![sim.bud()];
-    for _ in 0..keyframes {
+    while !sim.finished() {
         computed.push(sim.step(&|| false, &mut |_| {}).expect("converges"));
     }
     let mut failures = Vec::new();
@@ -2261,6 +2262,14 @@ fn feed_simulated(harness: &mut Harness<'_, AnthesisApp>, keyframes: u32) {
             &mut failures,
         );
     }
+    session.accept(
+        Event::Finished {
+            run,
+            keyframes: project.settings.keyframes,
+            seconds: 1.0,
+        },
+        &mut failures,
+    );
     assert!(failures.is_empty());
     harness.run();
 }
@@ -2381,7 +2390,7 @@ fn a_five_petal_flower_is_built_from_the_empty_start_in_the_flower_panel_and_sim
     assert!((lean(&before[0]) - 8.0).abs() < 1e-6);
 
     // Simulated by the engine: the petals open.
-    feed_simulated(&mut harness, 30);
+    feed_simulated(&mut harness);
     let session = harness.state().session();
     let keyframes = session.keyframes();
     let tip_distance = |k: usize| {
@@ -2390,12 +2399,18 @@ fn a_five_petal_flower_is_built_from_the_empty_start_in_the_flower_panel_and_sim
             .map(|p| p.x.hypot(p.z))
             .fold(0.0, f64::max)
     };
+    assert_eq!(keyframes.len(), 101);
+    // Wider all the way: it opens into a saucer, not curling back under.
+    for k in (10..=100).step_by(10) {
+        assert!(tip_distance(k) > tip_distance(k - 10), "keyframe {k}");
+    }
     assert!(
-        tip_distance(30) > tip_distance(0) + 0.5,
+        tip_distance(100) > tip_distance(0) + 5.0,
         "opened: {} -> {}",
         tip_distance(0),
-        tip_distance(30)
+        tip_distance(100)
     );
+    harness.get_by_label("100 keyframes in 1 s");
     harness.snapshot("flower_panel_five_petals");
 }
 
