@@ -26,11 +26,16 @@ pub use render::RenderArgs;
 #[command(
     name = "anthesis",
     version,
-    about = "Author flower-opening animations by painting growth."
+    about = "Author flower-opening animations by painting growth.",
+    args_conflicts_with_subcommands = true
 )]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
+    /// Without a command: the project the window opens (a project file, its
+    /// folder, or builtin:NAME; default: the last one, else the lily).
+    #[arg(value_name = "PROJECT")]
+    pub project: Option<PathBuf>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -208,8 +213,8 @@ fn one_line(message: &str) -> String {
 
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        // No subcommand: the desktop window.
-        None => crate::desktop::run(),
+        // No subcommand: the desktop window, on PROJECT if one is given.
+        None => crate::desktop::run(cli.project.as_deref().map(open).transpose()?),
         Some(Command::Info { project, edge }) => simulate::info(&project, edge),
         Some(Command::Simulate {
             project,
@@ -275,6 +280,18 @@ fn load(path: &Path) -> Result<Project> {
     let project = load_project(path).context("cannot open project")?;
     check_units(&project)?;
     Ok(project)
+}
+
+/// The project the window opens at `path` and the file it saves to (none
+/// for a built-in flower, which Save asks a place for).
+fn open(path: &Path) -> Result<(Project, Option<PathBuf>)> {
+    let project = load(path)?;
+    let file = if path.to_str().is_some_and(|p| p.starts_with("builtin:")) {
+        None
+    } else {
+        Some(anthesis_flower::project::project_file(path).context("cannot open project")?)
+    };
+    Ok((project, file))
 }
 
 /// `anthesis new --from NAME DIR`: the built-in flower NAME saved as

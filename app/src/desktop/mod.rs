@@ -84,8 +84,9 @@ fn autosave_interval(settings: &Settings) -> std::time::Duration {
 /// The key under which [`Settings`] are stored.
 const SETTINGS_KEY: &str = "anthesis-settings";
 
-/// Opens the window; returns when it is closed.
-pub fn run() -> Result<()> {
+/// Opens the window, on `project` (and the file it came from) if given,
+/// else as [`Startup::default`]; returns when it is closed.
+pub fn run(project: Option<(Project, Option<PathBuf>)>) -> Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("Anthesis")
@@ -98,7 +99,11 @@ pub fn run() -> Result<()> {
         APP_ID,
         options,
         Box::new(|cc| {
-            let mut app = AnthesisApp::new(cc, Startup::default()).map_err(|e| e.to_string())?;
+            let startup = Startup {
+                project,
+                ..Startup::default()
+            };
+            let mut app = AnthesisApp::new(cc, startup).map_err(|e| e.to_string())?;
             match eframe::storage_dir(APP_ID) {
                 Some(data) => app.enable_autosave(
                     RecoveryFolder::new(data.join("recovery")),
