@@ -389,6 +389,33 @@ fn the_built_in_lily_needs_no_files() {
 }
 
 #[test]
+fn a_project_the_window_cannot_open_is_refused_before_any_window() {
+    // No display is needed: the project is loaded before the window opens,
+    // and a bad one ends there with one line naming it.
+    for (arg, says) in [
+        // The message lists the flowers there are.
+        (
+            "builtin:tulip",
+            &["no built-in flower `tulip`", "apple"][..],
+        ),
+        ("/no/such/folder", &["/no/such/folder"][..]),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+            .arg(arg)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .expect("runs");
+        assert!(!out.status.success(), "{arg}");
+        let stderr = text(&out.stderr);
+        for said in says {
+            assert!(stderr.contains(said), "{arg}: {stderr}");
+        }
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    }
+}
+
+#[test]
 fn a_mesh_in_another_unit_is_named_before_the_run() {
     // The whorl's petal mesh made in another unit: ×100 on the mesh alone
     // (thickness and positions as they were).
