@@ -2456,10 +2456,32 @@ fn whorls_and_the_overlap_order_are_edited_in_the_flower_panel_and_undone() {
     harness.get_by_label("swapped");
     harness.snapshot("flower_panel_overlap_order");
 
-    // A listed organ of a new template, then undo all the way back.
+    // A new template, a listed organ moved out by typing its distance,
+    // then undo all the way back.
     click_in_view(&mut harness, "Add simple petal");
     assert_eq!(harness.state().project().flower.templates.len(), 2);
-    for _ in 0..3 {
+    click_in_view(&mut harness, "Add organ");
+    let flower = &harness.state().project().flower;
+    assert_eq!(flower.organs.len(), 11);
+    assert_eq!(flower.made_organ_count(), 10);
+    let added = flower.organs[10].clone();
+    click_in_view(&mut harness, "Organs (11)");
+    click_in_view(&mut harness, "distance");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("distance").type_text("9");
+    harness.run();
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    let app = harness.state();
+    let moved = &app.project().flower.organs[10];
+    let p = moved.placement.position;
+    assert!((p.x.hypot(p.z) - 9.0).abs() < 1e-9, "{p}");
+    assert_eq!(moved.placement.azimuth_deg, added.placement.azimuth_deg);
+    assert_eq!(
+        app.document().undo_label().map(str::to_owned),
+        Some(format!("distance of {}", added.name))
+    );
+    for _ in 0..5 {
         harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
         harness.run();
     }

@@ -768,6 +768,14 @@ pub fn flower_ui(
                         ));
                     }
                 });
+                if i >= made
+                    && let Some((field, moved)) = placement_rows(ui, organ, i)
+                {
+                    outcomes.push(outcome(
+                        format!("{field} of {}", organ.name),
+                        flower.with_organ_changed(i, moved),
+                    ));
+                }
             }
         });
     ui.horizontal(|ui| {
@@ -844,6 +852,77 @@ pub fn flower_ui(
     // Parts.
     commands.extend(parts_panel::parts_ui(ui, project));
     commands
+}
+
+/// Where a listed organ sits: its base's azimuth and distance from the
+/// axis, its height and its joint angle. A turn about the axis turns the
+/// whole organ (position and facing); returns the field changed and the
+/// moved organ.
+fn placement_rows(
+    ui: &mut egui::Ui,
+    organ: &anthesis_flower::Organ,
+    id: usize,
+) -> Option<(&'static str, anthesis_flower::Organ)> {
+    let p = organ.placement;
+    let at_deg = p.position.x.atan2(p.position.z).to_degrees();
+    let (mut azimuth, mut distance, mut height, mut joint) = (
+        at_deg,
+        p.position.x.hypot(p.position.z),
+        p.position.y,
+        p.joint_angle_deg,
+    );
+    let mut field = None;
+    egui::Grid::new(("organ placement", id))
+        .num_columns(2)
+        .spacing([12.0, 4.0])
+        .show(ui, |ui| {
+            let rows: [(&'static str, &str, &mut f64, std::ops::RangeInclusive<f64>); 4] = [
+                (
+                    "azimuth",
+                    "Where its base sits around the axis, in degrees (0: +Z).",
+                    &mut azimuth,
+                    -360.0..=360.0,
+                ),
+                (
+                    "distance",
+                    "Distance of its base from the axis.",
+                    &mut distance,
+                    0.0..=1000.0,
+                ),
+                (
+                    "height",
+                    "Height of its base.",
+                    &mut height,
+                    -1000.0..=1000.0,
+                ),
+                (
+                    "joint angle",
+                    "Initial tilt outwards, in degrees.",
+                    &mut joint,
+                    -180.0..=180.0,
+                ),
+            ];
+            for (name, tooltip, value, range) in rows {
+                if number(ui, name, tooltip, value, range) && field.is_none() {
+                    field = Some(name);
+                }
+            }
+        });
+    let field = field?;
+    let mut moved = organ.clone();
+    let turn = glam::DQuat::from_rotation_y((azimuth - at_deg).to_radians());
+    let turned = turn * p.position;
+    let horizontal = glam::DVec2::new(turned.x, turned.z);
+    let horizontal = if horizontal.length() > 1e-12 {
+        horizontal.normalize() * distance
+    } else {
+        let a = azimuth.to_radians();
+        glam::DVec2::new(a.sin(), a.cos()) * distance
+    };
+    moved.placement.position = glam::DVec3::new(horizontal.x, height, horizontal.y);
+    moved.placement.azimuth_deg = p.azimuth_deg + (azimuth - at_deg);
+    moved.placement.joint_angle_deg = joint;
+    Some((field, moved))
 }
 
 /// Whorls start open when there are few of them.
