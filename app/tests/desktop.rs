@@ -2186,6 +2186,7 @@ fn file_new_shows_every_built_in_starting_point_as_its_bud_and_opens_the_one_cho
     let app = harness.state();
     assert_eq!(app.project(), &builtin("five-petal"));
     assert!(!app.document().is_dirty(), "a new project is not an edit");
+    harness.get_by_label_contains("new project from Five petals (`five-petal`)");
     assert!(
         harness.query_by_label("New flower").is_none(),
         "the gallery closes"

@@ -35,6 +35,8 @@ impl AnthesisApp {
             Pending::New(name) => match new_project(&name) {
                 Ok(project) => {
                     self.discard_recovery();
+                    self.log
+                        .info(format!("new project from {} (`{name}`)", project.name));
                     self.replace_document(Document::new(project, None));
                     self.log.succeeded(Topic::Project);
                 }
