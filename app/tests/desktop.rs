@@ -2489,3 +2489,40 @@ fn whorls_and_the_overlap_order_are_edited_in_the_flower_panel_and_undone() {
     assert_eq!(harness.state().project(), &builtin("five-petal"));
     assert_eq!(harness.state().selected_organ(), 0);
 }
+
+#[test]
+fn the_apple_s_l_system_shows_in_the_flower_panel_and_a_whorl_arrangement_replaces_it() {
+    let apple = builtin("apple");
+    let Some(anthesis_flower::structure::Structure::LSystem { text, .. }) =
+        apple.flower.structure.clone()
+    else {
+        panic!("the apple is arranged by an L-system");
+    };
+    let mut harness = harness(apple.clone());
+    harness.run();
+    harness.get_by_label("Flower").click();
+    harness.run();
+    // Its text as the project has it, without an error, and its pairs.
+    assert_eq!(harness.state().flower_panel().text(), text);
+    assert!(harness.state().flower_panel().text_error().is_none());
+    harness.get_by_value(&text);
+    harness.get_by_label(&format!(
+        "Overlap order ({} pairs)",
+        apple.flower.overlaps.len()
+    ));
+    // Whorls in its place: one ring per template, as many organs as it had.
+    click_in_view(&mut harness, "arrange by");
+    harness.get_by_label("Whorls").click();
+    harness.run();
+    let flower = &harness.state().project().flower;
+    assert!(matches!(
+        flower.structure,
+        Some(anthesis_flower::structure::Structure::Whorls { .. })
+    ));
+    assert_eq!(flower.organs.len(), apple.flower.organs.len());
+    assert_eq!(flower.parts, apple.flower.parts);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().project(), &apple);
+    assert_eq!(harness.state().flower_panel().text(), text);
+}
