@@ -2526,3 +2526,65 @@ fn the_apple_s_l_system_shows_in_the_flower_panel_and_a_whorl_arrangement_replac
     assert_eq!(harness.state().project(), &apple);
     assert_eq!(harness.state().flower_panel().text(), text);
 }
+
+#[test]
+fn edit_menu_fits_growth_maps_to_a_target_and_applies_them_as_one_undo_step() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let project = small_flower();
+    // The first organ's own final shape, as `anthesis simulate --out` writes it.
+    let maps = project.flower.template_of(0).maps.clone();
+    let shape = anthesis_fit::simulate_final(&project, 0, maps, &|| false).expect("simulates");
+    let mut obj = format!("o {}\n", project.flower.organs[0].name);
+    for p in &shape {
+        obj.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    let target = dir.path().join("open.obj");
+    std::fs::write(&target, obj).expect("write");
+
+    let mut harness = harness(project);
+    harness.run();
+    harness.get_by_label("Edit").click();
+    harness.run();
+    harness.get_by_label("Fit growth maps to a target…").click();
+    harness.run();
+    harness.get_by_label("Target OBJ").click();
+    harness.run();
+    harness
+        .get_by_label("Target OBJ")
+        .type_text(&target.display().to_string());
+    harness.run();
+    harness.get_by_label("Fit").click();
+    harness.step();
+    let started = Instant::now();
+    while harness.state().fit_dialog().is_running() {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "the fit hangs: {:?}",
+            harness.state().fit_dialog().state()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        harness.step();
+    }
+    harness.run();
+    // In the dialog and in the log.
+    assert!(
+        harness
+            .query_all_by_label_contains("fitted: RMS")
+            .next()
+            .is_some(),
+        "{:?}",
+        harness.state().fit_dialog().state()
+    );
+    let before = harness.state().document().project().flower.templates[0]
+        .maps
+        .clone();
+    harness.get_by_label("Apply the fitted maps").click();
+    harness.run();
+    let after = &harness.state().document().project().flower.templates[0].maps;
+    assert_ne!(*after, before);
+    assert_eq!(after.keys().len(), 1, "one time key, as asked");
+    assert_eq!(
+        harness.state().document().undo_label(),
+        Some("fit growth maps")
+    );
+}

@@ -347,6 +347,7 @@ impl AnthesisApp {
     /// The menu bar; what is chosen is queued as commands.
     pub(super) fn menu_bar(&mut self, ui: &mut egui::Ui) {
         let mut chosen = Vec::new();
+        let mut open_fit = false;
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
                 if ui.button("New").clicked() {
@@ -411,6 +412,10 @@ impl AnthesisApp {
                 {
                     chosen.push(Command::Redo);
                 }
+                ui.separator();
+                if ui.button("Fit growth maps to a target…").clicked() {
+                    open_fit = true;
+                }
             });
             ui.menu_button("View", |ui| {
                 let mut view = self.view;
@@ -457,6 +462,9 @@ impl AnthesisApp {
             });
         });
         self.queued.extend(chosen);
+        if open_fit {
+            self.fit.open = true;
+        }
     }
 }
 

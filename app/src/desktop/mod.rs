@@ -15,6 +15,7 @@ pub mod command;
 pub mod document;
 pub mod export;
 pub mod files;
+pub mod fit;
 pub mod flower_panel;
 mod framing;
 mod gallery;
@@ -172,6 +173,7 @@ pub struct AnthesisApp {
     log: Log,
     dialogs: Dialogs,
     export: ExportDialog,
+    fit: fit::FitDialog,
     paint: PaintState,
     /// An action waiting for "save changes?".
     pending: Option<Pending>,
@@ -280,6 +282,7 @@ impl AnthesisApp {
             log,
             dialogs: Dialogs::default(),
             export: ExportDialog::default(),
+            fit: fit::FitDialog::default(),
             paint: PaintState::default(),
             pending: None,
             unit_offer: None,
@@ -344,6 +347,10 @@ impl AnthesisApp {
 
     pub fn export_dialog(&self) -> &ExportDialog {
         &self.export
+    }
+
+    pub fn fit_dialog(&self) -> &fit::FitDialog {
+        &self.fit
     }
 
     pub fn log(&self) -> &Log {
@@ -561,6 +568,7 @@ impl eframe::App for AnthesisApp {
             .show(ui, |ui| self.paint_panel(ui));
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport_panel(ui));
         self.export_window(&ctx);
+        self.fit_window(&ctx);
         self.history_window(&ctx);
         self.shortcuts_window(&ctx);
         self.gallery_window(&ctx);

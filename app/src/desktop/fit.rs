@@ -1,0 +1,416 @@
+//! Edit → "Fit growth maps to a target…": the fit of `anthesis-fit` for the
+//! selected organ, on a thread named `anthesis-fit`, with its progress
+//! (iteration, RMS and largest distance) and a Cancel button; the fitted
+//! maps replace the organ's template's maps as one undo step when the user
+//! applies them.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, sync_channel};
+
+use anthesis_fit::{Fit, FitProgress, FitSettings};
+use anthesis_flower::Project;
+use anthesis_mesh::obj::MAX_OBJ_BYTES;
+use eframe::egui;
+
+use super::AnthesisApp;
+use super::command::{Command, ProjectEdit};
+
+/// Where a fit stands.
+#[derive(Debug, Clone)]
+pub enum FitState {
+    Idle,
+    Running { progress: Option<FitProgress> },
+    Done { fit: Box<Fit> },
+    Failed { message: String },
+    Cancelled,
+}
+
+enum Message {
+    Progress(FitProgress),
+    Done(Result<Fit, anthesis_fit::FitError>),
+}
+
+/// A fit on its thread: its messages, its cancel flag, and what it fits.
+struct Job {
+    receiver: Receiver<Message>,
+    cancel: Arc<AtomicBool>,
+}
+
+/// The dialog's fields and the running fit.
+pub struct FitDialog {
+    pub open: bool,
+    /// The target OBJ's path, as typed.
+    pub target: String,
+    /// Time keys of the fitted maps.
+    pub keys: u32,
+    /// The organ fitted (index into the project's organs) and the
+    /// document revision it was started on.
+    started: Option<(usize, u64)>,
+    state: FitState,
+    job: Option<Job>,
+}
+
+impl Default for FitDialog {
+    fn default() -> Self {
+        FitDialog {
+            open: false,
+            target: String::new(),
+            keys: 1,
+            started: None,
+            state: FitState::Idle,
+            job: None,
+        }
+    }
+}
+
+/// What the user asked of the dialog this frame.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct FitRequests {
+    pub start: bool,
+    pub apply: bool,
+}
+
+impl FitDialog {
+    pub fn state(&self) -> &FitState {
+        &self.state
+    }
+
+    pub fn is_running(&self) -> bool {
+        self.job.is_some()
+    }
+
+    /// Starts fitting organ `organ` of `resolved` (the project at the
+    /// resolution it is simulated at) to the OBJ at `target`; `revision`
+    /// is the document's, so that the result is applied only to the
+    /// project it was fitted on.
+    pub fn start(
+        &mut self,
+        resolved: Arc<Project>,
+        organ: usize,
+        revision: u64,
+        target: &Path,
+    ) -> Result<(), String> {
+        if self.is_running() {
+            return Err("a fit is already running".into());
+        }
+        let organ_def = resolved
+            .flower
+            .organs
+            .get(organ)
+            .ok_or_else(|| format!("there is no organ {organ}"))?;
+        let text = anthesis_files::read_regular_text(target, MAX_OBJ_BYTES, "an OBJ mesh")
+            .map_err(|e| format!("cannot read the target {}: {e}", target.display()))?;
+        let expected = resolved.flower.template_of(organ).mesh.vertex_count();
+        let positions = anthesis_fit::read_target(&text, &organ_def.name, expected)
+            .map_err(|e| format!("target {}: {e}", target.display()))?;
+        let settings = FitSettings {
+            keys: self.keys.clamp(1, resolved.settings.keyframes + 1),
+            ..FitSettings::default()
+        };
+        // One message per iteration and the result: the fit's iteration
+        // limit keeps them well within the bound, and progress that would
+        // not fit is dropped rather than waited for.
+        let (sender, receiver) = sync_channel(64);
+        let cancel = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&cancel);
+        std::thread::Builder::new()
+            .name("anthesis-fit".into())
+            .spawn(move || {
+                let progress_sender = sender.clone();
+                let result = anthesis_fit::fit(
+                    &resolved,
+                    organ,
+                    &positions,
+                    &settings,
+                    &mut |p| {
+                        let _ = progress_sender.try_send(Message::Progress(p));
+                    },
+                    &|| flag.load(Ordering::Relaxed),
+                );
+                let _ = sender.send(Message::Done(result));
+            })
+            .map_err(|e| format!("cannot start the fit: {e}"))?;
+        self.job = Some(Job { receiver, cancel });
+        self.started = Some((organ, revision));
+        self.state = FitState::Running { progress: None };
+        Ok(())
+    }
+
+    /// Asks the running fit to stop (it ends within one simulation step).
+    pub fn cancel(&self) {
+        if let Some(job) = &self.job {
+            job.cancel.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Takes what the fit thread sent; true when the fit ended this call.
+    pub fn poll(&mut self) -> bool {
+        let Some(job) = &self.job else {
+            return false;
+        };
+        let mut ended = None;
+        while let Ok(message) = job.receiver.try_recv() {
+            match message {
+                Message::Progress(p) => {
+                    self.state = FitState::Running { progress: Some(p) };
+                }
+                Message::Done(result) => ended = Some(result),
+            }
+        }
+        if ended.is_none()
+            && matches!(
+                job.receiver.try_recv(),
+                Err(std::sync::mpsc::TryRecvError::Disconnected)
+            )
+        {
+            ended = Some(Err(anthesis_fit::FitError::Target(
+                "the fit stopped without a result".into(),
+            )));
+        }
+        let Some(result) = ended else {
+            return false;
+        };
+        self.job = None;
+        self.state = match result {
+            Ok(fit) => FitState::Done { fit: Box::new(fit) },
+            Err(anthesis_fit::FitError::Cancelled) => FitState::Cancelled,
+            Err(error) => FitState::Failed {
+                message: error.to_string(),
+            },
+        };
+        true
+    }
+
+    /// The edit that puts the fitted maps into `project`'s template of the
+    /// fitted organ, if there is a result and `project` is still at the
+    /// revision the fit started on.
+    pub fn apply_edit(&self, project: &Project, revision: u64) -> Result<Command, String> {
+        let FitState::Done { fit } = &self.state else {
+            return Err("there is no fit to apply".into());
+        };
+        let Some((organ, started)) = self.started else {
+            return Err("there is no fit to apply".into());
+        };
+        if started != revision {
+            return Err(
+                "the project changed while the fit ran; fit again to apply maps to it".into(),
+            );
+        }
+        let template = project
+            .flower
+            .organs
+            .get(organ)
+            .map(|o| o.template)
+            .ok_or("the fitted organ is gone")?;
+        let mut value = project.flower.templates[template].clone();
+        value.maps = fit.maps.clone();
+        Ok(Command::Edit {
+            label: "fit growth maps".into(),
+            edit: ProjectEdit::Template {
+                template,
+                value: Box::new(value),
+                keyframes: project.settings.keyframes,
+            },
+        })
+    }
+
+    /// The dialog window; returns what was asked.
+    pub fn ui(&mut self, ctx: &egui::Context, organ_name: &str) -> FitRequests {
+        let mut requests = FitRequests::default();
+        if !self.open {
+            return requests;
+        }
+        let mut open = self.open;
+        egui::Window::new("Fit growth maps to a target")
+            .open(&mut open)
+            .resizable(false)
+            .show(ctx, |ui| {
+                ui.label(format!(
+                    "Finds the growth maps of organ {organ_name}'s template whose simulation \
+                     ends at the target: an OBJ of this organ's vertices in world coordinates, \
+                     as `anthesis simulate --organ {organ_name} --out FOLDER/` writes them."
+                ));
+                let running = self.is_running();
+                ui.add_enabled_ui(!running, |ui| {
+                    egui::Grid::new("fit-grid").num_columns(2).show(ui, |ui| {
+                        let label = ui.label("Target OBJ").id;
+                        ui.add(
+                            egui::TextEdit::singleline(&mut self.target)
+                                .hint_text("/path/to/open.obj")
+                                .desired_width(300.0),
+                        )
+                        .labelled_by(label);
+                        ui.end_row();
+                        let label = ui.label("Time keys").id;
+                        ui.add(egui::DragValue::new(&mut self.keys).range(1..=5))
+                            .labelled_by(label);
+                        ui.end_row();
+                    });
+                });
+                ui.horizontal(|ui| {
+                    if running {
+                        if ui.button("Cancel").clicked() {
+                            self.cancel();
+                        }
+                    } else if ui
+                        .add_enabled(!self.target.trim().is_empty(), egui::Button::new("Fit"))
+                        .clicked()
+                    {
+                        requests.start = true;
+                    }
+                    if matches!(self.state, FitState::Done { .. })
+                        && ui.button("Apply the fitted maps").clicked()
+                    {
+                        requests.apply = true;
+                    }
+                });
+                match &self.state {
+                    FitState::Idle => {}
+                    FitState::Running { progress: None } => {
+                        ui.label("first guess…");
+                    }
+                    FitState::Running { progress: Some(p) } => {
+                        ui.label(format!(
+                            "iteration {}: RMS {:.2} %, max {:.2} % of the organ's length \
+                             ({} simulations, {:.0} s)",
+                            p.iteration,
+                            100.0 * p.rms,
+                            100.0 * p.max,
+                            p.simulations,
+                            p.seconds
+                        ));
+                    }
+                    FitState::Done { fit } => {
+                        ui.label(fit.verdict());
+                    }
+                    FitState::Failed { message } => {
+                        ui.colored_label(ui.visuals().error_fg_color, message);
+                    }
+                    FitState::Cancelled => {
+                        ui.label("cancelled");
+                    }
+                }
+            });
+        self.open = open;
+        requests
+    }
+}
+
+impl AnthesisApp {
+    /// The fit dialog: starts a fit, follows it, applies its maps.
+    pub(super) fn fit_window(&mut self, ctx: &egui::Context) {
+        if self.fit.poll() {
+            match self.fit.state() {
+                FitState::Done { fit } => self.log.info(fit.verdict()),
+                FitState::Failed { message } => self.log.warn(format!("fit: {message}")),
+                _ => {}
+            }
+        }
+        let organ = self.selected_organ;
+        let name = self
+            .doc
+            .project()
+            .flower
+            .organs
+            .get(organ)
+            .map_or_else(String::new, |o| o.name.clone());
+        let requests = self.fit.ui(ctx, &name);
+        if requests.start {
+            let resolved = self.resolved_project();
+            let revision = self.doc.revision();
+            let target = std::path::PathBuf::from(self.fit.target.trim());
+            if let Err(message) = self.fit.start(resolved, organ, revision, &target) {
+                self.fit.state = FitState::Failed { message };
+            }
+        }
+        if requests.apply {
+            match self.fit.apply_edit(self.doc.project(), self.doc.revision()) {
+                Ok(command) => self.queued.push(command),
+                Err(message) => self.fit.state = FitState::Failed { message },
+            }
+        }
+        if self.fit.is_running() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(200));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small petal whose final shape (keyframe 8) is written as OBJ.
+    fn petal_and_target(dir: &Path) -> (Arc<Project>, std::path::PathBuf) {
+        let mut project = anthesis_sim::fixtures::whorl(1, 6, 10, 8);
+        project.flower.templates[0].dg = 0.03;
+        let maps = project.flower.templates[0].maps.clone();
+        let shape = anthesis_fit::simulate_final(&project, 0, maps, &|| false).expect("simulates");
+        let mut text = String::from("o petal-1\n");
+        for p in &shape {
+            text.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+        }
+        let path = dir.join("open.obj");
+        std::fs::write(&path, text).expect("write");
+        (Arc::new(project), path)
+    }
+
+    fn wait(dialog: &mut FitDialog) {
+        while dialog.is_running() {
+            dialog.poll();
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+    }
+
+    #[test]
+    fn a_fit_runs_reports_and_applies_as_one_edit() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (project, target) = petal_and_target(dir.path());
+        let mut dialog = FitDialog::default();
+        dialog
+            .start(Arc::clone(&project), 0, 7, &target)
+            .expect("starts");
+        wait(&mut dialog);
+        let FitState::Done { fit } = dialog.state() else {
+            panic!("{:?}", dialog.state());
+        };
+        assert!(fit.rms < fit.guess_rms, "{fit:?}");
+        let fitted_maps = fit.maps.clone();
+        // Another revision: refused.
+        assert!(dialog.apply_edit(&project, 8).is_err());
+        let Ok(Command::Edit { edit, .. }) = dialog.apply_edit(&project, 7) else {
+            panic!("an edit");
+        };
+        let mut edited = (*project).clone();
+        edit.apply(&mut edited);
+        assert_eq!(edited.flower.templates[0].maps, fitted_maps);
+    }
+
+    #[test]
+    fn cancel_stops_the_fit() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (project, target) = petal_and_target(dir.path());
+        let mut dialog = FitDialog::default();
+        dialog.start(project, 0, 1, &target).expect("starts");
+        dialog.cancel();
+        wait(&mut dialog);
+        assert!(
+            matches!(dialog.state(), FitState::Cancelled),
+            "{:?}",
+            dialog.state()
+        );
+    }
+
+    #[test]
+    fn a_bad_target_is_said_before_anything_runs() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (project, _) = petal_and_target(dir.path());
+        let bad = dir.path().join("bad.obj");
+        std::fs::write(&bad, "o petal-1\nv 0 0 0\n").expect("write");
+        let mut dialog = FitDialog::default();
+        let error = dialog.start(project, 0, 1, &bad).expect_err("one vertex");
+        assert!(error.contains("the target has 1 vertices"), "{error}");
+        assert!(!dialog.is_running());
+    }
+}
