@@ -1036,5 +1036,31 @@ fn fit_finds_maps_for_a_simulated_open_shape_and_refuses_bad_targets() {
         err.contains("target vertex 1 (from 1) has a coordinate that is not a finite number"),
         "{err}"
     );
+    // The same vertices with one triangle turned over: another mesh.
+    let flipped = dir.path().join("flipped.obj");
+    let mut done = false;
+    let turned: String = text_obj
+        .lines()
+        .map(|line| match line.strip_prefix("f ") {
+            Some(corners) if !done => {
+                done = true;
+                let c: Vec<&str> = corners.split_whitespace().collect();
+                format!("f {} {} {}", c[0], c[2], c[1])
+            }
+            _ => line.to_owned(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&flipped, turned).expect("write");
+    let args = fit_args(
+        flipped.to_str().expect("utf-8"),
+        new_out.to_str().expect("utf-8"),
+    );
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let err = text(&one_line_error(&args).stderr);
+    assert!(
+        err.contains("the target's faces are not organ `petal-1`'s triangles"),
+        "{err}"
+    );
     assert!(!new_out.exists());
 }

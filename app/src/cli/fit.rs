@@ -113,8 +113,8 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
     let resolved = at_resolution(project.clone(), None, None)?;
     let text = anthesis_files::read_regular_text(&args.target, MAX_OBJ_BYTES, "an OBJ mesh")
         .with_context(|| format!("cannot read the target {}", args.target.display()))?;
-    let expected = resolved.flower.template_of(organ).mesh.vertex_count();
-    let target = anthesis_fit::read_target(&text, &args.organ, expected)
+    let mesh = &resolved.flower.template_of(organ).mesh;
+    let target = anthesis_fit::read_target(&text, &args.organ, mesh)
         .with_context(|| format!("target {}", args.target.display()))?;
 
     let settings = FitSettings {

@@ -102,8 +102,8 @@ impl FitDialog {
             .ok_or_else(|| format!("there is no organ {organ}"))?;
         let text = anthesis_files::read_regular_text(target, MAX_OBJ_BYTES, "an OBJ mesh")
             .map_err(|e| format!("cannot read the target {}: {e}", target.display()))?;
-        let expected = resolved.flower.template_of(organ).mesh.vertex_count();
-        let positions = anthesis_fit::read_target(&text, &organ_def.name, expected)
+        let mesh = &resolved.flower.template_of(organ).mesh;
+        let positions = anthesis_fit::read_target(&text, &organ_def.name, mesh)
             .map_err(|e| format!("target {}: {e}", target.display()))?;
         let settings = FitSettings {
             keys: self.keys.clamp(1, resolved.settings.keyframes + 1),

@@ -43,6 +43,7 @@ use std::time::Instant;
 
 use anthesis_flower::Project;
 use anthesis_maps::{KeyedMaps, MapError};
+use anthesis_mesh::Mesh;
 use anthesis_sim::{Selection, SimError, Simulation};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -125,6 +126,16 @@ pub enum FitError {
         expected: usize,
         /// The target's vertices.
         found: usize,
+    },
+    /// The target has the organ's vertex count but other triangles.
+    #[error(
+        "the target's faces are not organ `{organ}`'s triangles: it is another mesh with as many \
+         vertices; the target must be this organ's mesh, as `anthesis simulate --organ {organ} \
+         --out FOLDER/` writes it"
+    )]
+    Connectivity {
+        /// The organ's name.
+        organ: String,
     },
     /// A target coordinate is NaN or infinite.
     #[error("target vertex {vertex} (from 1) has a coordinate that is not a finite number")]
@@ -224,16 +235,70 @@ impl Fit {
     }
 }
 
-/// The target positions of organ `organ` (named `name`) from OBJ text: the
-/// object called `name`, or the only object, with as many vertices as the
-/// organ has particles (`expected`), every coordinate finite.
-pub fn read_target(text: &str, name: &str, expected: usize) -> Result<Vec<DVec3>, FitError> {
+/// The target positions of the organ named `name`, whose mesh (at the
+/// resolution it is simulated at) is `mesh`, from OBJ text: the object
+/// called `name`, or the only object, with as many vertices as the mesh,
+/// every coordinate finite, and, if it has faces, the mesh's triangles (in
+/// any order, each with its winding).
+pub fn read_target(text: &str, name: &str, mesh: &Mesh) -> Result<Vec<DVec3>, FitError> {
     let object = anthesis_mesh::obj::object_text(text, Some(name))
         .or_else(|named| anthesis_mesh::obj::object_text(text, None).map_err(|_| named))
         .map_err(|e| FitError::Target(e.to_string()))?;
     let positions = vertex_lines(&object)?;
-    check_target(&positions, name, expected)?;
+    check_target(&positions, name, mesh.vertex_count())?;
+    let faces = face_lines(&object)?;
+    if !faces.is_empty() && !same_triangles(&faces, &mesh.triangles) {
+        return Err(FitError::Connectivity {
+            organ: name.to_string(),
+        });
+    }
     Ok(positions)
+}
+
+/// The faces of OBJ text whose face indices count from 1 (as
+/// `object_text` renumbers them), as vertex indices from 0.
+fn face_lines(text: &str) -> Result<Vec<Vec<u32>>, FitError> {
+    let mut faces = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        let Some(rest) = line.trim_start().strip_prefix("f ") else {
+            continue;
+        };
+        let corners = rest
+            .split_whitespace()
+            .map(|corner| {
+                corner
+                    .split('/')
+                    .next()
+                    .and_then(|i| i.parse::<u32>().ok())
+                    .and_then(|i| i.checked_sub(1))
+                    .ok_or_else(|| {
+                        FitError::Target(format!("line {}: bad face corner `{corner}`", number + 1))
+                    })
+            })
+            .collect::<Result<Vec<u32>, _>>()?;
+        faces.push(corners);
+    }
+    Ok(faces)
+}
+
+/// Whether `faces` are the triangles `triangles`, in any order, each
+/// starting at any corner but with the same winding.
+fn same_triangles(faces: &[Vec<u32>], triangles: &[[u32; 3]]) -> bool {
+    if faces.len() != triangles.len() || faces.iter().any(|f| f.len() != 3) {
+        return false;
+    }
+    let canonical = |t: [u32; 3]| {
+        let first = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+        [t[first], t[(first + 1) % 3], t[(first + 2) % 3]]
+    };
+    let mut a: Vec<[u32; 3]> = faces
+        .iter()
+        .map(|f| canonical([f[0], f[1], f[2]]))
+        .collect();
+    let mut b: Vec<[u32; 3]> = triangles.iter().map(|&t| canonical(t)).collect();
+    a.sort_unstable();
+    b.sort_unstable();
+    a == b
 }
 
 /// The `v` statements of OBJ text, read here (not by the mesh parser) so

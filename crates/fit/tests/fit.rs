@@ -204,14 +204,37 @@ fn another_mesh_or_a_nan_is_refused_with_a_clear_message() {
 
 #[test]
 fn the_target_is_the_object_named_like_the_organ_or_the_only_one() {
-    let two = "o receptacle\nv 0 0 0\nv 1 0 0\no petal-1\nv 1 2 3\nv 4 5 6\nv 7 8 9\n";
-    let petal = read_target(two, "petal-1", 3).expect("named object");
+    // A one-triangle organ.
+    let mesh = anthesis_mesh::Mesh {
+        positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+        uvs: vec![glam::DVec2::ZERO, glam::DVec2::X, glam::DVec2::Y],
+        triangles: vec![[0, 1, 2]],
+    };
+    let two = "o receptacle\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\no petal-1\nv 1 2 3\nv 4 5 6\nv 7 8 9\nf 5 6 4\n";
+    let petal = read_target(two, "petal-1", &mesh).expect("named object, faces rotated");
     assert_eq!(petal[2], DVec3::new(7.0, 8.0, 9.0));
-    let only = "o something\nv 1 2 3\nv 4 5 nan\n";
-    let error = read_target(only, "petal-1", 2).expect_err("NaN");
+    let only = "o something\nv 1 2 3\nv 4 5 nan\nv 0 0 0\n";
+    let error = read_target(only, "petal-1", &mesh).expect_err("NaN");
     assert!(error.to_string().contains("vertex 2"), "{error}");
-    let error = read_target(two, "petal-9", 3).expect_err("no such object");
+    let error = read_target(two, "petal-9", &mesh).expect_err("no such object");
     assert!(error.to_string().contains("petal-9"), "{error}");
-    let error = read_target(two, "petal-1", 4).expect_err("too few");
-    assert!(error.to_string().contains("has 4"), "{error}");
+    let four = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
+    let error = read_target(four, "petal-1", &mesh).expect_err("too many");
+    assert!(error.to_string().contains("has 3"), "{error}");
+    // As many vertices, other triangles: the winding turned over.
+    let flipped = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 3 2\n";
+    let error = read_target(flipped, "petal-1", &mesh).expect_err("other connectivity");
+    assert!(matches!(error, FitError::Connectivity { .. }), "{error}");
+    assert!(
+        error
+            .to_string()
+            .contains("not organ `petal-1`'s triangles"),
+        "{error}"
+    );
+    // Positions alone are taken as the organ's vertices in order.
+    let bare = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    assert_eq!(
+        read_target(bare, "petal-1", &mesh).expect("no faces").len(),
+        3
+    );
 }
