@@ -808,7 +808,16 @@ pub fn flower_ui(
             if flower.overlaps.is_empty() {
                 ui.label("No organs overlap: none lies inside another.");
             }
-            for (i, (rule, origin)) in flower.overlaps.iter().zip(&origins).enumerate() {
+            // By pair, whichever way round: a swapped pair keeps its row.
+            let mut order: Vec<usize> = (0..flower.overlaps.len()).collect();
+            order.sort_by_key(|&i| {
+                let o = flower.overlaps[i];
+                (o.inner.min(o.outer), o.inner.max(o.outer))
+            });
+            for i in order {
+                let (Some(rule), Some(origin)) = (flower.overlaps.get(i), origins.get(i)) else {
+                    continue;
+                };
                 let (Some(inner), Some(outer)) =
                     (flower.organs.get(rule.inner), flower.organs.get(rule.outer))
                 else {

@@ -379,23 +379,29 @@ impl Flower {
                 index,
             });
         };
-        let made = self.made();
+        let name = |i: usize| {
+            self.organs
+                .get(i)
+                .map(|o| o.name.clone())
+                .ok_or(EditError::Missing {
+                    what: "organ",
+                    index: i,
+                })
+        };
+        let (inner, outer) = (name(rule.inner)?, name(rule.outer)?);
         let swapped = Overlap {
             inner: rule.outer,
             outer: rule.inner,
         };
-        let mut flower = self.clone();
-        flower.overlaps[index] = swapped;
-        if made.overlaps.contains(&swapped) {
-            // Back to the structure's: nothing listed for the pair.
-            let name = |i: usize| flower.organs[i].name.clone();
-            let mut listed = flower.listed();
-            listed
-                .rules
-                .retain(|(a, b)| !(*a == name(swapped.inner) && *b == name(swapped.outer)));
-            return flower.remade(listed);
+        // The rule is no longer listed; the swapped one is, unless it is
+        // the structure's own (back to the made rule). Remade as loading
+        // makes them, so the rules come in the order a saved file gives.
+        let mut listed = self.listed();
+        listed.rules.retain(|(a, b)| !(*a == inner && *b == outer));
+        if !self.made().overlaps.contains(&swapped) {
+            listed.rules.push((outer, inner));
         }
-        Ok(flower)
+        self.clone().remade(listed)
     }
 }
 

@@ -219,10 +219,23 @@ fn swapping_a_rule_overrides_it_and_swapping_back_restores_the_made_one() {
         .position(|o| *o == RuleOrigin::Made)
         .unwrap();
     let swapped = flower.with_rule_swapped(made).unwrap();
-    assert_eq!(swapped.rule_origins()[made], RuleOrigin::Overridden);
+    let rule = flower.overlaps[made];
+    let reversed = Overlap {
+        inner: rule.outer,
+        outer: rule.inner,
+    };
+    assert!(!swapped.overlaps.contains(&rule));
+    let at = swapped
+        .overlaps
+        .iter()
+        .position(|o| *o == reversed)
+        .expect("the swapped rule");
+    assert_eq!(swapped.rule_origins()[at], RuleOrigin::Overridden);
+    assert_eq!(swapped.overlaps.len(), flower.overlaps.len());
+    // As loading would make it from the structure and the listed rules.
     assert_eq!(
-        (swapped.overlaps[made].inner, swapped.overlaps[made].outer),
-        (flower.overlaps[made].outer, flower.overlaps[made].inner)
+        swapped.with_structure(swapped.structure.clone()).unwrap(),
+        swapped
     );
     // The override survives remaking the organs (a new whorl offset).
     let mut whorls = whorls_of(&swapped);
@@ -236,7 +249,7 @@ fn swapping_a_rule_overrides_it_and_swapping_back_restores_the_made_one() {
     let inner = &flower.organs[flower.overlaps[made].outer].name;
     let outer = &flower.organs[flower.overlaps[made].inner].name;
     assert!(rule_names(&remade).contains(&(inner.clone(), outer.clone())));
-    let back = swapped.with_rule_swapped(made).unwrap();
+    let back = swapped.with_rule_swapped(at).unwrap();
     assert_eq!(back, flower);
     assert!(flower.with_rule_swapped(99).is_err());
 }
@@ -312,4 +325,39 @@ fn a_spiral_like_the_whorls_holds_all_their_organs() {
     let arranged = flower.arranged_by(Structure::Spiral(spiral)).unwrap();
     assert_eq!(arranged.organs.len(), 6);
     assert!(arranged.organs.iter().all(|o| o.template == 1));
+}
+
+#[test]
+fn an_edited_flower_saves_and_loads_as_it_is() {
+    // Swapped rules, a new whorl count and a listed organ: the file holds
+    // the structure, the listed organ and the listed rules, and loading it
+    // makes the same flower (organs and rules in the same order).
+    let flower = flower();
+    let made = flower
+        .rule_origins()
+        .iter()
+        .position(|o| *o == RuleOrigin::Made)
+        .unwrap();
+    let mut whorls = whorls_of(&flower);
+    whorls[0].count = 4;
+    let edited = flower
+        .with_rule_swapped(made)
+        .unwrap()
+        .with_structure(Some(Structure::Whorls {
+            whorls,
+            contorted: false,
+        }))
+        .unwrap();
+    let project = crate::Project {
+        name: "edited".to_string(),
+        flower: edited,
+        settings: crate::SimulationSettings::default(),
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("edited.anthesis.toml");
+    crate::project::save_project(&project, &path).unwrap();
+    let loaded = crate::project::load_project(&path).unwrap();
+    assert_eq!(loaded.flower.organs, project.flower.organs);
+    assert_eq!(loaded.flower.overlaps, project.flower.overlaps);
+    assert_eq!(loaded.flower.structure, project.flower.structure);
 }
