@@ -308,7 +308,11 @@ fn blender_imports_the_lily_and_shows_anthesis_renders_colours() {
 
         // Tepal pixels both draw, away from edges.
         let tepals = id_mask(&ids, |i| i < TEPALS.len());
-        let both: Vec<bool> = our_mask.iter().zip(&tepals).map(|(a, b)| *a && *b).collect();
+        let both: Vec<bool> = our_mask
+            .iter()
+            .zip(&tepals)
+            .map(|(a, b)| *a && *b)
+            .collect();
         let both = inside(&both, width);
 
         // Their mean colour: the same chromaticity, anthesis's shading
