@@ -2492,6 +2492,26 @@ fn whorls_and_the_overlap_order_are_edited_in_the_flower_panel_and_undone() {
     }
     assert_eq!(harness.state().project(), &builtin("five-petal"));
     assert_eq!(harness.state().selected_organ(), 0);
+
+    // The template renamed by typing; the whorl's organs keep their names.
+    click_in_view(&mut harness, "name");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("name").type_text("blade");
+    harness.run();
+    assert_eq!(
+        harness.state().project().flower.templates[0].name,
+        "petal",
+        "not while typing"
+    );
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.project().flower.templates[0].name, "blade");
+    assert_eq!(app.project().flower.organs[0].name, "petal-1");
+    assert_eq!(
+        app.document().undo_label(),
+        Some("rename template petal to blade")
+    );
 }
 
 #[test]

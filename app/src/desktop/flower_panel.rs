@@ -40,6 +40,8 @@ pub struct FlowerPanelState {
     refused: Option<String>,
     /// The template a new organ is made of.
     new_organ_template: usize,
+    /// A template name being typed: the template and the text.
+    renaming: Option<(usize, String)>,
     /// The L-system's units (project units per turtle unit), kept as the
     /// project has them.
     units: f64,
@@ -543,9 +545,29 @@ pub fn flower_ui(
     for (i, template) in flower.templates.iter().enumerate() {
         let organs = flower.organs.iter().filter(|o| o.template == i).count();
         ui.horizontal(|ui| {
+            // The name as typed, applied when the field is left.
+            let mut text = match &state.renaming {
+                Some((t, typed)) if *t == i => typed.clone(),
+                _ => template.name.clone(),
+            };
+            let label = ui.label("name").id;
+            let field = ui
+                .add(egui::TextEdit::singleline(&mut text).desired_width(90.0))
+                .labelled_by(label)
+                .on_hover_text("The template's name (Enter or leaving the field renames it)");
+            if field.lost_focus() {
+                state.renaming = None;
+                if text.trim() != template.name {
+                    outcomes.push(outcome(
+                        format!("rename template {} to {}", template.name, text.trim()),
+                        flower.with_template_renamed(i, &text),
+                    ));
+                }
+            } else if field.has_focus() {
+                state.renaming = Some((i, text));
+            }
             ui.label(format!(
-                "{} — {organs} organ{}",
-                template.name,
+                "{organs} organ{}",
                 if organs == 1 { "" } else { "s" }
             ));
             let remove = ui

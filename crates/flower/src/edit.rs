@@ -31,6 +31,9 @@ pub enum EditError {
     /// The edit would leave the flower without organs.
     #[error("a flower needs at least one organ")]
     NoOrgans,
+    /// A template name that is empty or taken.
+    #[error("a template name must be new and not empty: \"{0}\"")]
+    TemplateName(String),
     /// The edit would leave the flower without templates.
     #[error("a flower needs at least one template")]
     NoTemplates,
@@ -203,6 +206,45 @@ impl Flower {
         let mut flower = self.clone();
         flower.templates.push(template);
         flower
+    }
+
+    /// The flower with template `index` called `name`. Organs an L-system
+    /// names after their template are renamed with it, and the listed
+    /// rules that name them follow.
+    pub fn with_template_renamed(&self, index: usize, name: &str) -> Result<Flower, EditError> {
+        let name = name.trim();
+        if index >= self.templates.len() {
+            return Err(EditError::Missing {
+                what: "template",
+                index,
+            });
+        }
+        let taken = self
+            .templates
+            .iter()
+            .enumerate()
+            .any(|(i, t)| i != index && t.name == name);
+        if name.is_empty() || taken {
+            return Err(EditError::TemplateName(name.to_string()));
+        }
+        let before = self.made();
+        let mut listed = self.listed();
+        let mut flower = self.clone();
+        flower.templates[index].name = name.to_string();
+        let after = match &flower.structure {
+            Some(structure) => structure.arrange(&flower.templates)?,
+            None => Arrangement::default(),
+        };
+        for (old, new) in before.organs.iter().zip(&after.organs) {
+            for rule in &mut listed.rules {
+                for end in [&mut rule.0, &mut rule.1] {
+                    if *end == old.name {
+                        end.clone_from(&new.name);
+                    }
+                }
+            }
+        }
+        flower.remade(listed)
     }
 
     /// The flower without template `index`: its listed organs go, and the

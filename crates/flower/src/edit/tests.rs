@@ -361,3 +361,49 @@ fn an_edited_flower_saves_and_loads_as_it_is() {
     assert_eq!(loaded.flower.overlaps, project.flower.overlaps);
     assert_eq!(loaded.flower.structure, project.flower.structure);
 }
+
+#[test]
+fn a_renamed_template_keeps_its_organs_and_an_l_system_s_organs_follow_the_name() {
+    let flower = flower();
+    let renamed = flower.with_template_renamed(1, "tepal").unwrap();
+    assert_eq!(renamed.templates[1].name, "tepal");
+    assert_eq!(
+        renamed.organs, flower.organs,
+        "whorl organs keep their names"
+    );
+    assert!(matches!(
+        flower.with_template_renamed(1, "petal"),
+        Err(EditError::TemplateName(_))
+    ));
+    assert!(flower.with_template_renamed(0, "  ").is_err());
+    // An L-system names organs after their templates: `sepal-1` becomes
+    // `tepal-1`, and a rule listed for it follows.
+    let (text, steps, surfaces) = lsystem_like(&whorls_of(&flower));
+    let by_lsystem = flower
+        .arranged_by(Structure::LSystem {
+            text,
+            steps,
+            surfaces,
+            units: 1.0,
+        })
+        .unwrap();
+    let sepal = by_lsystem.organ_index("sepal-1").unwrap();
+    let petal = by_lsystem.organ_index("petal-1").unwrap();
+    let rule = by_lsystem
+        .overlaps
+        .iter()
+        .position(|o| o.inner == petal && o.outer == sepal)
+        .expect("petal-1 inside sepal-1");
+    let swapped = by_lsystem.with_rule_swapped(rule).unwrap();
+    let renamed = swapped.with_template_renamed(1, "tepal").unwrap();
+    let tepal = renamed.organ_index("tepal-1").unwrap();
+    let petal = renamed.organ_index("petal-1").unwrap();
+    assert!(renamed.overlaps.contains(&Overlap {
+        inner: tepal,
+        outer: petal
+    }));
+    assert!(!renamed.overlaps.contains(&Overlap {
+        inner: petal,
+        outer: tepal
+    }));
+}
