@@ -296,6 +296,38 @@ fn an_edit_keeps_the_viewed_frame_stale_until_the_new_run_reaches_it() {
 }
 
 #[test]
+fn a_key_gets_its_own_growth_scale_in_the_paint_panel_as_one_undo_step() {
+    let mut harness = opened_small_flower();
+    let first_run = harness.state().session().run();
+    let template_dg = harness.state().project().flower.templates[0].dg;
+    let selected = |h: &Harness<'static, AnthesisApp>| {
+        h.state().project().flower.templates[0]
+            .maps
+            .keys()
+            .iter()
+            .map(|k| k.dg)
+            .collect::<Vec<_>>()
+    };
+    assert!(selected(&harness).iter().all(Option::is_none));
+    harness.get_by_label("own").click();
+    harness.run();
+    // The selected (first) key takes the template's dg as its own, to
+    // change from there; the run restarts and the undo names the key.
+    let keys = selected(&harness);
+    assert_eq!(keys[0], Some(template_dg), "{keys:?}");
+    assert!(keys[1..].iter().all(Option::is_none), "{keys:?}");
+    assert!(harness.state().session().run() > first_run);
+    let label = harness.state().document().undo_label().map(str::to_owned);
+    assert!(
+        label.as_deref().is_some_and(|l| l.starts_with("dg of key")),
+        "{label:?}"
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert!(selected(&harness).iter().all(Option::is_none));
+}
+
+#[test]
 fn parameter_edits_restart_the_run_and_undo_redo_with_shortcuts() {
     let mut harness = opened_small_flower();
     let first_run = harness.state().session().run();

@@ -483,6 +483,7 @@ mod tests {
             ProjectEdit::AddKey {
                 template: 0,
                 key: Box::new(MapKey {
+                    dg: None,
                     step: 77,
                     maps: GrowthMaps::default(),
                 }),
@@ -541,6 +542,7 @@ mod tests {
         let add = ProjectEdit::AddKey {
             template: 0,
             key: Box::new(MapKey {
+                dg: None,
                 step: 45,
                 maps: GrowthMaps::default(),
             }),

@@ -301,6 +301,46 @@ impl PaintState {
                 .labelled_by(label);
                 ui.end_row();
 
+                let label = ui.label("Key dg").id;
+                ui.horizontal(|ui| {
+                    let key = &current.maps.keys()[self.key];
+                    let mut own = key.dg.is_some();
+                    let mut dg = key.dg.unwrap_or(current.dg);
+                    let toggled = ui
+                        .checkbox(&mut own, "own")
+                        .on_hover_text(
+                            "This key's own growth scale in place of the template's dg, \
+                             blended between keys like the maps; negative: the organ \
+                             shrinks (wilting after it opened)",
+                        )
+                        .changed();
+                    let dragged = ui
+                        .add_enabled(
+                            own,
+                            egui::DragValue::new(&mut dg)
+                                .speed(0.0001)
+                                .range(-0.5..=0.5)
+                                .max_decimals(4),
+                        )
+                        .labelled_by(label)
+                        .changed();
+                    if toggled || dragged {
+                        let mut value = current.clone();
+                        if let Some(k) = value.maps.keys_mut().get_mut(self.key) {
+                            k.dg = own.then_some(dg);
+                        }
+                        chosen.push(Command::Edit {
+                            label: format!("dg of key {} of {}", key.step, current.name),
+                            edit: ProjectEdit::Template {
+                                template,
+                                value: Box::new(value),
+                                keyframes: project.settings.keyframes,
+                            },
+                        });
+                    }
+                });
+                ui.end_row();
+
                 let label = ui.label("New key").id;
                 ui.horizontal(|ui| {
                     ui.add(egui::DragValue::new(&mut self.new_key_step).range(0..=100_000))
@@ -326,7 +366,11 @@ impl PaintState {
                             label: format!("add key {step} to {}", current.name),
                             edit: ProjectEdit::AddKey {
                                 template,
-                                key: Box::new(MapKey { step, maps }),
+                                key: Box::new(MapKey {
+                                    dg: None,
+                                    step,
+                                    maps,
+                                }),
                             },
                         });
                     }
@@ -643,6 +687,17 @@ impl PaintState {
         self.dab(project, template, point_in_uv)
     }
 
+    /// The growth scale of the selected key of `current`: its own, else the
+    /// template's.
+    fn key_dg(&self, current: &Template) -> f64 {
+        current
+            .maps
+            .keys()
+            .get(self.key)
+            .and_then(|k| k.dg)
+            .unwrap_or(current.dg)
+    }
+
     /// The colour bar of the shown map with its values, what 0 and 1 mean
     /// for that map, and the value under the pointer on the canvas.
     fn legend_ui(&mut self, ui: &mut egui::Ui, current: &Template) {
@@ -717,8 +772,8 @@ impl PaintState {
                 }
                 let (text, meant) = match self.target {
                     PaintTarget::Scalar(kind) => (
-                        legend(kind, current.dg),
-                        value_under.map(|v| meaning(kind, current.dg, v)),
+                        legend(kind, self.key_dg(current)),
+                        value_under.map(|v| meaning(kind, self.key_dg(current), v)),
                     ),
                     _ => (
                         "colour: how much of the second colour shows over the base colour \
@@ -783,7 +838,7 @@ pub fn legend(kind: MapKind, dg: f64) -> String {
             };
             format!(
                 "{}: relative growth per step of the {layer} {way}. 0 = no growth, \
-                 1 = {percent:+.1} % per step (the template's dg = {dg}; rate = 1 + dg · value). \
+                 1 = {percent:+.1} % per step (dg = {dg} at this key; rate = 1 + dg · value). \
                  Inner > base bends the organ outwards.",
                 kind.label()
             )

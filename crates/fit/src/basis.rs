@@ -160,6 +160,7 @@ impl Layout {
                     })
                 };
                 MapKey {
+                    dg: None,
                     step,
                     maps: GrowthMaps {
                         e_growth: scalar(0),

@@ -68,10 +68,12 @@ fn petal_template() -> Template {
     let maps = KeyedMaps::new(
         vec![
             MapKey {
+                dg: None,
                 step: 50,
                 maps: late,
             },
             MapKey {
+                dg: None,
                 step: 0,
                 maps: early,
             },
@@ -117,7 +119,11 @@ fn sepal_template() -> Template {
         name: "Outer sepal".to_string(),
         mesh: test_petal(12.0, 3.0, 5, 7),
         maps: KeyedMaps::new(
-            vec![MapKey { step: 10, maps }],
+            vec![MapKey {
+                dg: None,
+                step: 10,
+                maps,
+            }],
             Blend::Logistic { steepness: 7.5 },
         )
         .expect("one key"),
@@ -431,21 +437,21 @@ fn a_newer_version_says_so() {
     // A newer version may have fields this build does not know: the version
     // error must win over the unknown field.
     edit(&path, |text| {
-        replace_once(text, "version = 2", "version = 6\nwind = \"strong\"")
+        replace_once(text, "version = 2", "version = 7\nwind = \"strong\"")
     });
     let error = load_project(&path).expect_err("newer");
     assert_eq!(
         error,
         ProjectError::NewerVersion {
             path: path.clone(),
-            found: 6,
+            found: 7,
             supported: FORMAT_VERSION,
         }
     );
     assert_eq!(
         error.to_string(),
         format!(
-            "{} was written by a newer Anthesis (format version 6; this build reads up to 5)",
+            "{} was written by a newer Anthesis (format version 7; this build reads up to 6)",
             path.display()
         )
     );
@@ -1719,10 +1725,7 @@ fn parts_are_saved_as_readable_tables_and_load_back_equal() {
     let path = folder.path().join("lily.anthesis.toml");
     save_project(&project, &path).expect("saves");
     let text = fs::read_to_string(&path).expect("read");
-    assert!(
-        text.contains(&format!("version = {FORMAT_VERSION}")),
-        "{text}"
-    );
+    assert!(text.contains("version = 5"), "{text}");
     assert_eq!(text.matches("[[parts]]").count(), 4, "{text}");
     assert!(text.contains("kind = \"stamen\"") && text.contains("anther_tilt_deg = 90.0"));
     assert!(text.contains("[[parts.schedule]]"), "{text}");
@@ -1808,10 +1811,7 @@ fn a_colour_map_survives_saving_and_loading() {
             && text.contains("colour_map = \"maps/petal-colour.png\""),
         "{text}"
     );
-    assert!(
-        text.contains(&format!("version = {FORMAT_VERSION}")),
-        "{text}"
-    );
+    assert!(text.contains("version = 5"), "{text}");
     // Only the template that has one names a colour map.
     assert_eq!(text.matches("colour_map").count(), 1, "{text}");
     assert!(folder.path().join("maps/petal-colour.png").is_file());
@@ -1909,4 +1909,31 @@ fn half_a_colour_map_or_colours_out_of_range_are_refused() {
     }
     let error = save_project(&project, &path).expect_err("second colour out of range");
     assert!(error.to_string().contains("second_color"), "{error}");
+}
+
+#[test]
+fn a_keys_own_growth_scale_is_saved_as_version_6_and_a_bad_one_is_refused() {
+    let mut project = lily();
+    project.flower.templates[0].maps.keys_mut()[0].dg = Some(-0.004);
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("lily.anthesis.toml");
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("version = 6"), "{text}");
+    assert_eq!(text.matches("dg = -0.004").count(), 1, "{text}");
+    assert_eq!(load_project(&path).expect("loads"), project);
+    // Without one, the file stays at the version it needed before.
+    save_project(&lily(), &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(!text.contains("version = 6"), "{text}");
+    // A rate 1 + dg × value must stay positive.
+    save_project(&project, &path).expect("saves");
+    edit(&path, |text| replace_once(text, "dg = -0.004", "dg = -1.5"));
+    let err = load_project(&path).expect_err("dg -1.5");
+    let message = err.to_string();
+    assert!(
+        message.contains("map key at step")
+            && message.contains("dg must be a number greater than -1"),
+        "{message}"
+    );
 }

@@ -253,7 +253,11 @@ pub fn lily_maps(excess: LilyExcess) -> Result<KeyedMaps, MapError> {
 pub(crate) fn keyed(keys: Vec<(u32, GrowthMaps)>) -> Result<KeyedMaps, MapError> {
     KeyedMaps::new(
         keys.into_iter()
-            .map(|(step, maps)| MapKey { step, maps })
+            .map(|(step, maps)| MapKey {
+                dg: None,
+                step,
+                maps,
+            })
             .collect(),
         Blend::Linear,
     )

@@ -552,6 +552,7 @@ mod tests {
         growth.e_growth = ScalarMap::from_fn(32, 24, |uv| uv.y as f32);
         let mut maps = KeyedMaps::new(
             vec![MapKey {
+                dg: None,
                 step: 0,
                 maps: growth,
             }],

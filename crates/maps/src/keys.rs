@@ -96,6 +96,23 @@ pub struct MapKey {
     pub step: u32,
     /// The maps at that step.
     pub maps: GrowthMaps,
+    /// The growth scale at this key, in place of its template's `dg`
+    /// (`None`: the template's). A growth value `m` of this key is a rate
+    /// `1 + dg · m` per step, blended between keys like the maps: a
+    /// negative `dg` makes a late key shrink the organ (a flower that
+    /// wilts after it opened).
+    pub dg: Option<f64>,
+}
+
+impl MapKey {
+    /// The key at `step` with `maps` and the template's growth scale.
+    pub fn new(step: u32, maps: GrowthMaps) -> MapKey {
+        MapKey {
+            step,
+            maps,
+            dg: None,
+        }
+    }
 }
 
 /// Map sets keyed by simulation step, blended between keys.
@@ -125,7 +142,7 @@ impl KeyedMaps {
     /// One key at step 0: these maps at every step.
     pub fn single(maps: GrowthMaps) -> Self {
         Self {
-            keys: vec![MapKey { step: 0, maps }],
+            keys: vec![MapKey::new(0, maps)],
             blend: Blend::Linear,
         }
     }

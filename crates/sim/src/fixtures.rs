@@ -82,10 +82,12 @@ fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
     let maps = KeyedMaps::new(
         vec![
             MapKey {
+                dg: None,
                 step: 40,
                 maps: early,
             },
             MapKey {
+                dg: None,
                 step: 50,
                 maps: late,
             },

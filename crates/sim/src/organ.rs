@@ -90,6 +90,17 @@ impl SampledKey {
     }
 }
 
+/// The growth scale of each of `template`'s keys: the key's own `dg`, else
+/// the template's.
+fn key_growth_scales(template: &Template) -> Vec<f64> {
+    template
+        .maps
+        .keys()
+        .iter()
+        .map(|k| k.dg.unwrap_or(template.dg))
+        .collect()
+}
+
 pub(crate) struct OrganSim {
     pub name: String,
     pub color: [f32; 4],
@@ -118,7 +129,8 @@ pub(crate) struct OrganSim {
     /// template (a copy per organ cost 4 GB for 16k maps).
     key_schedule: KeySchedule,
     keys: Vec<SampledKey>,
-    dg: f64,
+    /// Each key's growth scale: its own `dg`, else the template's.
+    key_dg: Vec<f64>,
     model: Model,
     growth_model: GrowthModel,
     /// The membrane's Lamé parameter per edge (consistent model).
@@ -203,6 +215,7 @@ impl OrganSim {
             .iter()
             .map(|k| SampledKey::new(&k.maps, &template.mesh, &topology))
             .collect();
+        let key_dg = key_growth_scales(template);
         let mut sim = OrganSim {
             name: organ.name.clone(),
             color: template.color,
@@ -226,7 +239,7 @@ impl OrganSim {
             base,
             key_schedule: template.maps.schedule(),
             keys,
-            dg: template.dg,
+            key_dg,
             model: settings.model,
             growth_model: GrowthModel {
                 thickness: template.thickness,
@@ -255,19 +268,20 @@ impl OrganSim {
         self.mean_edge = self.elastic.rest_lengths.iter().sum::<f64>()
             / self.elastic.rest_lengths.len().max(1) as f64;
         let weights = self.key_schedule.weights_at(f64::from(step));
+        // Each key's growth values times its growth scale, blended: a key
+        // with its own (negative) dg shrinks the organ as it takes over.
         let blend = |values: fn(&SampledKey) -> &Vec<f64>, t: usize| -> f64 {
             weights
                 .iter()
-                .map(|&(k, w)| w * values(&self.keys[k])[t])
+                .map(|&(k, w)| w * self.key_dg[k] * values(&self.keys[k])[t])
                 .sum()
         };
-        let dg = self.dg;
         self.rates = (0..self.mesh.triangles.len())
             .map(|t| GrowthRates {
-                e: 1.0 + dg * blend(|k| &k.e, t),
-                w: 1.0 + dg * blend(|k| &k.w, t),
-                e_in: 1.0 + dg * blend(|k| &k.e_in, t),
-                w_in: 1.0 + dg * blend(|k| &k.w_in, t),
+                e: 1.0 + blend(|k| &k.e, t),
+                w: 1.0 + blend(|k| &k.w, t),
+                e_in: 1.0 + blend(|k| &k.e_in, t),
+                w_in: 1.0 + blend(|k| &k.w_in, t),
                 direction_in_uv: weights
                     .iter()
                     .map(|&(k, w)| self.keys[k].direction[t] * w)
@@ -441,6 +455,7 @@ impl OrganSim {
                     .unwrap_or_else(|| SampledKey::new(&key.maps, &self.mesh, &self.topology))
             })
             .collect();
+        self.key_dg = key_growth_scales(new);
         self.key_schedule = new.maps.schedule();
         self.schedule.clone_from(&new.joint_schedule);
         self.color = new.color;

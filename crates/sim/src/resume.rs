@@ -84,7 +84,16 @@ fn first_step_reading_a_change(old: &Template, new: &Template, limit: u32) -> Op
     // same[i][j]: old key i and new key j hold the same maps.
     let same: Vec<Vec<bool>> = old_keys
         .iter()
-        .map(|o| new_keys.iter().map(|n| o.maps == n.maps).collect())
+        .map(|o| {
+            new_keys
+                .iter()
+                .map(|n| {
+                    // The same maps at the same growth scale.
+                    o.maps == n.maps
+                        && o.dg.unwrap_or(old.dg).to_bits() == n.dg.unwrap_or(new.dg).to_bits()
+                })
+                .collect()
+        })
         .collect();
     (1..limit).find(|&step| {
         let s = f64::from(step);
@@ -126,6 +135,19 @@ mod tests {
         // The sepals do not read the petals' maps: a run of one sepal keeps
         // everything.
         assert_eq!(edit_between(&before, &after, &[1]), Edit::Nothing);
+    }
+
+    #[test]
+    fn a_keys_own_growth_scale_acts_like_its_maps() {
+        let before = lily_like();
+        let mut after = before.clone();
+        after.flower.templates[0].maps.keys_mut()[1].dg = Some(-0.004);
+        assert_eq!(edit_between(&before, &after, &ALL), Edit::From(40));
+        // The template's own dg, written on the key, changes nothing.
+        let mut same = before.clone();
+        let dg = same.flower.templates[0].dg;
+        same.flower.templates[0].maps.keys_mut()[1].dg = Some(dg);
+        assert_eq!(edit_between(&before, &same, &ALL), Edit::Nothing);
     }
 
     #[test]

@@ -345,6 +345,16 @@ fn template_problem(template: &Template) -> Option<String> {
         ));
     }
     for key in template.maps.keys() {
+        if let Some(dg) = key.dg
+            && (!dg.is_finite() || dg <= -1.0)
+        {
+            return Some(format!(
+                "map key at step {}: dg must be a number greater than -1 (a growth rate \
+                 1 + dg × map value must stay positive), found {}",
+                key.step,
+                short_number(dg)
+            ));
+        }
         for kind in MapKind::ALL {
             let values = key.maps.scalar(kind).values();
             if let Some(value) = values.iter().find(|value| !value.is_finite()) {

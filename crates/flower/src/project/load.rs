@@ -341,6 +341,7 @@ impl Loader<'_> {
             keys.push(MapKey {
                 step: key.step,
                 maps,
+                dg: key.dg,
             });
         }
         size.finish()?;

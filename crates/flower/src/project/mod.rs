@@ -54,6 +54,10 @@
 //! stretch = 1.0
 //! bend = 1
 //! direction = [0.0, 1.0]                        # a [u, v] vector, or a PNG
+//! dg = -0.004                  # optional (version 6): this key's growth
+//!                              # scale in place of the template's, blended
+//!                              # between keys like the maps (negative:
+//!                              # the organ shrinks, e.g. wilting)
 //!
 //! [[organs]]
 //! name = "petal-1"
@@ -185,7 +189,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 
 /// Checks `project` by the rules every loaded or saved project obeys
 /// (names, counts, numbers, parts), as the app does before it takes an

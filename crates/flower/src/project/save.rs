@@ -87,11 +87,18 @@ pub(super) fn plan_save(
 /// everything it sets, so a project that sets nothing new stays readable by
 /// older builds and saves byte for byte as before (version 3 added
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
-/// `[[parts]]`, colour maps).
+/// `[[parts]]`, colour maps, version 6 a key's own `dg`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
-    if !flower.parts.is_empty() {
+    let key_dg = flower
+        .templates
+        .iter()
+        .any(|t| t.maps.keys().iter().any(|k| k.dg.is_some()));
+    if key_dg {
         return FORMAT_VERSION;
+    }
+    if !flower.parts.is_empty() {
+        return 5;
     }
     let placed = flower.structure.is_some()
         || flower
@@ -99,7 +106,7 @@ fn file_version(project: &Project) -> u32 {
             .iter()
             .any(|o| o.placement.orientation != glam::DQuat::IDENTITY);
     if flower.templates.iter().any(|t| t.colouring.is_some()) {
-        return FORMAT_VERSION;
+        return 5;
     }
     match (placed, project.settings.resolution) {
         (true, _) => 4,
@@ -130,6 +137,7 @@ pub(super) fn template_file(
     for key in template.maps.keys() {
         let mut key_file = KeyFile {
             step: key.step,
+            dg: key.dg,
             ..KeyFile::default()
         };
         let map_relative =

@@ -243,6 +243,9 @@ pub(super) struct JointRampFile {
 #[serde(deny_unknown_fields)]
 pub(super) struct KeyFile {
     pub(super) step: u32,
+    /// This key's growth scale in place of the template's (version 6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) dg: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) e_growth: Option<ScalarEntry>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

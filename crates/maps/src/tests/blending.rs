@@ -21,6 +21,7 @@ fn keyed(steps: &[u32], blend: Blend) -> KeyedMaps {
     let keys = steps
         .iter()
         .map(|&step| MapKey {
+            dg: None,
             step,
             maps: maps_with_e_growth(step as f32),
         })
@@ -184,14 +185,17 @@ fn keys_are_sorted_and_steps_must_be_distinct() {
     );
     let twice = vec![
         MapKey {
+            dg: None,
             step: 5,
             maps: GrowthMaps::uniform(),
         },
         MapKey {
+            dg: None,
             step: 9,
             maps: GrowthMaps::uniform(),
         },
         MapKey {
+            dg: None,
             step: 5,
             maps: GrowthMaps::uniform(),
         },
@@ -207,6 +211,7 @@ fn insert_and_remove_keep_the_keys_valid() {
     let mut maps = keyed(&[10, 50], Blend::Linear);
     let index = maps
         .insert(MapKey {
+            dg: None,
             step: 30,
             maps: maps_with_e_growth(30.0),
         })
@@ -214,6 +219,7 @@ fn insert_and_remove_keep_the_keys_valid() {
     assert_eq!(index, 1);
     assert_eq!(
         maps.insert(MapKey {
+            dg: None,
             step: 50,
             maps: GrowthMaps::uniform()
         }),
@@ -238,10 +244,12 @@ fn blended_triangle_values_mix_the_keys() {
     let maps = KeyedMaps::new(
         vec![
             MapKey {
+                dg: None,
                 step: 0,
                 maps: early,
             },
             MapKey {
+                dg: None,
                 step: 40,
                 maps: late,
             },
