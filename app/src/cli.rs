@@ -110,8 +110,8 @@ pub enum Command {
     Fit(fit::FitArgs),
     /// Write a starting point as a project folder: a flower built into the
     /// binary (lily, eustoma-maite-lady, eustoma-mellow-yellow,
-    /// eustoma-pinocchio, apple, or five-petal: an empty flower of five
-    /// simple petals), to paint and change from there.
+    /// eustoma-pinocchio, apple, lily-decay, or five-petal: an empty flower
+    /// of five simple petals), to paint and change from there.
     New {
         /// The starting point's name.
         #[arg(long = "from", value_name = "NAME")]

@@ -42,15 +42,16 @@ pub enum GardenError {
 }
 
 /// The names of the default flowers (folder names under `assets/flowers/`):
-/// the paper's four, the seed's apple flower and the empty five-petal
-/// starting point.
-pub const FLOWER_NAMES: [&str; 6] = [
+/// the paper's four, the seed's apple flower, the empty five-petal
+/// starting point and the lily's bloom and decay.
+pub const FLOWER_NAMES: [&str; 7] = [
     "lily",
     "eustoma-mellow-yellow",
     "eustoma-maite-lady",
     "eustoma-pinocchio",
     "apple",
     crate::five_petal::FIVE_PETAL_NAME,
+    "lily-decay",
 ];
 
 /// Builds the default flower called `name` (one of [`FLOWER_NAMES`]).
@@ -79,6 +80,7 @@ pub fn flower_at_resolution(name: &str, edge_scale: f64) -> Option<Result<Projec
         "eustoma-pinocchio" => eustoma_at(Cultivar::Pinocchio, edge_scale),
         crate::five_petal::FIVE_PETAL_NAME => crate::five_petal::five_petal_at(edge_scale),
         "apple" => crate::apple::apple_at(edge_scale / EDGE_SCALE),
+        "lily-decay" => crate::decay::lily_decay_at(edge_scale),
         _ => return None,
     })
 }
@@ -131,11 +133,11 @@ pub fn lily_sepal_bud() -> RingOrgan {
 }
 
 /// Half the width of the lily's midrib band, in `u`.
-const LILY_MIDRIB_HALF_WIDTH: f64 = 0.12;
+pub(crate) const LILY_MIDRIB_HALF_WIDTH: f64 = 0.12;
 
 /// Where the lily's maps change: the attachment (`v` up to this) does not
 /// grow.
-const LILY_BASE_V: f64 = 0.06;
+pub(crate) const LILY_BASE_V: f64 = 0.06;
 
 /// How much e-growth-in exceeds e-growth on the lily's tepals (negative:
 /// the outer side grows more).
@@ -439,7 +441,7 @@ pub fn lily() -> Result<Project, GardenError> {
     lily_at(EDGE_SCALE)
 }
 
-fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
+pub(crate) fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
     let templates = vec![
         lily_petal_template_at(edge_scale)?,
         lily_sepal_template_at(edge_scale)?,

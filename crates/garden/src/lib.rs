@@ -11,6 +11,7 @@
 //!   [`flowers::eustoma`]);
 //! - [`apple`]: the apple flower of `lsystem-bezier-flower.txt` §3–§4, placed
 //!   by the seed's own L-system;
+//! - [`decay`]: the lily, bloom and decay (negative growth in late keys);
 //! - [`five_petal`]: the empty starting point, one whorl of five simple
 //!   petals with uniform maps;
 //! - [`shape`]: numeric shape descriptors (opening angles, turning,
@@ -28,6 +29,7 @@
 pub use anthesis_flower::structure::whorl as arrangement;
 pub mod apple;
 pub mod buds;
+pub mod decay;
 pub mod five_petal;
 pub mod flowers;
 pub mod paint;
