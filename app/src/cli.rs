@@ -5,6 +5,7 @@
 mod blossom;
 mod bud;
 mod fit;
+mod pde_blossom;
 mod render;
 mod simulate;
 
@@ -105,6 +106,12 @@ pub enum Command {
     /// two-state blossom: per-triangle growth ellipses, G(t; g, T) and a
     /// spherical interpolation of directions), without a growth simulation.
     Blossom(blossom::BlossomArgs),
+    /// Animate a swept organ between two PDE sweep surfaces (its bud and
+    /// its open state) by the PDE-driven in-betweening of
+    /// pde-surfaces-lily.txt §V: each generator's deformation from the
+    /// dynamic equation (13), its force corrected (eq. 21) until the open
+    /// state is met.
+    PdeBlossom(pde_blossom::PdeBlossomArgs),
     /// Fit growth maps to a target open shape of one organ ("which maps make
     /// it open like this?") and write the project with the fitted maps.
     Fit(fit::FitArgs),
@@ -259,6 +266,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(args)) => render::render(&args),
         Some(Command::Bud(args)) => bud::bud(&args),
         Some(Command::Blossom(args)) => blossom::blossom(&args),
+        Some(Command::PdeBlossom(args)) => pde_blossom::pde_blossom(&args),
         Some(Command::Fit(args)) => fit::fit(&args),
         Some(Command::New { from, dir }) => new_project(&from, &dir),
     }

@@ -738,6 +738,82 @@ fn blossom_animates_a_simulated_petal_from_its_bud_to_its_open_state() {
 }
 
 #[test]
+fn pde_blossom_in_betweens_a_swept_petal_and_meets_its_open_state() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = |name: &str| dir.path().join(name).to_str().expect("utf-8").to_owned();
+    let out = anthesis(&[
+        "bud",
+        "--example",
+        "lily-petal",
+        "--save-surface",
+        &path("bud.json"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // The open state: every control point (and tangent) turned back about
+    // the base's x axis, more towards the tip.
+    let bud: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path("bud.json")).expect("read"))
+            .expect("json");
+    let mut open = bud.clone();
+    for key in ["margin0", "margin1", "tangent0", "tangent1"] {
+        for (k, p) in open[key]
+            .as_array_mut()
+            .expect("points")
+            .iter_mut()
+            .enumerate()
+        {
+            let a = 0.5 * k as f64 / 3.0;
+            let (y, z) = (p[1].as_f64().expect("y"), p[2].as_f64().expect("z"));
+            p[1] = serde_json::json!(a.cos() * y - a.sin() * z);
+            p[2] = serde_json::json!(a.sin() * y + a.cos() * z);
+        }
+    }
+    std::fs::write(path("open.json"), open.to_string()).expect("write");
+    let out = anthesis(&[
+        "pde-blossom",
+        &path("bud.json"),
+        &path("open.json"),
+        "--keyframes",
+        "20",
+        "--out",
+        &path("frames"),
+        "--report",
+        &path("report.json"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path("report.json")).expect("report"))
+            .expect("json");
+    assert!(
+        report["final_error"].as_f64().expect("error") <= 1e-6,
+        "{report}"
+    );
+    assert!(report["corrections"].as_u64().is_some(), "{report}");
+    assert!(text(&out.stdout).contains("force corrections (eq. 21)"));
+    assert_eq!(std::fs::read_dir(path("frames")).expect("list").count(), 21);
+    // The first keyframe is the bud, the last has moved by the turn.
+    let points = |frame: u32| -> Vec<glam::DVec3> {
+        let obj =
+            std::fs::read_to_string(dir.path().join(format!("frames/keyframe_{frame:04}.obj")))
+                .expect("frame");
+        anthesis_mesh::parse_obj(&obj).expect("parses").positions
+    };
+    let (first, last) = (points(0), points(20));
+    let tip = first
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.y.total_cmp(&b.1.y))
+        .map(|(i, _)| i)
+        .expect("points");
+    let moved = first[tip].distance(last[tip]);
+    assert!(moved > 5.0, "the tip moved {moved}");
+    // Two surfaces that are not PDE sweeps are refused, naming the file.
+    std::fs::write(path("bad.json"), "{}").expect("write");
+    let err = text(&one_line_error(&["pde-blossom", &path("bud.json"), &path("bad.json")]).stderr);
+    assert!(err.contains("bad.json"), "{err}");
+}
+
+#[test]
 fn a_project_folder_works_where_a_project_file_is_expected() {
     let lily = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/flowers/lily");
     let folder = anthesis(&["info", lily.to_str().expect("utf-8")]);

@@ -250,7 +250,7 @@ fn read_bezier(path: &Path) -> Result<BezierPatch> {
     read_surface(path, "Bézier patch", parse_bezier)
 }
 
-fn read_pde(path: &Path) -> Result<PdeSweep> {
+pub(super) fn read_pde(path: &Path) -> Result<PdeSweep> {
     read_surface(path, "PDE sweep surface", parse_pde)
 }
 

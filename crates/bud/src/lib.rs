@@ -27,6 +27,7 @@
 
 #![warn(missing_docs)]
 
+pub mod dynamic;
 mod examples;
 mod from_mesh;
 mod quality;
