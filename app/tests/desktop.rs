@@ -2644,3 +2644,161 @@ fn edit_menu_fits_growth_maps_to_a_target_and_applies_them_as_one_undo_step() {
         Some("fit growth maps")
     );
 }
+
+/// The Shape section's preview once the remesher has answered.
+fn wait_for_remesh_preview(
+    harness: &mut Harness<'_, AnthesisApp>,
+) -> Result<anthesis_bud::MeshQuality, String> {
+    for _ in 0..1000 {
+        harness.step();
+        if let Some(preview) = harness.state().flower_panel().shape().preview() {
+            let preview = preview.copied();
+            harness.run();
+            return preview;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("the remesh preview did not come");
+}
+
+/// Chooses `file` in the in-app browser opened by "Import OBJ…".
+fn import_obj(harness: &mut Harness<'_, AnthesisApp>, file: &str) {
+    click_in_view(harness, "Import OBJ…");
+    harness.get_by_label(&format!("🗋 {file}")).click();
+    harness.run();
+    harness.get_by_label("Open").click();
+    harness.run();
+}
+
+#[test]
+fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let petal = anthesis_mesh::generate::test_petal(4.0, 2.0, 6, 10);
+    std::fs::write(
+        dir.path().join("bloom.obj"),
+        anthesis_mesh::obj_string(&petal),
+    )
+    .expect("write obj");
+    // A face that names a vertex the file does not have.
+    std::fs::write(
+        dir.path().join("broken.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 9/3\n",
+    )
+    .expect("write obj");
+    let mut harness = harness_with_file_browser(&dir.path().join("flower.anthesis.toml"));
+    harness.get_by_label("Flower").click();
+    harness.run();
+    let before = harness.state().project().clone();
+
+    // Import: a new template with the simple petal's uniform maps and one
+    // organ of it, in one undo step.
+    import_obj(&mut harness, "bloom.obj");
+    let app = harness.state();
+    let flower = &app.project().flower;
+    assert_eq!(flower.templates.len(), before.flower.templates.len() + 1);
+    let index = flower.templates.len() - 1;
+    let template = &flower.templates[index];
+    assert_eq!(template.name, "bloom");
+    assert_eq!(template.mesh.positions.len(), petal.positions.len());
+    assert_eq!(
+        template.maps,
+        anthesis_garden::five_petal::simple_petal_maps()
+    );
+    assert_eq!(flower.organs.len(), before.flower.organs.len() + 1);
+    assert_eq!(flower.organs.last().map(|o| o.template), Some(index));
+    assert_eq!(app.document().undo_label(), Some("import template bloom"));
+    assert_eq!(app.flower_panel().shape().template(), index);
+
+    // The Shape section opened on it: its inner side and, at its own
+    // edge, a preview.
+    harness.get_by_label("inner side: −Z (the template frame's inner side)");
+    wait_for_remesh_preview(&mut harness).expect("the petal remeshes");
+
+    // Flip the inner side: every triangle wound the other way, one step.
+    click_in_view(&mut harness, "Flip inner side");
+    harness.get_by_label("inner side: +Z (the template frame wants −Z: flip it?)");
+    let app = harness.state();
+    let flipped = &app.project().flower.templates[index].mesh;
+    assert_eq!(flipped, &anthesis_bud::with_inner_side_flipped(&petal));
+    assert_eq!(
+        app.document().undo_label(),
+        Some("flip inner side of bloom")
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().project().flower.templates[index].mesh,
+        petal
+    );
+
+    // A finer edge: the particle count and quality are shown before
+    // anything changes.
+    click_in_view(&mut harness, "remesh edge");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("remesh edge").type_text("0.25");
+    harness.run();
+    harness.key_press(egui::Key::Enter);
+    let quality = wait_for_remesh_preview(&mut harness).expect("remeshes at 0.25");
+    assert!(
+        (quality.mean_edge - 0.25).abs() < 0.05,
+        "mean edge {}",
+        quality.mean_edge
+    );
+    assert!(quality.vertices > 2 * petal.positions.len());
+    harness.get_by_label_contains(&format!("remeshed: {} particles", quality.vertices));
+    assert_eq!(
+        harness.state().project().flower.templates[index].mesh,
+        petal,
+        "nothing changes before Remesh"
+    );
+    let imported = harness.state().project().clone();
+    // The log names the temporary folder: cleared for the snapshot.
+    harness.get_by_label("Clear").click();
+    harness.hover_at(egui::pos2(600.0, 300.0));
+    harness.run();
+    harness.snapshot("flower_panel_shape");
+
+    click_in_view(&mut harness, "Remesh");
+    let app = harness.state();
+    let remeshed = &app.project().flower.templates[index];
+    assert_eq!(remeshed.mesh.positions.len(), quality.vertices);
+    assert_eq!(remeshed.maps, imported.flower.templates[index].maps);
+    assert_eq!(
+        app.document().undo_label(),
+        Some("remesh bloom at edge 0.25")
+    );
+    // One undo step gives the imported mesh back, the next removes it.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(harness.state().project(), &imported);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    harness.run();
+    assert_eq!(
+        harness.state().project().flower.templates,
+        before.flower.templates
+    );
+    harness.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
+    harness.run();
+    assert_eq!(harness.state().project(), &imported);
+
+    // A broken file is refused with the element it names; nothing changes.
+    let now = harness.state().project().clone();
+    import_obj(&mut harness, "broken.obj");
+    assert_eq!(harness.state().project(), &now);
+    let refused = harness
+        .state()
+        .flower_panel()
+        .refused()
+        .expect("refused")
+        .to_string();
+    assert!(
+        refused.contains("broken.obj") && refused.contains('9'),
+        "{refused}"
+    );
+    assert!(refused.contains("line 7"), "names the line: {refused}");
+    // In the Flower panel and the log's banner.
+    assert_eq!(harness.get_all_by_label(&refused).count(), 2);
+}

@@ -45,6 +45,8 @@ pub enum Command {
     OpenExportDialog,
     /// Ask where to export.
     BrowseExportPath,
+    /// Ask for an OBJ mesh to make a new template of.
+    BrowseTemplateObj,
     /// A file dialog (native or the in-app browser) answered: the path
     /// chosen for `purpose`, or `None` when cancelled.
     FileChosen {
@@ -264,6 +266,7 @@ impl AnthesisApp {
             Command::DropFile(path) => self.drop_file(&path),
             Command::OpenExportDialog => self.open_export(),
             Command::BrowseExportPath => self.ask_for_path(DialogPurpose::ExportGlb),
+            Command::BrowseTemplateObj => self.ask_for_path(DialogPurpose::ImportTemplateObj),
             Command::FileChosen { purpose, path } => self.file_chosen(purpose, path),
             Command::StartExport => self.start_export(),
             Command::Undo => self.undo(),

@@ -34,6 +34,8 @@ pub enum DialogPurpose {
     OpenProject,
     SaveProjectAs,
     ExportGlb,
+    /// An OBJ mesh to make a new template of (the Flower panel).
+    ImportTemplateObj,
 }
 
 impl DialogPurpose {
@@ -42,13 +44,14 @@ impl DialogPurpose {
             DialogPurpose::OpenProject => "Open an Anthesis project",
             DialogPurpose::SaveProjectAs => "Save the project as",
             DialogPurpose::ExportGlb => "Export the animation (.glb, .usda, .usdc or .gif)",
+            DialogPurpose::ImportTemplateObj => "Import an OBJ mesh as a new template",
         }
     }
 
     /// The file name offered when saving.
     fn suggested_name(self) -> Option<&'static str> {
         match self {
-            DialogPurpose::OpenProject => None,
+            DialogPurpose::OpenProject | DialogPurpose::ImportTemplateObj => None,
             DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml"),
             DialogPurpose::ExportGlb => Some("flower.glb"),
         }
@@ -60,6 +63,7 @@ impl DialogPurpose {
         match self {
             DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => &[PROJECT_EXTENSION],
             DialogPurpose::ExportGlb => &["glb", "usda", "usdc", "usd", "gif"],
+            DialogPurpose::ImportTemplateObj => &["obj"],
         }
     }
 }
@@ -197,7 +201,9 @@ impl Dialogs {
                 .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
         });
         let mut browser = match purpose {
-            DialogPurpose::OpenProject => egui_file::FileDialog::open_file(),
+            DialogPurpose::OpenProject | DialogPurpose::ImportTemplateObj => {
+                egui_file::FileDialog::open_file()
+            }
             DialogPurpose::SaveProjectAs | DialogPurpose::ExportGlb => {
                 egui_file::FileDialog::save_file()
             }
@@ -267,6 +273,9 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
             .add_filter("Anthesis project", purpose.extensions())
             .set_file_name(purpose.suggested_name().unwrap_or_default())
             .save_file(),
+        DialogPurpose::ImportTemplateObj => dialog
+            .add_filter("OBJ mesh", purpose.extensions())
+            .pick_file(),
         DialogPurpose::ExportGlb => dialog
             .add_filter("glTF binary", &["glb"])
             .add_filter("USD layer", &["usda", "usdc", "usd"])

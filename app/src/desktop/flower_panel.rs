@@ -21,6 +21,7 @@ use eframe::egui::{self, Color32, DragValue, RichText};
 
 use super::command::{Command, ProjectEdit};
 use super::parts_panel;
+use super::shape_panel::{ShapeState, shape_ui};
 
 /// How long typing must pause before the L-system text is applied.
 pub const TYPING_PAUSE_SECONDS: f64 = 0.5;
@@ -45,6 +46,8 @@ pub struct FlowerPanelState {
     /// The L-system's units (project units per turtle unit), kept as the
     /// project has them.
     units: f64,
+    /// The Shape section: remeshing and the inner side of one template.
+    shape: ShapeState,
 }
 
 /// An error of the L-system text and where it is.
@@ -64,6 +67,34 @@ impl FlowerPanelState {
     /// The error shown under the L-system text, if any.
     pub fn text_error(&self) -> Option<&str> {
         self.error.as_ref().map(|e| e.message.as_str())
+    }
+
+    /// Why the last edit (or import) was refused, as shown in the panel.
+    pub fn refused(&self) -> Option<&str> {
+        self.refused.as_deref()
+    }
+
+    /// Shows why an edit made outside the panel (an import) was refused.
+    pub(super) fn refuse(&mut self, message: String) {
+        self.refused = Some(message);
+    }
+
+    /// A template was imported: it is the one the Shape section shows.
+    pub(super) fn imported(&mut self, template: usize) {
+        self.refused = None;
+        self.shape.template = template;
+        self.shape.edge = None;
+        self.shape.open_now = true;
+    }
+
+    /// The Shape section's state (for tests).
+    pub fn shape(&self) -> &ShapeState {
+        &self.shape
+    }
+
+    /// Sets the mean edge the Shape section remeshes at (as typing it).
+    pub fn set_remesh_edge(&mut self, edge: f64) {
+        self.shape.edge = Some(edge);
     }
 }
 
@@ -538,6 +569,7 @@ pub fn flower_ui(
 ) -> Vec<Command> {
     let flower = &project.flower;
     let mut outcomes: Vec<Outcome> = Vec::new();
+    let mut commands_early: Vec<Command> = Vec::new();
 
     // Templates.
     ui.strong("Templates")
@@ -608,6 +640,16 @@ pub fn flower_ui(
         let source = state
             .new_organ_template
             .min(flower.templates.len().saturating_sub(1));
+        if ui
+            .button("Import OBJ…")
+            .on_hover_text(
+                "A new template of an OBJ mesh (UVs: u across, v from base to tip; inner side \
+                 facing −Z) with uniform growth maps, and one organ of it",
+            )
+            .clicked()
+        {
+            commands_early.push(Command::BrowseTemplateObj);
+        }
         if let Some(template) = flower.templates.get(source)
             && ui
                 .button("Duplicate template")
@@ -622,6 +664,10 @@ pub fn flower_ui(
             outcomes.push(Outcome::Edit(format!("add template {name}"), added));
         }
     });
+    ui.separator();
+
+    // The shape of one template.
+    shape_ui(ui, flower, &mut state.shape, &mut commands_early);
     ui.separator();
 
     // Arrangement.
@@ -867,7 +913,7 @@ pub fn flower_ui(
         });
     ui.separator();
 
-    let mut commands = Vec::new();
+    let mut commands = commands_early;
     for out in outcomes {
         match out {
             Outcome::Edit(label, flower) => {

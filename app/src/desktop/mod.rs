@@ -30,6 +30,7 @@ mod prompts;
 pub mod rerun;
 pub mod resolution;
 pub mod session;
+pub mod shape_panel;
 pub mod timeline;
 pub mod viewport;
 

@@ -280,6 +280,51 @@ impl AnthesisApp {
             DialogPurpose::ExportGlb => {
                 self.export.path = path.display().to_string();
             }
+            DialogPurpose::ImportTemplateObj => self.import_template(&path),
+        }
+    }
+
+    /// Makes a new template of the OBJ mesh at `path` (uniform growth maps
+    /// like the simple petal) with one organ of it, as one undo step; a
+    /// file that is not a valid mesh, or a mesh in another unit, is refused
+    /// with the reason, in the log and the Flower panel.
+    pub(super) fn import_template(&mut self, path: &Path) {
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().trim().to_string())
+            .filter(|s| !s.is_empty())
+            .unwrap_or_else(|| "imported".to_string());
+        let result = anthesis_mesh::load_obj(path)
+            .map_err(|e| e.to_string())
+            .and_then(|mesh| {
+                let template = anthesis_garden::five_petal::simple_template_of_mesh(&name, mesh);
+                self.project()
+                    .flower
+                    .with_template_and_organ(template)
+                    .map_err(|e| e.to_string())
+            });
+        match result {
+            Ok(flower) => {
+                let added = flower
+                    .templates
+                    .last()
+                    .map_or(name.clone(), |t| t.name.clone());
+                self.edit(
+                    &format!("import template {added}"),
+                    ProjectEdit::Flower(Box::new(flower)),
+                );
+                self.doc.seal();
+                self.flower_panel
+                    .imported(self.project().flower.templates.len() - 1);
+                self.log
+                    .info(format!("new template {added} from {}", path.display()));
+                self.log.succeeded(Topic::Import);
+            }
+            Err(e) => {
+                let message = format!("cannot import {} as a template: {e}", path.display());
+                self.flower_panel.refuse(message.clone());
+                self.log.error_about(Topic::Import, message);
+            }
         }
     }
 

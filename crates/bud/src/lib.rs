@@ -253,6 +253,32 @@ pub fn mean_normal(mesh: &Mesh) -> glam::DVec3 {
         .sum()
 }
 
+/// Whether `mesh`'s inner side (the side its triangles wind
+/// counter-clockwise around) faces the template frame's inner direction,
+/// −Z, on average: `Some(true)` when the area-weighted mean normal points to
+/// −Z, `Some(false)` to +Z, `None` when it has no Z component (a mesh
+/// standing edge-on to Z: no side is inner by this test).
+pub fn inner_side_faces_minus_z(mesh: &Mesh) -> Option<bool> {
+    let z = mean_normal(mesh).z;
+    if z < 0.0 {
+        Some(true)
+    } else if z > 0.0 {
+        Some(false)
+    } else {
+        None
+    }
+}
+
+/// `mesh` with its inner side swapped: every triangle wound the other way
+/// (positions, UVs and vertex order stay, so painted maps stay valid).
+pub fn with_inner_side_flipped(mesh: &Mesh) -> Mesh {
+    let mut flipped = mesh.clone();
+    for t in &mut flipped.triangles {
+        t.swap(1, 2);
+    }
+    flipped
+}
+
 /// Sets the winding. The remesher winds counter-clockwise in UV, i.e. around
 /// `dS/du × dS/dv`.
 fn orient(mesh: &mut Mesh, inner_side: InnerSide) {

@@ -412,3 +412,29 @@ fn examples_sit_in_the_template_frame() {
         }
     }
 }
+
+#[test]
+fn flipping_the_inner_side_winds_every_triangle_the_other_way_and_back() {
+    let bud = anthesis_bud::build_organ(
+        &anthesis_bud::lily_petal_surface(),
+        &anthesis_bud::RemeshOptions::new(1.3),
+    )
+    .unwrap();
+    // Built with the inner side chosen automatically: it faces −Z.
+    assert_eq!(
+        anthesis_bud::inner_side_faces_minus_z(&bud.mesh),
+        Some(true)
+    );
+    let flipped = anthesis_bud::with_inner_side_flipped(&bud.mesh);
+    assert_eq!(
+        anthesis_bud::inner_side_faces_minus_z(&flipped),
+        Some(false)
+    );
+    assert_eq!(flipped.positions, bud.mesh.positions);
+    assert_eq!(flipped.uvs, bud.mesh.uvs);
+    assert_eq!(
+        anthesis_bud::mean_normal(&flipped),
+        -anthesis_bud::mean_normal(&bud.mesh)
+    );
+    assert_eq!(anthesis_bud::with_inner_side_flipped(&flipped), bud.mesh);
+}

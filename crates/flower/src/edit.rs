@@ -40,6 +40,9 @@ pub enum EditError {
     /// The organ is made by the structure: change the structure instead.
     #[error("organ \"{0}\" is made by the arrangement: change the arrangement to remove it")]
     MadeByStructure(String),
+    /// A new template's mesh is not in the project's unit of length.
+    #[error("{0}")]
+    Scale(Box<crate::scale::ScaleMismatch>),
     /// An index that does not exist.
     #[error("there is no {what} {index}")]
     Missing {
@@ -206,6 +209,25 @@ impl Flower {
         let mut flower = self.clone();
         flower.templates.push(template);
         flower
+    }
+
+    /// The flower with `template` added (renamed as [`Flower::with_template`]
+    /// does) and one listed organ of it, placed as [`Flower::new_organ`]
+    /// places one: a shape made in the app (an imported OBJ, a Bézier
+    /// petal) becomes a visible organ at once. Refused when the template's
+    /// mesh does not fit its thickness (a mesh in another unit, see
+    /// [`crate::scale::check_template`]).
+    pub fn with_template_and_organ(&self, template: Template) -> Result<Flower, EditError> {
+        if let Some(mismatch) = crate::scale::check_template(&template) {
+            return Err(EditError::Scale(Box::new(mismatch)));
+        }
+        let added = self.with_template(template);
+        let index = added.templates.len() - 1;
+        let organ = added.new_organ(index).ok_or(EditError::Missing {
+            what: "template",
+            index,
+        })?;
+        added.with_organ(organ)
     }
 
     /// The flower with template `index` called `name`. Organs an L-system

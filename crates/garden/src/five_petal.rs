@@ -82,7 +82,15 @@ pub fn simple_petal_template(name: &str, edge_scale: f64) -> Result<Template, Ga
     let mesh = simple_petal_bud()
         .build(SIMPLE_PETAL_EDGE * edge_scale)
         .map_err(|error| GardenError::Bud { organ, error })?;
-    Ok(Template {
+    Ok(simple_template_of_mesh(name, mesh))
+}
+
+/// A template named `name` of `mesh` (made in the app: an imported OBJ, a
+/// Bézier petal) with what the simple petal has besides its shape:
+/// [`simple_petal_maps`], Eustoma's material, the joint ramp and colour;
+/// its base particles those with `v <= 0.05` (at least two rows).
+pub fn simple_template_of_mesh(name: &str, mesh: anthesis_mesh::Mesh) -> Template {
+    Template {
         name: name.to_string(),
         base_region: base_region(&mesh, 0.05),
         mesh,
@@ -94,7 +102,7 @@ pub fn simple_petal_template(name: &str, edge_scale: f64) -> Result<Template, Ga
         joint_schedule: vec![SIMPLE_JOINT],
         color: SIMPLE_PINK,
         colouring: None,
-    })
+    }
 }
 
 /// The whorl of `count` simple petals of template `template`, from azimuth

@@ -407,3 +407,40 @@ fn a_renamed_template_keeps_its_organs_and_an_l_system_s_organs_follow_the_name(
         outer: tepal
     }));
 }
+
+#[test]
+fn a_template_made_in_the_app_comes_with_one_organ_unless_its_mesh_is_in_another_unit() {
+    let flower = flower();
+    // 4 long on a thickness of 0.2: 20 thicknesses, a plausible organ.
+    let added = flower.with_template_and_organ(template("petal")).unwrap();
+    assert_eq!(added.templates.len(), 3);
+    assert_eq!(added.templates[2].name, "petal 2");
+    assert_eq!(added.organs.len(), flower.organs.len() + 1);
+    let organ = added.organs.last().unwrap();
+    assert_eq!(organ.template, 2);
+    assert_eq!(organ.name, "petal 2-1");
+    // Placed as new_organ places the first organ of a template: at the
+    // distance of the farthest organ from the axis, facing +Z.
+    let expected = added.new_organ(2).map(|o| o.placement);
+    assert!(expected.is_some());
+    let farthest = flower
+        .organs
+        .iter()
+        .map(|o| o.placement.position.x.hypot(o.placement.position.z))
+        .fold(0.0, f64::max);
+    let p = organ.placement.position;
+    assert!((p.x.hypot(p.z) - farthest).abs() < 1e-9);
+
+    // The same mesh made in millimetres for a project in centimetres.
+    let mut big = template("big");
+    for p in &mut big.mesh.positions {
+        *p *= 1000.0;
+    }
+    match flower.with_template_and_organ(big) {
+        Err(EditError::Scale(mismatch)) => {
+            assert_eq!(mismatch.template, "big");
+            assert!(mismatch.to_string().contains("\"big\""), "{mismatch}");
+        }
+        other => panic!("expected a unit mismatch, got {other:?}"),
+    }
+}
