@@ -2645,6 +2645,26 @@ fn edit_menu_fits_growth_maps_to_a_target_and_applies_them_as_one_undo_step() {
     );
 }
 
+/// Runs frames until the app stops asking for them (the remesher's
+/// thread asks for one more when its preview is ready, at any time).
+fn settle(harness: &mut Harness<'_, AnthesisApp>) {
+    for _ in 0..50 {
+        if harness.try_run().is_ok() {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("the app keeps asking for frames");
+}
+
+/// [`click_in_view`] with [`settle`].
+fn click_settled(harness: &mut Harness<'_, AnthesisApp>, label: &str) {
+    harness.get_by_label(label).scroll_to_me();
+    settle(harness);
+    harness.get_by_label(label).click();
+    settle(harness);
+}
+
 /// The Shape section's preview once the remesher has answered.
 fn wait_for_remesh_preview(
     harness: &mut Harness<'_, AnthesisApp>,
@@ -2653,7 +2673,7 @@ fn wait_for_remesh_preview(
         harness.step();
         if let Some(preview) = harness.state().flower_panel().shape().preview() {
             let preview = preview.copied();
-            harness.run();
+            settle(harness);
             return preview;
         }
         std::thread::sleep(Duration::from_millis(10));
@@ -2663,11 +2683,11 @@ fn wait_for_remesh_preview(
 
 /// Chooses `file` in the in-app browser opened by "Import OBJ…".
 fn import_obj(harness: &mut Harness<'_, AnthesisApp>, file: &str) {
-    click_in_view(harness, "Import OBJ…");
+    click_settled(harness, "Import OBJ…");
     harness.get_by_label(&format!("🗋 {file}")).click();
-    harness.run();
+    settle(harness);
     harness.get_by_label("Open").click();
-    harness.run();
+    settle(harness);
 }
 
 #[test]
@@ -2687,7 +2707,7 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
     .expect("write obj");
     let mut harness = harness_with_file_browser(&dir.path().join("flower.anthesis.toml"));
     harness.get_by_label("Flower").click();
-    harness.run();
+    settle(&mut harness);
     let before = harness.state().project().clone();
 
     // Import: a new template with the simple petal's uniform maps and one
@@ -2715,7 +2735,7 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
     wait_for_remesh_preview(&mut harness).expect("the petal remeshes");
 
     // Flip the inner side: every triangle wound the other way, one step.
-    click_in_view(&mut harness, "Flip inner side");
+    click_settled(&mut harness, "Flip inner side");
     harness.get_by_label("inner side: +Z (the template frame wants −Z: flip it?)");
     let app = harness.state();
     let flipped = &app.project().flower.templates[index].mesh;
@@ -2725,7 +2745,7 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
         Some("flip inner side of bloom")
     );
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    settle(&mut harness);
     assert_eq!(
         harness.state().project().flower.templates[index].mesh,
         petal
@@ -2733,10 +2753,10 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
 
     // A finer edge: the particle count and quality are shown before
     // anything changes.
-    click_in_view(&mut harness, "remesh edge");
+    click_settled(&mut harness, "remesh edge");
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
     harness.get_by_label("remesh edge").type_text("0.25");
-    harness.run();
+    settle(&mut harness);
     harness.key_press(egui::Key::Enter);
     let quality = wait_for_remesh_preview(&mut harness).expect("remeshes at 0.25");
     assert!(
@@ -2755,10 +2775,10 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
     // The log names the temporary folder: cleared for the snapshot.
     harness.get_by_label("Clear").click();
     harness.hover_at(egui::pos2(600.0, 300.0));
-    harness.run();
+    settle(&mut harness);
     harness.snapshot("flower_panel_shape");
 
-    click_in_view(&mut harness, "Remesh");
+    click_settled(&mut harness, "Remesh");
     let app = harness.state();
     let remeshed = &app.project().flower.templates[index];
     assert_eq!(remeshed.mesh.positions.len(), quality.vertices);
@@ -2769,10 +2789,10 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
     );
     // One undo step gives the imported mesh back, the next removes it.
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    settle(&mut harness);
     assert_eq!(harness.state().project(), &imported);
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
-    harness.run();
+    settle(&mut harness);
     assert_eq!(
         harness.state().project().flower.templates,
         before.flower.templates
@@ -2781,7 +2801,7 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
         egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
         egui::Key::Z,
     );
-    harness.run();
+    settle(&mut harness);
     assert_eq!(harness.state().project(), &imported);
 
     // A broken file is refused with the element it names; nothing changes.
