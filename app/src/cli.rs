@@ -302,26 +302,33 @@ fn open(path: &Path) -> Result<(Project, Option<PathBuf>)> {
     Ok((project, file))
 }
 
+/// Refuses folder `dir` if it already holds a project file, so nothing is
+/// overwritten.
+fn refuse_project_folder(dir: &Path) -> Result<()> {
+    let existing = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read the folder {}", dir.display()))?
+        .filter_map(Result::ok)
+        .any(|entry| {
+            entry
+                .file_name()
+                .to_string_lossy()
+                .ends_with(anthesis_flower::project::PROJECT_EXTENSION)
+        });
+    if existing {
+        bail!(
+            "{} already holds a project; choose an empty or new folder",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
 /// `anthesis new --from NAME DIR`: the built-in flower NAME saved as
 /// `DIR/NAME.anthesis.toml` with its meshes and maps.
 fn new_project(from: &str, dir: &Path) -> Result<()> {
     let project = load(Path::new(&format!("builtin:{from}")))?;
     if dir.is_dir() {
-        let existing = std::fs::read_dir(dir)
-            .with_context(|| format!("cannot read the folder {}", dir.display()))?
-            .filter_map(Result::ok)
-            .any(|entry| {
-                entry
-                    .file_name()
-                    .to_string_lossy()
-                    .ends_with(anthesis_flower::project::PROJECT_EXTENSION)
-            });
-        if existing {
-            bail!(
-                "{} already holds a project; choose an empty or new folder",
-                dir.display()
-            );
-        }
+        refuse_project_folder(dir)?;
     }
     let path = dir.join(format!(
         "{from}{}",

@@ -6,7 +6,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anthesis_export::{GlbOptions, Timing, Track};
+use anthesis_export::Track;
 use anthesis_mesh::Mesh;
 use anthesis_mesh::obj::{MAX_OBJ_BYTES, object_text, parse_obj};
 use anthesis_twostate::{GrowthFunction, TwoState};
@@ -14,7 +14,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 
 use super::EncodingArg;
-use super::simulate::{OutputKind, check_output, write_tracks};
+use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
 
 /// `anthesis blossom BUD.obj OPEN.obj`.
 #[derive(Debug, Args)]
@@ -60,18 +60,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     if args.keyframes == 0 {
         bail!("--keyframes must be at least 1");
     }
-    let fps = args
-        .fps
-        .unwrap_or(anthesis_export::DEFAULT_FRAMES_PER_SECOND);
-    if !(fps.is_finite() && fps > 0.0) {
-        bail!("--fps must be positive, got {fps}");
-    }
-    let glb = GlbOptions {
-        timing: Timing::FramesPerSecond(fps),
-        max_morph_targets: anthesis_export::DEFAULT_MAX_MORPH_TARGETS,
-        normals: true,
-        encoding: args.encoding.into(),
-    };
+    let glb = animation_options(args.fps, args.encoding)?;
     if let Some(out) = &args.out {
         check_output(out, &glb, args.keyframes)?;
     }

@@ -235,30 +235,9 @@ fn check_out_folder(out: &Path) -> Result<()> {
         bail!("--out {} must be a folder", out.display());
     }
     if out.is_dir() {
-        let existing = std::fs::read_dir(out)
-            .with_context(|| format!("cannot read the folder {}", out.display()))?
-            .filter_map(Result::ok)
-            .any(|entry| {
-                entry
-                    .file_name()
-                    .to_string_lossy()
-                    .ends_with(anthesis_flower::project::PROJECT_EXTENSION)
-            });
-        if existing {
-            bail!(
-                "{} already holds a project; choose an empty or new folder",
-                out.display()
-            );
-        }
+        super::refuse_project_folder(out)?;
     } else {
-        let parent = anthesis_files::folder_of(out);
-        if !parent.is_dir() {
-            bail!(
-                "--out {}: cannot create the folder, {} does not exist",
-                out.display(),
-                parent.display()
-            );
-        }
+        super::simulate::check_creatable_folder(out)?;
     }
     Ok(())
 }

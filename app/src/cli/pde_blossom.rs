@@ -9,14 +9,14 @@ use std::time::Instant;
 
 use anthesis_bud::dynamic::{Dynamics, SweepInBetween};
 use anthesis_bud::{RemeshOptions, Surface, build_organ};
-use anthesis_export::{GlbOptions, Timing, Track};
+use anthesis_export::Track;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec2;
 
 use super::EncodingArg;
 use super::bud::read_pde;
-use super::simulate::{OutputKind, check_output, write_tracks};
+use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
 
 /// `anthesis pde-blossom BUD.json OPEN.json`.
 #[derive(Debug, Args)]
@@ -77,18 +77,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
     if !(args.tolerance >= 0.0 && args.tolerance.is_finite()) {
         bail!("--tolerance must be 0 or more, got {}", args.tolerance);
     }
-    let fps = args
-        .fps
-        .unwrap_or(anthesis_export::DEFAULT_FRAMES_PER_SECOND);
-    if !(fps.is_finite() && fps > 0.0) {
-        bail!("--fps must be positive, got {fps}");
-    }
-    let glb = GlbOptions {
-        timing: Timing::FramesPerSecond(fps),
-        max_morph_targets: anthesis_export::DEFAULT_MAX_MORPH_TARGETS,
-        normals: true,
-        encoding: args.encoding.into(),
-    };
+    let glb = animation_options(args.fps, args.encoding)?;
     if let Some(out) = &args.out {
         check_output(out, &glb, args.keyframes)?;
     }

@@ -12,7 +12,7 @@ use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
-use super::{at_resolution, load, selection};
+use super::{EncodingArg, at_resolution, load, selection};
 
 pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
     let project = at_resolution(load(path)?, edge, None)?;
@@ -301,18 +301,38 @@ pub(super) fn check_output(out: &Path, glb: &GlbOptions, keyframes: u32) -> Resu
             out.display()
         ),
         OutputKind::ObjFolder if out.is_dir() => {}
-        OutputKind::ObjFolder => {
-            let parent = anthesis_files::folder_of(out);
-            if !parent.is_dir() {
-                bail!(
-                    "--out {}: cannot create the folder, {} does not exist",
-                    out.display(),
-                    parent.display()
-                );
-            }
-        }
+        OutputKind::ObjFolder => check_creatable_folder(out)?,
     }
     Ok(())
+}
+
+/// `--out` folder `out`, which does not exist yet, can be made: its parent
+/// folder exists.
+pub(super) fn check_creatable_folder(out: &Path) -> Result<()> {
+    let parent = anthesis_files::folder_of(out);
+    if !parent.is_dir() {
+        bail!(
+            "--out {}: cannot create the folder, {} does not exist",
+            out.display(),
+            parent.display()
+        );
+    }
+    Ok(())
+}
+
+/// The .glb options of a two-state or PDE animation at `fps` keyframes per
+/// second (default [`anthesis_export::DEFAULT_FRAMES_PER_SECOND`]).
+pub(super) fn animation_options(fps: Option<f64>, encoding: EncodingArg) -> Result<GlbOptions> {
+    let fps = fps.unwrap_or(anthesis_export::DEFAULT_FRAMES_PER_SECOND);
+    if !(fps.is_finite() && fps > 0.0) {
+        bail!("--fps must be positive, got {fps}");
+    }
+    Ok(GlbOptions {
+        timing: anthesis_export::Timing::FramesPerSecond(fps),
+        max_morph_targets: anthesis_export::DEFAULT_MAX_MORPH_TARGETS,
+        normals: true,
+        encoding: encoding.into(),
+    })
 }
 
 fn rayon_threads() -> usize {
