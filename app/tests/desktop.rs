@@ -2822,3 +2822,108 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
     // In the Flower panel and the log's banner.
     assert_eq!(harness.get_all_by_label(&refused).count(), 2);
 }
+
+#[test]
+fn a_bezier_petal_is_made_its_control_points_dragged_and_typed_and_applied_in_one_undo_step() {
+    use anthesis_bud::BezierPatch;
+    let mut harness = opened_small_flower();
+    harness.get_by_label("Flower").click();
+    settle(&mut harness);
+    let before = harness.state().project().clone();
+
+    // A new template of the starting net, with one organ, its net in the
+    // Shape section.
+    click_settled(&mut harness, "New Bézier petal");
+    let app = harness.state();
+    let flower = &app.project().flower;
+    let index = flower.templates.len() - 1;
+    assert_eq!(index, before.flower.templates.len());
+    assert_eq!(flower.templates[index].name, "bezier petal");
+    assert_eq!(flower.organs.len(), before.flower.organs.len() + 1);
+    let shape = app.flower_panel().shape();
+    assert_eq!(shape.template(), index);
+    assert_eq!(shape.net("bezier petal"), Some(&BezierPatch::petal()));
+    let made = flower.templates[index].clone();
+    wait_for_remesh_preview(&mut harness).expect("the new petal remeshes");
+
+    // Drag the tip's right-hand point 30 pixels to the right in the front
+    // view: its mirror image across the midrib moves left with it.
+    harness.get_by_label("Bézier net").scroll_to_me();
+    settle(&mut harness);
+    let from = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .control_point_on_screen(3, 3)
+        .expect("drawn");
+    harness.hover_at(from);
+    settle(&mut harness);
+    harness.drag_at(from);
+    settle(&mut harness);
+    for k in 1..=3 {
+        harness.hover_at(from + egui::vec2(10.0 * k as f32, 0.0));
+        settle(&mut harness);
+    }
+    harness.drop_at(from + egui::vec2(30.0, 0.0));
+    settle(&mut harness);
+    let start = BezierPatch::petal();
+    let net = *harness
+        .state()
+        .flower_panel()
+        .shape()
+        .net("bezier petal")
+        .expect("net");
+    assert!(
+        net.control[3][3].x > start.control[3][3].x + 0.5,
+        "{} from {}",
+        net.control[3][3],
+        start.control[3][3]
+    );
+    assert_eq!(net.control[3][3].y, start.control[3][3].y);
+    assert_eq!(net.control[3][0], anthesis_bud::mirrored(net.control[3][3]));
+    assert_eq!(
+        harness.state().project().flower.templates[index],
+        made,
+        "the net is a draft until applied"
+    );
+
+    // Type the dragged (now chosen) point's z.
+    click_settled(&mut harness, "z");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("z").type_text("-1.5");
+    settle(&mut harness);
+    harness.key_press(egui::Key::Enter);
+    settle(&mut harness);
+    let net = *harness
+        .state()
+        .flower_panel()
+        .shape()
+        .net("bezier petal")
+        .expect("net");
+    assert_eq!(net.control[3][3].z, -1.5);
+    assert_eq!(net.control[3][0].z, -1.5);
+    assert!(net.is_symmetric(0.0));
+    harness.get_by_label("Bézier net").scroll_to_me();
+    harness.hover_at(egui::pos2(600.0, 300.0));
+    settle(&mut harness);
+    harness.snapshot("flower_panel_bezier");
+
+    // Apply: the patch meshed at the remesh edge replaces the mesh, the
+    // maps stay, one undo step.
+    click_settled(&mut harness, "Apply net");
+    let app = harness.state();
+    let applied = &app.project().flower.templates[index];
+    let edge = anthesis_bud::quality(&made.mesh).mean_edge;
+    let expected =
+        anthesis_bud::build_organ(&net, &anthesis_bud::RemeshOptions::new(edge)).expect("meshes");
+    assert_eq!(applied.mesh, expected.mesh);
+    assert_ne!(applied.mesh, made.mesh);
+    assert_eq!(applied.maps, made.maps);
+    assert_eq!(
+        app.document().undo_label(),
+        Some("Bézier net of bezier petal")
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(harness.state().project().flower.templates[index], made);
+}

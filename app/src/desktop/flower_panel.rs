@@ -637,6 +637,39 @@ pub fn flower_ui(
                 Err(error) => outcomes.push(Outcome::Refused(error.to_string())),
             }
         }
+        if ui
+            .button("New Bézier petal")
+            .on_hover_text(
+                "A new template from a 4×4 Bézier control net (edit it under Shape) with uniform \
+                 growth maps, and one organ of it",
+            )
+            .clicked()
+        {
+            let net = anthesis_bud::BezierPatch::petal();
+            let edge = anthesis_garden::five_petal::SIMPLE_PETAL_EDGE
+                * anthesis_garden::flowers::EDGE_SCALE;
+            match anthesis_bud::build_organ(&net, &anthesis_bud::RemeshOptions::new(edge)) {
+                Ok(bud) => {
+                    let template = anthesis_garden::five_petal::simple_template_of_mesh(
+                        "bezier petal",
+                        bud.mesh,
+                    );
+                    match flower.with_template_and_organ(template) {
+                        Ok(added) => {
+                            let index = added.templates.len() - 1;
+                            let name = added.templates[index].name.clone();
+                            state.shape.nets.insert(name.clone(), net);
+                            state.shape.template = index;
+                            state.shape.edge = None;
+                            state.shape.open_now = true;
+                            outcomes.push(Outcome::Edit(format!("add template {name}"), added));
+                        }
+                        Err(error) => outcomes.push(Outcome::Refused(error.to_string())),
+                    }
+                }
+                Err(error) => outcomes.push(Outcome::Refused(error.to_string())),
+            }
+        }
         let source = state
             .new_organ_template
             .min(flower.templates.len().saturating_sub(1));

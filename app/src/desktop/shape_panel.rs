@@ -8,12 +8,14 @@
 //! thread of its own and the section shows the answer when it comes.
 //! Accepting is one [`ProjectEdit::Mesh`].
 
+use std::collections::BTreeMap;
 use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
-use anthesis_bud::{Bud, BudError, MeshQuality, RemeshOptions};
+use anthesis_bud::{BezierPatch, Bud, BudError, MeshQuality, RemeshOptions};
 use anthesis_flower::Flower;
 use anthesis_mesh::Mesh;
-use eframe::egui::{self, DragValue, RichText};
+use eframe::egui::{self, Color32, DragValue, RichText};
+use glam::DVec3;
 
 use super::command::{Command, ProjectEdit};
 
@@ -38,9 +40,39 @@ pub struct ShapeState {
     current: Option<(u64, MeshQuality)>,
     /// Open the section in the next frame (a template was just made).
     pub(super) open_now: bool,
+    /// The Bézier nets of templates made from one, by template name, as
+    /// edited (applied to the mesh with "Apply net").
+    pub(super) nets: BTreeMap<String, BezierPatch>,
+    /// The control point being edited: row (base to tip), column.
+    point: (usize, usize),
+    /// Edit each point alone (off: its mirror image about the midrib
+    /// follows).
+    asymmetric: bool,
+    /// The 2D view looks from the side (z, y) instead of the front (x, y).
+    side_view: bool,
+    /// Where the control points were drawn in the last frame.
+    on_screen: Option<[[egui::Pos2; 4]; 4]>,
+    /// Why the net could not be meshed.
+    net_error: Option<String>,
 }
 
 impl ShapeState {
+    /// The Bézier net of the template named `name`, as edited.
+    pub fn net(&self, name: &str) -> Option<&BezierPatch> {
+        self.nets.get(name)
+    }
+
+    /// Where control point `(row, column)` was drawn in the 2D view.
+    pub fn control_point_on_screen(&self, row: usize, column: usize) -> Option<egui::Pos2> {
+        self.on_screen
+            .and_then(|p| p.get(row).and_then(|r| r.get(column)).copied())
+    }
+
+    /// Why the net could not be meshed, if it could not.
+    pub fn net_error(&self) -> Option<&str> {
+        self.net_error.as_deref()
+    }
+
     /// The template the section shows.
     pub fn template(&self) -> usize {
         self.template
@@ -114,25 +146,27 @@ fn shape_rows(
     state: &mut ShapeState,
     commands: &mut Vec<Command>,
 ) {
-    state.template = state.template.min(flower.templates.len() - 1);
+    // Not written back when clamped: a template added this frame is in
+    // the flower from the next one.
+    let before = state.template.min(flower.templates.len() - 1);
+    let mut index = before;
     ui.horizontal(|ui| {
         let label = ui.label("template").id;
-        let selected = flower.templates[state.template].name.as_str();
-        let before = state.template;
+        let selected = flower.templates[index].name.as_str();
         egui::ComboBox::from_id_salt("shape template")
             .selected_text(selected)
             .show_ui(ui, |ui| {
                 for (i, t) in flower.templates.iter().enumerate() {
-                    ui.selectable_value(&mut state.template, i, &t.name);
+                    ui.selectable_value(&mut index, i, &t.name);
                 }
             })
             .response
             .labelled_by(label);
-        if state.template != before {
-            state.edge = None;
-        }
     });
-    let index = state.template;
+    if index != before {
+        state.template = index;
+        state.edge = None;
+    }
     let template = &flower.templates[index];
     let mesh = &template.mesh;
     let print = fingerprint(mesh);
@@ -254,5 +288,191 @@ fn shape_rows(
         Some(Preview::Waiting(_)) | None => {
             ui.label("remeshing…");
         }
+    }
+    if let Some(net) = state.nets.get(&template.name).copied() {
+        ui.separator();
+        bezier_ui(ui, (index, &template.name), net, edge, state, commands);
+    } else {
+        state.on_screen = None;
+    }
+}
+
+/// The names of a net's rows, base to tip.
+const ROW_NAMES: [&str; 4] = ["base", "lower", "upper", "tip"];
+
+/// The Bézier net editor of template `index` (named `name`): the net in a
+/// 2D view (front or side) whose points can be dragged, the chosen point's
+/// coordinates typed in, and "Apply net", which meshes the patch at
+/// `edge` and replaces the template's mesh (one undo step; the maps stay).
+fn bezier_ui(
+    ui: &mut egui::Ui,
+    (index, name): (usize, &str),
+    mut net: BezierPatch,
+    edge: f64,
+    state: &mut ShapeState,
+    commands: &mut Vec<Command>,
+) {
+    ui.strong("Bézier net").on_hover_text(
+        "The 4×4 control net of the bicubic patch: rows from the base to the tip, columns \
+         across (the midrib between the middle two). Drag a point in the view or type its \
+         coordinates; Apply net remeshes the petal at the remesh edge above.",
+    );
+    let before = net;
+    let mut symmetric = !state.asymmetric;
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut symmetric, "symmetric about the midrib")
+            .on_hover_text("A point's mirror image across the midrib moves with it");
+        ui.selectable_value(&mut state.side_view, false, "front")
+            .on_hover_text("Looking at the inner side: x across, y from base to tip");
+        ui.selectable_value(&mut state.side_view, true, "side")
+            .on_hover_text("From the side: z (inner side to the left), y from base to tip");
+    });
+    state.asymmetric = !symmetric;
+    let (row, column) = state.point;
+
+    // The 2D view.
+    let across = |p: DVec3, side: bool| if side { p.z } else { p.x };
+    let side = state.side_view;
+    let (mut low, mut high) = (
+        glam::DVec2::splat(f64::INFINITY),
+        glam::DVec2::splat(f64::NEG_INFINITY),
+    );
+    for p in net.control.iter().flatten() {
+        let q = glam::DVec2::new(across(*p, side), p.y);
+        low = low.min(q);
+        high = high.max(q);
+    }
+    let size = egui::vec2(ui.available_width().max(120.0), 220.0);
+    let (response, painter) = ui.allocate_painter(size, egui::Sense::hover());
+    let rect = response.rect.shrink(14.0);
+    let extent = (high - low).max(glam::DVec2::splat(1e-6));
+    let scale = (f64::from(rect.width()) / extent.x).min(f64::from(rect.height()) / extent.y);
+    let middle = (low + high) * 0.5;
+    let to_screen = |p: DVec3| {
+        let q = glam::DVec2::new(across(p, side), p.y) - middle;
+        egui::pos2(
+            rect.center().x + (q.x * scale) as f32,
+            rect.center().y - (q.y * scale) as f32,
+        )
+    };
+    painter.rect_filled(response.rect, 4.0, ui.visuals().extreme_bg_color);
+    let line = egui::Stroke::new(1.0, ui.visuals().weak_text_color());
+    let points = net.control.map(|r| r.map(to_screen));
+    for j in 0..4 {
+        for i in 0..4 {
+            if i < 3 {
+                painter.line_segment([points[j][i], points[j][i + 1]], line);
+            }
+            if j < 3 {
+                painter.line_segment([points[j][i], points[j + 1][i]], line);
+            }
+        }
+    }
+    // The midrib plane in the front view.
+    if !side {
+        let x = to_screen(DVec3::ZERO).x;
+        painter.line_segment(
+            [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
+            egui::Stroke::new(1.0, Color32::from_rgb(90, 140, 90)),
+        );
+    }
+    let mut moved = None;
+    for (j, r) in points.iter().enumerate() {
+        for (i, at) in r.iter().enumerate() {
+            let id = ui.scope_id().with(("bezier point", j, i));
+            let hit = ui.interact(
+                egui::Rect::from_center_size(*at, egui::vec2(14.0, 14.0)),
+                id,
+                egui::Sense::click_and_drag(),
+            );
+            if hit.clicked() || hit.drag_started() {
+                state.point = (j, i);
+            }
+            if hit.dragged() {
+                let d = hit.drag_delta();
+                let delta = glam::DVec2::new(f64::from(d.x), -f64::from(d.y)) / scale;
+                let p = net.control[j][i];
+                let q = if side {
+                    DVec3::new(p.x, p.y + delta.y, p.z + delta.x)
+                } else {
+                    DVec3::new(p.x + delta.x, p.y + delta.y, p.z)
+                };
+                moved = Some((j, i, q));
+            }
+            let chosen = state.point == (j, i);
+            let colour = if chosen {
+                Color32::from_rgb(255, 170, 40)
+            } else {
+                ui.visuals().strong_text_color()
+            };
+            painter.circle_filled(*at, if chosen { 5.0 } else { 4.0 }, colour);
+        }
+    }
+    state.on_screen = Some(points);
+    if let Some((j, i, q)) = moved {
+        net = net.with_point(j, i, q, symmetric);
+    }
+
+    // The chosen point's coordinates.
+    ui.horizontal(|ui| {
+        let label = ui.label("control point").id;
+        egui::ComboBox::from_id_salt("bezier point")
+            .selected_text(format!("{} row, column {}", ROW_NAMES[row], column + 1))
+            .show_ui(ui, |ui| {
+                for (j, name) in ROW_NAMES.iter().enumerate() {
+                    for i in 0..4 {
+                        ui.selectable_value(
+                            &mut state.point,
+                            (j, i),
+                            format!("{name} row, column {}", i + 1),
+                        );
+                    }
+                }
+            })
+            .response
+            .labelled_by(label);
+    });
+    let (row, column) = state.point;
+    let mut p = net.control[row][column];
+    let mut typed = false;
+    ui.horizontal(|ui| {
+        for (axis, value) in [("x", &mut p.x), ("y", &mut p.y), ("z", &mut p.z)] {
+            let label = ui.label(axis).id;
+            typed |= ui
+                .add(DragValue::new(value).speed(0.05).max_decimals(3))
+                .labelled_by(label)
+                .changed();
+        }
+    });
+    if typed {
+        net = net.with_point(row, column, p, symmetric);
+    }
+    if net != before {
+        state.nets.insert(name.to_string(), net);
+    }
+
+    if ui
+        .button("Apply net")
+        .on_hover_text(
+            "Mesh the patch at the remesh edge and use it for the template (one undo step)",
+        )
+        .clicked()
+    {
+        match anthesis_bud::build_organ(&net, &RemeshOptions::new(edge)) {
+            Ok(bud) => {
+                state.net_error = None;
+                commands.push(Command::Edit {
+                    label: format!("Bézier net of {name}"),
+                    edit: ProjectEdit::Mesh {
+                        template: index,
+                        mesh: Box::new(bud.mesh),
+                    },
+                });
+            }
+            Err(e) => state.net_error = Some(format!("cannot mesh the net: {e}")),
+        }
+    }
+    if let Some(error) = &state.net_error {
+        ui.label(RichText::new(error).color(ui.visuals().error_fg_color));
     }
 }

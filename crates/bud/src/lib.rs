@@ -30,12 +30,14 @@
 pub mod dynamic;
 mod examples;
 mod from_mesh;
+mod net;
 mod quality;
 mod remesh;
 mod surface;
 
 pub use examples::{eustoma_petal_surface, lily_petal_surface};
 pub use from_mesh::{MeshSurface, remesh_mesh};
+pub use net::mirrored;
 pub use quality::{MeshQuality, find_self_intersection, quality};
 pub use surface::{BezierCurve, BezierPatch, MAX_STRETCH_TO_BEND, PdeSweep, Surface, bernstein3};
 
