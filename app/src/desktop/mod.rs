@@ -408,8 +408,9 @@ impl AnthesisApp {
     /// marked stale, until the new run reaches it; only when nothing is
     /// shown yet does the view follow the new keyframes. `dragging`: the
     /// pointer is down, so the edit is not finished yet; the time until a
-    /// finished edit's result is on screen is measured and logged.
-    fn start_run(&mut self, dragging: bool) {
+    /// finished edit's result is on screen is measured and logged. `clock`:
+    /// the frame clock (egui's input time) the restarts are paced on.
+    fn start_run(&mut self, dragging: bool, clock: f64) {
         let selection = self.selection();
         let project = self.resolved_project();
         // A run too large for the memory would be killed by the kernel,
@@ -438,6 +439,7 @@ impl AnthesisApp {
             !dragging && edited,
             dragging,
             std::time::Instant::now(),
+            clock,
         );
         if self.session.is_live() && self.session.shown_end().is_none() {
             self.playback.follow = true;
@@ -451,9 +453,10 @@ impl AnthesisApp {
             return;
         }
         let dragging = ctx.input(|i| i.pointer.any_down());
-        let wait = self.rerun.wait(dragging, std::time::Instant::now());
+        let clock = ctx.input(|i| i.time);
+        let wait = self.rerun.wait(dragging, clock);
         if wait.is_zero() {
-            self.start_run(dragging);
+            self.start_run(dragging, clock);
         } else {
             ctx.request_repaint_after(wait);
         }

@@ -21,8 +21,11 @@ pub const RESTART_EVERY_WHILE_DRAGGING: Duration = Duration::from_millis(100);
 /// Restart pacing and the edit latency being measured.
 #[derive(Debug, Default)]
 pub struct Rerun {
-    /// When the last run started.
-    last_start: Option<Instant>,
+    /// When the last run started, on the frame clock (egui's input time in
+    /// seconds: wall time in the window, the stepped time of a test
+    /// harness, so the pacing does not depend on how fast frames are
+    /// drawn).
+    last_start: Option<f64>,
     /// The run that will show the last finished edit, and when that edit
     /// finished.
     waiting: Option<(RunId, Instant)>,
@@ -32,22 +35,32 @@ pub struct Rerun {
 }
 
 impl Rerun {
-    /// How long a wanted run must still wait: zero when the pointer is up
-    /// (`dragging` false) or the last run started long enough ago.
-    pub fn wait(&self, dragging: bool, now: Instant) -> Duration {
+    /// How long a wanted run must still wait at frame-clock time `clock`:
+    /// zero when the pointer is up (`dragging` false) or the last run
+    /// started long enough ago.
+    pub fn wait(&self, dragging: bool, clock: f64) -> Duration {
         match self.last_start {
             Some(last) if dragging => {
-                RESTART_EVERY_WHILE_DRAGGING.saturating_sub(now.saturating_duration_since(last))
+                let since = Duration::try_from_secs_f64(clock - last).unwrap_or(Duration::ZERO);
+                RESTART_EVERY_WHILE_DRAGGING.saturating_sub(since)
             }
             _ => Duration::ZERO,
         }
     }
 
-    /// Notes that `run` started at `now`. `finished_edit`: it is the run of
-    /// an edit the user has finished (pointer up) over a result already on
-    /// screen, so its latency is measured. `dragging`: the pointer is down.
-    pub fn started(&mut self, run: RunId, finished_edit: bool, dragging: bool, now: Instant) {
-        self.last_start = Some(now);
+    /// Notes that `run` started at `now` (frame-clock time `clock`).
+    /// `finished_edit`: it is the run of an edit the user has finished
+    /// (pointer up) over a result already on screen, so its latency is
+    /// measured. `dragging`: the pointer is down.
+    pub fn started(
+        &mut self,
+        run: RunId,
+        finished_edit: bool,
+        dragging: bool,
+        now: Instant,
+        clock: f64,
+    ) {
+        self.last_start = Some(clock);
         self.started_while_dragging = dragging.then_some(run);
         if finished_edit {
             self.waiting = Some((run, now));
@@ -98,15 +111,18 @@ mod tests {
 
     #[test]
     fn runs_wait_only_while_dragging_and_only_after_a_recent_start() {
-        let t0 = Instant::now();
         let mut rerun = Rerun::default();
-        assert_eq!(rerun.wait(true, t0), Duration::ZERO, "the first dab runs");
-        rerun.started(1, false, true, t0);
-        let later = t0 + Duration::from_millis(30);
-        assert_eq!(rerun.wait(true, later), Duration::from_millis(70));
-        assert_eq!(rerun.wait(false, later), Duration::ZERO, "release runs");
-        let much_later = t0 + Duration::from_millis(250);
-        assert_eq!(rerun.wait(true, much_later), Duration::ZERO);
+        assert_eq!(rerun.wait(true, 2.0), Duration::ZERO, "the first dab runs");
+        rerun.started(1, false, true, Instant::now(), 2.0);
+        let wait = rerun.wait(true, 2.03);
+        assert!(
+            (wait.as_secs_f64() - 0.07).abs() < 1e-9,
+            "{wait:?} after 30 ms"
+        );
+        assert_eq!(rerun.wait(false, 2.03), Duration::ZERO, "release runs");
+        assert_eq!(rerun.wait(true, 2.25), Duration::ZERO);
+        // A clock that went back (a new harness) waits at most the pace.
+        assert!(rerun.wait(true, 1.0) <= RESTART_EVERY_WHILE_DRAGGING);
     }
 }
 
@@ -129,7 +145,7 @@ mod release_tests {
         for dab in 0..3 {
             let run = session.start(Arc::clone(&project), Selection::All);
             let at = t0 + Duration::from_millis(150 * dab);
-            rerun.started(run, false, true, at);
+            rerun.started(run, false, true, at, 0.15 * dab as f64);
         }
         let released_at = t0 + Duration::from_millis(400);
         rerun.released(false, released_at);
@@ -137,10 +153,10 @@ mod release_tests {
 
         // With an edit left to run, the run started at release is measured.
         let run = session.start(Arc::clone(&project), Selection::All);
-        rerun.started(run, false, true, released_at);
+        rerun.started(run, false, true, released_at, 0.4);
         rerun.released(true, released_at);
         let next = session.start(project, Selection::All);
-        rerun.started(next, true, false, released_at);
+        rerun.started(next, true, false, released_at, 0.4);
         assert_eq!(rerun.waiting, Some((next, released_at)));
     }
 }
