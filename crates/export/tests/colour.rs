@@ -29,6 +29,7 @@ fn template(name: &str, color: [f32; 4], colouring: Option<Colouring>) -> Templa
         joint_schedule: Vec::new(),
         color,
         colouring,
+        two_state: None,
     }
 }
 

@@ -166,6 +166,7 @@ mod tests {
             joint_schedule: Vec::new(),
             color: [1.0, 0.0, 0.0, 1.0],
             colouring,
+            two_state: None,
         }
     }
 

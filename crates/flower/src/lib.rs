@@ -58,6 +58,50 @@ pub struct Template {
     /// A second colour painted over `color` with a mix map ([`Colouring`]);
     /// `None`: the organ is `color` all over.
     pub colouring: Option<Colouring>,
+    /// `Some`: the template's organs are not grown but animated from the
+    /// bud (`mesh`) to an open shape by the two-state blossom
+    /// (`anthesis-twostate`); the maps, `dg` and stiffness are then unused.
+    pub two_state: Option<TwoStateAnimation>,
+}
+
+/// A two-state animation (`sketch-based-floral-blossom.txt` §4): the
+/// template's organs go from the bud (the template mesh) to `open` along
+/// the growth function G(t; g, T) and the velocity curve, instead of
+/// growing. Organs of such a template are kinematic in a run: placed like
+/// any organ, obstacles to the growing organs, never pushed by them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoStateAnimation {
+    /// The open shape: the template mesh's vertices moved (same order,
+    /// triangles and UVs), in the template frame and the project's units.
+    pub open: Vec<DVec3>,
+    /// `g` and `T` of eq. (4); `T` (`duration`) is in keyframes.
+    pub growth: anthesis_twostate::GrowthFunction,
+    /// How the cells' growth directions turn over time.
+    pub velocity: anthesis_twostate::VelocityCurve,
+}
+
+impl TwoStateAnimation {
+    /// An animation to `open` reaching it at keyframe `keyframes` (g = 6,
+    /// the velocity curve following the growth function).
+    pub fn new(open: Vec<DVec3>, keyframes: u32) -> TwoStateAnimation {
+        TwoStateAnimation {
+            open,
+            growth: anthesis_twostate::GrowthFunction {
+                g: 6.0,
+                duration: f64::from(keyframes.max(1)),
+            },
+            velocity: anthesis_twostate::VelocityCurve::FollowGrowth,
+        }
+    }
+
+    /// The open shape as a mesh: `bud`'s triangles and UVs at `open`.
+    pub fn open_mesh(&self, bud: &Mesh) -> Mesh {
+        Mesh {
+            positions: self.open.clone(),
+            uvs: bud.uvs.clone(),
+            triangles: bud.triangles.clone(),
+        }
+    }
 }
 
 /// The base particles: those whose UV lies in this region.

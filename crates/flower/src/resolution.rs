@@ -141,8 +141,12 @@ pub fn resolve(project: &Project) -> Result<Project, ResolutionError> {
     let mut resolved = project.clone();
     resolved.settings.resolution = Resolution::AsBuilt;
     if let Resolution::MeanEdge(edge) = project.settings.resolution {
+        // A two-state template keeps its mesh: its open shape has that
+        // mesh's vertices, which a remesh would not keep.
         for template in &mut resolved.flower.templates {
-            template.mesh = remesh_template(template, edge)?;
+            if template.two_state.is_none() {
+                template.mesh = remesh_template(template, edge)?;
+            }
         }
     }
     Ok(resolved)
@@ -191,6 +195,7 @@ mod tests {
             joint_schedule: Vec::new(),
             color: [1.0; 4],
             colouring: None,
+            two_state: None,
         }
     }
 

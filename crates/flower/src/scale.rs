@@ -431,6 +431,7 @@ mod tests {
             joint_schedule: Vec::new(),
             color: [1.0; 4],
             colouring: None,
+            two_state: None,
         }
     }
 

@@ -108,6 +108,7 @@ fn petal_template() -> Template {
         ],
         color: [0.98, 0.62, 0.32, 1.0],
         colouring: None,
+        two_state: None,
     }
 }
 
@@ -135,6 +136,7 @@ fn sepal_template() -> Template {
         joint_schedule: Vec::new(),
         color: [0.3, 0.55, 0.2, 0.9],
         colouring: None,
+        two_state: None,
     }
 }
 
@@ -437,21 +439,21 @@ fn a_newer_version_says_so() {
     // A newer version may have fields this build does not know: the version
     // error must win over the unknown field.
     edit(&path, |text| {
-        replace_once(text, "version = 2", "version = 7\nwind = \"strong\"")
+        replace_once(text, "version = 2", "version = 8\nwind = \"strong\"")
     });
     let error = load_project(&path).expect_err("newer");
     assert_eq!(
         error,
         ProjectError::NewerVersion {
             path: path.clone(),
-            found: 7,
+            found: 8,
             supported: FORMAT_VERSION,
         }
     );
     assert_eq!(
         error.to_string(),
         format!(
-            "{} was written by a newer Anthesis (format version 7; this build reads up to 6)",
+            "{} was written by a newer Anthesis (format version 8; this build reads up to 7)",
             path.display()
         )
     );

@@ -259,6 +259,7 @@ fn apple_template(
         joint_schedule: Vec::new(),
         color,
         colouring: None,
+        two_state: None,
     }
 }
 

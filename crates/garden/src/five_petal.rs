@@ -102,6 +102,7 @@ pub fn simple_template_of_mesh(name: &str, mesh: anthesis_mesh::Mesh) -> Templat
         joint_schedule: vec![SIMPLE_JOINT],
         color: SIMPLE_PINK,
         colouring: None,
+        two_state: None,
     }
 }
 

@@ -316,6 +316,7 @@ fn template(
         joint_schedule: vec![spec.joint],
         color: spec.color,
         colouring: None,
+        two_state: None,
     })
 }
 

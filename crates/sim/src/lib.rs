@@ -711,25 +711,28 @@ impl Simulation {
         let offset = self.settings.collision_offset;
         for &(inner, outer) in &self.overlaps {
             // Inner particles stay on the outer organ's inner side, outer
-            // particles on the inner organ's outer side.
-            contacts_against(
-                &surfaces[inner],
-                &surfaces[outer],
-                &trackers[outer],
-                1.0,
-                offset,
-                violated,
-                &mut contacts[inner],
-            );
-            contacts_against(
-                &surfaces[outer],
-                &surfaces[inner],
-                &trackers[inner],
-                -1.0,
-                offset,
-                violated,
-                &mut contacts[outer],
-            );
+            // particles on the inner organ's outer side. A kinematic organ
+            // (two-state) gets no contacts and never gives way, so the
+            // organ against it moves all the way, as against a part.
+            for (moving, other, side) in [(inner, outer, 1.0), (outer, inner, -1.0)] {
+                if self.organs[moving].is_kinematic() {
+                    continue;
+                }
+                let violated = if self.organs[other].is_kinematic() {
+                    Violated::MoveAll
+                } else {
+                    violated
+                };
+                contacts_against(
+                    &surfaces[moving],
+                    &surfaces[other],
+                    &trackers[other],
+                    side,
+                    offset,
+                    violated,
+                    &mut contacts[moving],
+                );
+            }
         }
         self.drop_base_contacts(&mut contacts);
         contacts
@@ -748,6 +751,9 @@ impl Simulation {
     fn obstacle_contacts(&self, contacts: &mut [Vec<Contact>]) {
         let offset = self.settings.collision_offset;
         for (organ, list) in self.organs.iter().zip(contacts) {
+            if organ.is_kinematic() {
+                continue;
+            }
             for obstacle in &self.obstacles {
                 let near = organ
                     .positions
@@ -793,6 +799,9 @@ impl Simulation {
             for index in 0..self.overlaps.len() {
                 let (inner, outer) = self.overlaps[index];
                 for (moving, other, side) in [(inner, outer, 1.0), (outer, inner, -1.0)] {
+                    if self.organs[moving].is_kinematic() {
+                        continue;
+                    }
                     let contacts = self.contacts_between(moving, other, side);
                     pushed_in_pass += push_back(
                         &mut self.organs[moving].positions,

@@ -12,6 +12,7 @@ use anthesis_physics::{
     Contact, Elastic, GrowthModel, GrowthRates, Model, NewtonSolver, RegionalGrowth, SolverError,
     SolverSettings, StepReport,
 };
+use anthesis_twostate::TwoState;
 use std::collections::VecDeque;
 use std::sync::Arc;
 
@@ -150,6 +151,10 @@ pub(crate) struct OrganSim {
     /// The current positions as [`OrganSim::save`] stored them, so the next
     /// keyframe's history shares them instead of copying.
     saved: Option<Arc<Vec<DVec3>>>,
+    /// `Some` for an organ of a two-state template: kinematic, its shape at
+    /// each keyframe the two-state in-between (template frame), placed;
+    /// not grown, not solved, never pushed (see [`OrganSim::is_kinematic`]).
+    two_state: Option<TwoState>,
 }
 
 /// What an organ carries from the end of one keyframe into the next: with
@@ -216,7 +221,18 @@ impl OrganSim {
             .map(|k| SampledKey::new(&k.maps, &template.mesh, &topology))
             .collect();
         let key_dg = key_growth_scales(template);
+        let two_state = match &template.two_state {
+            None => None,
+            Some(animation) => {
+                let mut two = TwoState::new(&template.mesh, &animation.open, &base)
+                    .map_err(|e| bad(format!("two_state: {e}")))?;
+                two.growth = animation.growth;
+                two.velocity = animation.velocity.clone();
+                Some(two)
+            }
+        };
         let mut sim = OrganSim {
+            two_state,
             name: organ.name.clone(),
             color: template.color,
             mesh: template.mesh.clone(),
@@ -265,6 +281,10 @@ impl OrganSim {
     /// Regional growth for `step`: new rest lengths, rest angles and
     /// stiffness from the current shape and the maps blended at `step`.
     pub fn grow(&mut self, step: u32) {
+        if self.two_state.is_some() {
+            self.move_to(step);
+            return;
+        }
         self.mean_edge = self.elastic.rest_lengths.iter().sum::<f64>()
             / self.elastic.rest_lengths.len().max(1) as f64;
         let weights = self.key_schedule.weights_at(f64::from(step));
@@ -301,6 +321,41 @@ impl OrganSim {
         self.update_stiffness(step);
         self.solver.begin_keyframe();
         self.predict();
+    }
+
+    /// Whether this organ is kinematic (a two-state template): its
+    /// positions are set by [`OrganSim::grow`] and nothing else moves them.
+    /// Growing organs get contacts against it as against any organ, it
+    /// gets none (it never gives way), like the parts in `obstacle.rs`.
+    pub fn is_kinematic(&self) -> bool {
+        self.two_state.is_some()
+    }
+
+    /// A kinematic organ's shape at `step`: the two-state in-between at
+    /// time `step` (keyframes), placed by the placement and the joint
+    /// schedule like any organ.
+    fn move_to(&mut self, step: u32) {
+        let Some(two) = &self.two_state else {
+            return;
+        };
+        let extra = joint_angle_after(&self.schedule, step);
+        self.positions = two
+            .shape_at(f64::from(step))
+            .into_iter()
+            .map(|p| self.placement.world_from_template(p, extra))
+            .collect();
+        let (sum, count) = self
+            .topology
+            .edges
+            .iter()
+            .map(|e| {
+                let [a, b] = e.vertices;
+                self.positions[a as usize].distance(self.positions[b as usize])
+            })
+            .fold((0.0, 0usize), |(s, n), d| (s + d, n + 1));
+        if count > 0 {
+            self.mean_edge = sum / count as f64;
+        }
     }
 
     /// Starts the keyframe from the shape extrapolated through the last
@@ -392,6 +447,15 @@ impl OrganSim {
         contacts: &[Contact],
         settings: &SolverSettings,
     ) -> Result<StepReport, SolverError> {
+        if self.is_kinematic() {
+            return Ok(StepReport {
+                energy_before: 0.0,
+                energy_after: 0.0,
+                relative_gradient: 0.0,
+                converged: true,
+                step_fraction: 0.0,
+            });
+        }
         self.hold_base(step);
         self.solver
             .step(&self.elastic, contacts, &mut self.positions, settings)
@@ -413,6 +477,9 @@ impl OrganSim {
     /// Applies to the whole organ the rigid motion that best carries its
     /// base particles onto their places on the receptacle at `step`.
     pub fn attach(&mut self, step: u32) {
+        if self.is_kinematic() {
+            return;
+        }
         let extra = joint_angle_after(&self.schedule, step);
         self.base_current.clear();
         self.base_target.clear();
@@ -485,7 +552,12 @@ impl OrganSim {
         self.history.clone_from(&state.history);
     }
 
+    /// The elastic energy (0 for a kinematic organ, which has none: its
+    /// shape is given, not solved).
     pub fn energy(&self) -> f64 {
+        if self.is_kinematic() {
+            return 0.0;
+        }
         self.elastic.energy(&self.positions, &[])
     }
 
@@ -503,6 +575,9 @@ impl OrganSim {
     }
 
     pub fn relative_gradient(&mut self, contacts: &[Contact]) -> f64 {
+        if self.is_kinematic() {
+            return 0.0;
+        }
         self.solver
             .relative_gradient(&self.elastic, contacts, &self.positions)
     }

@@ -72,6 +72,7 @@ fn same_from_the_bud(before: &Project, after: &Project, organs: &[usize]) -> boo
             && old.stretch_stiffness.to_bits() == new.stretch_stiffness.to_bits()
             && old.bend_stiffness.to_bits() == new.bend_stiffness.to_bits()
             && old.base_region == new.base_region
+            && old.two_state == new.two_state
     })
 }
 

@@ -19,6 +19,7 @@ fn template(name: &str) -> Template {
         joint_schedule: Vec::new(),
         color: [1.0; 4],
         colouring: None,
+        two_state: None,
     }
 }
 

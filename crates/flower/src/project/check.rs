@@ -237,6 +237,40 @@ impl Template {
     }
 }
 
+/// What is wrong with a two-state animation of `bud`, if anything.
+fn two_state_problem(
+    animation: &crate::TwoStateAnimation,
+    bud: &anthesis_mesh::Mesh,
+) -> Option<String> {
+    if animation.open.len() != bud.positions.len() {
+        return Some(format!(
+            "the open shape has {} vertices but the template mesh has {}",
+            animation.open.len(),
+            bud.positions.len()
+        ));
+    }
+    if let Some(vertex) = animation.open.iter().position(|p| !p.is_finite()) {
+        return Some(format!(
+            "vertex {} of the open shape is not a finite point",
+            vertex + 1
+        ));
+    }
+    let growth = &animation.growth;
+    if !(growth.g > 0.0 && growth.g.is_finite()) {
+        return Some(format!(
+            "g must be a positive number, found {}",
+            short_number(growth.g)
+        ));
+    }
+    if !(growth.duration > 0.0 && growth.duration.is_finite()) {
+        return Some(format!(
+            "duration (T, in keyframes) must be a positive number, found {}",
+            short_number(growth.duration)
+        ));
+    }
+    animation.velocity.check().err()
+}
+
 fn template_problem(template: &Template) -> Option<String> {
     let positive = |value: f64| value > 0.0 && value.is_finite();
     if !template.dg.is_finite() || template.dg <= -1.0 {
@@ -285,6 +319,11 @@ fn template_problem(template: &Template) -> Option<String> {
             short_number(region.u_min),
             short_number(region.u_max)
         ));
+    }
+    if let Some(animation) = &template.two_state {
+        if let Some(problem) = two_state_problem(animation, &template.mesh) {
+            return Some(format!("two_state: {problem}"));
+        }
     }
     if template.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
         return Some(format!(

@@ -14,13 +14,15 @@ use super::check::{SizeCheck, check_names, check_project, check_unique};
 use super::error::{ProjectError, map_error};
 use super::schema::{
     DirectionEntry, ProjectFile, ScalarEntry, StructureFile, StructureKind, TemplateFile,
+    TwoStateFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::structure::{Arrangement, Spiral, Structure, Whorl};
 use crate::{
     BaseRegion, ColourLayer, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project,
-    Template,
+    Template, TwoStateAnimation,
 };
+use anthesis_twostate::{GrowthFunction, VelocityCurve};
 
 /// The largest project file read, in bytes; a project file names its
 /// meshes and maps, so even a garden of templates is a few kilobytes.
@@ -381,7 +383,12 @@ impl Loader<'_> {
                 )));
             }
         };
+        let two_state = match file.two_state {
+            None => None,
+            Some(two) => Some(self.two_state(two, &mesh, name)?),
+        };
         Ok(Template {
+            two_state,
             name: file.name,
             mesh,
             maps,
@@ -436,12 +443,65 @@ impl Loader<'_> {
         }
     }
 
-    fn mesh(&self, relative: &str, template: &str) -> Result<Mesh, ProjectError> {
-        let (bytes, path) = self.read(
-            relative,
-            FileKind::Mesh,
-            &format!("template \"{template}\": mesh"),
+    /// `[templates.two_state]`: its open mesh read and checked against the
+    /// template's `bud` (same vertices and triangles), its numbers checked.
+    fn two_state(
+        &self,
+        file: TwoStateFile,
+        bud: &Mesh,
+        template: &str,
+    ) -> Result<TwoStateAnimation, ProjectError> {
+        let (open, path) = self.mesh_entry(
+            &file.open_mesh,
+            &format!("template \"{template}\": two_state.open_mesh"),
         )?;
+        let shown = path.display();
+        let invalid = |message: String| {
+            self.invalid(format!(
+                "template \"{template}\": the open shape {shown} {message}"
+            ))
+        };
+        if open.positions.len() != bud.positions.len() {
+            return Err(invalid(format!(
+                "has {} vertices but the template mesh has {}; it must be the template mesh \
+                 moved (same vertices in the same order)",
+                open.positions.len(),
+                bud.positions.len()
+            )));
+        }
+        if let Some(t) = (0..bud.triangles.len().max(open.triangles.len()))
+            .find(|&t| bud.triangles.get(t) != open.triangles.get(t))
+        {
+            return Err(invalid(format!(
+                "differs from the template mesh at triangle {} ({} triangles against {}); it \
+                 must have the template mesh's triangles in the same order",
+                t + 1,
+                open.triangles.len(),
+                bud.triangles.len()
+            )));
+        }
+        let velocity = match file.velocity {
+            None => VelocityCurve::FollowGrowth,
+            Some(points) => VelocityCurve::Points(points),
+        };
+        Ok(TwoStateAnimation {
+            open: open.positions,
+            growth: GrowthFunction {
+                g: file.g,
+                duration: file.duration,
+            },
+            velocity,
+        })
+    }
+
+    fn mesh(&self, relative: &str, template: &str) -> Result<Mesh, ProjectError> {
+        self.mesh_entry(relative, &format!("template \"{template}\": mesh"))
+            .map(|(mesh, _)| mesh)
+    }
+
+    /// A mesh named at `entry`, and the path shown for it.
+    fn mesh_entry(&self, relative: &str, entry: &str) -> Result<(Mesh, PathBuf), ProjectError> {
+        let (bytes, path) = self.read(relative, FileKind::Mesh, entry)?;
         let parsed = match String::from_utf8(bytes) {
             Ok(text) => anthesis_mesh::parse_obj_file(&text),
             Err(_) => Err(MeshError::Io("the file is not UTF-8 text".to_string())),
@@ -454,7 +514,7 @@ impl Loader<'_> {
         for warning in file.warnings {
             warnings.push(format!("{}: {warning}", path.display()));
         }
-        Ok(file.mesh)
+        Ok((file.mesh, path))
     }
 
     fn scalar_map(

@@ -45,6 +45,18 @@
 //! base_region = { v_max = 0.06 }            # optional: v_max 0.05, u_min 0, u_max 1
 //! joint_schedule = [{ from_step = 0, to_step = 60, degrees = 23.0 }]  # optional
 //!
+//! [templates.two_state]        # optional (version 7): the organs are not
+//!                              # grown but go from the mesh (the bud) to this
+//!                              # open shape by the two-state blossom
+//! open_mesh = "meshes/petal.open.obj"  # the mesh's vertices moved (same order
+//!                              # and triangles), in the template frame
+//! g = 6.0                      # optional: g of G(t; g, T), eq. (4); 6 ends
+//!                              # at the open shape
+//! duration = 100.0             # T, in keyframes
+//! velocity = [[0.0, 0.0], [0.5, 0.8], [1.0, 1.0]]  # optional: [t / T,
+//!                              # fraction] of the directions' turn; absent:
+//!                              # it follows G
+//!
 //! [[templates.keys]]
 //! step = 40
 //! e_growth = "maps/petal-step40-e_growth.png"   # a PNG, or a number
@@ -189,7 +201,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 6;
+pub const FORMAT_VERSION: u32 = 7;
 
 /// Checks `project` by the rules every loaded or saved project obeys
 /// (names, counts, numbers, parts), as the app does before it takes an

@@ -187,6 +187,7 @@ mod tests {
             joint_schedule: Vec::new(),
             color: [1.0, 0.5, 0.5, 1.0],
             colouring: None,
+            two_state: None,
         };
         Project {
             name: name.into(),

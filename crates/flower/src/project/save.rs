@@ -10,11 +10,12 @@ use super::error::{ProjectError, map_error};
 use super::schema::{
     BaseRegionFile, BlendFile, ColourLayerFile, DirectionEntry, JointRampFile, KeyFile,
     LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SpiralFile,
-    StructureFile, StructureKind, TemplateFile, WhorlFile,
+    StructureFile, StructureKind, TemplateFile, TwoStateFile, WhorlFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
 use crate::structure::{Arrangement, Structure};
 use crate::{Project, Resolution, Template};
+use anthesis_twostate::VelocityCurve;
 
 /// The files of a saved project: the TOML text and the meshes and maps, by
 /// path relative to the project file.
@@ -87,15 +88,19 @@ pub(super) fn plan_save(
 /// everything it sets, so a project that sets nothing new stays readable by
 /// older builds and saves byte for byte as before (version 3 added
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
-/// `[[parts]]`, colour maps, version 6 a key's own `dg`).
+/// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
+/// `[templates.two_state]`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
+    if flower.templates.iter().any(|t| t.two_state.is_some()) {
+        return FORMAT_VERSION;
+    }
     let key_dg = flower
         .templates
         .iter()
         .any(|t| t.maps.keys().iter().any(|k| k.dg.is_some()));
     if key_dg {
-        return FORMAT_VERSION;
+        return 6;
     }
     if !flower.parts.is_empty() {
         return 5;
@@ -210,6 +215,23 @@ pub(super) fn template_file(
         }
     };
 
+    let two_state = template.two_state.as_ref().map(|animation| {
+        // A stem never holds a dot, so no template's files clash with this.
+        let open_mesh = format!("{MESH_FOLDER}/{stem}.open.obj");
+        files.push((
+            open_mesh.clone(),
+            anthesis_mesh::obj_string(&animation.open_mesh(&template.mesh)).into_bytes(),
+        ));
+        TwoStateFile {
+            open_mesh,
+            g: animation.growth.g,
+            duration: animation.growth.duration,
+            velocity: match &animation.velocity {
+                VelocityCurve::FollowGrowth => None,
+                VelocityCurve::Points(points) => Some(points.clone()),
+            },
+        }
+    });
     let region = &template.base_region;
     Ok(TemplateFile {
         name: template.name.clone(),
@@ -233,6 +255,7 @@ pub(super) fn template_file(
             .iter()
             .map(JointRampFile::from)
             .collect(),
+        two_state,
         keys,
     })
 }

@@ -180,7 +180,32 @@ pub(super) struct TemplateFile {
     pub(super) base_region: BaseRegionFile,
     #[serde(default)]
     pub(super) joint_schedule: Vec<JointRampFile>,
+    /// Version 7: animated from two shapes instead of grown.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) two_state: Option<TwoStateFile>,
     pub(super) keys: Vec<KeyFile>,
+}
+
+/// `[templates.two_state]`: the open shape and the timing of a template
+/// animated by the two-state blossom (version 7).
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TwoStateFile {
+    /// An OBJ with the template mesh's vertices (same order) and triangles.
+    pub(super) open_mesh: String,
+    /// The growth rate g of eq. (4) (6 ends at the open shape).
+    #[serde(default = "default_g")]
+    pub(super) g: f64,
+    /// T of eq. (4), in keyframes.
+    pub(super) duration: f64,
+    /// The velocity curve's `[time / T, fraction]` points; absent: it
+    /// follows the growth function.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) velocity: Option<Vec<[f64; 2]>>,
+}
+
+fn default_g() -> f64 {
+    6.0
 }
 
 /// `[[templates.colour_layers]]`: a colour and where it shows.
