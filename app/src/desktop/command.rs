@@ -47,6 +47,8 @@ pub enum Command {
     BrowseExportPath,
     /// Ask for an OBJ mesh to make a new template of.
     BrowseTemplateObj,
+    /// Ask for an OBJ to use as this template's open shape (two-state).
+    BrowseOpenShape(usize),
     /// A file dialog (native or the in-app browser) answered: the path
     /// chosen for `purpose`, or `None` when cancelled.
     FileChosen {
@@ -267,6 +269,9 @@ impl AnthesisApp {
             Command::OpenExportDialog => self.open_export(),
             Command::BrowseExportPath => self.ask_for_path(DialogPurpose::ExportGlb),
             Command::BrowseTemplateObj => self.ask_for_path(DialogPurpose::ImportTemplateObj),
+            Command::BrowseOpenShape(template) => {
+                self.ask_for_path(DialogPurpose::OpenShape(template));
+            }
             Command::FileChosen { purpose, path } => self.file_chosen(purpose, path),
             Command::StartExport => self.start_export(),
             Command::Undo => self.undo(),

@@ -36,6 +36,8 @@ pub enum DialogPurpose {
     ExportGlb,
     /// An OBJ mesh to make a new template of (the Flower panel).
     ImportTemplateObj,
+    /// An OBJ as the open shape of this template (two-state).
+    OpenShape(usize),
 }
 
 impl DialogPurpose {
@@ -45,13 +47,16 @@ impl DialogPurpose {
             DialogPurpose::SaveProjectAs => "Save the project as",
             DialogPurpose::ExportGlb => "Export the animation (.glb, .usda, .usdc or .gif)",
             DialogPurpose::ImportTemplateObj => "Import an OBJ mesh as a new template",
+            DialogPurpose::OpenShape(_) => "Open shape: an OBJ of the template mesh moved",
         }
     }
 
     /// The file name offered when saving.
     fn suggested_name(self) -> Option<&'static str> {
         match self {
-            DialogPurpose::OpenProject | DialogPurpose::ImportTemplateObj => None,
+            DialogPurpose::OpenProject
+            | DialogPurpose::ImportTemplateObj
+            | DialogPurpose::OpenShape(_) => None,
             DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml"),
             DialogPurpose::ExportGlb => Some("flower.glb"),
         }
@@ -64,6 +69,7 @@ impl DialogPurpose {
             DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => &[PROJECT_EXTENSION],
             DialogPurpose::ExportGlb => &["glb", "usda", "usdc", "usd", "gif"],
             DialogPurpose::ImportTemplateObj => &["obj"],
+            DialogPurpose::OpenShape(_) => &["obj"],
         }
     }
 }
@@ -201,9 +207,9 @@ impl Dialogs {
                 .is_some_and(|e| extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
         });
         let mut browser = match purpose {
-            DialogPurpose::OpenProject | DialogPurpose::ImportTemplateObj => {
-                egui_file::FileDialog::open_file()
-            }
+            DialogPurpose::OpenProject
+            | DialogPurpose::ImportTemplateObj
+            | DialogPurpose::OpenShape(_) => egui_file::FileDialog::open_file(),
             DialogPurpose::SaveProjectAs | DialogPurpose::ExportGlb => {
                 egui_file::FileDialog::save_file()
             }
@@ -268,6 +274,9 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
     match purpose {
         DialogPurpose::OpenProject => dialog
             .add_filter("Anthesis project", purpose.extensions())
+            .pick_file(),
+        DialogPurpose::OpenShape(_) => dialog
+            .add_filter("OBJ mesh", purpose.extensions())
             .pick_file(),
         DialogPurpose::SaveProjectAs => dialog
             .add_filter("Anthesis project", purpose.extensions())

@@ -32,6 +32,7 @@ pub mod resolution;
 pub mod session;
 pub mod shape_panel;
 pub mod timeline;
+pub mod two_state;
 pub mod viewport;
 
 use std::path::PathBuf;

@@ -69,17 +69,37 @@ impl AnthesisApp {
         }
         let template = self.selected_template();
         let resolved = self.resolved_project();
+        let viewed = self.viewed_organ();
         egui::ScrollArea::vertical()
             .id_salt("parameters")
             .show(ui, |ui| {
-                chosen.extend(params::parameters_ui(
+                chosen.extend(params::parameters_ui_viewing(
                     ui,
                     self.doc.project(),
                     &resolved,
                     template,
+                    viewed.as_ref(),
                 ));
             });
         self.queued.extend(chosen);
+    }
+
+    /// The selected organ's shape at the keyframe shown (the playhead
+    /// rounded to the nearest computed keyframe), when the run has it.
+    fn viewed_organ(&self) -> Option<super::two_state::ViewedOrgan> {
+        let organ = self.selected_organ();
+        let slot = self.session.organs().iter().position(|&o| o == organ)?;
+        let wanted = self.playback.time_in_keyframes.round().max(0.0) as u32;
+        let keyframe = self
+            .session
+            .keyframes()
+            .iter()
+            .find(|k| k.index == wanted)?;
+        Some(super::two_state::ViewedOrgan {
+            organ,
+            keyframe: keyframe.index,
+            positions_in_world: keyframe.positions_in_world.get(slot)?.clone(),
+        })
     }
 
     /// The timeline panel (the playhead is scrubbed directly; buttons

@@ -1,6 +1,7 @@
 //! The parameters panel: the selected organ's template (dg, thickness,
 //! Ks, Kb, joint schedule, base region, base and second colour), the
-//! project's keyframe count and
+//! project's keyframe count, the two-state opening (g, T, the velocity
+//! curve and their plot; [`super::two_state`]) and
 //! its resolution (with the particles each organ gets), each with a tooltip
 //! saying what it does. An edit becomes a [`Command::Edit`], so each is
 //! undoable and restarts the simulation.
@@ -10,6 +11,7 @@ use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOR, JointRamp, Project, Resol
 use eframe::egui::{self, DragValue};
 
 use super::command::{Command, ProjectEdit};
+use super::two_state::{ViewedOrgan, two_state_ui};
 
 /// A labelled number row; returns whether it changed.
 fn number(
@@ -43,6 +45,18 @@ pub fn parameters_ui(
     project: &Project,
     resolved: &Project,
     template: usize,
+) -> Option<Command> {
+    parameters_ui_viewing(ui, project, resolved, template, None)
+}
+
+/// [`parameters_ui`] knowing the selected organ's shape at the keyframe
+/// shown (for "Open shape from keyframe N").
+pub fn parameters_ui_viewing(
+    ui: &mut egui::Ui,
+    project: &Project,
+    resolved: &Project,
+    template: usize,
+    viewed: Option<&ViewedOrgan>,
 ) -> Option<Command> {
     let Some(original) = project.flower.templates.get(template) else {
         ui.label("No organ selected.");
@@ -239,6 +253,10 @@ pub fn parameters_ui(
         mark(true, "add joint ramp");
     }
 
+    ui.separator();
+    if let Some(command) = two_state_ui(ui, project, template, &mut draft, viewed, &mut mark) {
+        return Some(command);
+    }
     ui.separator();
     if let Some(edit) = resolution_ui(ui, project, resolved, template) {
         return Some(edit);

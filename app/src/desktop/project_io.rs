@@ -281,6 +281,7 @@ impl AnthesisApp {
                 self.export.path = path.display().to_string();
             }
             DialogPurpose::ImportTemplateObj => self.import_template(&path),
+            DialogPurpose::OpenShape(template) => self.open_shape_from_obj(template, &path),
         }
     }
 
@@ -326,6 +327,80 @@ impl AnthesisApp {
                 self.log.error_about(Topic::Import, message);
             }
         }
+    }
+
+    /// Makes template `template` two-state with the OBJ at `path` as its
+    /// open shape (one undo step), or says why the file does not fit.
+    fn open_shape_from_obj(&mut self, template: usize, path: &Path) {
+        let Some(current) = self.project().flower.templates.get(template).cloned() else {
+            return;
+        };
+        let read = anthesis_files::read_regular_text(
+            path,
+            anthesis_mesh::obj::MAX_OBJ_BYTES,
+            "an OBJ mesh",
+        )
+        .map_err(|e| e.to_string())
+        .and_then(|text| {
+            anthesis_mesh::obj::object_text(&text, None)
+                .and_then(|text| anthesis_mesh::obj::parse_obj(&text))
+                .map_err(|e| e.to_string())
+        });
+        let open = match read {
+            Ok(mesh) => mesh,
+            Err(e) => {
+                self.log.error_about(
+                    Topic::Project,
+                    format!("cannot read the open shape {}: {e}", path.display()),
+                );
+                return;
+            }
+        };
+        let problem = if open.positions.len() != current.mesh.positions.len() {
+            Some(format!(
+                "it has {} vertices but the mesh of template \"{}\" has {}",
+                open.positions.len(),
+                current.name,
+                current.mesh.positions.len()
+            ))
+        } else if open.triangles != current.mesh.triangles {
+            Some(format!(
+                "its triangles are not those of template \"{}\" (same vertices in the same \
+                 order and the same triangles are needed)",
+                current.name
+            ))
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
+            self.log.error_about(
+                Topic::Project,
+                format!("cannot use {} as the open shape: {problem}", path.display()),
+            );
+            return;
+        }
+        let keyframes = self.project().settings.keyframes;
+        let mut value = current;
+        match &mut value.two_state {
+            Some(animation) => animation.open = open.positions,
+            None => {
+                value.two_state = Some(anthesis_flower::TwoStateAnimation::new(
+                    open.positions,
+                    keyframes,
+                ));
+            }
+        }
+        let label = format!("open shape of {}", value.name);
+        self.edit(
+            &label,
+            ProjectEdit::Template {
+                template,
+                value: Box::new(value),
+                keyframes,
+            },
+        );
+        self.doc.seal();
+        self.log.info(format!("{label} from {}", path.display()));
     }
 
     /// Shows the export dialog, suggesting a .glb beside the project.

@@ -204,6 +204,16 @@ impl Placement {
             * DQuat::from_rotation_x(self.joint_angle_deg.to_radians() + extra_joint);
         self.position + rotation * point_in_template
     }
+
+    /// The template-frame point that [`Placement::world_from_template`]
+    /// with the same `extra_joint` puts at `point_in_world` (e.g. a
+    /// simulated keyframe taken back as a template's open shape).
+    pub fn template_from_world(&self, point_in_world: DVec3, extra_joint: f64) -> DVec3 {
+        let rotation = DQuat::from_rotation_y(self.azimuth_deg.to_radians())
+            * self.orientation
+            * DQuat::from_rotation_x(self.joint_angle_deg.to_radians() + extra_joint);
+        rotation.inverse() * (point_in_world - self.position)
+    }
 }
 
 /// One organ: an instance of a template on the receptacle.
@@ -348,5 +358,9 @@ mod tests {
         assert!((turned.joint_axis() - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12);
         let tip = turned.world_from_template(DVec3::Y, 0.0);
         assert!(tip.x > 0.1, "azimuth 90 opens towards +X, got {tip}");
+        // And back.
+        let p = DVec3::new(0.3, 2.0, -0.4);
+        let there = turned.world_from_template(p, 0.2);
+        assert!((turned.template_from_world(there, 0.2) - p).length() < 1e-12);
     }
 }

@@ -320,10 +320,10 @@ fn template_problem(template: &Template) -> Option<String> {
             short_number(region.u_max)
         ));
     }
-    if let Some(animation) = &template.two_state {
-        if let Some(problem) = two_state_problem(animation, &template.mesh) {
-            return Some(format!("two_state: {problem}"));
-        }
+    if let Some(animation) = &template.two_state
+        && let Some(problem) = two_state_problem(animation, &template.mesh)
+    {
+        return Some(format!("two_state: {problem}"));
     }
     if template.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
         return Some(format!(
