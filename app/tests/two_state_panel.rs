@@ -174,4 +174,15 @@ fn the_keyframe_shown_becomes_the_open_shape_in_the_template_frame() {
             .query_by_label("Open shape from keyframe …")
             .is_some()
     );
+
+    // Nor does a run at another resolution (other vertices): the button
+    // is there but disabled, and a click makes no edit.
+    let mut remeshed = viewed(&project, 12);
+    remeshed.positions_in_world.pop();
+    assert!(open_shape_from_keyframe(&project, &project.flower.templates[0], &remeshed).is_none());
+    let (mut harness, chosen) = panel(project.clone(), Some(remeshed));
+    harness.run();
+    harness.get_by_label("Open shape from keyframe 12").click();
+    harness.run();
+    assert!(template_edits(&chosen).is_empty(), "{:?}", chosen.borrow());
 }

@@ -88,14 +88,18 @@ pub fn two_state_ui(
             Some(v) => format!("Open shape from keyframe {}", v.keyframe),
             None => "Open shape from keyframe …".to_owned(),
         };
-        let button = ui.add_enabled(from_run.is_some(), egui::Button::new(label));
+        // None too when the run is at another resolution (other vertices).
         let taken = from_run.and_then(|v| open_shape_from_keyframe(project, draft, v));
+        let button = ui.add_enabled(taken.is_some(), egui::Button::new(label));
         if button
             .on_hover_text(
                 "The selected organ's shape at the keyframe shown, taken back to the template \
                  frame, as the open shape (show a computed keyframe after the bud)",
             )
-            .on_disabled_hover_text("Show a computed keyframe after the bud of this organ")
+            .on_disabled_hover_text(
+                "Show a computed keyframe after the bud of this organ, simulated with the \
+                 template's mesh as built",
+            )
             .clicked()
             && let Some(open) = taken
         {
