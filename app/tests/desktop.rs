@@ -2920,9 +2920,19 @@ fn a_bezier_petal_is_made_its_control_points_dragged_and_typed_and_applied_in_on
     assert_ne!(applied.mesh, made.mesh);
     assert_eq!(applied.maps, made.maps);
     assert_eq!(
+        applied.source,
+        Some(anthesis_flower::TemplateSource::Bezier { net, edge })
+    );
+    assert_eq!(
         app.document().undo_label(),
         Some("Bézier net of bezier petal")
     );
+    // The net is saved with the project and read back, to edit again.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("bezier.anthesis.toml");
+    anthesis_flower::project::save_project(app.project(), &path).expect("saves");
+    let reopened = anthesis_flower::project::load_project(&path).expect("loads");
+    assert_eq!(reopened.flower.templates[index].source, applied.source);
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut harness);
     assert_eq!(harness.state().project().flower.templates[index], made);

@@ -650,15 +650,15 @@ pub fn flower_ui(
                 * anthesis_garden::flowers::EDGE_SCALE;
             match anthesis_bud::build_organ(&net, &anthesis_bud::RemeshOptions::new(edge)) {
                 Ok(bud) => {
-                    let template = anthesis_garden::five_petal::simple_template_of_mesh(
+                    let mut template = anthesis_garden::five_petal::simple_template_of_mesh(
                         "bezier petal",
                         bud.mesh,
                     );
+                    template.source = Some(anthesis_flower::TemplateSource::Bezier { net, edge });
                     match flower.with_template_and_organ(template) {
                         Ok(added) => {
                             let index = added.templates.len() - 1;
                             let name = added.templates[index].name.clone();
-                            state.shape.nets.insert(name.clone(), net);
                             state.shape.template = index;
                             state.shape.edge = None;
                             state.shape.open_now = true;

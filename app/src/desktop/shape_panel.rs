@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_bud::{BezierPatch, Bud, BudError, MeshQuality, RemeshOptions};
-use anthesis_flower::Flower;
+use anthesis_flower::{Flower, TemplateSource};
 use anthesis_mesh::Mesh;
 use eframe::egui::{self, Color32, DragValue, RichText};
 use glam::DVec3;
@@ -40,9 +40,11 @@ pub struct ShapeState {
     current: Option<(u64, MeshQuality)>,
     /// Open the section in the next frame (a template was just made).
     pub(super) open_now: bool,
-    /// The Bézier nets of templates made from one, by template name, as
-    /// edited (applied to the mesh with "Apply net").
-    pub(super) nets: BTreeMap<String, BezierPatch>,
+    /// The Bézier nets being edited, by template name: the template's
+    /// saved net they started from, and the net as edited (applied to the
+    /// template with "Apply net"). A saved net that changed (an undo, a
+    /// project opened) replaces the draft.
+    drafts: BTreeMap<String, (BezierPatch, BezierPatch)>,
     /// The control point being edited: row (base to tip), column.
     point: (usize, usize),
     /// Edit each point alone (off: its mirror image about the midrib
@@ -57,9 +59,10 @@ pub struct ShapeState {
 }
 
 impl ShapeState {
-    /// The Bézier net of the template named `name`, as edited.
+    /// The Bézier net of the template named `name` as edited, once the
+    /// section has shown it.
     pub fn net(&self, name: &str) -> Option<&BezierPatch> {
-        self.nets.get(name)
+        self.drafts.get(name).map(|(_, draft)| draft)
     }
 
     /// Where control point `(row, column)` was drawn in the 2D view.
@@ -289,9 +292,14 @@ fn shape_rows(
             ui.label("remeshing…");
         }
     }
-    if let Some(net) = state.nets.get(&template.name).copied() {
+    if let Some(TemplateSource::Bezier { net: saved, .. }) = template.source {
+        let draft = match state.drafts.get(&template.name) {
+            Some((from, draft)) if *from == saved => *draft,
+            _ => saved,
+        };
+        state.drafts.insert(template.name.clone(), (saved, draft));
         ui.separator();
-        bezier_ui(ui, (index, &template.name), net, edge, state, commands);
+        bezier_ui(ui, (flower, index), draft, edge, state, commands);
     } else {
         state.on_screen = None;
     }
@@ -306,12 +314,13 @@ const ROW_NAMES: [&str; 4] = ["base", "lower", "upper", "tip"];
 /// `edge` and replaces the template's mesh (one undo step; the maps stay).
 fn bezier_ui(
     ui: &mut egui::Ui,
-    (index, name): (usize, &str),
+    (flower, index): (&Flower, usize),
     mut net: BezierPatch,
     edge: f64,
     state: &mut ShapeState,
     commands: &mut Vec<Command>,
 ) {
+    let name = flower.templates[index].name.as_str();
     ui.strong("Bézier net").on_hover_text(
         "The 4×4 control net of the bicubic patch: rows from the base to the tip, columns \
          across (the midrib between the middle two). Drag a point in the view or type its \
@@ -447,8 +456,10 @@ fn bezier_ui(
     if typed {
         net = net.with_point(row, column, p, symmetric);
     }
-    if net != before {
-        state.nets.insert(name.to_string(), net);
+    if net != before
+        && let Some((_, draft)) = state.drafts.get_mut(name)
+    {
+        *draft = net;
     }
 
     if ui
@@ -461,12 +472,13 @@ fn bezier_ui(
         match anthesis_bud::build_organ(&net, &RemeshOptions::new(edge)) {
             Ok(bud) => {
                 state.net_error = None;
+                // The mesh and the net it was made of, in one step.
+                let mut edited = flower.clone();
+                edited.templates[index].mesh = bud.mesh;
+                edited.templates[index].source = Some(TemplateSource::Bezier { net, edge });
                 commands.push(Command::Edit {
                     label: format!("Bézier net of {name}"),
-                    edit: ProjectEdit::Mesh {
-                        template: index,
-                        mesh: Box::new(bud.mesh),
-                    },
+                    edit: ProjectEdit::Flower(Box::new(edited)),
                 });
             }
             Err(e) => state.net_error = Some(format!("cannot mesh the net: {e}")),

@@ -30,6 +30,7 @@ fn template(name: &str, color: [f32; 4], colouring: Option<Colouring>) -> Templa
         color,
         colouring,
         two_state: None,
+        source: None,
     }
 }
 

@@ -167,6 +167,7 @@ mod tests {
             color: [1.0, 0.0, 0.0, 1.0],
             colouring,
             two_state: None,
+            source: None,
         }
     }
 

@@ -62,6 +62,24 @@ pub struct Template {
     /// bud (`mesh`) to an open shape by the two-state blossom
     /// (`anthesis-twostate`); the maps, `dg` and stiffness are then unused.
     pub two_state: Option<TwoStateAnimation>,
+    /// How the mesh was made in the app, kept so the shape can be edited
+    /// again (`[templates.source]`, project version 7); `None`: a mesh
+    /// only (an OBJ, a built-in flower's bud).
+    pub source: Option<TemplateSource>,
+}
+
+/// How a template's mesh was made, when it was made from something that
+/// can be edited again.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TemplateSource {
+    /// A bicubic Bézier patch (its control net, rows from the base to the
+    /// tip, columns across) meshed at mean edge `edge`.
+    Bezier {
+        /// The control net.
+        net: anthesis_bud::BezierPatch,
+        /// The mean edge it was meshed at.
+        edge: f64,
+    },
 }
 
 /// A two-state animation (`sketch-based-floral-blossom.txt` §4): the

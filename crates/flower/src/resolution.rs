@@ -196,6 +196,7 @@ mod tests {
             color: [1.0; 4],
             colouring: None,
             two_state: None,
+            source: None,
         }
     }
 

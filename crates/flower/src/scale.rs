@@ -432,6 +432,7 @@ mod tests {
             color: [1.0; 4],
             colouring: None,
             two_state: None,
+            source: None,
         }
     }
 

@@ -109,6 +109,7 @@ fn petal_template() -> Template {
         color: [0.98, 0.62, 0.32, 1.0],
         colouring: None,
         two_state: None,
+        source: None,
     }
 }
 
@@ -137,6 +138,7 @@ fn sepal_template() -> Template {
         color: [0.3, 0.55, 0.2, 0.9],
         colouring: None,
         two_state: None,
+        source: None,
     }
 }
 
@@ -1938,4 +1940,40 @@ fn a_keys_own_growth_scale_is_saved_as_version_6_and_a_bad_one_is_refused() {
             && message.contains("dg must be a number greater than -1"),
         "{message}"
     );
+}
+
+#[test]
+fn a_bezier_template_keeps_its_control_net_through_a_save_as_version_7() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("bezier.anthesis.toml");
+    let mut project = lily();
+    let net = anthesis_bud::BezierPatch::petal().with_point(3, 2, DVec3::new(0.9, 21.0, 1.5), true);
+    project.flower.templates[0].source =
+        Some(anthesis_flower::TemplateSource::Bezier { net, edge: 1.25 });
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("version = 7"), "{text}");
+    assert!(text.contains("[templates.source]"), "{text}");
+    assert!(text.contains("kind = \"bezier\""), "{text}");
+    assert!(text.contains("edge = 1.25"), "{text}");
+    let loaded = load_project(&path).expect("loads");
+    assert_eq!(loaded, project);
+    match loaded.flower.templates[0].source {
+        Some(anthesis_flower::TemplateSource::Bezier { net: read, edge }) => {
+            assert_eq!(read, net);
+            assert_eq!(edge, 1.25);
+        }
+        None => panic!("the source is lost"),
+    }
+    // A broken source is refused with what is wrong.
+    edit(&path, |t| replace_once(t, "edge = 1.25", "edge = -1.0"));
+    let error = load_project(&path).expect_err("a negative edge");
+    assert!(
+        error.to_string().contains("edge must be a positive"),
+        "{error}"
+    );
+    // Without a source the file stays at the version it needed before.
+    save_project(&lily(), &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("version = 2"), "{text}");
 }

@@ -31,6 +31,7 @@ fn template(name: &str) -> Template {
         joint_schedule: Vec::new(),
         color: [0.9, 0.5, 0.6, 1.0],
         colouring: None,
+        source: None,
         two_state: None,
     }
 }

@@ -260,6 +260,7 @@ fn apple_template(
         color,
         colouring: None,
         two_state: None,
+        source: None,
     }
 }
 

@@ -103,6 +103,7 @@ pub fn simple_template_of_mesh(name: &str, mesh: anthesis_mesh::Mesh) -> Templat
         color: SIMPLE_PINK,
         colouring: None,
         two_state: None,
+        source: None,
     }
 }
 

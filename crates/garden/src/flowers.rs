@@ -317,6 +317,7 @@ fn template(
         color: spec.color,
         colouring: None,
         two_state: None,
+        source: None,
     })
 }
 

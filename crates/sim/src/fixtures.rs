@@ -115,6 +115,7 @@ fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
         color: [0.95, 0.55, 0.35, 1.0],
         colouring: None,
         two_state: None,
+        source: None,
     }
 }
 

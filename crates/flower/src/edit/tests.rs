@@ -20,6 +20,7 @@ fn template(name: &str) -> Template {
         color: [1.0; 4],
         colouring: None,
         two_state: None,
+        source: None,
     }
 }
 

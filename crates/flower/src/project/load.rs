@@ -13,8 +13,8 @@ use glam::{DQuat, DVec2, DVec3};
 use super::check::{SizeCheck, check_names, check_project, check_unique};
 use super::error::{ProjectError, map_error};
 use super::schema::{
-    DirectionEntry, ProjectFile, ScalarEntry, StructureFile, StructureKind, TemplateFile,
-    TwoStateFile,
+    DirectionEntry, ProjectFile, ScalarEntry, SourceFile, StructureFile, StructureKind,
+    TemplateFile, TwoStateFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::structure::{Arrangement, Spiral, Structure, Whorl};
@@ -387,6 +387,33 @@ impl Loader<'_> {
             None => None,
             Some(two) => Some(self.two_state(two, &mesh, name)?),
         };
+        let source = match file.source {
+            None => None,
+            Some(SourceFile::Bezier { net, edge }) => {
+                let points: Vec<glam::DVec3> = net.iter().map(|p| glam::DVec3::from(*p)).collect();
+                if points.len() != 16 || !points.iter().all(|p| p.is_finite()) {
+                    return Err(self.invalid(format!(
+                        "template \"{name}\": a Bézier source's net needs 16 finite points \
+                         [x, y, z] (four rows of four, base to tip), found {}",
+                        points.len()
+                    )));
+                }
+                if !(edge.is_finite() && edge > 0.0) {
+                    return Err(self.invalid(format!(
+                        "template \"{name}\": a Bézier source's edge must be a positive number, \
+                         found {edge}"
+                    )));
+                }
+                let mut control = [[glam::DVec3::ZERO; 4]; 4];
+                for (k, p) in points.into_iter().enumerate() {
+                    control[k / 4][k % 4] = p;
+                }
+                Some(crate::TemplateSource::Bezier {
+                    net: anthesis_bud::BezierPatch::new(control),
+                    edge,
+                })
+            }
+        };
         Ok(Template {
             two_state,
             name: file.name,
@@ -404,6 +431,7 @@ impl Loader<'_> {
             joint_schedule: file.joint_schedule.iter().map(JointRamp::from).collect(),
             color: file.color,
             colouring,
+            source,
         })
     }
 

@@ -56,6 +56,11 @@
 //! velocity = [[0.0, 0.0], [0.5, 0.8], [1.0, 1.0]]  # optional: [t / T,
 //!                              # fraction] of the directions' turn; absent:
 //!                              # it follows G
+//! [templates.source]           # optional (version 7): how the mesh was made
+//! kind = "bezier"              # a bicubic Bézier patch (the app's editor)
+//! net = [[-1.2, 0.0, -0.3], [-0.4, 0.0, 0.0], ...]  # 16 points [x, y, z]:
+//!                              # four rows of four, base to tip
+//! edge = 1.2                   # the mean edge it was meshed at
 //!
 //! [[templates.keys]]
 //! step = 40

@@ -188,6 +188,7 @@ mod tests {
             color: [1.0, 0.5, 0.5, 1.0],
             colouring: None,
             two_state: None,
+            source: None,
         };
         Project {
             name: name.into(),

@@ -9,8 +9,8 @@ use super::check::{SizeCheck, check_project};
 use super::error::{ProjectError, map_error};
 use super::schema::{
     BaseRegionFile, BlendFile, ColourLayerFile, DirectionEntry, JointRampFile, KeyFile,
-    LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SpiralFile,
-    StructureFile, StructureKind, TemplateFile, TwoStateFile, WhorlFile,
+    LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SourceFile,
+    SpiralFile, StructureFile, StructureKind, TemplateFile, TwoStateFile, WhorlFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
 use crate::structure::{Arrangement, Structure};
@@ -89,10 +89,14 @@ pub(super) fn plan_save(
 /// older builds and saves byte for byte as before (version 3 added
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
 /// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
-/// `[templates.two_state]`).
+/// `[templates.two_state]` and `[templates.source]`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
-    if flower.templates.iter().any(|t| t.two_state.is_some()) {
+    if flower
+        .templates
+        .iter()
+        .any(|t| t.two_state.is_some() || t.source.is_some())
+    {
         return FORMAT_VERSION;
     }
     let key_dg = flower
@@ -256,6 +260,12 @@ pub(super) fn template_file(
             .map(JointRampFile::from)
             .collect(),
         two_state,
+        source: template.source.map(|source| match source {
+            crate::TemplateSource::Bezier { net, edge } => SourceFile::Bezier {
+                net: net.control.iter().flatten().map(|p| p.to_array()).collect(),
+                edge,
+            },
+        }),
         keys,
     })
 }

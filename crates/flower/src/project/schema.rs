@@ -183,7 +183,20 @@ pub(super) struct TemplateFile {
     /// Version 7: animated from two shapes instead of grown.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) two_state: Option<TwoStateFile>,
+    /// Version 7: how the mesh was made (`[templates.source]`), to edit it
+    /// again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) source: Option<SourceFile>,
     pub(super) keys: Vec<KeyFile>,
+}
+
+/// `[templates.source]`: `kind = "bezier"`, its 16 control points `net`
+/// (rows from the base to the tip, four points across each) and the mean
+/// `edge` it was meshed at.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, tag = "kind", rename_all = "lowercase")]
+pub(super) enum SourceFile {
+    Bezier { net: Vec<[f64; 3]>, edge: f64 },
 }
 
 /// `[templates.two_state]`: the open shape and the timing of a template
