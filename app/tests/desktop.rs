@@ -2936,4 +2936,18 @@ fn a_bezier_petal_is_made_its_control_points_dragged_and_typed_and_applied_in_on
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut harness);
     assert_eq!(harness.state().project().flower.templates[index], made);
+
+    // The undo took the editor's net back with it; a flipped inner side
+    // stays flipped when that net is applied again.
+    assert_eq!(
+        harness.state().flower_panel().shape().net("bezier petal"),
+        Some(&start)
+    );
+    click_settled(&mut harness, "Flip inner side");
+    click_settled(&mut harness, "Apply net");
+    let mesh = &harness.state().project().flower.templates[index].mesh;
+    let again =
+        anthesis_bud::build_organ(&start, &anthesis_bud::RemeshOptions::new(edge)).expect("meshes");
+    assert_eq!(mesh, &anthesis_bud::with_inner_side_flipped(&again.mesh));
+    assert_eq!(anthesis_bud::inner_side_faces_minus_z(mesh), Some(false));
 }

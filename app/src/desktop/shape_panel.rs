@@ -473,8 +473,17 @@ fn bezier_ui(
             Ok(bud) => {
                 state.net_error = None;
                 // The mesh and the net it was made of, in one step.
+                // The inner side stays where the template has it (a flip
+                // made before is kept).
+                let flipped = anthesis_bud::inner_side_faces_minus_z(&flower.templates[index].mesh)
+                    == Some(false);
+                let mesh = if flipped {
+                    anthesis_bud::with_inner_side_flipped(&bud.mesh)
+                } else {
+                    bud.mesh
+                };
                 let mut edited = flower.clone();
-                edited.templates[index].mesh = bud.mesh;
+                edited.templates[index].mesh = mesh;
                 edited.templates[index].source = Some(TemplateSource::Bezier { net, edge });
                 commands.push(Command::Edit {
                     label: format!("Bézier net of {name}"),
