@@ -774,6 +774,86 @@ fn coarse_run(
 mod tests {
     use super::*;
 
+    /// The gradient of the fit's cost, `2 Jᵀ r` with the Jacobian the fit
+    /// uses (forward differences on the coarse run), against central
+    /// differences of the cost of the full run (issue 15 item 6).
+    #[test]
+    fn the_fits_gradient_agrees_with_central_differences_of_the_full_run() {
+        let keyframes = 40;
+        let mut project = anthesis_sim::fixtures::whorl(1, 6, 10, keyframes);
+        project.flower.templates[0].dg = 0.01;
+        let layout = Layout {
+            growth: Grid {
+                nodes_u: 1,
+                nodes_v: 2,
+            },
+            direction: Grid {
+                nodes_u: 0,
+                nodes_v: 0,
+            },
+            key_steps: basis::key_steps(1, keyframes),
+        };
+        let size = (32, 32);
+        let template = project.flower.template_of(0);
+        let maps_of = |p: &[f64]| layout.maps(p, size, &template.maps).expect("maps");
+        // The target: the organ grown from other maps than the point the
+        // gradient is taken at, so the residual is not zero.
+        let known = [0.2, 0.8, 0.5, 0.3, 0.35, 0.95, 0.5, 0.45];
+        let target = simulate_final(&project, 0, maps_of(&known), &|| false).expect("target");
+        let coarse = coarse_run(&project, 0, &layout, FitSettings::default().coarse);
+        assert!(coarse.is_some(), "40 keyframes have a coarse run");
+        let problem = Problem {
+            project: &project,
+            coarse,
+            organ: 0,
+            layout: layout.clone(),
+            size,
+            target: &target,
+            length: 1.0,
+            cancel: &|| false,
+        };
+        let p = [0.3, 0.6, 0.45, 0.4, 0.4, 0.8, 0.5, 0.5];
+        let r = problem.residual(&p).expect("runs").expect("simulates");
+        let (jacobian, _) =
+            finite_differences(&problem, &p, &r, FitSettings::default().step).expect("runs");
+        let rows = r.len();
+        let fits: Vec<f64> = (0..p.len())
+            .map(|i| {
+                2.0 * (0..rows)
+                    .map(|k| jacobian[i * rows + k] * r[k])
+                    .sum::<f64>()
+            })
+            .collect();
+        let h = 1e-4;
+        let central: Vec<f64> = (0..p.len())
+            .map(|i| {
+                let at = |d: f64| {
+                    let mut q = p.to_vec();
+                    q[i] += d;
+                    cost(&problem.residual(&q).expect("runs").expect("simulates"))
+                };
+                (at(h) - at(-h)) / (2.0 * h)
+            })
+            .collect();
+        let dot: f64 = fits.iter().zip(&central).map(|(a, b)| a * b).sum();
+        let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let cosine = dot / (norm(&fits) * norm(&central));
+        let relative = fits
+            .iter()
+            .zip(&central)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt()
+            / norm(&central);
+        // Measured: cosine 0.99984, relative difference 2.5 % (the coarse
+        // run's final shapes lie within a few tenths of a per cent of the
+        // full run's).
+        assert!(
+            cosine > 0.999 && relative < 0.06,
+            "cosine {cosine:.4}, relative difference {relative:.3}\nfit's {fits:?}\ncentral {central:?}"
+        );
+    }
+
     #[test]
     fn the_coarse_run_takes_half_the_steps_at_twice_the_growth() {
         let project = anthesis_sim::fixtures::whorl(1, 6, 10, 40);
