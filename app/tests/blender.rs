@@ -22,7 +22,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{anthesis, text};
+use common::{anthesis_mask, image_at, run_ok, text};
 use image::RgbaImage;
 use serde_json::{Value, json};
 
@@ -43,35 +43,6 @@ const HEIGHT: u32 = 360;
 
 fn blender_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/blender")
-}
-
-fn run_ok(args: &[&str]) {
-    let out = anthesis(args);
-    assert!(
-        out.status.success(),
-        "anthesis {args:?} failed: {}",
-        text(&out.stderr)
-    );
-}
-
-fn image_at(path: &str) -> RgbaImage {
-    image::open(path)
-        .unwrap_or_else(|e| panic!("cannot read {path}: {e}"))
-        .to_rgba8()
-}
-
-/// Pixels `anthesis render` drew something on (not its magenta background,
-/// which the ground shadow darkens but leaves magenta), as in the three.js
-/// check (browser.rs).
-fn anthesis_mask(picture: &RgbaImage) -> Vec<bool> {
-    picture
-        .pixels()
-        .map(|p| {
-            let [r, g, b, _] = p.0.map(i32::from);
-            let magenta = g < 80 && (r - b).abs() < 10 + r.max(b) * 35 / 100;
-            !magenta
-        })
-        .collect()
 }
 
 /// Pixels Blender drew something on: its background is transparent.

@@ -10,7 +10,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{anthesis, text};
+use common::{anthesis_mask, image_at, run_ok, text};
 use image::RgbaImage;
 use serde_json::{Value, json};
 
@@ -28,38 +28,6 @@ const HEIGHT: u32 = 360;
 
 fn browser_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/browser")
-}
-
-fn run_ok(args: &[&str]) {
-    let out = anthesis(args);
-    assert!(
-        out.status.success(),
-        "anthesis {args:?} failed: {}",
-        text(&out.stderr)
-    );
-}
-
-fn image_at(path: &str) -> RgbaImage {
-    image::open(path)
-        .unwrap_or_else(|e| panic!("cannot read {path}: {e}"))
-        .to_rgba8()
-}
-
-/// Pixels `anthesis render` drew an organ or a part on: anything clearly
-/// away from the magenta background, which the ground shadow darkens but
-/// leaves magenta (red as strong as blue, no green); antialiased edges
-/// half-way count.
-fn anthesis_mask(picture: &RgbaImage) -> Vec<bool> {
-    // Red and blue in proportion, not just close: a shaded anther or
-    // stigma (deep red, little green and blue) is no background.
-    picture
-        .pixels()
-        .map(|p| {
-            let [r, g, b, _] = p.0.map(i32::from);
-            let magenta = g < 80 && (r - b).abs() < 10 + r.max(b) * 35 / 100;
-            !magenta
-        })
-        .collect()
 }
 
 /// Pixels three.js drew an organ on in the ids picture (black background).

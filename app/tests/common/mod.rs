@@ -29,3 +29,36 @@ pub fn one_line_error(args: &[&str]) -> Output {
     assert!(stderr.starts_with("error: "), "{stderr}");
     out
 }
+
+/// Runs the binary with `args` and asserts it succeeds.
+pub fn run_ok(args: &[&str]) {
+    let out = anthesis(args);
+    assert!(
+        out.status.success(),
+        "anthesis {args:?} failed: {}",
+        text(&out.stderr)
+    );
+}
+
+/// The picture at `path`, as RGBA.
+pub fn image_at(path: &str) -> image::RgbaImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("cannot read {path}: {e}"))
+        .to_rgba8()
+}
+
+/// Pixels `anthesis render` drew an organ or a part on: anything clearly
+/// away from the magenta background, which the ground shadow darkens but
+/// leaves magenta (red as strong as blue, no green); antialiased edges
+/// half-way count. Red and blue in proportion, not just close: a shaded
+/// anther or stigma (deep red, little green and blue) is no background.
+pub fn anthesis_mask(picture: &image::RgbaImage) -> Vec<bool> {
+    picture
+        .pixels()
+        .map(|p| {
+            let [r, g, b, _] = p.0.map(i32::from);
+            let magenta = g < 80 && (r - b).abs() < 10 + r.max(b) * 35 / 100;
+            !magenta
+        })
+        .collect()
+}
