@@ -22,7 +22,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{anthesis_mask, image_at, run_ok, text};
+use common::{anthesis_mask, image_at, render_lily, run_ok, text};
 use image::RgbaImage;
 use serde_json::{Value, json};
 
@@ -174,24 +174,7 @@ fn blender_imports_the_lily_and_shows_anthesis_renders_colours() {
     let glb = d("lily.glb");
     run_ok(&["simulate", "builtin:lily", "--out", &glb]);
     let renders = d("anthesis");
-    std::fs::create_dir(&renders).expect("mkdir");
-    let frames: Vec<String> = KEYFRAMES.iter().map(u32::to_string).collect();
-    run_ok(&[
-        "render",
-        "builtin:lily",
-        "--frames",
-        &frames.join(","),
-        "--size",
-        &format!("{WIDTH}x{HEIGHT}"),
-        "--background",
-        "ff00ff",
-        "--out",
-        &renders,
-    ]);
-    let camera: Value = serde_json::from_str(
-        &std::fs::read_to_string(Path::new(&renders).join("camera.json")).expect("camera.json"),
-    )
-    .expect("camera JSON");
+    let camera = render_lily(&renders, &KEYFRAMES, WIDTH, HEIGHT);
 
     let out = d("blender");
     std::fs::create_dir(&out).expect("mkdir");

@@ -62,3 +62,27 @@ pub fn anthesis_mask(picture: &image::RgbaImage) -> Vec<bool> {
         })
         .collect()
 }
+
+/// `anthesis render builtin:lily` of `keyframes` at `width` x `height` on a
+/// magenta background into folder `renders` (created), and the camera it
+/// wrote (`camera.json`), which the three.js and Blender checks look
+/// through.
+pub fn render_lily(renders: &str, keyframes: &[u32], width: u32, height: u32) -> serde_json::Value {
+    std::fs::create_dir(renders).expect("mkdir");
+    let frames: Vec<String> = keyframes.iter().map(u32::to_string).collect();
+    run_ok(&[
+        "render",
+        "builtin:lily",
+        "--frames",
+        &frames.join(","),
+        "--size",
+        &format!("{width}x{height}"),
+        "--background",
+        "ff00ff",
+        "--out",
+        renders,
+    ]);
+    let camera = std::path::Path::new(renders).join("camera.json");
+    serde_json::from_str(&std::fs::read_to_string(camera).expect("camera.json"))
+        .expect("camera JSON")
+}
