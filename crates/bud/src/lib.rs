@@ -34,11 +34,13 @@ mod net;
 mod quality;
 mod remesh;
 mod surface;
+mod vein;
 
 pub use examples::{eustoma_petal_surface, lily_petal_surface};
 pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use net::mirrored;
 pub use quality::{MeshQuality, find_self_intersection, quality};
+pub use vein::{SideStroke, Vein, VeinError, bend_along_vein};
 pub use surface::{BezierCurve, BezierPatch, MAX_STRETCH_TO_BEND, PdeSweep, Surface, bernstein3};
 
 use anthesis_mesh::{Mesh, MeshError};
