@@ -122,6 +122,30 @@ impl Vein {
         })
     }
 
+    /// A vein through exactly these points (`(y, z)`, base first; moved
+    /// so it starts at the origin), as [`Vein::points`] gave them: for
+    /// reading one back from a file. Refuses fewer than two points, no
+    /// length, NaN and a self-crossing.
+    pub fn from_points(points: &[DVec2]) -> Result<Vein, VeinError> {
+        if points.iter().any(|p| !p.is_finite()) {
+            return Err(VeinError::NotFinite);
+        }
+        let length = polyline_length(points);
+        if points.len() < 2 || length <= 0.0 {
+            return Err(VeinError::TooShort {
+                length,
+                minimum: 0.0,
+            });
+        }
+        if let Some(at) = self_crossing(points) {
+            return Err(VeinError::SelfIntersecting { r: at.y, h: at.x });
+        }
+        let origin = points[0];
+        Ok(Vein {
+            points: points.iter().map(|p| *p - origin).collect(),
+        })
+    }
+
     /// The points `(y, z)`, base first.
     pub fn points(&self) -> &[DVec2] {
         &self.points

@@ -31,6 +31,7 @@ fn template(name: &str, color: [f32; 4], colouring: Option<Colouring>) -> Templa
         colouring,
         two_state: None,
         source: None,
+        vein: None,
     }
 }
 

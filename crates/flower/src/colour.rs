@@ -168,6 +168,7 @@ mod tests {
             colouring,
             two_state: None,
             source: None,
+            vein: None,
         }
     }
 

@@ -66,6 +66,11 @@ pub struct Template {
     /// again (`[templates.source]`, project version 7); `None`: a mesh
     /// only (an OBJ, a built-in flower's bud).
     pub source: Option<TemplateSource>,
+    /// The primary vein the bud was sketched with (issue 14 item 7,
+    /// `[templates.vein]`, project version 8): the mesh is bent so its
+    /// midrib follows it, and a shape made again from `source` is bent
+    /// the same way ([`Template::shaped`]). `None`: the mesh as made.
+    pub vein: Option<anthesis_bud::Vein>,
 }
 
 /// How a template's mesh was made, when it was made from something that

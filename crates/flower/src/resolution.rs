@@ -197,6 +197,7 @@ mod tests {
             colouring: None,
             two_state: None,
             source: None,
+            vein: None,
         }
     }
 

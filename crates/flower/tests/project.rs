@@ -110,6 +110,7 @@ fn petal_template() -> Template {
         colouring: None,
         two_state: None,
         source: None,
+        vein: None,
     }
 }
 
@@ -139,6 +140,7 @@ fn sepal_template() -> Template {
         colouring: None,
         two_state: None,
         source: None,
+        vein: None,
     }
 }
 
@@ -441,14 +443,18 @@ fn a_newer_version_says_so() {
     // A newer version may have fields this build does not know: the version
     // error must win over the unknown field.
     edit(&path, |text| {
-        replace_once(text, "version = 2", "version = 8\nwind = \"strong\"")
+        replace_once(
+            text,
+            "version = 2",
+            &format!("version = {}\nwind = \"strong\"", FORMAT_VERSION + 1),
+        )
     });
     let error = load_project(&path).expect_err("newer");
     assert_eq!(
         error,
         ProjectError::NewerVersion {
             path: path.clone(),
-            found: 8,
+            found: i64::from(FORMAT_VERSION) + 1,
             supported: FORMAT_VERSION,
         }
     );

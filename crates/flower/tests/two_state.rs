@@ -32,6 +32,7 @@ fn template(name: &str) -> Template {
         color: [0.9, 0.5, 0.6, 1.0],
         colouring: None,
         source: None,
+        vein: None,
         two_state: None,
     }
 }

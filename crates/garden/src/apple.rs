@@ -261,6 +261,7 @@ fn apple_template(
         colouring: None,
         two_state: None,
         source: None,
+        vein: None,
     }
 }
 

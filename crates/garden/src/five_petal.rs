@@ -108,6 +108,7 @@ pub fn simple_template_of_mesh(name: &str, mesh: anthesis_mesh::Mesh) -> Templat
         colouring: None,
         two_state: None,
         source: None,
+        vein: None,
     }
 }
 

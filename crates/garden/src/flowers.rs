@@ -318,6 +318,7 @@ fn template(
         colouring: None,
         two_state: None,
         source: None,
+        vein: None,
     })
 }
 

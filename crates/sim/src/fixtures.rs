@@ -116,6 +116,7 @@ fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
         colouring: None,
         two_state: None,
         source: None,
+        vein: None,
     }
 }
 

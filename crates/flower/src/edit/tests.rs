@@ -21,6 +21,7 @@ fn template(name: &str) -> Template {
         colouring: None,
         two_state: None,
         source: None,
+        vein: None,
     }
 }
 

@@ -414,7 +414,17 @@ impl Loader<'_> {
                 })
             }
         };
+        let vein = match file.vein {
+            None => None,
+            Some(vein) => {
+                let points: Vec<glam::DVec2> = vein.points.iter().map(|p| glam::DVec2::from(*p)).collect();
+                Some(anthesis_bud::Vein::from_points(&points).map_err(|e| {
+                    self.invalid(format!("template \"{name}\": [templates.vein]: {e}"))
+                })?)
+            }
+        };
         Ok(Template {
+            vein,
             two_state,
             name: file.name,
             mesh,

@@ -61,6 +61,10 @@
 //! net = [[-1.2, 0.0, -0.3], [-0.4, 0.0, 0.0], ...]  # 16 points [x, y, z]:
 //!                              # four rows of four, base to tip
 //! edge = 1.2                   # the mean edge it was meshed at
+//! [templates.vein]             # optional (version 8): the primary vein the
+//! points = [[0.0, 0.0], [0.3, 0.1], ...]  # bud was sketched with, [y, z]
+//!                              # in the template frame from the base; the
+//!                              # mesh's midrib follows it
 //!
 //! [[templates.keys]]
 //! step = 40
@@ -206,7 +210,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 7;
+pub const FORMAT_VERSION: u32 = 8;
 
 /// Checks `project` by the rules every loaded or saved project obeys
 /// (names, counts, numbers, parts), as the app does before it takes an

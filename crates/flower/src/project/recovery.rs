@@ -189,6 +189,7 @@ mod tests {
             colouring: None,
             two_state: None,
             source: None,
+            vein: None,
         };
         Project {
             name: name.into(),

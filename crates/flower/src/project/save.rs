@@ -9,7 +9,7 @@ use super::check::{SizeCheck, check_project};
 use super::error::{ProjectError, map_error};
 use super::schema::{
     BaseRegionFile, BlendFile, ColourLayerFile, DirectionEntry, JointRampFile, KeyFile,
-    LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SourceFile,
+    LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SourceFile, VeinFile,
     SpiralFile, StructureFile, StructureKind, TemplateFile, TwoStateFile, WhorlFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
@@ -89,15 +89,19 @@ pub(super) fn plan_save(
 /// older builds and saves byte for byte as before (version 3 added
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
 /// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
-/// `[templates.two_state]` and `[templates.source]`).
+/// `[templates.two_state]` and `[templates.source]`, version 8
+/// `[templates.vein]`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
+    if flower.templates.iter().any(|t| t.vein.is_some()) {
+        return FORMAT_VERSION;
+    }
     if flower
         .templates
         .iter()
         .any(|t| t.two_state.is_some() || t.source.is_some())
     {
-        return FORMAT_VERSION;
+        return 7;
     }
     let key_dg = flower
         .templates
@@ -265,6 +269,9 @@ pub(super) fn template_file(
                 net: net.control.iter().flatten().map(|p| p.to_array()).collect(),
                 edge,
             },
+        }),
+        vein: template.vein.as_ref().map(|vein| VeinFile {
+            points: vein.points().iter().map(|p| p.to_array()).collect(),
         }),
         keys,
     })

@@ -187,6 +187,10 @@ pub(super) struct TemplateFile {
     /// again.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) source: Option<SourceFile>,
+    /// Version 8: the primary vein the bud was sketched with
+    /// (`[templates.vein]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) vein: Option<VeinFile>,
     pub(super) keys: Vec<KeyFile>,
 }
 
@@ -197,6 +201,14 @@ pub(super) struct TemplateFile {
 #[serde(deny_unknown_fields, tag = "kind", rename_all = "lowercase")]
 pub(super) enum SourceFile {
     Bezier { net: Vec<[f64; 3]>, edge: f64 },
+}
+
+/// `[templates.vein]`: the midrib's path in the template frame's `y`–`z`
+/// plane, `[y, z]` points from the base (version 8).
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct VeinFile {
+    pub(super) points: Vec<[f64; 2]>,
 }
 
 /// `[templates.two_state]`: the open shape and the timing of a template
