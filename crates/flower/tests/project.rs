@@ -461,8 +461,10 @@ fn a_newer_version_says_so() {
     assert_eq!(
         error.to_string(),
         format!(
-            "{} was written by a newer Anthesis (format version 8; this build reads up to 7)",
-            path.display()
+            "{} was written by a newer Anthesis (format version {}; this build reads up to {})",
+            path.display(),
+            FORMAT_VERSION + 1,
+            FORMAT_VERSION
         )
     );
 }
