@@ -40,8 +40,8 @@ pub use examples::{eustoma_petal_surface, lily_petal_surface};
 pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use net::mirrored;
 pub use quality::{MeshQuality, find_self_intersection, quality};
-pub use vein::{SideStroke, Vein, VeinError, bend_along_vein};
 pub use surface::{BezierCurve, BezierPatch, MAX_STRETCH_TO_BEND, PdeSweep, Surface, bernstein3};
+pub use vein::{SideStroke, Vein, VeinError, bend_along_vein};
 
 use anthesis_mesh::{Mesh, MeshError};
 use thiserror::Error;

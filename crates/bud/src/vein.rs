@@ -253,7 +253,7 @@ pub fn bend_along_vein(mesh: &Mesh, vein: &Vein) -> Result<Mesh, BudError> {
         arc[k] = arc[k - 1] + midrib[k].distance(midrib[k - 1]);
     }
     let midrib_length = arc[MIDRIB_SAMPLES];
-    if !(midrib_length > 0.0) {
+    if midrib_length.is_nan() || midrib_length <= 0.0 {
         return Err(BudError::ZeroLength);
     }
     let frames: Vec<[DVec3; 3]> = (0..midrib.len())

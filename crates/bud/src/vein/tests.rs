@@ -24,7 +24,9 @@ fn edge_lengths(mesh: &Mesh) -> Vec<f64> {
     mesh.triangles
         .iter()
         .flat_map(|t| {
-            (0..3).map(move |k| mesh.positions[t[k] as usize].distance(mesh.positions[t[(k + 1) % 3] as usize]))
+            (0..3).map(move |k| {
+                mesh.positions[t[k] as usize].distance(mesh.positions[t[(k + 1) % 3] as usize])
+            })
         })
         .collect()
 }
@@ -73,26 +75,42 @@ fn a_flat_petal_bent_along_a_circle_keeps_its_edge_lengths_and_its_midrib_lies_o
     let bent = bend_along_vein(&mesh, &vein).unwrap();
     // A flat sheet bent about its across direction is not stretched.
     for (before, after) in edge_lengths(&mesh).iter().zip(edge_lengths(&bent)) {
-        assert!((after / before - 1.0).abs() < 0.01, "edge {before} became {after}");
+        assert!(
+            (after / before - 1.0).abs() < 0.01,
+            "edge {before} became {after}"
+        );
     }
     let centre = DVec3::new(0.0, 0.0, radius);
     for (p, uv) in bent.positions.iter().zip(&bent.uvs) {
         // Every point keeps its distance across (x) and lies on the
         // cylinder the circle sweeps.
         let q = DVec3::new(0.0, p.y, p.z);
-        assert!(((q - centre).length() - radius).abs() < 0.02 * radius, "{p} (uv {uv}) is off the circle");
+        assert!(
+            ((q - centre).length() - radius).abs() < 0.02 * radius,
+            "{p} (uv {uv}) is off the circle"
+        );
     }
     for (a, b) in mesh.positions.iter().zip(&bent.positions) {
         assert!((a.x - b.x).abs() < 0.01, "across moved: {a} -> {b}");
     }
     // The tip ends at the quarter circle's end, (y, z) = (R, R).
-    let tip = bent.positions.iter().copied().max_by(|a, b| a.z.total_cmp(&b.z)).unwrap();
-    assert!((tip.y - radius).abs() < 0.05 && (tip.z - radius).abs() < 0.05, "{tip}");
+    let tip = bent
+        .positions
+        .iter()
+        .copied()
+        .max_by(|a, b| a.z.total_cmp(&b.z))
+        .unwrap();
+    assert!(
+        (tip.y - radius).abs() < 0.05 && (tip.z - radius).abs() < 0.05,
+        "{tip}"
+    );
 }
 
 #[test]
 fn a_cupped_petal_keeps_its_cup_across_when_its_midrib_is_straightened() {
-    let mesh = build_organ(&BezierPatch::petal(), &RemeshOptions::new(1.2)).unwrap().mesh;
+    let mesh = build_organ(&BezierPatch::petal(), &RemeshOptions::new(1.2))
+        .unwrap()
+        .mesh;
     let bent = bend_along_vein(&mesh, &straight(21.0)).unwrap();
     // Margins stay on the inner side (−z) of the midrib, as in the cup.
     let depth = |m: &Mesh| {
@@ -132,7 +150,10 @@ fn a_side_stroke_drawn_from_the_tip_down_or_left_of_the_axis_gives_the_same_vein
     for other in [&down, &left] {
         assert_eq!(other.base, up.base);
         for (a, b) in up.vein.points().iter().zip(other.vein.points()) {
-            assert!(a.distance(*b) < 0.05 * up.vein.length() / STROKE_SAMPLES as f64, "{a} vs {b}");
+            assert!(
+                a.distance(*b) < 0.05 * up.vein.length() / STROKE_SAMPLES as f64,
+                "{a} vs {b}"
+            );
         }
     }
     // In the template frame y is the height and z the distance outwards.
@@ -154,7 +175,10 @@ fn bad_side_strokes_are_refused_saying_why() {
         DVec2::new(7.0, 2.0),
     ];
     let error = SideStroke::new(&loop_stroke, 1.0).unwrap_err();
-    assert!(matches!(error, VeinError::SelfIntersecting { .. }), "{error:?}");
+    assert!(
+        matches!(error, VeinError::SelfIntersecting { .. }),
+        "{error:?}"
+    );
     assert!(error.to_string().contains("crosses itself"), "{error}");
     let across = [DVec2::new(-3.0, 0.0), DVec2::new(3.0, 6.0)];
     let error = SideStroke::new(&across, 1.0).unwrap_err();
@@ -162,7 +186,15 @@ fn bad_side_strokes_are_refused_saying_why() {
     let short = [DVec2::new(1.0, 0.0), DVec2::new(1.0, 0.5)];
     let error = SideStroke::new(&short, 1.0).unwrap_err();
     assert!(error.to_string().contains("too short"), "{error}");
-    assert_eq!(SideStroke::new(&[DVec2::new(1.0, 1.0)], 1.0).unwrap_err(), VeinError::TooShort { length: 0.0, minimum: 1.0 });
-    assert_eq!(SideStroke::new(&[DVec2::new(f64::NAN, 1.0), DVec2::ONE], 1.0).unwrap_err(), VeinError::NotFinite);
+    assert_eq!(
+        SideStroke::new(&[DVec2::new(1.0, 1.0)], 1.0).unwrap_err(),
+        VeinError::TooShort {
+            length: 0.0,
+            minimum: 1.0
+        }
+    );
+    assert_eq!(
+        SideStroke::new(&[DVec2::new(f64::NAN, 1.0), DVec2::ONE], 1.0).unwrap_err(),
+        VeinError::NotFinite
+    );
 }
-

@@ -417,7 +417,8 @@ impl Loader<'_> {
         let vein = match file.vein {
             None => None,
             Some(vein) => {
-                let points: Vec<glam::DVec2> = vein.points.iter().map(|p| glam::DVec2::from(*p)).collect();
+                let points: Vec<glam::DVec2> =
+                    vein.points.iter().map(|p| glam::DVec2::from(*p)).collect();
                 Some(anthesis_bud::Vein::from_points(&points).map_err(|e| {
                     self.invalid(format!("template \"{name}\": [templates.vein]: {e}"))
                 })?)

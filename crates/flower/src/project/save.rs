@@ -9,8 +9,8 @@ use super::check::{SizeCheck, check_project};
 use super::error::{ProjectError, map_error};
 use super::schema::{
     BaseRegionFile, BlendFile, ColourLayerFile, DirectionEntry, JointRampFile, KeyFile,
-    LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SourceFile, VeinFile,
-    SpiralFile, StructureFile, StructureKind, TemplateFile, TwoStateFile, WhorlFile,
+    LSystemFile, OrganFile, OverlapFile, ProjectFile, ScalarEntry, SimulationFile, SourceFile,
+    SpiralFile, StructureFile, StructureKind, TemplateFile, TwoStateFile, VeinFile, WhorlFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION, MAP_FOLDER, MESH_FOLDER};
 use crate::structure::{Arrangement, Structure};
