@@ -27,12 +27,14 @@
 
 #![warn(missing_docs)]
 
+pub mod bspline;
 pub mod dynamic;
 mod examples;
 mod from_mesh;
 mod net;
 mod quality;
 mod remesh;
+mod sketch;
 mod surface;
 mod vein;
 
@@ -40,6 +42,10 @@ pub use examples::{eustoma_petal_surface, lily_petal_surface};
 pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use net::mirrored;
 pub use quality::{MeshQuality, find_self_intersection, quality};
+pub use sketch::{
+    PetalSketch, SKETCH_COLUMNS, SKETCH_ROWS, SketchError, SketchFrame, SketchTool, SketchedPetal,
+    StrokeRole,
+};
 pub use surface::{BezierCurve, BezierPatch, MAX_STRETCH_TO_BEND, PdeSweep, Surface, bernstein3};
 pub use vein::{SideStroke, Vein, VeinError, bend_along_vein};
 
