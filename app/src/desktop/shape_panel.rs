@@ -292,7 +292,8 @@ fn shape_rows(
             ui.label("remeshing…");
         }
     }
-    if let Some(TemplateSource::Bezier { net: saved, .. }) = template.source {
+    if let Some(TemplateSource::Bezier { net: saved, .. }) = &template.source {
+        let saved = *saved;
         let draft = match state.drafts.get(&template.name) {
             Some((from, draft)) if *from == saved => *draft,
             _ => saved,

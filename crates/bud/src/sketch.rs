@@ -9,10 +9,13 @@
 //! template frame's x, y: +Y up on the canvas), in any order and any
 //! direction. Each is resampled evenly by arc length and smoothed (its ends
 //! stay). The vein is the one between the other two; all three are
-//! oriented from the base to the tip, the base being the end where the
-//! strokes come closer together or, when both ends are alike, the lower
-//! one. The petal is then put in the template frame: the vein's base at the
-//! origin and its chord (base to tip) along +Y.
+//! oriented from the base to the tip. The base is the lower end when the
+//! petal is drawn upright (within 45° of the canvas's vertical, as the
+//! template frame has it: base down, growing up); a petal drawn lying down
+//! has its base at the end where the strokes come closer together (where
+//! strokes meet is no rule for an upright petal: a pointed tip is where
+//! they meet best). The petal is then put in the template frame: the
+//! vein's base at the origin and its chord (base to tip) along +Y.
 //!
 //! **The flat surface.** [`SKETCH_ROWS`] rows of [`SKETCH_COLUMNS`] control
 //! points, row `j` at the arc-length fraction `j / (rows - 1)` of every
@@ -297,6 +300,30 @@ struct Outline {
 }
 
 impl PetalSketch {
+    /// A new petal's strokes (the app's "New sketched petal"): 20 long from
+    /// the base at the origin along +Y, 2.4 wide at the base, widest (about
+    /// 8) a little above the middle, pointed at the tip, a straight vein,
+    /// and one cross-section over the middle that cups the margins about 1
+    /// towards the inner side.
+    pub fn petal() -> PetalSketch {
+        let half_width = |t: f64| {
+            1.2 * (1.0 - t) * (1.0 - t)
+                + 4.2 * (std::f64::consts::PI * t.powf(0.85)).sin() * (1.0 - 0.3 * t)
+        };
+        let along = |f: &dyn Fn(f64) -> DVec2| -> Vec<DVec2> {
+            (0..=24).map(|k| f(f64::from(k) / 24.0)).collect()
+        };
+        let reach = half_width(0.57) + 0.3;
+        PetalSketch {
+            left: along(&|t| DVec2::new(-half_width(t), 20.0 * t)),
+            right: along(&|t| DVec2::new(half_width(t), 20.0 * t)),
+            vein: along(&|t| DVec2::new(0.0, 20.0 * t)),
+            sections: vec![along(&|t| {
+                DVec2::new(-reach + 2.0 * reach * t, 11.4 - 4.8 * t * (1.0 - t))
+            })],
+        }
+    }
+
     /// The strokes of `role` (an empty slice when not drawn or past the
     /// cross-sections).
     pub fn stroke(&self, role: StrokeRole) -> &[DVec2] {
@@ -724,19 +751,19 @@ fn sort_and_orient(mut strokes: [Vec<DVec2>; 3]) -> ([usize; 3], [Vec<DVec2>; 3]
             s.reverse();
         }
     }
-    // The base is where the strokes come closer together, or the lower end.
+    // The base is the lower end on the canvas (where the template frame
+    // has it) when the petal is drawn upright; drawn lying down, it is the
+    // end where the strokes come closer together.
     let spread = |ends: [DVec2; 3]| {
         ends[0].distance(ends[1]) + ends[1].distance(ends[2]) + ends[0].distance(ends[2])
     };
     let starts = [strokes[0][0], strokes[1][0], strokes[2][0]];
     let ends = strokes.clone().map(|s| s[s.len() - 1]);
-    let longest = strokes.iter().map(|s| length(s)).fold(0.0, f64::max);
-    let (spread_start, spread_end) = (spread(starts), spread(ends));
-    let reverse = if (spread_start - spread_end).abs() > 0.1 * longest {
-        spread_start > spread_end
+    let along = ends.iter().sum::<DVec2>() - starts.iter().sum::<DVec2>();
+    let reverse = if along.y.abs() >= along.x.abs() {
+        along.y < 0.0
     } else {
-        let mean_y = |p: [DVec2; 3]| p.iter().map(|q| q.y).sum::<f64>();
-        mean_y(starts) > mean_y(ends)
+        spread(starts) > spread(ends)
     };
     if reverse {
         for s in &mut strokes {

@@ -75,13 +75,25 @@ pub struct Template {
 
 /// How a template's mesh was made, when it was made from something that
 /// can be edited again.
-#[derive(Debug, Clone, Copy, PartialEq)]
+// One per template, so the Bézier net's 384 bytes inline cost nothing;
+// boxing it would change every use of the net.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum TemplateSource {
     /// A bicubic Bézier patch (its control net, rows from the base to the
     /// tip, columns across) meshed at mean edge `edge`.
     Bezier {
         /// The control net.
         net: anthesis_bud::BezierPatch,
+        /// The mean edge it was meshed at.
+        edge: f64,
+    },
+    /// A sketched petal (`sketch-based-floral-blossom.txt` §3.1): its
+    /// outline, vein and cross-section strokes as drawn, meshed at mean
+    /// edge `edge` (`kind = "sketch"`, project version 8).
+    Sketch {
+        /// The strokes.
+        sketch: anthesis_bud::PetalSketch,
         /// The mean edge it was meshed at.
         edge: f64,
     },

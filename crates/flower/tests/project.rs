@@ -1966,12 +1966,12 @@ fn a_bezier_template_keeps_its_control_net_through_a_save_as_version_7() {
     assert!(text.contains("edge = 1.25"), "{text}");
     let loaded = load_project(&path).expect("loads");
     assert_eq!(loaded, project);
-    match loaded.flower.templates[0].source {
+    match &loaded.flower.templates[0].source {
         Some(anthesis_flower::TemplateSource::Bezier { net: read, edge }) => {
-            assert_eq!(read, net);
-            assert_eq!(edge, 1.25);
+            assert_eq!(*read, net);
+            assert_eq!(*edge, 1.25);
         }
-        None => panic!("the source is lost"),
+        other => panic!("the source is lost: {other:?}"),
     }
     // A broken source is refused with what is wrong.
     edit(&path, |t| replace_once(t, "edge = 1.25", "edge = -1.0"));
@@ -1984,4 +1984,85 @@ fn a_bezier_template_keeps_its_control_net_through_a_save_as_version_7() {
     save_project(&lily(), &path).expect("saves");
     let text = fs::read_to_string(&path).expect("read");
     assert!(text.contains("version = 2"), "{text}");
+}
+
+/// A sketched petal's strokes: margins meeting at the base and tip, a
+/// vein, a cross-section cupping the middle.
+fn petal_sketch() -> anthesis_bud::PetalSketch {
+    let along = |f: &dyn Fn(f64) -> glam::DVec2| (0..=24).map(|k| f(f64::from(k) / 24.0)).collect();
+    let width = |t: f64| 4.0 * (std::f64::consts::PI * t).sin();
+    anthesis_bud::PetalSketch {
+        left: along(&|t| glam::DVec2::new(-width(t), 18.0 * t)),
+        right: along(&|t| glam::DVec2::new(width(t), 18.0 * t)),
+        vein: along(&|t| glam::DVec2::new(0.0, 18.0 * t)),
+        sections: vec![along(&|t| {
+            glam::DVec2::new(-4.2 + 8.4 * t, 9.0 - 4.0 * t * (1.0 - t))
+        })],
+    }
+}
+
+#[test]
+fn a_sketched_template_keeps_its_strokes_through_a_save_as_version_8() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("sketch.anthesis.toml");
+    let mut project = lily();
+    let sketch = petal_sketch();
+    sketch.build().expect("the strokes make a petal");
+    project.flower.templates[0].source = Some(anthesis_flower::TemplateSource::Sketch {
+        sketch: sketch.clone(),
+        edge: 1.25,
+    });
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("version = 8"), "{text}");
+    assert!(text.contains("kind = \"sketch\""), "{text}");
+    let loaded = load_project(&path).expect("loads");
+    assert_eq!(loaded, project);
+    match &loaded.flower.templates[0].source {
+        Some(anthesis_flower::TemplateSource::Sketch { sketch: read, edge }) => {
+            assert_eq!(*read, sketch);
+            assert_eq!(*edge, 1.25);
+        }
+        other => panic!("the strokes are lost: {other:?}"),
+    }
+    // Broken sources are refused naming the template and what is wrong.
+    let name = &project.flower.templates[0].name;
+    let refused = |from: &str, to: &str| {
+        save_project(&project, &path).expect("saves");
+        edit(&path, |t| replace_once(t, from, to));
+        load_project(&path).expect_err(to).to_string()
+    };
+    let message = refused("edge = 1.25", "edge = 0.0");
+    assert!(
+        message.contains(&format!(
+            "template \"{name}\": a sketch source's edge must be a positive number"
+        )),
+        "{message}"
+    );
+    let message = refused("vein = [[", "vein = [[0.0, 0.0]]\nunused = [[");
+    assert!(message.contains("unused"), "{message}");
+    let message = refused("sections = [[[", "sections = [[[1.0, 1.0]], [[");
+    assert!(
+        message.contains(&format!(
+            "template \"{name}\": a sketch source's cross-section 1 needs at least two finite points"
+        )),
+        "{message}"
+    );
+    // Strokes that make no petal: the right margin moved over the vein.
+    let mut crossing = project.clone();
+    if let Some(anthesis_flower::TemplateSource::Sketch { sketch, .. }) =
+        &mut crossing.flower.templates[0].source
+    {
+        for p in &mut sketch.right[8..16] {
+            p.x = -3.0;
+        }
+    }
+    save_project(&crossing, &path).expect("saves");
+    let message = load_project(&path).expect_err("crossing").to_string();
+    assert!(
+        message.contains(&format!(
+            "template \"{name}\": its sketch makes no petal: the"
+        )) && message.contains("cross near"),
+        "{message}"
+    );
 }

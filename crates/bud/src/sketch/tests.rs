@@ -120,6 +120,35 @@ fn the_strokes_may_come_in_any_order_and_direction_and_anywhere() {
     {
         assert!((*a - *b).length() < 1e-9, "{a} {b}");
     }
+    // Lying down (turned by 100°), the base is where the strokes meet:
+    // here the margins meet the vein only at the base.
+    let fan = PetalSketch {
+        left: stroke(20, |t| DVec2::new(-3.0 * t, 14.0 * t)),
+        right: stroke(20, |t| DVec2::new(3.0 * t, 14.0 * t)),
+        vein: stroke(20, |t| DVec2::new(0.0, 14.0 * t)),
+        sections: Vec::new(),
+    };
+    let lying = DVec2::from_angle(100f64.to_radians());
+    let turn_all = |v: &Vec<DVec2>| v.iter().rev().map(|p| lying.rotate(*p)).collect::<Vec<_>>();
+    let built = PetalSketch {
+        left: turn_all(&fan.left),
+        right: turn_all(&fan.right),
+        vein: turn_all(&fan.vein),
+        sections: Vec::new(),
+    }
+    .build()
+    .unwrap();
+    assert!(built.frame.origin.length() < 1e-9, "{:?}", built.frame);
+    let upright = fan.build().unwrap();
+    for (a, b) in built
+        .surface
+        .control
+        .iter()
+        .flatten()
+        .zip(upright.surface.control.iter().flatten())
+    {
+        assert!((*a - *b).length() < 1e-9, "{a} {b}");
+    }
     // And back in the sketch plane where it was drawn.
     let corner = turned.control_in_sketch()[0][0];
     assert!(
@@ -446,4 +475,36 @@ fn sketched_petals_of_several_shapes_mesh_within_the_quality_bounds() {
             }
         }
     }
+}
+
+#[test]
+fn the_new_petal_sketch_is_symmetric_cupped_and_meshes_at_the_simple_petals_edge() {
+    let built = PetalSketch::petal().build().unwrap();
+    assert_eq!(built.section_rows.len(), 1);
+    let row = built.section_rows[0];
+    let control = &built.surface.control;
+    for row in control {
+        for i in 0..SKETCH_COLUMNS {
+            let (p, q) = (row[i], row[SKETCH_COLUMNS - 1 - i]);
+            assert!(
+                (p.x + q.x).abs() < 1e-9 && (p.y - q.y).abs() < 1e-9 && (p.z - q.z).abs() < 1e-9
+            );
+        }
+    }
+    let base = built.surface.point(DVec2::new(0.5, 0.0));
+    assert!(base.length() < 1e-9, "{base}");
+    let tip = built.surface.point(DVec2::new(0.5, 1.0));
+    assert!((tip - DVec3::new(0.0, 20.0, 0.0)).length() < 1e-9, "{tip}");
+    let width = built
+        .surface
+        .point(DVec2::new(0.0, 0.0))
+        .distance(built.surface.point(DVec2::new(1.0, 0.0)));
+    assert!((width - 2.4).abs() < 1e-9, "{width}");
+    // Cupped: the margins over the middle lie towards -Z.
+    assert!(control[row][0].z < -0.9, "{}", control[row][0]);
+    let bud = build_organ(&built.surface, &RemeshOptions::new(1.2)).unwrap();
+    println!("{:?}", bud.quality);
+    assert!(bud.quality.min_angle_deg >= 30.0, "{:?}", bud.quality);
+    assert!(bud.quality.edge_spread <= 0.15, "{:?}", bud.quality);
+    assert_eq!(crate::inner_side_faces_minus_z(&bud.mesh), Some(true));
 }

@@ -413,6 +413,13 @@ impl Loader<'_> {
                     edge,
                 })
             }
+            Some(SourceFile::Sketch {
+                left,
+                right,
+                vein,
+                sections,
+                edge,
+            }) => Some(self.sketch_source(name, [left, right, vein], sections, edge)?),
         };
         let vein = match file.vein {
             None => None,
@@ -444,6 +451,57 @@ impl Loader<'_> {
             colouring,
             source,
         })
+    }
+
+    /// A sketched petal's `[templates.source]`: every stroke at least two
+    /// finite points, a positive edge, and strokes that make a petal.
+    fn sketch_source(
+        &self,
+        name: &str,
+        [left, right, vein]: [Vec<[f64; 2]>; 3],
+        sections: Vec<Vec<[f64; 2]>>,
+        edge: f64,
+    ) -> Result<crate::TemplateSource, ProjectError> {
+        let stroke = |points: Vec<[f64; 2]>, what: &str| {
+            if points.len() < 2 || !points.iter().flatten().all(|v| v.is_finite()) {
+                return Err(self.invalid(format!(
+                    "template \"{name}\": a sketch source's {what} needs at least two finite \
+                     points [x, y], found {} point(s){}",
+                    points.len(),
+                    if points.iter().flatten().all(|v| v.is_finite()) {
+                        ""
+                    } else {
+                        " with a number that is not finite"
+                    }
+                )));
+            }
+            Ok(points
+                .into_iter()
+                .map(glam::DVec2::from)
+                .collect::<Vec<_>>())
+        };
+        if !(edge.is_finite() && edge > 0.0) {
+            return Err(self.invalid(format!(
+                "template \"{name}\": a sketch source's edge must be a positive number, found \
+                 {edge}"
+            )));
+        }
+        let sketch = anthesis_bud::PetalSketch {
+            left: stroke(left, "left")?,
+            right: stroke(right, "right")?,
+            vein: stroke(vein, "vein")?,
+            sections: sections
+                .into_iter()
+                .enumerate()
+                .map(|(k, s)| stroke(s, &format!("cross-section {}", k + 1)))
+                .collect::<Result<_, _>>()?,
+        };
+        if let Err(e) = sketch.build() {
+            return Err(self.invalid(format!(
+                "template \"{name}\": its sketch makes no petal: {e}"
+            )));
+        }
+        Ok(crate::TemplateSource::Sketch { sketch, edge })
     }
 
     /// The bytes of a file named in the project, and the path to show for

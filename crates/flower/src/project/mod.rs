@@ -61,6 +61,12 @@
 //! net = [[-1.2, 0.0, -0.3], [-0.4, 0.0, 0.0], ...]  # 16 points [x, y, z]:
 //!                              # four rows of four, base to tip
 //! edge = 1.2                   # the mean edge it was meshed at
+//! # or (version 8) a sketched petal's strokes as drawn, [x, y] points in
+//! # the base plane (any order and direction; see anthesis_bud::PetalSketch):
+//! # kind = "sketch"
+//! # left = [[-0.5, 0.0], ...]   right = [...]   vein = [...]
+//! # sections = [[[-4.0, 9.0], ...], ...]   # optional cross-sections
+//! # edge = 1.2
 //! [templates.vein]             # optional (version 8): the primary vein the
 //! points = [[0.0, 0.0], [0.3, 0.1], ...]  # bud was sketched with, [y, z]
 //!                              # in the template frame from the base; the

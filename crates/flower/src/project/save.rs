@@ -90,10 +90,14 @@ pub(super) fn plan_save(
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
 /// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
 /// `[templates.two_state]` and `[templates.source]`, version 8
-/// `[templates.vein]`).
+/// `[templates.vein]` and a sketched petal's `[templates.source]`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
-    if flower.templates.iter().any(|t| t.vein.is_some()) {
+    if flower
+        .templates
+        .iter()
+        .any(|t| t.vein.is_some() || matches!(t.source, Some(crate::TemplateSource::Sketch { .. })))
+    {
         return FORMAT_VERSION;
     }
     if flower
@@ -264,11 +268,21 @@ pub(super) fn template_file(
             .map(JointRampFile::from)
             .collect(),
         two_state,
-        source: template.source.map(|source| match source {
+        source: template.source.as_ref().map(|source| match source {
             crate::TemplateSource::Bezier { net, edge } => SourceFile::Bezier {
                 net: net.control.iter().flatten().map(|p| p.to_array()).collect(),
-                edge,
+                edge: *edge,
             },
+            crate::TemplateSource::Sketch { sketch, edge } => {
+                let points = |s: &[glam::DVec2]| s.iter().map(|p| p.to_array()).collect();
+                SourceFile::Sketch {
+                    left: points(&sketch.left),
+                    right: points(&sketch.right),
+                    vein: points(&sketch.vein),
+                    sections: sketch.sections.iter().map(|s| points(s)).collect(),
+                    edge: *edge,
+                }
+            }
         }),
         vein: template.vein.as_ref().map(|vein| VeinFile {
             points: vein.points().iter().map(|p| p.to_array()).collect(),

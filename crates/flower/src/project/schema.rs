@@ -196,11 +196,25 @@ pub(super) struct TemplateFile {
 
 /// `[templates.source]`: `kind = "bezier"`, its 16 control points `net`
 /// (rows from the base to the tip, four points across each) and the mean
-/// `edge` it was meshed at.
+/// `edge` it was meshed at; or `kind = "sketch"`, the strokes `left`,
+/// `right`, `vein` and `sections` of a sketched petal and its `edge`.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields, tag = "kind", rename_all = "lowercase")]
 pub(super) enum SourceFile {
-    Bezier { net: Vec<[f64; 3]>, edge: f64 },
+    Bezier {
+        net: Vec<[f64; 3]>,
+        edge: f64,
+    },
+    /// Version 8: a sketched petal's strokes as drawn, `[x, y]` points in
+    /// the sketch plane (the template frame's base plane).
+    Sketch {
+        left: Vec<[f64; 2]>,
+        right: Vec<[f64; 2]>,
+        vein: Vec<[f64; 2]>,
+        #[serde(default)]
+        sections: Vec<Vec<[f64; 2]>>,
+        edge: f64,
+    },
 }
 
 /// `[templates.vein]`: the midrib's path in the template frame's `y`–`z`
