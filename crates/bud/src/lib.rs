@@ -34,6 +34,7 @@ mod from_mesh;
 mod net;
 mod quality;
 mod remesh;
+mod scan;
 mod sketch;
 mod surface;
 mod vein;
@@ -41,6 +42,10 @@ mod vein;
 pub use examples::{eustoma_petal_surface, lily_petal_surface};
 pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use net::mirrored;
+pub use scan::{
+    ScanCorners, ScanError, ScanFit, ScanFitOptions, ScanOutline, fit_scan, midrib_length,
+    reversed_across,
+};
 pub use quality::{MeshQuality, find_self_intersection, quality};
 pub use sketch::{
     PetalSketch, SKETCH_COLUMNS, SKETCH_ROWS, SketchError, SketchFrame, SketchTool, SketchedPetal,

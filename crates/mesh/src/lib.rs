@@ -22,12 +22,12 @@ pub mod validate;
 
 pub use error::{MeshError, Space};
 pub use obj::{
-    ObjFile, ObjWarning, load_obj, load_obj_file, obj_string, parse_obj, parse_obj_file,
-    parse_obj_unvalidated, write_obj,
+    ObjFile, ObjWarning, load_obj, load_obj_file, load_obj_shape, obj_string, parse_obj,
+    parse_obj_file, parse_obj_shape, parse_obj_unvalidated, write_obj,
 };
 pub use subdivide::Subdivision;
 pub use topology::{Edge, EdgeSide, Topology};
-pub use validate::validate;
+pub use validate::{validate, validate_shape};
 
 use glam::{DVec2, DVec3};
 

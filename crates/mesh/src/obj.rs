@@ -100,7 +100,7 @@ pub fn parse_obj(text: &str) -> Result<Mesh, MeshError> {
 /// with the OBJ line and the OBJ's own numbers (from 1) where one element
 /// is at fault.
 pub fn parse_obj_file(text: &str) -> Result<ObjFile, MeshError> {
-    let parsed = parse(text)?;
+    let parsed = parse(text, true)?;
     if let Err(error) = validate::validate(&parsed.mesh) {
         return Err(parsed.locate(error));
     }
@@ -114,7 +114,31 @@ pub fn parse_obj_file(text: &str) -> Result<ObjFile, MeshError> {
 /// on syntax errors, an empty file, missing UVs and UV seams, because those
 /// make a mesh with one UV per vertex impossible to build.
 pub fn parse_obj_unvalidated(text: &str) -> Result<Mesh, MeshError> {
-    parse(text).map(|parsed| parsed.mesh)
+    parse(text, true).map(|parsed| parsed.mesh)
+}
+
+/// Reads the OBJ file at `path` as a bare shape: like [`load_obj_file`],
+/// but texture coordinates are not needed and, where there are any, not
+/// read (a scanned or CAD petal without a UV layout; the mesh's UVs are
+/// all zero). Positions, faces and topology are validated as for
+/// [`load_obj_file`] ([`validate::validate_shape`]), errors naming the OBJ
+/// line and element.
+pub fn load_obj_shape(path: &Path) -> Result<ObjFile, MeshError> {
+    let text = anthesis_files::read_regular_text(path, MAX_OBJ_BYTES, "an OBJ mesh")
+        .map_err(|e| MeshError::Io(format!("{}: {e}", path.display())))?;
+    parse_obj_shape(&text)
+}
+
+/// Parses OBJ text as a bare shape (see [`load_obj_shape`]).
+pub fn parse_obj_shape(text: &str) -> Result<ObjFile, MeshError> {
+    let parsed = parse(text, false)?;
+    if let Err(error) = validate::validate_shape(&parsed.mesh) {
+        return Err(parsed.locate(error));
+    }
+    Ok(ObjFile {
+        mesh: parsed.mesh,
+        warnings: parsed.warnings,
+    })
 }
 
 /// The OBJ text of one object of `text` alone (its `v`, `vt` and `f`
@@ -329,7 +353,9 @@ impl Parsed {
     }
 }
 
-fn parse(text: &str) -> Result<Parsed, MeshError> {
+/// With `uvs` false the texture coordinates are read past: every vertex
+/// gets UV zero, and faces need none.
+fn parse(text: &str, uvs: bool) -> Result<Parsed, MeshError> {
     // Notepad and some exporters start UTF-8 files with a byte-order mark.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut positions: Vec<DVec3> = Vec::new();
@@ -372,8 +398,11 @@ fn parse(text: &str) -> Result<Parsed, MeshError> {
             "f" => {
                 let mut corners = Vec::new();
                 for word in words {
-                    let corner =
+                    let mut corner =
                         parse_corner(word, positions.len(), texcoords.len()).map_err(syntax)?;
+                    if !uvs {
+                        corner.texcoord = None;
+                    }
                     if corner.texcoord.is_none() && first_face_without_uv.is_none() {
                         first_face_without_uv = Some(line);
                     }
@@ -420,16 +449,20 @@ fn parse(text: &str) -> Result<Parsed, MeshError> {
     if triangles.is_empty() {
         return Err(MeshError::NoFaces);
     }
-    if texcoords.is_empty() {
+    if uvs && texcoords.is_empty() {
         return Err(MeshError::MissingUvs);
     }
-    if let Some(line) = first_face_without_uv {
+    if let Some(line) = first_face_without_uv.filter(|_| uvs) {
         return Err(MeshError::MissingUvOnFace { line });
     }
 
     // One texture coordinate per position; a second, different one is a seam.
     let mut texcoord_of_position: Vec<Option<usize>> = vec![None; positions.len()];
+    let mut used_position = vec![false; positions.len()];
     for (triangle, corners) in triangles.iter().enumerate() {
+        for corner in corners {
+            used_position[corner.position] = true;
+        }
         for corner in corners {
             let Some(texcoord) = corner.texcoord else {
                 continue;
@@ -462,13 +495,23 @@ fn parse(text: &str) -> Result<Parsed, MeshError> {
     let mesh = &mut parsed.mesh;
     let mut new_index: Vec<u32> = vec![u32::MAX; positions.len()];
     for (position_index, texcoord) in texcoord_of_position.iter().enumerate() {
-        if let Some(texcoord) = *texcoord {
-            new_index[position_index] = mesh.positions.len() as u32;
-            mesh.positions.push(positions[position_index]);
-            mesh.uvs.push(texcoords[texcoord]);
-            parsed.vertex_number.push(position_index + 1);
-            parsed.vertex_line.push(position_lines[position_index]);
-            parsed.texcoord_line.push(texcoord_lines[texcoord]);
+        if !used_position[position_index] {
+            continue;
+        }
+        new_index[position_index] = mesh.positions.len() as u32;
+        mesh.positions.push(positions[position_index]);
+        parsed.vertex_number.push(position_index + 1);
+        parsed.vertex_line.push(position_lines[position_index]);
+        match *texcoord {
+            Some(texcoord) => {
+                mesh.uvs.push(texcoords[texcoord]);
+                parsed.texcoord_line.push(texcoord_lines[texcoord]);
+            }
+            // Only when UVs are not read (otherwise every corner has one).
+            None => {
+                mesh.uvs.push(DVec2::ZERO);
+                parsed.texcoord_line.push(position_lines[position_index]);
+            }
         }
     }
     mesh.triangles = triangles
@@ -750,6 +793,25 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
     fn file_without_any_vt_is_missing_uvs() {
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n";
         assert_eq!(parse_obj(text), Err(MeshError::MissingUvs));
+    }
+
+    #[test]
+    fn a_shape_needs_no_uvs_and_its_errors_still_name_the_obj_element() {
+        // No vt at all, an unused vertex dropped, a quad fanned.
+        let text = "v 0 0 0\nv 1 0 0\nv 9 9 9\nv 1 1 0\nv 0 1 0\nf 1 2 4 5\n";
+        let shape = parse_obj_shape(text).unwrap().mesh;
+        assert_eq!(shape.positions.len(), 4);
+        assert_eq!(shape.uvs, vec![DVec2::ZERO; 4]);
+        assert_eq!(shape.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        // Faces with and without vt, UVs that would be a seam or flipped:
+        // all read past.
+        let mixed = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 1\n\
+                     f 1/1 2/2 3\nf 1/2 3 4\n";
+        assert_eq!(parse_obj_shape(mixed).unwrap().mesh.triangles.len(), 2);
+        // A degenerate triangle is still refused, naming its OBJ line.
+        let flat = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 4\nf 2 3 4\nf 1 2 3\n";
+        let error = parse_obj_shape(flat).unwrap_err().to_string();
+        assert!(error.starts_with("OBJ line 7:") && error.contains("zero area"), "{error}");
     }
 
     #[test]

@@ -28,6 +28,18 @@ pub const MAX_COORDINATE: f64 = 1e6;
 /// [`Topology::build`]), non-manifold vertex, flipped UV triangle, more than
 /// one connected piece.
 pub fn validate(mesh: &Mesh) -> Result<Topology, MeshError> {
+    validate_with(mesh, true)
+}
+
+/// [`validate`] for a shape whose UVs do not matter yet (a scanned petal
+/// before it is fitted and given UVs by convention): the same checks of the
+/// triangles, positions and topology, none of the UVs (they must still be
+/// one per vertex, e.g. all zero).
+pub fn validate_shape(mesh: &Mesh) -> Result<Topology, MeshError> {
+    validate_with(mesh, false)
+}
+
+fn validate_with(mesh: &Mesh, check_uvs: bool) -> Result<Topology, MeshError> {
     if mesh.triangles.is_empty() {
         return Err(MeshError::Empty);
     }
@@ -56,7 +68,7 @@ pub fn validate(mesh: &Mesh) -> Result<Topology, MeshError> {
     if let Some(vertex) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(MeshError::NonFinitePosition { vertex });
     }
-    if let Some(vertex) = mesh.uvs.iter().position(|uv| !uv.is_finite()) {
+    if let Some(vertex) = mesh.uvs.iter().position(|uv| check_uvs && !uv.is_finite()) {
         return Err(MeshError::NonFiniteUv { vertex });
     }
     let too_large = |values: &[f64]| values.iter().copied().find(|v| v.abs() > MAX_COORDINATE);
@@ -65,7 +77,7 @@ pub fn validate(mesh: &Mesh) -> Result<Topology, MeshError> {
             return Err(MeshError::CoordinateOutOfRange { vertex, value });
         }
     }
-    for (vertex, uv) in mesh.uvs.iter().enumerate() {
+    for (vertex, uv) in mesh.uvs.iter().enumerate().filter(|_| check_uvs) {
         if let Some(value) = too_large(&uv.to_array()) {
             return Err(MeshError::UvOutOfRange { vertex, value });
         }
@@ -79,12 +91,16 @@ pub fn validate(mesh: &Mesh) -> Result<Topology, MeshError> {
     }
 
     check_areas(mesh, Space::World)?;
-    check_areas(mesh, Space::Uv)?;
+    if check_uvs {
+        check_areas(mesh, Space::Uv)?;
+    }
 
     let topology = Topology::build(mesh)?;
 
     check_vertex_fans(mesh, &topology)?;
-    check_uv_orientation(mesh)?;
+    if check_uvs {
+        check_uv_orientation(mesh)?;
+    }
 
     let pieces = count_pieces(mesh.triangles.len(), &topology);
     if pieces > 1 {
