@@ -62,7 +62,7 @@ pub fn eustoma_petal_surface() -> BezierPatch {
 /// (a cubic Hermite curve) a parabola across with the midrib `cupping` above
 /// the margins. Because the sweep is linear in its boundary data, the
 /// profiles can be combined control point by control point.
-fn pde_petal(
+pub(crate) fn pde_petal(
     height: [f64; 4],
     half_width: [f64; 4],
     midrib_z: [f64; 4],

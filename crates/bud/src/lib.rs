@@ -37,21 +37,23 @@ mod remesh;
 mod scan;
 mod sketch;
 mod surface;
+mod sweep_edit;
 mod vein;
 
 pub use examples::{eustoma_petal_surface, lily_petal_surface};
 pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use net::mirrored;
+pub use quality::{MeshQuality, find_self_intersection, quality};
 pub use scan::{
     ScanCorners, ScanError, ScanFit, ScanFitOptions, ScanOutline, fit_scan, midrib_length,
     reversed_across,
 };
-pub use quality::{MeshQuality, find_self_intersection, quality};
 pub use sketch::{
     PetalSketch, SKETCH_COLUMNS, SKETCH_ROWS, SketchError, SketchFrame, SketchTool, SketchedPetal,
     StrokeRole,
 };
 pub use surface::{BezierCurve, BezierPatch, MAX_STRETCH_TO_BEND, PdeSweep, Surface, bernstein3};
+pub use sweep_edit::SweepCurve;
 pub use vein::{SideStroke, Vein, VeinError, bend_along_vein};
 
 use anthesis_mesh::{Mesh, MeshError};

@@ -581,7 +581,10 @@ fn parameterise(
     let m = free.len();
     if m > 0 {
         // Start from the mean of the outline.
-        let start = (0..n).filter(|&v| fixed[v]).map(|v| domain[v]).sum::<DVec2>()
+        let start = (0..n)
+            .filter(|&v| fixed[v])
+            .map(|v| domain[v])
+            .sum::<DVec2>()
             / (n - m).max(1) as f64;
         let mut x = vec![start; m];
         let mut ax = vec![DVec2::ZERO; m];
@@ -589,9 +592,8 @@ fn parameterise(
         let mut r: Vec<DVec2> = (0..m).map(|k| rhs[k] - ax[k]).collect();
         let mut z: Vec<DVec2> = (0..m).map(|k| r[k] / diagonal[k]).collect();
         let mut p = z.clone();
-        let dot = |a: &[DVec2], b: &[DVec2]| -> DVec2 {
-            a.iter().zip(b).map(|(a, b)| *a * *b).sum()
-        };
+        let dot =
+            |a: &[DVec2], b: &[DVec2]| -> DVec2 { a.iter().zip(b).map(|(a, b)| *a * *b).sum() };
         let mut rz = dot(&r, &z);
         let norm0 = dot(&rhs, &rhs).max_element().sqrt().max(1e-300);
         let mut ap = vec![DVec2::ZERO; m];
@@ -789,9 +791,11 @@ fn project(
     for _ in 0..6 {
         let s = surface.point(q);
         let r = s - p;
-        let du = (surface.point(DVec2::new(q.x + h, q.y)) - surface.point(DVec2::new(q.x - h, q.y)))
+        let du = (surface.point(DVec2::new(q.x + h, q.y))
+            - surface.point(DVec2::new(q.x - h, q.y)))
             / (2.0 * h);
-        let dv = (surface.point(DVec2::new(q.x, q.y + h)) - surface.point(DVec2::new(q.x, q.y - h)))
+        let dv = (surface.point(DVec2::new(q.x, q.y + h))
+            - surface.point(DVec2::new(q.x, q.y - h)))
             / (2.0 * h);
         let step = match (held_u.is_some(), held_v.is_some()) {
             (true, _) => {
@@ -1008,9 +1012,8 @@ fn surface_to_scan(surface: &PdeSweep, mesh: &Mesh) -> [f64; 2] {
     let samples = 40;
     let points: Vec<DVec3> = (0..=samples)
         .flat_map(|j| {
-            (0..=samples).map(move |i| {
-                surface.point(DVec2::new(i as f64, j as f64) / samples as f64)
-            })
+            (0..=samples)
+                .map(move |i| surface.point(DVec2::new(i as f64, j as f64) / samples as f64))
         })
         .collect();
     let (mut sum, mut max) = (0.0, 0.0f64);

@@ -4,13 +4,16 @@
 use std::path::PathBuf;
 
 use anthesis_bud::{
-    RemeshOptions, Surface, ScanError, ScanFitOptions, ScanOutline, build_organ, fit_scan, remesh_mesh,
+    RemeshOptions, ScanError, ScanFitOptions, ScanOutline, Surface, build_organ, fit_scan,
+    remesh_mesh,
 };
 use anthesis_mesh::{Mesh, MeshError};
 use glam::{DMat3, DVec3};
 
 fn asset(path: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets").join(path)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../assets")
+        .join(path)
 }
 
 /// A small deterministic generator (xorshift), uniform in [-1, 1).
@@ -44,7 +47,9 @@ fn scanned(path: &str, noise: f64) -> (Mesh, DMat3, DVec3, f64, DVec3) {
     let surface = anthesis_bud::MeshSurface::new(&template).unwrap();
     let length = anthesis_bud::midrib_length(&surface);
     let tip = surface.point(glam::DVec2::new(0.5, 1.0));
-    let remeshed = remesh_mesh(&template, &RemeshOptions::new(0.9)).unwrap().mesh;
+    let remeshed = remesh_mesh(&template, &RemeshOptions::new(0.9))
+        .unwrap()
+        .mesh;
     assert_ne!(remeshed.vertex_count(), template.vertex_count());
     let rotation = DMat3::from_axis_angle(DVec3::new(0.3, -1.0, 0.5).normalize(), 2.1);
     let shift = DVec3::new(120.0, -35.0, 7.5);
@@ -82,7 +87,10 @@ fn a_shipped_petal_retriangulated_with_noise_and_moved_is_fitted_back_within_two
     assert!(b0.y < 0.03 * length && b1.y < 0.03 * length, "{b0} {b1}");
     assert!(corners.pointed(), "the lily's tip is pointed: {corners:?}");
     let tip = at(corners.tip[0]);
-    assert!(tip.distance(true_tip) < 0.03 * length, "tip found at {tip}, not {true_tip}");
+    assert!(
+        tip.distance(true_tip) < 0.03 * length,
+        "tip found at {tip}, not {true_tip}"
+    );
 
     let fit = fit_scan(&scan, None, &ScanFitOptions::default()).unwrap();
     let [rms, max] = fit.relative_scan_to_surface();
@@ -91,10 +99,18 @@ fn a_shipped_petal_retriangulated_with_noise_and_moved_is_fitted_back_within_two
     assert!(rms < 0.02, "RMS {:.2} % of the length", 100.0 * rms);
     // The noise itself is 0.3 % per axis (uniform: RMS 0.17 % per axis,
     // 0.3 % in 3D); the fit should not be far above it.
-    assert!(rms < 0.006, "RMS {:.3} % is well above the noise", 100.0 * rms);
+    assert!(
+        rms < 0.006,
+        "RMS {:.3} % is well above the noise",
+        100.0 * rms
+    );
     assert!(max < 0.03, "max {:.2} %", 100.0 * max);
     assert!(back_rms < 0.01 && back_max < 0.05, "{back_rms} {back_max}");
-    assert!((fit.length / length - 1.0).abs() < 0.02, "{} vs {length}", fit.length);
+    assert!(
+        (fit.length / length - 1.0).abs() < 0.02,
+        "{} vs {length}",
+        fit.length
+    );
 
     // In the template frame: base at the origin, tip along +Y, meshed with
     // the inner side to −Z (the lily petal is cupped to −Z: concave there).
@@ -102,7 +118,10 @@ fn a_shipped_petal_retriangulated_with_noise_and_moved_is_fitted_back_within_two
     assert!(base.length() < 0.05 * length, "{base}");
     let bud = build_organ(&fit.sweep, &RemeshOptions::new(1.3)).unwrap();
     assert!(bud.quality.min_angle_deg >= 20.0);
-    assert_eq!(anthesis_bud::inner_side_faces_minus_z(&bud.mesh), Some(true));
+    assert_eq!(
+        anthesis_bud::inner_side_faces_minus_z(&bud.mesh),
+        Some(true)
+    );
     // The placement undoes the motion up to the choice of axes: the
     // template's own midrib normal (−Z inner) maps near −Z.
     let motion_back = fit.rotation * rotation;
@@ -121,9 +140,10 @@ fn a_scan_with_a_hole_or_a_non_manifold_edge_is_refused_with_its_message() {
     let inner = (0..scan.vertex_count())
         .find(|&v| {
             !on_outline[v]
-                && scan.triangles.iter().all(|t| {
-                    !t.contains(&(v as u32)) || t.iter().all(|&w| !on_outline[w as usize])
-                })
+                && scan
+                    .triangles
+                    .iter()
+                    .all(|t| !t.contains(&(v as u32)) || t.iter().all(|&w| !on_outline[w as usize]))
         })
         .unwrap();
     let mut holed = scan.clone();
@@ -140,11 +160,21 @@ fn a_scan_with_a_hole_or_a_non_manifold_edge_is_refused_with_its_message() {
     }
     let error = fit_scan(&holed, None, &ScanFitOptions::default()).unwrap_err();
     assert!(
-        matches!(error, ScanError::Holes { loops: 2, holes: 1, .. }),
+        matches!(
+            error,
+            ScanError::Holes {
+                loops: 2,
+                holes: 1,
+                ..
+            }
+        ),
         "{error:?}"
     );
     let message = error.to_string();
-    assert!(message.contains("2 boundary loops") && message.contains("fill the holes"), "{message}");
+    assert!(
+        message.contains("2 boundary loops") && message.contains("fill the holes"),
+        "{message}"
+    );
 
     // A non-manifold edge: a third triangle on an edge of the OBJ.
     let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0.5 0.5 1\n\
@@ -168,8 +198,14 @@ fn a_scan_with_a_hole_or_a_non_manifold_edge_is_refused_with_its_message() {
         triangles: vec![[0, 1, 2], [1, 3, 2], [1, 2, 4]],
     };
     let error = fit_scan(&mesh, None, &ScanFitOptions::default()).unwrap_err();
-    assert!(matches!(error, ScanError::Mesh(MeshError::NonManifoldEdge { .. })), "{error:?}");
-    assert!(error.to_string().contains("not one manifold surface"), "{error}");
+    assert!(
+        matches!(error, ScanError::Mesh(MeshError::NonManifoldEdge { .. })),
+        "{error:?}"
+    );
+    assert!(
+        error.to_string().contains("not one manifold surface"),
+        "{error}"
+    );
 }
 
 #[test]
@@ -190,7 +226,10 @@ fn a_shipped_eustoma_petal_with_a_rounded_top_is_fitted_back_too() {
     // top's); the rounded top has no sharp corners, so where its span
     // starts and ends is a guess the user may correct.
     let base_middle = (at(corners.base[0]) + at(corners.base[1])) * 0.5;
-    assert!(base_middle.length() < 0.03 * length, "base found at {base_middle}");
+    assert!(
+        base_middle.length() < 0.03 * length,
+        "base found at {base_middle}"
+    );
     assert!(!corners.pointed());
     let fit = fit_scan(&scan, None, &ScanFitOptions::default()).unwrap();
     println!("eustoma scan (noise 0.3 % of length): {}", fit.summary());

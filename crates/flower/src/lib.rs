@@ -97,6 +97,15 @@ pub enum TemplateSource {
         /// The mean edge it was meshed at.
         edge: f64,
     },
+    /// A PDE sweep surface (`pde-surfaces-lily.txt` §IV, eq. 12): margins,
+    /// across-tangents and `k_s/k_b`, meshed at mean edge `edge` (the app's
+    /// PDE petal editor, or a fitted scan; project version 8).
+    Pde {
+        /// The surface.
+        sweep: anthesis_bud::PdeSweep,
+        /// The mean edge it was meshed at.
+        edge: f64,
+    },
 }
 
 /// A two-state animation (`sketch-based-floral-blossom.txt` §4): the

@@ -2066,3 +2066,61 @@ fn a_sketched_template_keeps_its_strokes_through_a_save_as_version_8() {
         "{message}"
     );
 }
+
+#[test]
+fn a_pde_template_keeps_its_curves_through_a_save_as_version_8_and_a_broken_one_is_named() {
+    let folder = tempfile::tempdir().expect("temp dir");
+    let path = folder.path().join("pde.anthesis.toml");
+    let mut project = lily();
+    let sweep = anthesis_bud::PdeSweep::petal()
+        .with_point(
+            anthesis_bud::SweepCurve::Margin0,
+            1,
+            DVec3::new(5.5, 7.5, -1.0),
+            true,
+        )
+        .with_stretch_to_bend(2.5);
+    project.flower.templates[0].source =
+        Some(anthesis_flower::TemplateSource::Pde { sweep, edge: 1.1 });
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("version = 8"), "{text}");
+    assert!(text.contains("kind = \"pde\""), "{text}");
+    assert!(text.contains("stretch_to_bend = 2.5"), "{text}");
+    let loaded = load_project(&path).expect("loads");
+    assert_eq!(loaded, project);
+    match &loaded.flower.templates[0].source {
+        Some(anthesis_flower::TemplateSource::Pde { sweep: read, edge }) => {
+            assert_eq!(*read, sweep);
+            assert_eq!(*edge, 1.1);
+        }
+        other => panic!("the source is lost: {other:?}"),
+    }
+    // Broken sources are refused naming the template and the field.
+    let name = &project.flower.templates[0].name;
+    for (from, to, says) in [
+        (
+            "edge = 1.1",
+            "edge = 0.0",
+            "a PDE source's edge must be a positive number",
+        ),
+        (
+            "stretch_to_bend = 2.5",
+            "stretch_to_bend = -1.0",
+            "stretch_to_bend (k_s/k_b) must be from 0 to 100",
+        ),
+        (
+            "margin1 = [",
+            "margin1 = [[0.0, 0.0, 0.0], ",
+            "a PDE source's margin1 needs 4 points",
+        ),
+    ] {
+        save_project(&project, &path).expect("saves");
+        edit(&path, |t| replace_once(t, from, to));
+        let error = load_project(&path).expect_err(to).to_string();
+        assert!(
+            error.contains(&format!("template \"{name}\"")) && error.contains(says),
+            "{error}"
+        );
+    }
+}

@@ -811,7 +811,10 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         // A degenerate triangle is still refused, naming its OBJ line.
         let flat = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 4\nf 2 3 4\nf 1 2 3\n";
         let error = parse_obj_shape(flat).unwrap_err().to_string();
-        assert!(error.starts_with("OBJ line 7:") && error.contains("zero area"), "{error}");
+        assert!(
+            error.starts_with("OBJ line 7:") && error.contains("zero area"),
+            "{error}"
+        );
     }
 
     #[test]

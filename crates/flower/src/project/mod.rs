@@ -67,6 +67,12 @@
 //! # left = [[-0.5, 0.0], ...]   right = [...]   vein = [...]
 //! # sections = [[[-4.0, 9.0], ...], ...]   # optional cross-sections
 //! # edge = 1.2
+//! # or (version 8) a PDE sweep (eq. 12 of pde-surfaces-lily.txt):
+//! # kind = "pde"
+//! # margin0 = [[1.2, 0, -0.3], ...]  # 4 Bézier control points, base to tip
+//! # margin1 = [...]; tangent0 = [...]; tangent1 = [...]  # dS/du there
+//! # stretch_to_bend = 0.0      # k_s/k_b, 0 to 100 (0: the cubic)
+//! # edge = 1.2
 //! [templates.vein]             # optional (version 8): the primary vein the
 //! points = [[0.0, 0.0], [0.3, 0.1], ...]  # bud was sketched with, [y, z]
 //!                              # in the template frame from the base; the

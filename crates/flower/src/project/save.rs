@@ -90,14 +90,16 @@ pub(super) fn plan_save(
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
 /// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
 /// `[templates.two_state]` and `[templates.source]`, version 8
-/// `[templates.vein]` and a sketched petal's `[templates.source]`).
+/// `[templates.vein]` and a sketched or PDE petal's `[templates.source]`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
-    if flower
-        .templates
-        .iter()
-        .any(|t| t.vein.is_some() || matches!(t.source, Some(crate::TemplateSource::Sketch { .. })))
-    {
+    if flower.templates.iter().any(|t| {
+        t.vein.is_some()
+            || matches!(
+                t.source,
+                Some(crate::TemplateSource::Sketch { .. } | crate::TemplateSource::Pde { .. })
+            )
+    }) {
         return FORMAT_VERSION;
     }
     if flower
@@ -280,6 +282,19 @@ pub(super) fn template_file(
                     right: points(&sketch.right),
                     vein: points(&sketch.vein),
                     sections: sketch.sections.iter().map(|s| points(s)).collect(),
+                    edge: *edge,
+                }
+            }
+            crate::TemplateSource::Pde { sweep, edge } => {
+                let points = |c: &anthesis_bud::BezierCurve| {
+                    c.control.iter().map(|p| p.to_array()).collect()
+                };
+                SourceFile::Pde {
+                    margin0: points(&sweep.curve0),
+                    margin1: points(&sweep.curve1),
+                    tangent0: points(&sweep.tangent0),
+                    tangent1: points(&sweep.tangent1),
+                    stretch_to_bend: sweep.stretch_to_bend(),
                     edge: *edge,
                 }
             }

@@ -215,6 +215,17 @@ pub(super) enum SourceFile {
         sections: Vec<Vec<[f64; 2]>>,
         edge: f64,
     },
+    /// Version 8: a PDE sweep, its margins and across-tangents four Bézier
+    /// control points each (base to tip), `k_s/k_b` and the edge.
+    Pde {
+        margin0: Vec<[f64; 3]>,
+        margin1: Vec<[f64; 3]>,
+        tangent0: Vec<[f64; 3]>,
+        tangent1: Vec<[f64; 3]>,
+        #[serde(default)]
+        stretch_to_bend: f64,
+        edge: f64,
+    },
 }
 
 /// `[templates.vein]`: the midrib's path in the template frame's `y`–`z`
