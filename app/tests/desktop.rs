@@ -2951,3 +2951,300 @@ fn a_bezier_petal_is_made_its_control_points_dragged_and_typed_and_applied_in_on
     assert_eq!(mesh, &anthesis_bud::with_inner_side_flipped(&again.mesh));
     assert_eq!(anthesis_bud::inner_side_faces_minus_z(mesh), Some(false));
 }
+
+/// Drags from `from` by `by` in three steps, settling between them.
+fn drag_by(harness: &mut Harness<'_, AnthesisApp>, from: egui::Pos2, by: egui::Vec2) {
+    harness.hover_at(from);
+    settle(harness);
+    harness.drag_at(from);
+    settle(harness);
+    for k in 1..=3 {
+        harness.hover_at(from + by * (k as f32 / 3.0));
+        settle(harness);
+    }
+    harness.drop_at(from + by);
+    settle(harness);
+}
+
+#[test]
+fn a_pde_petal_is_made_its_margin_dragged_applied_in_one_undo_step_and_saved_with_its_curves() {
+    use anthesis_bud::{PdeSweep, SweepCurve};
+    let mut harness = opened_small_flower();
+    harness.get_by_label("Flower").click();
+    settle(&mut harness);
+    let before = harness.state().project().clone();
+
+    // A new template of the starting sweep, with one organ, its curves in
+    // the Shape section.
+    click_settled(&mut harness, "New PDE petal");
+    let app = harness.state();
+    let flower = &app.project().flower;
+    let index = flower.templates.len() - 1;
+    assert_eq!(index, before.flower.templates.len());
+    assert_eq!(flower.templates[index].name, "pde petal");
+    assert_eq!(flower.organs.len(), before.flower.organs.len() + 1);
+    let shape = app.flower_panel().shape();
+    assert_eq!(shape.template(), index);
+    let start = PdeSweep::petal();
+    assert_eq!(shape.pde().sweep("pde petal"), Some(&start));
+    let made = flower.templates[index].clone();
+    assert_eq!(
+        made.source,
+        Some(anthesis_flower::TemplateSource::Pde {
+            sweep: start,
+            edge: anthesis_garden::five_petal::SIMPLE_PETAL_EDGE
+                * anthesis_garden::flowers::EDGE_SCALE
+        })
+    );
+    wait_for_remesh_preview(&mut harness).expect("the new petal remeshes");
+
+    // Drag margin 1's upper control point 30 pixels to the right in the
+    // front view: its mirror image on margin 2 moves left with it.
+    harness.get_by_label("PDE surface").scroll_to_me();
+    settle(&mut harness);
+    let from = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .point_on_screen(SweepCurve::Margin0, 2)
+        .expect("drawn");
+    drag_by(&mut harness, from, egui::vec2(30.0, 0.0));
+    let sweep = *harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .sweep("pde petal")
+        .expect("sweep");
+    let (moved, was) = (sweep.curve0.control[2], start.curve0.control[2]);
+    assert!(moved.x > was.x + 0.5, "{moved} from {was}");
+    assert_eq!(moved.y, was.y);
+    assert_eq!(sweep.curve1.control[2], anthesis_bud::mirrored(moved));
+    assert!(sweep.is_symmetric(0.0));
+    assert_eq!(
+        harness.state().project().flower.templates[index],
+        made,
+        "the surface is a draft until applied"
+    );
+
+    // Drag the upper tangent handle of margin 2 up: the tangent turns
+    // (three times the handle's move) and its mirror follows.
+    let handle = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .point_on_screen(SweepCurve::Tangent1, 2)
+        .expect("drawn");
+    drag_by(&mut harness, handle, egui::vec2(0.0, -15.0));
+    let turned = *harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .sweep("pde petal")
+        .expect("sweep");
+    assert!(
+        turned.tangent1.control[2].y > 0.5,
+        "{}",
+        turned.tangent1.control[2]
+    );
+    assert_eq!(turned.tangent1.control[2].x, start.tangent1.control[2].x);
+    assert!(turned.is_symmetric(1e-12));
+    // The mesh it would become is shown before applying.
+    let quality = *harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .built()
+        .expect("built")
+        .expect("meshes");
+    harness.get_by_label_contains(&format!("surface meshed: {} particles", quality.vertices));
+    harness.get_by_label("Apply surface").scroll_to_me();
+    harness.remove_cursor();
+    settle(&mut harness);
+    harness.snapshot("flower_panel_pde");
+
+    // Apply: the sweep meshed at the remesh edge replaces the mesh, the
+    // maps stay, one undo step.
+    click_settled(&mut harness, "Apply surface");
+    let app = harness.state();
+    let applied = &app.project().flower.templates[index];
+    let edge = anthesis_bud::quality(&made.mesh).mean_edge;
+    let expected = anthesis_bud::build_organ(&turned, &anthesis_bud::RemeshOptions::new(edge))
+        .expect("meshes");
+    assert_eq!(applied.mesh, expected.mesh);
+    assert_eq!(applied.mesh.vertex_count(), quality.vertices);
+    assert_eq!(applied.maps, made.maps);
+    assert_eq!(
+        applied.source,
+        Some(anthesis_flower::TemplateSource::Pde {
+            sweep: turned,
+            edge
+        })
+    );
+    assert_eq!(
+        app.document().undo_label(),
+        Some("PDE surface of pde petal")
+    );
+    // The curves are saved with the project and read back, to edit again.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("pde.anthesis.toml");
+    anthesis_flower::project::save_project(app.project(), &path).expect("saves");
+    assert!(
+        std::fs::read_to_string(&path)
+            .expect("read")
+            .contains("kind = \"pde\"")
+    );
+    let reopened = anthesis_flower::project::load_project(&path).expect("loads");
+    assert_eq!(reopened.flower.templates[index].source, applied.source);
+    assert_eq!(reopened.flower.templates[index].mesh, applied.mesh);
+
+    // One undo takes mesh, curves and the editor's draft back.
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(harness.state().project().flower.templates[index], made);
+    assert_eq!(
+        harness
+            .state()
+            .flower_panel()
+            .shape()
+            .pde()
+            .sweep("pde petal"),
+        Some(&start)
+    );
+}
+
+#[test]
+fn a_scanned_petal_is_fitted_its_base_moved_and_made_a_template_in_one_undo_step() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // The lily petal as a scan: another triangulation, no UVs, moved.
+    let lily = anthesis_mesh::load_obj(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../assets/flowers/lily/meshes/petal.obj"),
+    )
+    .expect("lily petal");
+    let scan = anthesis_bud::remesh_mesh(&lily, &anthesis_bud::RemeshOptions::new(2.0))
+        .expect("remeshes")
+        .mesh;
+    let mut text = String::new();
+    for p in &scan.positions {
+        text.push_str(&format!("v {} {} {}\n", p.x + 10.0, p.z, -p.y));
+    }
+    for t in &scan.triangles {
+        text.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    std::fs::write(dir.path().join("scan.obj"), text).expect("write obj");
+    let mut harness = harness_with_file_browser(&dir.path().join("flower.anthesis.toml"));
+    harness.get_by_label("Flower").click();
+    settle(&mut harness);
+    let before = harness.state().project().clone();
+
+    click_settled(&mut harness, "Import scanned petal…");
+    harness.get_by_label("🗋 scan.obj").click();
+    settle(&mut harness);
+    harness.get_by_label("Open").click();
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().project().flower,
+        before.flower,
+        "nothing changes until the template is made"
+    );
+    let panel = harness.state().flower_panel();
+    let review = panel.shape().pde().scan().expect("the scan is reviewed");
+    let fit = review.fit().expect("fits").clone();
+    let [rms, max] = fit.relative_scan_to_surface();
+    assert!(rms < 0.02 && max < 0.05, "RMS {rms}, max {max}");
+    let (corners, found) = review.corners();
+    assert_eq!(corners, found);
+    assert!(corners.pointed());
+    harness.get_by_label_contains(&format!("fit error: RMS {:.2} %", 100.0 * rms));
+    // The log names the temporary folder: cleared for the picture.
+    click_settled(&mut harness, "Clear");
+    harness.get_by_label("Scanned petal: scan.obj");
+    harness.get_by_label("inner side convex").scroll_to_me();
+    harness.remove_cursor();
+    settle(&mut harness);
+    harness.snapshot("flower_panel_scan");
+
+    // Move the first base corner: click on the outline two vertices
+    // further round; the fit is made again with it.
+    harness.get_by_label("inner side convex").scroll_to_me();
+    settle(&mut harness);
+    let review = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .scan()
+        .expect("review");
+    let n = review.outline().len();
+    let moved_to = (corners.base[0] + n - 2) % n;
+    let at = review.outline_on_screen(moved_to).expect("drawn");
+    harness.hover_at(at);
+    settle(&mut harness);
+    harness.drag_at(at);
+    settle(&mut harness);
+    // Released where it was pressed, the pointer still there: a click.
+    harness.event(egui::Event::PointerButton {
+        pos: at,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    settle(&mut harness);
+    let review = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .scan()
+        .expect("review");
+    let (now, _) = review.corners();
+    assert_eq!(now.base[0], moved_to);
+    let refit = review.fit().expect("fits again").clone();
+    assert_ne!(refit.sweep, fit.sweep);
+    assert_eq!(refit.corners, now);
+    click_settled(&mut harness, "Found corners");
+    let (back, _) = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .pde()
+        .scan()
+        .expect("review")
+        .corners();
+    assert_eq!(back, found);
+
+    // Make the template: the fitted sweep as its source, one organ, one
+    // undo step.
+    click_settled(&mut harness, "Make template");
+    let app = harness.state();
+    assert!(app.flower_panel().shape().pde().scan().is_none());
+    let flower = &app.project().flower;
+    assert_eq!(flower.templates.len(), before.flower.templates.len() + 1);
+    assert_eq!(flower.organs.len(), before.flower.organs.len() + 1);
+    let template = flower.templates.last().expect("made");
+    assert_eq!(template.name, "scan");
+    let Some(anthesis_flower::TemplateSource::Pde { sweep, edge }) = template.source else {
+        panic!("no PDE source: {:?}", template.source);
+    };
+    assert_eq!(sweep, fit.sweep);
+    assert!((edge - fit.length / 36.0).abs() < 1e-12);
+    let expected =
+        anthesis_bud::build_organ(&sweep, &anthesis_bud::RemeshOptions::new(edge)).expect("meshes");
+    assert_eq!(template.mesh, expected.mesh);
+    assert_eq!(
+        anthesis_bud::inner_side_faces_minus_z(&template.mesh),
+        Some(true)
+    );
+    assert_eq!(
+        app.document().undo_label(),
+        Some("import scanned petal scan")
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(harness.state().project().flower, before.flower);
+}

@@ -47,6 +47,8 @@ pub enum Command {
     BrowseExportPath,
     /// Ask for an OBJ mesh to make a new template of.
     BrowseTemplateObj,
+    /// Ask for a scanned petal (an OBJ without UVs) to fit.
+    BrowseScan,
     /// Ask for an OBJ to use as this template's open shape (two-state).
     BrowseOpenShape(usize),
     /// A file dialog (native or the in-app browser) answered: the path
@@ -269,6 +271,7 @@ impl AnthesisApp {
             Command::OpenExportDialog => self.open_export(),
             Command::BrowseExportPath => self.ask_for_path(DialogPurpose::ExportGlb),
             Command::BrowseTemplateObj => self.ask_for_path(DialogPurpose::ImportTemplateObj),
+            Command::BrowseScan => self.ask_for_path(DialogPurpose::ImportScan),
             Command::BrowseOpenShape(template) => {
                 self.ask_for_path(DialogPurpose::OpenShape(template));
             }

@@ -36,6 +36,8 @@ pub enum DialogPurpose {
     ExportGlb,
     /// An OBJ mesh to make a new template of (the Flower panel).
     ImportTemplateObj,
+    /// A scanned petal (an OBJ, UVs not needed) to fit (the Flower panel).
+    ImportScan,
     /// An OBJ as the open shape of this template (two-state).
     OpenShape(usize),
 }
@@ -47,6 +49,7 @@ impl DialogPurpose {
             DialogPurpose::SaveProjectAs => "Save the project as",
             DialogPurpose::ExportGlb => "Export the animation (.glb, .usda, .usdc or .gif)",
             DialogPurpose::ImportTemplateObj => "Import an OBJ mesh as a new template",
+            DialogPurpose::ImportScan => "Import a scanned petal (OBJ) to fit",
             DialogPurpose::OpenShape(_) => "Open shape: an OBJ of the template mesh moved",
         }
     }
@@ -56,6 +59,7 @@ impl DialogPurpose {
         match self {
             DialogPurpose::OpenProject
             | DialogPurpose::ImportTemplateObj
+            | DialogPurpose::ImportScan
             | DialogPurpose::OpenShape(_) => None,
             DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml"),
             DialogPurpose::ExportGlb => Some("flower.glb"),
@@ -68,7 +72,7 @@ impl DialogPurpose {
         match self {
             DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => &[PROJECT_EXTENSION],
             DialogPurpose::ExportGlb => &["glb", "usda", "usdc", "usd", "gif"],
-            DialogPurpose::ImportTemplateObj => &["obj"],
+            DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => &["obj"],
             DialogPurpose::OpenShape(_) => &["obj"],
         }
     }
@@ -209,6 +213,7 @@ impl Dialogs {
         let mut browser = match purpose {
             DialogPurpose::OpenProject
             | DialogPurpose::ImportTemplateObj
+            | DialogPurpose::ImportScan
             | DialogPurpose::OpenShape(_) => egui_file::FileDialog::open_file(),
             DialogPurpose::SaveProjectAs | DialogPurpose::ExportGlb => {
                 egui_file::FileDialog::save_file()
@@ -282,7 +287,7 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
             .add_filter("Anthesis project", purpose.extensions())
             .set_file_name(purpose.suggested_name().unwrap_or_default())
             .save_file(),
-        DialogPurpose::ImportTemplateObj => dialog
+        DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => dialog
             .add_filter("OBJ mesh", purpose.extensions())
             .pick_file(),
         DialogPurpose::ExportGlb => dialog

@@ -87,6 +87,12 @@ impl FlowerPanelState {
         self.shape.open_now = true;
     }
 
+    /// A scanned petal was read: it is reviewed in the panel.
+    pub(super) fn scan_read(&mut self, review: super::pde_panel::ScanReview) {
+        self.refused = None;
+        self.shape.pde.scan = Some(review);
+    }
+
     /// The Shape section's state (for tests).
     pub fn shape(&self) -> &ShapeState {
         &self.shape
@@ -670,6 +676,28 @@ pub fn flower_ui(
                 Err(error) => outcomes.push(Outcome::Refused(error.to_string())),
             }
         }
+        if ui
+            .button("New PDE petal")
+            .on_hover_text(
+                "A new template from a PDE sweep between two margin curves (edit its curves and \
+                 tangents under Shape) with uniform growth maps, and one organ of it",
+            )
+            .clicked()
+        {
+            let edge = anthesis_garden::five_petal::SIMPLE_PETAL_EDGE
+                * anthesis_garden::flowers::EDGE_SCALE;
+            match super::pde_panel::new_pde_petal(flower, edge) {
+                Ok(added) => {
+                    let index = added.templates.len() - 1;
+                    let name = added.templates[index].name.clone();
+                    state.shape.template = index;
+                    state.shape.edge = None;
+                    state.shape.open_now = true;
+                    outcomes.push(Outcome::Edit(format!("add template {name}"), added));
+                }
+                Err(error) => outcomes.push(Outcome::Refused(error)),
+            }
+        }
         let source = state
             .new_organ_template
             .min(flower.templates.len().saturating_sub(1));
@@ -682,6 +710,16 @@ pub fn flower_ui(
             .clicked()
         {
             commands_early.push(Command::BrowseTemplateObj);
+        }
+        if ui
+            .button("Import scanned petal…")
+            .on_hover_text(
+                "A new template fitted to a petal mesh of any triangulation without UVs (a scan \
+                 or CAD export): check its base and tip, see the fit error, then make it",
+            )
+            .clicked()
+        {
+            commands_early.push(Command::BrowseScan);
         }
         if let Some(template) = flower.templates.get(source)
             && ui
@@ -698,6 +736,15 @@ pub fn flower_ui(
         }
     });
     ui.separator();
+
+    // A scanned petal under review.
+    if let Some(index) =
+        super::pde_panel::scan_ui(ui, flower, &mut state.shape.pde, &mut commands_early)
+    {
+        state.shape.template = index;
+        state.shape.edge = None;
+        state.shape.open_now = true;
+    }
 
     // The shape of one template.
     shape_ui(ui, flower, &mut state.shape, &mut commands_early);

@@ -25,6 +25,7 @@ pub mod paint;
 mod panels;
 pub mod params;
 pub mod parts_panel;
+pub mod pde_panel;
 mod project_io;
 mod prompts;
 pub mod rerun;

@@ -281,6 +281,7 @@ impl AnthesisApp {
                 self.export.path = path.display().to_string();
             }
             DialogPurpose::ImportTemplateObj => self.import_template(&path),
+            DialogPurpose::ImportScan => self.import_scan(&path),
             DialogPurpose::OpenShape(template) => self.open_shape_from_obj(template, &path),
         }
     }
@@ -323,6 +324,25 @@ impl AnthesisApp {
             }
             Err(e) => {
                 let message = format!("cannot import {} as a template: {e}", path.display());
+                self.flower_panel.refuse(message.clone());
+                self.log.error_about(Topic::Import, message);
+            }
+        }
+    }
+
+    /// Reads the scanned petal at `path` and fits it, for review in the
+    /// Flower panel (nothing changes until the user makes the template);
+    /// a scan that cannot be read or has no single outline is refused with
+    /// the reason, in the log and the Flower panel.
+    pub(super) fn import_scan(&mut self, path: &Path) {
+        match super::pde_panel::ScanReview::read(path, 1.0) {
+            Ok(review) => {
+                self.flower_panel.scan_read(review);
+                self.log
+                    .info(format!("scanned petal {} read", path.display()));
+            }
+            Err(e) => {
+                let message = format!("cannot import {} as a scanned petal: {e}", path.display());
                 self.flower_panel.refuse(message.clone());
                 self.log.error_about(Topic::Import, message);
             }

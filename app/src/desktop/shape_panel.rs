@@ -56,6 +56,8 @@ pub struct ShapeState {
     on_screen: Option<[[egui::Pos2; 4]; 4]>,
     /// Why the net could not be meshed.
     net_error: Option<String>,
+    /// The PDE editor and the scanned petal review.
+    pub(super) pde: super::pde_panel::PdeState,
 }
 
 impl ShapeState {
@@ -74,6 +76,11 @@ impl ShapeState {
     /// Why the net could not be meshed, if it could not.
     pub fn net_error(&self) -> Option<&str> {
         self.net_error.as_deref()
+    }
+
+    /// The PDE editor's and the scan review's state.
+    pub fn pde(&self) -> &super::pde_panel::PdeState {
+        &self.pde
     }
 
     /// The template the section shows.
@@ -301,6 +308,10 @@ fn shape_rows(
         state.drafts.insert(template.name.clone(), (saved, draft));
         ui.separator();
         bezier_ui(ui, (flower, index), draft, edge, state, commands);
+    } else if let Some(TemplateSource::Pde { sweep, .. }) = template.source {
+        state.on_screen = None;
+        ui.separator();
+        super::pde_panel::pde_ui(ui, (flower, index), sweep, edge, &mut state.pde, commands);
     } else {
         state.on_screen = None;
     }

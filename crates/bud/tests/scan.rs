@@ -41,14 +41,14 @@ fn scanned_lily(noise: f64) -> (Mesh, DMat3, DVec3, f64, DVec3) {
 }
 
 fn scanned(path: &str, noise: f64) -> (Mesh, DMat3, DVec3, f64, DVec3) {
-    let template = anthesis_mesh::load_obj(&asset(path)).unwrap();
+    let template = anthesis_mesh::load_obj(&asset(path)).expect("the shipped petal");
     // Its length along the surface (the midrib, u = 0.5, over its UVs)
     // and its tip.
-    let surface = anthesis_bud::MeshSurface::new(&template).unwrap();
+    let surface = anthesis_bud::MeshSurface::new(&template).expect("a surface");
     let length = anthesis_bud::midrib_length(&surface);
     let tip = surface.point(glam::DVec2::new(0.5, 1.0));
     let remeshed = remesh_mesh(&template, &RemeshOptions::new(0.9))
-        .unwrap()
+        .expect("remeshes")
         .mesh;
     assert_ne!(remeshed.vertex_count(), template.vertex_count());
     let rotation = DMat3::from_axis_angle(DVec3::new(0.3, -1.0, 0.5).normalize(), 2.1);
@@ -66,7 +66,7 @@ fn scanned(path: &str, noise: f64) -> (Mesh, DMat3, DVec3, f64, DVec3) {
     assert!(!text.contains("vt"));
     // The ordinary loader wants UVs; the shape loader does not.
     assert_eq!(anthesis_mesh::parse_obj(&text), Err(MeshError::MissingUvs));
-    let scan = anthesis_mesh::parse_obj_shape(&text).unwrap().mesh;
+    let scan = anthesis_mesh::parse_obj_shape(&text).expect("a shape").mesh;
     (scan, rotation, shift, length, tip)
 }
 
