@@ -1,10 +1,11 @@
-//! `anthesis info|simulate|render|bud|blossom|fit`: the engine without a window, for
+//! `anthesis info|simulate|render|bud|import-scan|blossom|fit`: the engine without a window, for
 //! batch work, CI and benchmarks. Errors print as one line and exit
 //! non-zero. Each subcommand lives in a module of `cli/`.
 
 mod blossom;
 mod bud;
 mod fit;
+mod import_scan;
 mod pde_blossom;
 mod render;
 mod simulate;
@@ -102,6 +103,10 @@ pub enum Command {
     /// Mesh an organ from a parametric surface (a built-in petal, a Bézier
     /// patch or a PDE sweep surface), write it as OBJ and print its quality.
     Bud(BudArgs),
+    /// Fit a scanned petal (an OBJ of any triangulation without UVs) by a
+    /// PDE sweep surface, print the fit error as fractions of its length
+    /// and write it meshed as a template OBJ.
+    ImportScan(import_scan::ImportScanArgs),
     /// Animate one organ from two shapes, its bud and its open state (the
     /// two-state blossom: per-triangle growth ellipses, G(t; g, T) and a
     /// spherical interpolation of directions), without a growth simulation.
@@ -265,6 +270,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Render(args)) => render::render(&args),
         Some(Command::Bud(args)) => bud::bud(&args),
+        Some(Command::ImportScan(args)) => import_scan::import_scan(&args),
         Some(Command::Blossom(args)) => blossom::blossom(&args),
         Some(Command::PdeBlossom(args)) => pde_blossom::pde_blossom(&args),
         Some(Command::Fit(args)) => fit::fit(&args),

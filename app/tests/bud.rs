@@ -201,3 +201,108 @@ fn bad_surfaces_and_files_give_one_line_and_a_non_zero_exit() {
     let out = anthesis(&["bud", "--pde", &stiff]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
 }
+
+/// `anthesis import-scan`: the lily petal remeshed coarser (another
+/// triangulation), written without UVs and moved, is fitted back and
+/// meshed; the round trip through `anthesis bud --pde` gives the same mesh.
+#[test]
+fn a_scanned_petal_is_fitted_and_meshed_from_the_command_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let lily = anthesis_mesh::load_obj(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/flowers/lily/meshes/petal.obj"),
+    )
+    .expect("lily petal");
+    let scan = anthesis_bud::remesh_mesh(&lily, &anthesis_bud::RemeshOptions::new(1.7))
+        .expect("remeshes")
+        .mesh;
+    let mut obj = String::new();
+    for p in &scan.positions {
+        obj.push_str(&format!("v {} {} {}\n", -p.y, p.x + 3.0, p.z));
+    }
+    for t in &scan.triangles {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    let scan_path = dir.path().join("scan.obj");
+    std::fs::write(&scan_path, obj).expect("write");
+    let (out, report, surface) = (
+        dir.path().join("petal.obj"),
+        dir.path().join("report.json"),
+        dir.path().join("petal.json"),
+    );
+    let run = anthesis(&[
+        "import-scan",
+        utf8(&scan_path),
+        "--out",
+        utf8(&out),
+        "--edge",
+        "1.3",
+        "--report",
+        utf8(&report),
+        "--save-surface",
+        utf8(&surface),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let numbers = quality(&text(&run.stdout));
+    assert!(
+        numbers["rms"] < 0.02 && numbers["max"] < 0.05,
+        "{numbers:?}"
+    );
+    assert!(numbers["min_angle_deg"] >= 20.0, "{numbers:?}");
+    let mesh = anthesis_mesh::load_obj(&out).expect("a template mesh with UVs");
+    assert_eq!(mesh.vertex_count() as f64, numbers["vertices"]);
+    assert_eq!(anthesis_bud::inner_side_faces_minus_z(&mesh), Some(true));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("json");
+    assert_eq!(json["pointed_tip"], serde_json::Value::Bool(true));
+    assert!((json["scan_to_surface_rms"].as_f64().expect("rms") - numbers["rms"]).abs() < 1e-5);
+    // The saved surface meshes to the same petal.
+    let again = dir.path().join("again.obj");
+    let run = anthesis(&[
+        "bud",
+        "--pde",
+        utf8(&surface),
+        "--edge",
+        "1.3",
+        "--out",
+        utf8(&again),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert_eq!(
+        anthesis_mesh::load_obj(&again)
+            .expect("again")
+            .positions
+            .len(),
+        mesh.vertex_count()
+    );
+
+    // A scan with a hole is refused in one line naming the loops.
+    let mut holed = String::new();
+    for p in &scan.positions {
+        holed.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    let boundary = anthesis_mesh::Topology::build(&scan)
+        .expect("topology")
+        .boundary_vertices(scan.vertex_count());
+    let inner = (0..scan.vertex_count())
+        .find(|&v| {
+            !boundary[v]
+                && scan
+                    .triangles
+                    .iter()
+                    .filter(|t| t.contains(&(v as u32)))
+                    .all(|t| t.iter().all(|&w| !boundary[w as usize]))
+        })
+        .expect("an inner vertex");
+    for t in scan
+        .triangles
+        .iter()
+        .filter(|t| !t.contains(&(inner as u32)))
+    {
+        holed.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    let holed_path = dir.path().join("holed.obj");
+    std::fs::write(&holed_path, holed).expect("write");
+    let refused = one_line_error(&["import-scan", utf8(&holed_path), "--out", utf8(&out)]);
+    let message = text(&refused.stderr);
+    assert!(message.contains("2 boundary loops"), "{message}");
+}

@@ -234,6 +234,11 @@ impl From<&PdeSweep> for PdeFile {
     }
 }
 
+/// A sweep in the `--pde` file format.
+pub(super) fn pde_json(sweep: &PdeSweep) -> Result<String> {
+    Ok(serde_json::to_string_pretty(&PdeFile::from(sweep))? + "\n")
+}
+
 /// Reads a surface file and parses it with `parse`; errors name the file.
 fn read_surface<T>(path: &Path, what: &str, parse: fn(&str) -> Result<T>) -> Result<T> {
     let text = std::fs::read_to_string(path)
