@@ -3248,3 +3248,204 @@ fn a_scanned_petal_is_fitted_its_base_moved_and_made_a_template_in_one_undo_step
     settle(&mut harness);
     assert_eq!(harness.state().project().flower, before.flower);
 }
+
+/// Draws `points` (sketch plane) on the sketch canvas with the pointer:
+/// pressed at the first, moved through the others, released at the last.
+fn draw_stroke(harness: &mut Harness<'_, AnthesisApp>, points: &[glam::DVec2]) {
+    let sketch = harness.state().flower_panel().shape().sketch();
+    let on_screen: Vec<egui::Pos2> = points
+        .iter()
+        .map(|p| sketch.sketch_to_screen(*p).expect("the canvas is drawn"))
+        .collect();
+    harness.hover_at(on_screen[0]);
+    settle(harness);
+    harness.drag_at(on_screen[0]);
+    settle(harness);
+    for at in &on_screen[1..on_screen.len() - 1] {
+        harness.hover_at(*at);
+        settle(harness);
+    }
+    harness.drop_at(on_screen[on_screen.len() - 1]);
+    settle(harness);
+}
+
+/// `count + 1` points along `f` over [0, 1].
+fn along(count: usize, f: impl Fn(f64) -> glam::DVec2) -> Vec<glam::DVec2> {
+    (0..=count).map(|k| f(k as f64 / count as f64)).collect()
+}
+
+#[test]
+fn a_petal_is_sketched_with_the_pointer_and_applied_in_one_undo_step_keeping_its_maps() {
+    use glam::DVec2;
+    let mut harness = opened_small_flower();
+    harness.get_by_label("Flower").click();
+    settle(&mut harness);
+    click_settled(&mut harness, "Shape");
+    wait_for_remesh_preview(&mut harness).expect("the petal remeshes");
+    let before = harness.state().project().flower.templates[0].clone();
+    let edge = anthesis_bud::quality(&before.mesh).mean_edge;
+
+    // A new shape for the flower's own petal, from an empty canvas.
+    click_settled(&mut harness, "Sketch a new shape");
+    let name = before.name.clone();
+    assert_eq!(
+        harness
+            .state()
+            .flower_panel()
+            .shape()
+            .sketch()
+            .sketch(&name),
+        Some(&anthesis_bud::PetalSketch::default())
+    );
+    harness.get_by_label("sketch canvas").scroll_to_me();
+    settle(&mut harness);
+    // The vein first, then the right margin drawn from the tip down, then
+    // the left margin from the base up (automatic roles).
+    let half_width = |t: f64| 1.0 + 3.5 * (std::f64::consts::PI * t).sin() - t;
+    let vein = along(12, |t| DVec2::new(0.0, 18.0 * t));
+    let right = along(16, |t| DVec2::new(half_width(1.0 - t), 18.0 * (1.0 - t)));
+    let left = along(16, |t| DVec2::new(-half_width(t), 18.0 * t));
+    for stroke in [&vein, &right, &left] {
+        draw_stroke(&mut harness, stroke);
+    }
+    let drawn = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .sketch()
+        .sketch(&name)
+        .expect("a draft")
+        .clone();
+    assert!(drawn.sections.is_empty());
+    // The strokes went where the pointer went (within a pixel), sorted into
+    // their roles: the left margin on the left.
+    for (got, want) in [
+        (&drawn.left, &left),
+        (&drawn.right, &right),
+        (&drawn.vein, &vein),
+    ] {
+        let (first, last) = (got[0], got[got.len() - 1]);
+        assert!(first.distance(want[0]) < 0.2, "{first} vs {}", want[0]);
+        assert!(last.distance(want[want.len() - 1]) < 0.2, "{last}");
+    }
+    let flat = drawn.build().expect("the outline makes a petal");
+    assert!(flat.surface.control.iter().flatten().all(|p| p.z == 0.0));
+
+    // A cross-section sagging towards the base over the middle: drawn
+    // across, it bends the row nearest its start.
+    let reach = half_width(0.5) + 0.4;
+    let section = along(16, |t| {
+        DVec2::new(-reach + 2.0 * reach * t, 9.0 - 5.0 * t * (1.0 - t))
+    });
+    draw_stroke(&mut harness, &section);
+    let sketch = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .sketch()
+        .sketch(&name)
+        .expect("a draft")
+        .clone();
+    assert_eq!(
+        sketch.sections.len(),
+        1,
+        "an across stroke is a cross-section"
+    );
+    assert_eq!(
+        (&sketch.left, &sketch.right, &sketch.vein),
+        (&drawn.left, &drawn.right, &drawn.vein)
+    );
+    let petal = sketch.build().expect("the sketch makes a petal");
+    let row = petal.section_rows[0];
+    assert!(
+        petal.surface.control[row][0].z < -0.5,
+        "cupped: {}",
+        petal.surface.control[row][0]
+    );
+    assert_eq!(
+        harness.state().project().flower.templates[0],
+        before,
+        "the sketch is a draft until applied"
+    );
+    let expected =
+        anthesis_bud::build_organ(&petal.surface, &anthesis_bud::RemeshOptions::new(edge))
+            .expect("meshes");
+    let shown = harness
+        .state()
+        .flower_panel()
+        .shape()
+        .sketch()
+        .preview()
+        .expect("a preview")
+        .copied()
+        .expect("meshes");
+    assert_eq!(shown, expected.quality);
+    harness.get_by_label(&format!(
+        "sketched: {} particles, mean edge {:.3}, smallest angle {:.1}°, edge spread {:.0} %",
+        shown.vertices,
+        shown.mean_edge,
+        shown.min_angle_deg,
+        100.0 * shown.edge_spread
+    ));
+    harness.get_by_label("sketch canvas").scroll_to_me();
+    harness.hover_at(egui::pos2(600.0, 300.0));
+    settle(&mut harness);
+    harness.snapshot("flower_panel_sketch");
+    harness.get_by_label("Apply sketch").scroll_to_me();
+    settle(&mut harness);
+    harness.snapshot("flower_panel_sketch_side");
+
+    // Apply: the petal meshed at the remesh edge replaces the mesh, the
+    // maps stay, the strokes are kept, one undo step.
+    click_settled(&mut harness, "Apply sketch");
+    let app = harness.state();
+    let applied = &app.project().flower.templates[0];
+    assert_eq!(applied.mesh, expected.mesh);
+    assert_eq!(applied.maps, before.maps);
+    assert_eq!(
+        applied.source,
+        Some(anthesis_flower::TemplateSource::Sketch {
+            sketch: sketch.clone(),
+            edge
+        })
+    );
+    assert_eq!(
+        app.document().undo_label(),
+        Some(format!("sketched shape of {name}").as_str())
+    );
+    // The strokes are saved with the project and read back, to edit again.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("sketch.anthesis.toml");
+    anthesis_flower::project::save_project(app.project(), &path).expect("saves");
+    let reopened = anthesis_flower::project::load_project(&path).expect("loads");
+    assert_eq!(reopened.flower.templates[0].source, applied.source);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(harness.state().project().flower.templates[0], before);
+
+    // A new sketched petal: a template of the starting strokes with one
+    // organ, its sketch in the editor.
+    let organs = harness.state().project().flower.organs.len();
+    click_settled(&mut harness, "New sketched petal");
+    let app = harness.state();
+    let flower = &app.project().flower;
+    let index = flower.templates.len() - 1;
+    assert_eq!(flower.templates[index].name, "sketched petal");
+    assert_eq!(flower.organs.len(), organs + 1);
+    assert_eq!(app.flower_panel().shape().template(), index);
+    assert!(matches!(
+        &flower.templates[index].source,
+        Some(anthesis_flower::TemplateSource::Sketch { sketch, .. })
+            if *sketch == anthesis_bud::PetalSketch::petal()
+    ));
+    settle(&mut harness);
+    assert_eq!(
+        harness
+            .state()
+            .flower_panel()
+            .shape()
+            .sketch()
+            .sketch("sketched petal"),
+        Some(&anthesis_bud::PetalSketch::petal())
+    );
+}

@@ -698,6 +698,31 @@ pub fn flower_ui(
                 Err(error) => outcomes.push(Outcome::Refused(error)),
             }
         }
+        if ui
+            .button("New sketched petal")
+            .on_hover_text(
+                "A new template of a petal drawn with strokes (two margins, the vein, \
+                 cross-sections; redraw them under Shape) with uniform growth maps, and one \
+                 organ of it",
+            )
+            .clicked()
+        {
+            let edge = anthesis_garden::five_petal::SIMPLE_PETAL_EDGE
+                * anthesis_garden::flowers::EDGE_SCALE;
+            let added = super::sketch_panel::new_sketched_template(edge)
+                .and_then(|t| flower.with_template_and_organ(t).map_err(|e| e.to_string()));
+            match added {
+                Ok(added) => {
+                    let index = added.templates.len() - 1;
+                    let name = added.templates[index].name.clone();
+                    state.shape.template = index;
+                    state.shape.edge = None;
+                    state.shape.open_now = true;
+                    outcomes.push(Outcome::Edit(format!("add template {name}"), added));
+                }
+                Err(error) => outcomes.push(Outcome::Refused(error)),
+            }
+        }
         let source = state
             .new_organ_template
             .min(flower.templates.len().saturating_sub(1));

@@ -32,6 +32,7 @@ pub mod rerun;
 pub mod resolution;
 pub mod session;
 pub mod shape_panel;
+pub mod sketch_panel;
 pub mod timeline;
 pub mod two_state;
 pub mod viewport;

@@ -58,6 +58,8 @@ pub struct ShapeState {
     net_error: Option<String>,
     /// The PDE editor and the scanned petal review.
     pub(super) pde: super::pde_panel::PdeState,
+    /// The sketched petal editor.
+    pub(super) sketch: super::sketch_panel::SketchState,
 }
 
 impl ShapeState {
@@ -81,6 +83,11 @@ impl ShapeState {
     /// The PDE editor's and the scan review's state.
     pub fn pde(&self) -> &super::pde_panel::PdeState {
         &self.pde
+    }
+
+    /// The sketched petal editor's state.
+    pub fn sketch(&self) -> &super::sketch_panel::SketchState {
+        &self.sketch
     }
 
     /// The template the section shows.
@@ -115,7 +122,7 @@ fn fingerprint(mesh: &Mesh) -> u64 {
 }
 
 /// One row of mesh numbers.
-fn quality_text(q: &MeshQuality) -> String {
+pub(super) fn quality_text(q: &MeshQuality) -> String {
     format!(
         "{} particles, mean edge {:.3}, smallest angle {:.1}°, edge spread {:.0} %",
         q.vertices,
@@ -314,6 +321,8 @@ fn shape_rows(
         super::pde_panel::pde_ui(ui, (flower, index), sweep, edge, &mut state.pde, commands);
     } else {
         state.on_screen = None;
+        ui.separator();
+        super::sketch_panel::sketch_ui(ui, (flower, index), edge, &mut state.sketch, commands);
     }
 }
 

@@ -1,0 +1,580 @@
+//! The Shape section's sketched petal editor
+//! (`sketch-based-floral-blossom.txt` §3.1, `anthesis_bud::PetalSketch`):
+//! a canvas in the base plane where the two outline strokes, the vein and
+//! cross-sections are drawn with the mouse, the B-spline surface's control
+//! net and outline drawn live over them, a side view of the bent rows, the
+//! particle count and mesh quality of the petal at the section's edge, and
+//! Apply, which replaces the template's mesh and keeps its strokes in one
+//! undo step (the maps stay: they live in UV space).
+//!
+//! A template made with "New sketched petal" starts from
+//! [`PetalSketch::petal`]; any other template can get a sketched shape
+//! ("Sketch a new shape"), which starts from an empty canvas with the
+//! template's mesh shown faintly behind it.
+
+use std::collections::BTreeMap;
+
+use anthesis_bud::{
+    MeshQuality, PetalSketch, RemeshOptions, SketchError, SketchTool, SketchedPetal, Surface,
+};
+use anthesis_flower::{Flower, TemplateSource};
+use eframe::egui::{self, Color32, Pos2, RichText, Stroke};
+use glam::{DVec2, DVec3};
+
+use super::command::{Command, ProjectEdit};
+use super::shape_panel::quality_text;
+
+/// The canvas's height, in points.
+const CANVAS_HEIGHT: f32 = 300.0;
+/// The side view's height, in points.
+const SIDE_HEIGHT: f32 = 110.0;
+/// What the canvas shows at least: the simple petal's size around the
+/// base (x from −12 to 12, y from −2 to 24).
+const DEFAULT_VIEW: [DVec2; 2] = [DVec2::new(-12.0, -2.0), DVec2::new(12.0, 24.0)];
+/// A drawn stroke keeps a pointer position this far (points) from the last.
+const MIN_SPACING: f32 = 2.0;
+/// The preview is not computed past this many particles (Apply still
+/// meshes it).
+const PREVIEW_MAX_VERTICES: usize = 50_000;
+
+/// The tools, with their labels.
+const TOOLS: [(SketchTool, &str, &str); 5] = [
+    (
+        SketchTool::Auto,
+        "auto roles",
+        "The first three strokes are the outline and the vein (any order, any direction); then \
+         a stroke across the petal is a cross-section and one along it replaces the nearest \
+         outline stroke or the vein",
+    ),
+    (
+        SketchTool::LeftOutline,
+        "left outline",
+        "Redraw the left margin",
+    ),
+    (
+        SketchTool::RightOutline,
+        "right outline",
+        "Redraw the right margin",
+    ),
+    (
+        SketchTool::Vein,
+        "primary vein",
+        "Redraw the primary vein (the midrib)",
+    ),
+    (
+        SketchTool::CrossSection,
+        "cross-section",
+        "Draw across the petal from margin to margin: the row of control points nearest its \
+         start bends like the stroke (a stroke sagging towards the base cups the petal)",
+    ),
+];
+
+/// A sketch being edited: the template's saved strokes it started from
+/// (`None`: a new shape for a template that has none) and the strokes as
+/// drawn since.
+#[derive(Debug, Clone)]
+struct Draft {
+    saved: Option<PetalSketch>,
+    sketch: PetalSketch,
+}
+
+/// The map from the sketch plane to the canvas.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct View {
+    /// The canvas's centre on screen.
+    centre_on_screen: Pos2,
+    /// The sketch point there.
+    centre: DVec2,
+    /// Points per project unit.
+    scale: f64,
+}
+
+impl View {
+    fn to_screen(self, p: DVec2) -> Pos2 {
+        let d = (p - self.centre) * self.scale;
+        Pos2::new(
+            self.centre_on_screen.x + d.x as f32,
+            self.centre_on_screen.y - d.y as f32,
+        )
+    }
+
+    fn to_sketch(self, at: Pos2) -> DVec2 {
+        let d = at - self.centre_on_screen;
+        self.centre + DVec2::new(f64::from(d.x), -f64::from(d.y)) / self.scale
+    }
+}
+
+/// The sketch editor's state (in the Shape section's).
+#[derive(Debug, Default)]
+pub struct SketchState {
+    /// The sketches being edited, by template name.
+    drafts: BTreeMap<String, Draft>,
+    /// What a new stroke is drawn as.
+    tool: SketchTool,
+    /// The stroke being drawn, in the sketch plane.
+    drawing: Option<Vec<DVec2>>,
+    /// The canvas's map while a stroke is drawn (the view does not move
+    /// under the pointer) and as last drawn.
+    view: Option<View>,
+    /// The petal's mesh numbers at the section's edge, for the sketch and
+    /// edge they were made of.
+    preview: Option<(u64, Result<MeshQuality, String>)>,
+    /// Why Apply could not mesh the petal.
+    apply_error: Option<String>,
+}
+
+impl SketchState {
+    /// The strokes being edited for template `name`, once shown.
+    pub fn sketch(&self, name: &str) -> Option<&PetalSketch> {
+        self.drafts.get(name).map(|d| &d.sketch)
+    }
+
+    /// Where sketch-plane point `p` was on the canvas in the last frame.
+    pub fn sketch_to_screen(&self, p: DVec2) -> Option<Pos2> {
+        self.view.map(|v| v.to_screen(p))
+    }
+
+    /// The previewed mesh numbers, or why the sketch cannot be meshed.
+    pub fn preview(&self) -> Option<Result<&MeshQuality, &str>> {
+        self.preview
+            .as_ref()
+            .map(|(_, p)| p.as_ref().map_err(String::as_str))
+    }
+
+    /// Chooses the drawing tool (as clicking it).
+    pub fn set_tool(&mut self, tool: SketchTool) {
+        self.tool = tool;
+    }
+}
+
+/// A hash of the sketch and the edge: whether the preview was made of them.
+fn key(sketch: &PetalSketch, edge: f64) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    let mut stroke = |s: &[DVec2]| {
+        s.len().hash(&mut h);
+        for p in s {
+            p.to_array().map(f64::to_bits).hash(&mut h);
+        }
+    };
+    stroke(&sketch.left);
+    stroke(&sketch.right);
+    stroke(&sketch.vein);
+    for s in &sketch.sections {
+        stroke(s);
+    }
+    edge.to_bits().hash(&mut h);
+    h.finish()
+}
+
+/// A template of a new sketched petal (`PetalSketch::petal`, meshed at
+/// `edge`) with the uniform maps of a simple petal.
+pub fn new_sketched_template(edge: f64) -> Result<anthesis_flower::Template, String> {
+    let sketch = PetalSketch::petal();
+    let petal = sketch.build().map_err(|e| e.to_string())?;
+    let bud = anthesis_bud::build_organ(&petal.surface, &RemeshOptions::new(edge))
+        .map_err(|e| e.to_string())?;
+    let mut template =
+        anthesis_garden::five_petal::simple_template_of_mesh("sketched petal", bud.mesh);
+    template.source = Some(TemplateSource::Sketch { sketch, edge });
+    Ok(template)
+}
+
+/// The sketch editor for template `index`, meshing at `edge`; pushes Apply
+/// onto `commands`.
+pub fn sketch_ui(
+    ui: &mut egui::Ui,
+    (flower, index): (&Flower, usize),
+    edge: f64,
+    state: &mut SketchState,
+    commands: &mut Vec<Command>,
+) {
+    let template = &flower.templates[index];
+    let name = template.name.as_str();
+    let saved = match &template.source {
+        Some(TemplateSource::Sketch { sketch, .. }) => Some(sketch.clone()),
+        _ => None,
+    };
+    // A saved sketch that changed (an Apply, an undo, a project opened)
+    // replaces the draft.
+    match state.drafts.get(name) {
+        Some(draft) if draft.saved == saved => {}
+        _ => match &saved {
+            Some(sketch) => {
+                state.drafts.insert(
+                    name.to_string(),
+                    Draft {
+                        saved: saved.clone(),
+                        sketch: sketch.clone(),
+                    },
+                );
+            }
+            None => {
+                state.drafts.remove(name);
+            }
+        },
+    }
+    let Some(draft) = state.drafts.get(name).cloned() else {
+        if ui
+            .button("Sketch a new shape")
+            .on_hover_text(
+                "Draw this template's petal on a canvas: two outline strokes and the primary \
+                 vein, then cross-sections; Apply replaces its mesh (its maps stay)",
+            )
+            .clicked()
+        {
+            state.drafts.insert(
+                name.to_string(),
+                Draft {
+                    saved: None,
+                    sketch: PetalSketch::default(),
+                },
+            );
+        }
+        state.view = None;
+        return;
+    };
+    ui.strong("Sketched petal").on_hover_text(
+        "Draw with the mouse on the canvas: the two margins and the primary vein (any order, any \
+         direction), then cross-sections across the petal. The petal is a B-spline surface \
+         whose control points are spread evenly inside the outline; Apply meshes it at the \
+         remesh edge above.",
+    );
+    ui.horizontal_wrapped(|ui| {
+        ui.label("draw");
+        for (tool, label, hover) in TOOLS {
+            ui.selectable_value(&mut state.tool, tool, label)
+                .on_hover_text(hover);
+        }
+    });
+    let mut sketch = draft.sketch.clone();
+    ui.horizontal(|ui| {
+        if ui
+            .add_enabled(
+                !sketch.sections.is_empty(),
+                egui::Button::new("Remove cross-sections"),
+            )
+            .on_hover_text("Make the petal flat again")
+            .clicked()
+        {
+            sketch.sections.clear();
+        }
+        if ui
+            .add_enabled(sketch != PetalSketch::default(), egui::Button::new("Clear"))
+            .on_hover_text("Start again from an empty canvas")
+            .clicked()
+        {
+            sketch = PetalSketch::default();
+        }
+    });
+    let built = sketch.build();
+    match &built {
+        Ok(_) => {}
+        Err(SketchError::Missing(_)) => {
+            let missing: Vec<&str> = [
+                (&sketch.left, "left outline"),
+                (&sketch.right, "right outline"),
+                (&sketch.vein, "primary vein"),
+            ]
+            .iter()
+            .filter(|(s, _)| s.is_empty())
+            .map(|(_, n)| *n)
+            .collect();
+            ui.label(format!(
+                "to draw: {} (any order, any direction)",
+                missing.join(", ")
+            ));
+        }
+        Err(e) => {
+            ui.label(RichText::new(e.to_string()).color(ui.visuals().error_fg_color));
+        }
+    }
+    let before = sketch.clone();
+    canvas(ui, template, &mut sketch, built.as_ref().ok(), state);
+    let built = if sketch == before {
+        built
+    } else {
+        // A stroke was drawn: shown from the next frame.
+        ui.ctx().request_repaint();
+        sketch.build()
+    };
+    if let Ok(petal) = &built {
+        side_view(ui, petal);
+    }
+
+    // The preview at the section's edge.
+    let k = key(&sketch, edge);
+    if state.preview.as_ref().is_none_or(|(old, _)| *old != k) {
+        let preview = match &built {
+            Ok(petal) => {
+                let options = RemeshOptions {
+                    max_vertices: PREVIEW_MAX_VERTICES,
+                    ..RemeshOptions::new(edge)
+                };
+                anthesis_bud::build_organ(&petal.surface, &options)
+                    .map(|bud| bud.quality)
+                    .map_err(|e| e.to_string())
+            }
+            Err(e) => Err(e.to_string()),
+        };
+        state.preview = Some((k, preview));
+    }
+    if let (Ok(_), Some((_, preview))) = (&built, &state.preview) {
+        match preview {
+            Ok(q) => {
+                ui.label(format!("sketched: {}", quality_text(q)));
+            }
+            Err(e) => {
+                ui.label(
+                    RichText::new(format!("cannot mesh: {e}")).color(ui.visuals().error_fg_color),
+                );
+            }
+        }
+    }
+    if ui
+        .add_enabled(built.is_ok(), egui::Button::new("Apply sketch"))
+        .on_hover_text(
+            "Mesh the sketched petal at the remesh edge and use it for the template (its maps \
+             stay; one undo step)",
+        )
+        .clicked()
+        && let Ok(petal) = &built
+    {
+        match anthesis_bud::build_organ(&petal.surface, &RemeshOptions::new(edge)) {
+            Ok(bud) => {
+                state.apply_error = None;
+                // The inner side stays where the template has it.
+                let flipped = anthesis_bud::inner_side_faces_minus_z(&template.mesh) == Some(false);
+                let mesh = if flipped {
+                    anthesis_bud::with_inner_side_flipped(&bud.mesh)
+                } else {
+                    bud.mesh
+                };
+                let mut edited = flower.clone();
+                edited.templates[index].mesh = mesh;
+                edited.templates[index].source = Some(TemplateSource::Sketch {
+                    sketch: sketch.clone(),
+                    edge,
+                });
+                commands.push(Command::Edit {
+                    label: format!("sketched shape of {name}"),
+                    edit: ProjectEdit::Flower(Box::new(edited)),
+                });
+            }
+            Err(e) => state.apply_error = Some(format!("cannot mesh the sketch: {e}")),
+        }
+    }
+    if let Some(error) = &state.apply_error {
+        ui.label(RichText::new(error).color(ui.visuals().error_fg_color));
+    }
+    if let Some(d) = state.drafts.get_mut(name) {
+        d.sketch = sketch;
+    }
+}
+
+/// The canvas: the template's mesh faintly, the strokes, the control net
+/// and outline of the petal; drawing on it adds a stroke to `sketch`.
+fn canvas(
+    ui: &mut egui::Ui,
+    template: &anthesis_flower::Template,
+    sketch: &mut PetalSketch,
+    petal: Option<&SketchedPetal>,
+    state: &mut SketchState,
+) {
+    let size = egui::vec2(ui.available_width().max(160.0), CANVAS_HEIGHT);
+    let (response, painter) = ui.allocate_painter(size, egui::Sense::drag());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "sketch canvas"));
+    let rect = response.rect;
+    // The map: kept while drawing, else fitted to what there is to show.
+    let view = match (state.view, &state.drawing) {
+        (Some(view), Some(_)) if view.centre_on_screen == rect.center() => view,
+        _ => {
+            let (mut low, mut high) = (DEFAULT_VIEW[0], DEFAULT_VIEW[1]);
+            let strokes = [&sketch.left, &sketch.right, &sketch.vein]
+                .into_iter()
+                .chain(&sketch.sections);
+            for p in strokes.flatten() {
+                low = low.min(*p);
+                high = high.max(*p);
+            }
+            for p in &template.mesh.positions {
+                low = low.min(p.truncate());
+                high = high.max(p.truncate());
+            }
+            let inner = rect.shrink(12.0);
+            let extent = (high - low).max(DVec2::splat(1e-6));
+            let scale =
+                (f64::from(inner.width()) / extent.x).min(f64::from(inner.height()) / extent.y);
+            View {
+                centre_on_screen: rect.center(),
+                centre: (low + high) * 0.5,
+                scale,
+            }
+        }
+    };
+    painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
+    let faint = Stroke::new(1.0, ui.visuals().weak_text_color().gamma_multiply(0.35));
+    // The template's mesh seen from its inner side's back (x, y).
+    for t in &template.mesh.triangles {
+        let [a, b, c] = t.map(|i| view.to_screen(template.mesh.positions[i as usize].truncate()));
+        painter.line_segment([a, b], faint);
+        painter.line_segment([b, c], faint);
+        painter.line_segment([c, a], faint);
+    }
+    // The base: the template frame's origin, growing up.
+    let origin = view.to_screen(DVec2::ZERO);
+    let axis = Stroke::new(1.0, Color32::from_rgb(90, 140, 90));
+    painter.line_segment(
+        [origin - egui::vec2(8.0, 0.0), origin + egui::vec2(8.0, 0.0)],
+        axis,
+    );
+    painter.line_segment([origin, origin - egui::vec2(0.0, 16.0)], axis);
+    // The petal: its control net and its outline.
+    if let Some(petal) = petal {
+        let net = petal.control_in_sketch();
+        let line = Stroke::new(1.0, Color32::from_rgb(150, 150, 170));
+        for (j, row) in net.iter().enumerate() {
+            for (i, p) in row.iter().enumerate() {
+                let at = view.to_screen(*p);
+                if let Some(q) = row.get(i + 1) {
+                    painter.line_segment([at, view.to_screen(*q)], line);
+                }
+                if let Some(q) = net.get(j + 1).map(|r| r[i]) {
+                    painter.line_segment([at, view.to_screen(q)], line);
+                }
+                painter.circle_filled(at, 2.5, Color32::from_rgb(200, 200, 220));
+            }
+        }
+        let outline: Vec<Pos2> = boundary(&petal.surface)
+            .into_iter()
+            .map(|p| view.to_screen(petal.frame.to_sketch(p.truncate())))
+            .collect();
+        painter.add(egui::Shape::closed_line(
+            outline,
+            Stroke::new(1.5, Color32::from_rgb(235, 150, 175)),
+        ));
+    }
+    // The strokes as drawn.
+    let colours = [
+        (&sketch.left, Color32::from_rgb(90, 160, 255)),
+        (&sketch.right, Color32::from_rgb(90, 160, 255)),
+        (&sketch.vein, Color32::from_rgb(110, 210, 110)),
+    ];
+    for (s, colour) in colours {
+        painter.add(egui::Shape::line(
+            s.iter().map(|p| view.to_screen(*p)).collect(),
+            Stroke::new(2.0, colour),
+        ));
+    }
+    for s in &sketch.sections {
+        painter.add(egui::Shape::line(
+            s.iter().map(|p| view.to_screen(*p)).collect(),
+            Stroke::new(2.0, Color32::from_rgb(255, 170, 40)),
+        ));
+    }
+
+    // Drawing.
+    if response.drag_started() {
+        let from = ui
+            .input(|i| i.pointer.press_origin())
+            .or(response.interact_pointer_pos());
+        state.drawing = from.map(|at| vec![view.to_sketch(at)]);
+    }
+    if let Some(points) = &mut state.drawing {
+        if let Some(at) = response.interact_pointer_pos()
+            && points
+                .last()
+                .is_none_or(|last| view.to_screen(*last).distance(at) >= MIN_SPACING)
+        {
+            points.push(view.to_sketch(at));
+        }
+        painter.add(egui::Shape::line(
+            points.iter().map(|p| view.to_screen(*p)).collect(),
+            Stroke::new(2.0, ui.visuals().strong_text_color()),
+        ));
+    }
+    if response.drag_stopped()
+        && let Some(points) = state.drawing.take()
+    {
+        if points.len() >= 2 {
+            *sketch = sketch.with_stroke(state.tool, points);
+        }
+    } else if !response.dragged() && !response.drag_started() {
+        state.drawing = None;
+    }
+    state.view = Some(view);
+}
+
+/// The surface's outline: base, right margin, tip, left margin.
+fn boundary(surface: &dyn Surface) -> Vec<DVec3> {
+    const STEPS: usize = 40;
+    let t = |k: usize| k as f64 / STEPS as f64;
+    let mut points = Vec::with_capacity(4 * STEPS);
+    points.extend((0..STEPS).map(|k| surface.point(DVec2::new(t(k), 0.0))));
+    points.extend((0..STEPS).map(|k| surface.point(DVec2::new(1.0, t(k)))));
+    points.extend((0..STEPS).map(|k| surface.point(DVec2::new(1.0 - t(k), 1.0))));
+    points.extend((0..STEPS).map(|k| surface.point(DVec2::new(0.0, 1.0 - t(k)))));
+    points
+}
+
+/// The side view: each bent row's section through the surface, across
+/// (x) against height, the inner side (−Z) up.
+fn side_view(ui: &mut egui::Ui, petal: &SketchedPetal) {
+    if petal.section_rows.is_empty() {
+        ui.label("no cross-sections: the petal is flat");
+        return;
+    }
+    ui.label("cross-sections from the base (inner side, −Z, up)");
+    let v = petal.surface.row_parameters();
+    let sections: Vec<Vec<DVec2>> = petal
+        .section_rows
+        .iter()
+        .map(|row| {
+            (0..=40)
+                .map(|k| {
+                    let p = petal.surface.point(DVec2::new(k as f64 / 40.0, v[*row]));
+                    DVec2::new(p.x, -p.z)
+                })
+                .collect()
+        })
+        .collect();
+    let (mut low, mut high) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in sections.iter().flatten() {
+        low = low.min(*p);
+        high = high.max(*p);
+    }
+    let size = egui::vec2(ui.available_width().max(160.0), SIDE_HEIGHT);
+    let (response, painter) = ui.allocate_painter(size, egui::Sense::hover());
+    let rect = response.rect;
+    painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
+    let inner = rect.shrink(10.0);
+    let extent = (high - low).max(DVec2::splat(1.0));
+    let scale = (f64::from(inner.width()) / extent.x).min(f64::from(inner.height()) / extent.y);
+    let centre = (low + high) * 0.5;
+    let to_screen = |p: DVec2| {
+        let d = (p - centre) * scale;
+        Pos2::new(rect.center().x + d.x as f32, rect.center().y - d.y as f32)
+    };
+    // The base plane (height 0).
+    let zero = to_screen(DVec2::new(centre.x, 0.0)).y;
+    painter.line_segment(
+        [
+            Pos2::new(inner.left(), zero),
+            Pos2::new(inner.right(), zero),
+        ],
+        Stroke::new(1.0, ui.visuals().weak_text_color().gamma_multiply(0.5)),
+    );
+    for (section, row) in sections.iter().zip(&petal.section_rows) {
+        painter.add(egui::Shape::line(
+            section.iter().map(|p| to_screen(*p)).collect(),
+            Stroke::new(2.0, Color32::from_rgb(255, 170, 40)),
+        ));
+        for p in &petal.surface.control[*row] {
+            painter.circle_filled(
+                to_screen(DVec2::new(p.x, -p.z)),
+                2.5,
+                Color32::from_rgb(200, 200, 220),
+            );
+        }
+    }
+}
