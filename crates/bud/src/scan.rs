@@ -867,46 +867,53 @@ pub fn fit_scan(
         Some(lambda) => vec![lambda],
         None => vec![0.0, 2.0, 10.0],
     };
-    let mut best: Option<(f64, PdeSweep, Vec<DVec2>)> = None;
-    for lambda in tried {
-        let mut uv = start.uv.clone();
-        let mut sweep = solve(&mesh.positions, &uv, &weight, &slots, lambda)?;
-        for _ in 0..options.rounds {
+    // Rounds of projecting the scan's points to their closest parameters
+    // and solving again.
+    let improve = |mut sweep: PdeSweep, mut uv: Vec<DVec2>, rounds: usize, lambda: f64| {
+        for _ in 0..rounds {
             for (k, p) in mesh.positions.iter().enumerate() {
                 uv[k] = project(&sweep, *p, uv[k], start.held_u[k], start.held_v[k]);
             }
             sweep = solve(&mesh.positions, &uv, &weight, &slots, lambda)?;
         }
-        for (k, p) in mesh.positions.iter().enumerate() {
-            uv[k] = project(&sweep, *p, uv[k], start.held_u[k], start.held_v[k]);
-        }
-        let total: f64 = weight.iter().sum();
-        let cost: f64 = mesh
-            .positions
+        Ok::<_, ScanError>((sweep, uv))
+    };
+    let total: f64 = weight.iter().sum::<f64>().max(1e-300);
+    let cost = |sweep: &PdeSweep, uv: &[DVec2]| {
+        mesh.positions
             .iter()
-            .zip(&uv)
+            .zip(uv)
             .zip(&weight)
             .map(|((p, q), w)| w * sweep.point(*q).distance_squared(*p))
             .sum::<f64>()
-            / total.max(1e-300);
-        if !cost.is_finite() {
-            continue;
-        }
-        if best.as_ref().is_none_or(|(c, _, _)| cost < *c) {
-            best = Some((cost, sweep, uv));
+            / total
+    };
+    // Each k_s/k_b gets two rounds; the best goes on.
+    let screening = options.rounds.min(2);
+    let mut best: Option<(f64, f64, PdeSweep, Vec<DVec2>)> = None;
+    for lambda in tried {
+        let first = solve(&mesh.positions, &start.uv, &weight, &slots, lambda)?;
+        let (sweep, uv) = improve(first, start.uv.clone(), screening, lambda)?;
+        let c = cost(&sweep, &uv);
+        if c.is_finite() && best.as_ref().is_none_or(|(b, ..)| c < *b) {
+            best = Some((c, lambda, sweep, uv));
         }
     }
-    let Some((cost, sweep, uv)) = best else {
+    let Some((_, lambda, sweep, uv)) = best else {
         return Err(ScanError::Fit("no finite fit".into()));
     };
-    // Distances: at the scan's vertices, with their own closest
-    // parameters (not held to their side: the true distance).
-    let mut max = 0.0f64;
-    for (p, q) in mesh.positions.iter().zip(&uv) {
+    let (sweep, uv) = improve(sweep, uv, options.rounds - screening, lambda)?;
+    // Distances at the scan's vertices, each at its own closest
+    // parameters (outline points not held to their side: the true
+    // distance).
+    let (mut sum, mut max) = (0.0, 0.0f64);
+    for ((p, q), w) in mesh.positions.iter().zip(&uv).zip(&weight) {
         let free = project(&sweep, *p, *q, None, None);
-        max = max.max(sweep.point(free).distance(*p));
+        let d = sweep.point(free).distance(*p);
+        sum += w * d * d;
+        max = max.max(d);
     }
-    let rms = cost.sqrt();
+    let rms = (sum / total).sqrt();
     let surface_to_scan = surface_to_scan(&sweep, mesh);
 
     // The template frame.
@@ -1007,25 +1014,159 @@ pub fn midrib_length(surface: &dyn Surface) -> f64 {
 }
 
 /// RMS and maximum distance from a 41×41 grid of the surface's parameters
-/// to the nearest scan triangle (every triangle tried).
+/// to the nearest scan triangle.
 fn surface_to_scan(surface: &PdeSweep, mesh: &Mesh) -> [f64; 2] {
     let samples = 40;
-    let points: Vec<DVec3> = (0..=samples)
-        .flat_map(|j| {
-            (0..=samples)
-                .map(move |i| surface.point(DVec2::new(i as f64, j as f64) / samples as f64))
-        })
-        .collect();
-    let (mut sum, mut max) = (0.0, 0.0f64);
-    for p in &points {
-        let mut best = f64::INFINITY;
-        for t in 0..mesh.triangles.len() {
-            let [a, b, c] = mesh.triangle_positions(t);
-            let (q, _) = anthesis_mesh::nearest::closest_point_on_triangle(*p, a, b, c);
-            best = best.min(q.distance_squared(*p));
+    let grid = TriangleGrid::new(mesh);
+    let (mut sum, mut max, mut count) = (0.0, 0.0f64, 0usize);
+    for j in 0..=samples {
+        for i in 0..=samples {
+            let p = surface.point(DVec2::new(i as f64, j as f64) / samples as f64);
+            let d = grid.distance(mesh, p);
+            sum += d * d;
+            max = max.max(d);
+            count += 1;
         }
-        sum += best;
-        max = max.max(best.sqrt());
     }
-    [(sum / points.len() as f64).sqrt(), max]
+    [(sum / count as f64).sqrt(), max]
+}
+
+/// The scan's triangles bucketed by the cells of a uniform grid their
+/// bounding boxes touch, for nearest-triangle queries.
+struct TriangleGrid {
+    low: DVec3,
+    cell: f64,
+    size: [i64; 3],
+    cells: std::collections::HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl TriangleGrid {
+    fn new(mesh: &Mesh) -> TriangleGrid {
+        let (mut low, mut high) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in &mesh.positions {
+            low = low.min(*p);
+            high = high.max(*p);
+        }
+        let edges: f64 = (0..mesh.triangles.len())
+            .map(|t| {
+                let [a, b, c] = mesh.triangle_positions(t);
+                a.distance(b) + b.distance(c) + c.distance(a)
+            })
+            .sum();
+        let mean_edge = edges / (3 * mesh.triangles.len().max(1)) as f64;
+        let extent = (high - low).max_element().max(1e-12);
+        let cell = (2.0 * mean_edge).max(extent / 256.0).max(1e-12);
+        let index = |p: DVec3| ((p - low) / cell).floor().as_i64vec3().to_array();
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<u32>> =
+            std::collections::HashMap::new();
+        for t in 0..mesh.triangles.len() {
+            let corners = mesh.triangle_positions(t);
+            let a = index(
+                corners
+                    .iter()
+                    .fold(DVec3::splat(f64::INFINITY), |m, p| m.min(*p)),
+            );
+            let b = index(
+                corners
+                    .iter()
+                    .fold(DVec3::splat(f64::NEG_INFINITY), |m, p| m.max(*p)),
+            );
+            for x in a[0]..=b[0] {
+                for y in a[1]..=b[1] {
+                    for z in a[2]..=b[2] {
+                        cells.entry([x, y, z]).or_default().push(t as u32);
+                    }
+                }
+            }
+        }
+        let size = index(high).map(|i| i + 1);
+        TriangleGrid {
+            low,
+            cell,
+            size,
+            cells,
+        }
+    }
+
+    /// The distance from `p` to the nearest triangle: cubes of cells
+    /// around `p`'s cell, growing until no farther cell can hold a nearer
+    /// triangle.
+    fn distance(&self, mesh: &Mesh, p: DVec3) -> f64 {
+        let q = (p - self.low) / self.cell;
+        let centre = q.floor().as_i64vec3().to_array();
+        let mut best = f64::INFINITY;
+        // A cube this large covers the whole grid.
+        let reach = (0..3)
+            .map(|k| centre[k].abs().max((centre[k] - self.size[k]).abs()))
+            .max()
+            .unwrap_or(0)
+            + 1;
+        for r in 0..=reach {
+            for x in centre[0] - r..=centre[0] + r {
+                for y in centre[1] - r..=centre[1] + r {
+                    for z in centre[2] - r..=centre[2] + r {
+                        let on_shell = (x - centre[0]).abs() == r
+                            || (y - centre[1]).abs() == r
+                            || (z - centre[2]).abs() == r;
+                        if !on_shell {
+                            continue;
+                        }
+                        let Some(triangles) = self.cells.get(&[x, y, z]) else {
+                            continue;
+                        };
+                        for &t in triangles {
+                            let [a, b, c] = mesh.triangle_positions(t as usize);
+                            let (n, _) =
+                                anthesis_mesh::nearest::closest_point_on_triangle(p, a, b, c);
+                            best = best.min(n.distance(p));
+                        }
+                    }
+                }
+            }
+            // Cells outside this cube are at least this far from p.
+            let inside = (0..3)
+                .map(|k| {
+                    let lower = q[k] - (centre[k] - r) as f64;
+                    let upper = (centre[k] + r + 1) as f64 - q[k];
+                    lower.min(upper)
+                })
+                .fold(f64::INFINITY, f64::min)
+                * self.cell;
+            if best <= inside {
+                break;
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_triangle_grid_finds_the_nearest_triangle_as_trying_every_one_does() {
+        let mesh = anthesis_mesh::generate::test_petal(10.0, 4.0, 7, 15);
+        let grid = TriangleGrid::new(&mesh);
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..300 {
+            // Points in and well outside the petal's box.
+            let p = DVec3::new(next() * 16.0 - 8.0, next() * 20.0 - 5.0, next() * 8.0 - 4.0);
+            let brute = (0..mesh.triangles.len())
+                .map(|t| {
+                    let [a, b, c] = mesh.triangle_positions(t);
+                    anthesis_mesh::nearest::closest_point_on_triangle(p, a, b, c)
+                        .0
+                        .distance(p)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!((grid.distance(&mesh, p) - brute).abs() < 1e-12, "{p}");
+        }
+    }
 }
