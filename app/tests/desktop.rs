@@ -3152,9 +3152,9 @@ fn a_scanned_petal_is_fitted_its_base_moved_and_made_a_template_in_one_undo_step
         before.flower,
         "nothing changes until the template is made"
     );
+    let fit = wait_for_scan_fit(&mut harness).expect("fits");
     let panel = harness.state().flower_panel();
     let review = panel.shape().pde().scan().expect("the scan is reviewed");
-    let fit = review.fit().expect("fits").clone();
     let [rms, max] = fit.relative_scan_to_surface();
     assert!(rms < 0.02 && max < 0.05, "RMS {rms}, max {max}");
     let (corners, found) = review.corners();
@@ -3195,6 +3195,7 @@ fn a_scanned_petal_is_fitted_its_base_moved_and_made_a_template_in_one_undo_step
         modifiers: egui::Modifiers::NONE,
     });
     settle(&mut harness);
+    let refit = wait_for_scan_fit(&mut harness).expect("fits again");
     let review = harness
         .state()
         .flower_panel()
@@ -3204,7 +3205,6 @@ fn a_scanned_petal_is_fitted_its_base_moved_and_made_a_template_in_one_undo_step
         .expect("review");
     let (now, _) = review.corners();
     assert_eq!(now.base[0], moved_to);
-    let refit = review.fit().expect("fits again").clone();
     assert_ne!(refit.sweep, fit.sweep);
     assert_eq!(refit.corners, now);
     click_settled(&mut harness, "Found corners");
@@ -3217,6 +3217,7 @@ fn a_scanned_petal_is_fitted_its_base_moved_and_made_a_template_in_one_undo_step
         .expect("review")
         .corners();
     assert_eq!(back, found);
+    assert_eq!(wait_for_scan_fit(&mut harness).expect("fits"), fit);
 
     // Make the template: the fitted sweep as its source, one organ, one
     // undo step.
@@ -3448,4 +3449,27 @@ fn a_petal_is_sketched_with_the_pointer_and_applied_in_one_undo_step_keeping_its
             .sketch("sketched petal"),
         Some(&anthesis_bud::PetalSketch::petal())
     );
+}
+
+/// The scan review's fit once its thread has answered.
+fn wait_for_scan_fit(
+    harness: &mut Harness<'_, AnthesisApp>,
+) -> Result<anthesis_bud::ScanFit, String> {
+    for _ in 0..1000 {
+        harness.step();
+        let fit = harness
+            .state()
+            .flower_panel()
+            .shape()
+            .pde()
+            .scan()
+            .and_then(|review| review.fit())
+            .map(|fit| fit.cloned().map_err(str::to_string));
+        if let Some(fit) = fit {
+            settle(harness);
+            return fit;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("the scan's fit did not come");
 }

@@ -28,6 +28,8 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_bud::{
     Bud, PdeSweep, RemeshOptions, ScanCorners, ScanFit, ScanFitOptions, ScanOutline, Surface,
@@ -112,19 +114,26 @@ pub struct ScanReview {
     /// The file and the template name it gives.
     path: PathBuf,
     name: String,
-    mesh: Mesh,
+    mesh: Arc<Mesh>,
     outline: ScanOutline,
     /// The corners in use (found, or moved by the user).
     corners: ScanCorners,
     /// The corners found automatically.
     detected: ScanCorners,
     flip: bool,
-    /// The edge to mesh at.
+    /// The edge to mesh at (the petal's length / 36 once fitted, until
+    /// the user sets one).
     edge: f64,
+    edge_set: bool,
     /// The corner a click on the outline moves: 0, 1 the base's, 2, 3 the
     /// tip's ends.
     moving: usize,
+    /// The last fit, or why there is none.
     fit: Result<ScanFit, String>,
+    /// A fit to start (the corners or the inner side changed).
+    fit_needed: bool,
+    /// The fit being made on its own thread.
+    fitting: Option<Receiver<Result<ScanFit, String>>>,
     /// The mesh of the fit at the edge.
     built: Option<(u64, Result<Bud, String>)>,
     /// The frame the view draws in (the last fit's).
@@ -134,8 +143,9 @@ pub struct ScanReview {
 }
 
 impl ScanReview {
-    /// Reads the scan at `path` and fits it with the corners found
-    /// automatically; `edge` is the edge offered for the mesh.
+    /// Reads the scan at `path` and finds its outline and corners; the
+    /// fit is made on a thread of its own once the review is shown.
+    /// `edge` is the edge offered until the fit gives the petal's length.
     pub fn read(path: &Path, edge: f64) -> Result<ScanReview, String> {
         let mesh = anthesis_mesh::load_obj_shape(path)
             .map_err(|e| e.to_string())?
@@ -147,47 +157,83 @@ impl ScanReview {
             .map(|s| s.to_string_lossy().trim().to_string())
             .filter(|s| !s.is_empty())
             .unwrap_or_else(|| "scanned".to_string());
-        let mut review = ScanReview {
+        Ok(ScanReview {
             path: path.to_path_buf(),
             name,
-            mesh,
+            mesh: Arc::new(mesh),
             outline,
             corners: detected,
             detected,
             flip: false,
             edge,
+            edge_set: false,
             moving: 0,
-            fit: Err(String::new()),
+            fit: Err("not fitted yet".to_string()),
+            fit_needed: true,
+            fitting: None,
             built: None,
             view: None,
             on_screen: Vec::new(),
-        };
-        review.refit();
-        // An edge for about 36 rows along the petal (the lily's 1.3 for
-        // its 47).
-        if let Ok(fit) = &review.fit {
-            review.edge = fit.length / 36.0;
-        }
-        Ok(review)
+        })
     }
 
-    /// Fits again with the current corners and inner side.
+    /// Fits again with the current corners and inner side (on the next
+    /// frame; a fit under way is dropped).
     fn refit(&mut self) {
-        let options = ScanFitOptions {
-            flip_inner_side: self.flip,
-            ..ScanFitOptions::default()
-        };
-        self.fit = anthesis_bud::fit_scan(&self.mesh, Some(self.corners), &options)
-            .map_err(|e| e.to_string());
-        if let Ok(fit) = &self.fit {
-            self.view = Some((fit.rotation, fit.origin));
-        }
+        self.fit_needed = true;
+        self.fitting = None;
         self.built = None;
     }
 
-    /// The fit, or why there is none.
-    pub fn fit(&self) -> Result<&ScanFit, &str> {
-        self.fit.as_ref().map_err(String::as_str)
+    /// Starts the fit that is needed and takes the answer of the one under
+    /// way; `ctx` is asked for a frame when it is done.
+    fn poll(&mut self, ctx: &egui::Context) {
+        if std::mem::take(&mut self.fit_needed) {
+            let options = ScanFitOptions {
+                flip_inner_side: self.flip,
+                ..ScanFitOptions::default()
+            };
+            let (mesh, corners, ctx) = (Arc::clone(&self.mesh), self.corners, ctx.clone());
+            let (send, receive) = sync_channel(1);
+            let spawned = std::thread::Builder::new()
+                .name("anthesis-scan-fit".into())
+                .spawn(move || {
+                    let fit = anthesis_bud::fit_scan(&mesh, Some(corners), &options)
+                        .map_err(|e| e.to_string());
+                    let _ = send.send(fit);
+                    ctx.request_repaint();
+                });
+            match spawned {
+                Ok(_) => self.fitting = Some(receive),
+                Err(e) => self.fit = Err(format!("cannot start the fit: {e}")),
+            }
+        }
+        if let Some(receive) = &self.fitting {
+            let answer = match receive.try_recv() {
+                Ok(fit) => fit,
+                Err(TryRecvError::Empty) => return,
+                Err(TryRecvError::Disconnected) => Err("the fit stopped".to_string()),
+            };
+            self.fitting = None;
+            if let Ok(fit) = &answer {
+                self.view = Some((fit.rotation, fit.origin));
+                // An edge for about 36 rows along the petal (the lily's
+                // 1.3 for its 47).
+                if !self.edge_set {
+                    self.edge = fit.length / 36.0;
+                }
+            }
+            self.fit = answer;
+            self.built = None;
+        }
+    }
+
+    /// The fit, or why there is none; `None` while it is being made.
+    pub fn fit(&self) -> Option<Result<&ScanFit, &str>> {
+        if self.fit_needed || self.fitting.is_some() {
+            return None;
+        }
+        Some(self.fit.as_ref().map_err(String::as_str))
     }
 
     /// The corners in use and the ones found automatically.
@@ -552,6 +598,7 @@ pub fn scan_ui(
     commands: &mut Vec<Command>,
 ) -> Option<usize> {
     let review = state.scan.as_mut()?;
+    review.poll(ui.ctx());
     let mut made = None;
     let mut close = false;
     ui.group(|ui| {
@@ -742,13 +789,22 @@ pub fn scan_ui(
                 .labelled_by(label)
                 .changed()
             {
+                review.edge_set = true;
                 review.built = None;
             }
         });
         if changed {
             review.refit();
+            // The fit starts in the next frame.
+            ui.ctx().request_repaint();
         }
+        let fitting = review.fit_needed || review.fitting.is_some();
         match &review.fit {
+            // No spinner: it would ask for frames all the time; the fit's
+            // thread asks for one when it is done.
+            _ if fitting => {
+                ui.label("fitting…");
+            }
             Ok(fit) => {
                 let [rms, max] = fit.relative_scan_to_surface();
                 let [back_rms, back_max] = fit.relative_surface_to_scan();
@@ -778,6 +834,7 @@ pub fn scan_ui(
         let mut refused = None;
         ui.horizontal(|ui| {
             match (&review.fit, review.built.as_ref().map(|(_, b)| b)) {
+                _ if fitting => {}
                 (Ok(fit), Some(Ok(bud))) => {
                     ui.label(format!("meshed: {}", quality_text(&bud.quality)));
                     if ui

@@ -338,6 +338,8 @@ impl AnthesisApp {
         match super::pde_panel::ScanReview::read(path, 1.0) {
             Ok(review) => {
                 self.flower_panel.scan_read(review);
+                // The review starts its fit when it is next drawn.
+                self.ctx.request_repaint();
                 self.log
                     .info(format!("scanned petal {} read", path.display()));
             }
