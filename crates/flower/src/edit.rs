@@ -43,6 +43,15 @@ pub enum EditError {
     /// A new template's mesh is not in the project's unit of length.
     #[error("{0}")]
     Scale(Box<crate::scale::ScaleMismatch>),
+    /// A shape that cannot be bent or made.
+    #[error("{0}")]
+    Shape(anthesis_bud::BudError),
+    /// A spiral of one template would replace organs of another.
+    #[error(
+        "the flower has organs of other templates (\"{0}\"); a spiral of one template would \
+         replace them: place the petals where the arrangement puts them instead"
+    )]
+    OtherOrgans(String),
     /// An index that does not exist.
     #[error("there is no {what} {index}")]
     Missing {

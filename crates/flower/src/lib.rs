@@ -11,6 +11,7 @@ pub mod project;
 mod receptacle;
 pub mod resolution;
 pub mod scale;
+pub mod sketched_bud;
 pub mod structure;
 
 pub use colour::{
