@@ -108,8 +108,8 @@ fn a_golden_spiral_puts_every_midrib_on_a_copy_of_the_stroke_137_5_degrees_apart
         let azimuth = (GOLDEN_ANGLE_DEG * k as f64).rem_euclid(360.0);
         assert!((organ.placement.azimuth_deg - azimuth).abs() < 1e-9, "{k}");
         assert_eq!(organ.placement.joint_angle_deg, 0.0);
-        // The midrib follows the stroke, moved in by k radius steps.
-        let shift = DVec2::new(bud.radius_step * k as f64, 0.0);
+        // The midrib follows the stroke, moved in and down by k steps.
+        let shift = DVec2::splat(bud.radius_step * k as f64);
         let copy: Vec<DVec2> = side.iter().map(|p| *p - shift).collect();
         let midrib = midrib_in_side_view(&bud.flower, k);
         assert!(midrib.len() >= 10);
