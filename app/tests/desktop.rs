@@ -2179,6 +2179,129 @@ fn builtin(name: &str) -> Project {
         .unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
+/// Draws `points` (side-view `(r, h)`) as one stroke in the Sketched bud
+/// section's view.
+fn stroke_in_bud_view(harness: &mut Harness<'_, AnthesisApp>, points: &[glam::DVec2]) {
+    harness.get_by_label("bud side view").scroll_to_me();
+    settle(harness);
+    let screen: Vec<egui::Pos2> = points
+        .iter()
+        .map(|p| {
+            harness
+                .state()
+                .flower_panel()
+                .bud_sketch()
+                .on_screen(*p)
+                .expect("the view is drawn")
+        })
+        .collect();
+    harness.hover_at(screen[0]);
+    settle(harness);
+    harness.drag_at(screen[0]);
+    settle(harness);
+    for p in &screen[1..] {
+        harness.hover_at(*p);
+        settle(harness);
+    }
+    harness.drop_at(*screen.last().expect("points"));
+    settle(harness);
+}
+
+#[test]
+fn a_bud_is_sketched_with_one_stroke_and_applied_in_one_undo_step() {
+    use anthesis_flower::structure::{GOLDEN_ANGLE_DEG, Structure};
+    use glam::DVec2;
+    let mut harness = harness(builtin("five-petal"));
+    harness.get_by_label("Flower").click();
+    settle(&mut harness);
+    click_settled(&mut harness, "Sketched bud");
+    let before = harness.state().project().clone();
+
+    // A vase: out from the five petals' bases and up, turning back in.
+    let stroke: Vec<DVec2> = (0..=24)
+        .map(|k| {
+            let t = k as f64 / 24.0;
+            DVec2::new(4.0 + 6.0 * (1.4 * t).sin(), 22.0 * t)
+        })
+        .collect();
+    stroke_in_bud_view(&mut harness, &stroke);
+    let app = harness.state();
+    let section = app.flower_panel().bud_sketch();
+    assert_eq!(section.problem(), None);
+    let bud = section.bud().expect("the stroke makes a bud");
+    assert_eq!(bud.flower.organs.len(), 5);
+    assert_eq!(
+        harness.state().project(),
+        &before,
+        "nothing changes until Apply"
+    );
+    harness.get_by_label("bud side view").scroll_to_me();
+    harness.hover_at(egui::pos2(600.0, 300.0));
+    settle(&mut harness);
+    harness.snapshot("flower_panel_sketched_bud");
+
+    click_settled(&mut harness, "Apply bud");
+    let app = harness.state();
+    let flower = &app.project().flower;
+    let Some(Structure::Spiral(spiral)) = &flower.structure else {
+        panic!("a spiral: {:?}", flower.structure);
+    };
+    assert_eq!(spiral.count, 5);
+    assert_eq!(spiral.divergence_deg, GOLDEN_ANGLE_DEG);
+    let template = &flower.templates[0];
+    assert_eq!(
+        template.maps, before.flower.templates[0].maps,
+        "the maps stay"
+    );
+    assert_eq!(template.mesh.uvs, before.flower.templates[0].mesh.uvs);
+    assert!(template.vein.is_some());
+    // The first petal's midrib follows the stroke as drawn (pixels apart at
+    // most: the stroke went through the screen).
+    let organ = &flower.organs[0];
+    let off_stroke = template
+        .mesh
+        .positions
+        .iter()
+        .zip(&template.mesh.uvs)
+        .filter(|(_, uv)| (uv.x - 0.5).abs() < 1e-6)
+        .map(|(p, _)| {
+            let w = organ.placement.world_from_template(*p, 0.0);
+            let q = DVec2::new(w.x.hypot(w.z), w.y);
+            stroke
+                .iter()
+                .map(|s| s.distance(q))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max);
+    assert!(
+        off_stroke < 0.6,
+        "the midrib is {off_stroke} off the stroke"
+    );
+    assert!(
+        app.document()
+            .undo_label()
+            .is_some_and(|l| l.contains("sketched bud")),
+        "{:?}",
+        app.document().undo_label()
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(harness.state().project(), &before, "one undo step");
+
+    // A stroke across the axis is refused, saying why.
+    let across: Vec<DVec2> = (0..=10)
+        .map(|k| DVec2::new(-5.0 + k as f64, 2.0 + k as f64))
+        .collect();
+    stroke_in_bud_view(&mut harness, &across);
+    let problem = harness.state().flower_panel().bud_sketch().problem();
+    assert!(
+        problem
+            .as_deref()
+            .is_some_and(|p| p.contains("crosses the flower's axis")),
+        "{problem:?}"
+    );
+}
+
 /// Steps until the New gallery has rendered every picture.
 fn wait_for_gallery(harness: &mut Harness<'_, AnthesisApp>) {
     let start = Instant::now();

@@ -19,6 +19,7 @@ use anthesis_flower::structure::{Spiral, Structure, StructureError, Whorl};
 use anthesis_flower::{Flower, Project};
 use eframe::egui::{self, Color32, DragValue, RichText};
 
+use super::bud_sketch::{BudSketchState, bud_sketch_ui};
 use super::command::{Command, ProjectEdit};
 use super::parts_panel;
 use super::shape_panel::{ShapeState, shape_ui};
@@ -48,6 +49,8 @@ pub struct FlowerPanelState {
     units: f64,
     /// The Shape section: remeshing and the inner side of one template.
     shape: ShapeState,
+    /// The Sketched bud section.
+    bud: BudSketchState,
 }
 
 /// An error of the L-system text and where it is.
@@ -96,6 +99,11 @@ impl FlowerPanelState {
     /// The Shape section's state (for tests).
     pub fn shape(&self) -> &ShapeState {
         &self.shape
+    }
+
+    /// The Sketched bud section's state (for tests).
+    pub fn bud_sketch(&self) -> &BudSketchState {
+        &self.bud
     }
 
     /// Sets the mean edge the Shape section remeshes at (as typing it).
@@ -773,6 +781,7 @@ pub fn flower_ui(
 
     // The shape of one template.
     shape_ui(ui, flower, &mut state.shape, &mut commands_early);
+    bud_sketch_ui(ui, flower, &mut state.bud, &mut commands_early);
     ui.separator();
 
     // Arrangement.

@@ -503,13 +503,19 @@ fn bezier_ui(
                 } else {
                     bud.mesh
                 };
-                let mut edited = flower.clone();
-                edited.templates[index].mesh = mesh;
-                edited.templates[index].source = Some(TemplateSource::Bezier { net, edge });
-                commands.push(Command::Edit {
-                    label: format!("Bézier net of {name}"),
-                    edit: ProjectEdit::Flower(Box::new(edited)),
-                });
+                // A sketched bud's bend stays.
+                match flower.templates[index].shaped(mesh) {
+                    Ok(mesh) => {
+                        let mut edited = flower.clone();
+                        edited.templates[index].mesh = mesh;
+                        edited.templates[index].source = Some(TemplateSource::Bezier { net, edge });
+                        commands.push(Command::Edit {
+                            label: format!("Bézier net of {name}"),
+                            edit: ProjectEdit::Flower(Box::new(edited)),
+                        });
+                    }
+                    Err(e) => state.net_error = Some(format!("cannot bend the net: {e}")),
+                }
             }
             Err(e) => state.net_error = Some(format!("cannot mesh the net: {e}")),
         }

@@ -360,13 +360,18 @@ fn segments_cross(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> Option<DVec2> {
 }
 
 /// The height where the stroke passes from one side of the axis (`r`) to
-/// the other, if it does.
+/// the other, if it does (touching it is not passing).
 fn axis_crossing(points: &[DVec2]) -> Option<f64> {
-    points.windows(2).find_map(|w| {
-        let (a, b) = (w[0], w[1]);
-        ((a.x < 0.0 && b.x > 0.0) || (a.x > 0.0 && b.x < 0.0))
-            .then(|| a.y + (b.y - a.y) * (a.x / (a.x - b.x)))
-    })
+    let mut last_off_axis: Option<DVec2> = None;
+    for &b in points.iter().filter(|p| p.x != 0.0) {
+        if let Some(a) = last_off_axis
+            && (a.x < 0.0) != (b.x < 0.0)
+        {
+            return Some(a.y + (b.y - a.y) * (a.x / (a.x - b.x)));
+        }
+        last_off_axis = Some(b);
+    }
+    None
 }
 
 #[cfg(test)]

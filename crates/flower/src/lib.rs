@@ -74,6 +74,22 @@ pub struct Template {
     pub vein: Option<anthesis_bud::Vein>,
 }
 
+impl Template {
+    /// `mesh`, a new shape for this template made from its source (a
+    /// control net, a sketch), bent along the template's vein when it has
+    /// one, so a bud drawn with a stroke keeps its pose when its petal is
+    /// reshaped.
+    pub fn shaped(
+        &self,
+        mesh: anthesis_mesh::Mesh,
+    ) -> Result<anthesis_mesh::Mesh, anthesis_bud::BudError> {
+        match &self.vein {
+            Some(vein) => anthesis_bud::bend_along_vein(&mesh, vein),
+            None => Ok(mesh),
+        }
+    }
+}
+
 /// How a template's mesh was made, when it was made from something that
 /// can be edited again.
 // One per template, so the Bézier net's 384 bytes inline cost nothing;

@@ -183,6 +183,16 @@ fn bad_side_strokes_are_refused_saying_why() {
     let across = [DVec2::new(-3.0, 0.0), DVec2::new(3.0, 6.0)];
     let error = SideStroke::new(&across, 1.0).unwrap_err();
     assert_eq!(error, VeinError::CrossesAxis { h: 3.0 });
+    // Through a point on the axis.
+    let through = [
+        DVec2::new(-1.0, 0.0),
+        DVec2::new(0.0, 1.0),
+        DVec2::new(1.0, 2.0),
+    ];
+    let error = SideStroke::new(&through, 1.0).unwrap_err();
+    assert_eq!(error, VeinError::CrossesAxis { h: 1.0 });
+    // Starting on the axis is not crossing it.
+    assert!(SideStroke::new(&through[1..], 1.0).is_ok());
     let short = [DVec2::new(1.0, 0.0), DVec2::new(1.0, 0.5)];
     let error = SideStroke::new(&short, 1.0).unwrap_err();
     assert!(error.to_string().contains("too short"), "{error}");

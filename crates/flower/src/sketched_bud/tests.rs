@@ -232,3 +232,25 @@ fn the_vein_is_saved_and_read_back() {
         bud.flower.templates[0].vein
     );
 }
+
+#[test]
+fn a_new_shape_for_a_template_with_a_vein_is_bent_along_it() {
+    let flower = five_petals(2.0);
+    let bud = flower
+        .with_sketched_bud(0, &bud_stroke(2.0, 1.0, 1.0), BudPlacement::Arrangement)
+        .unwrap();
+    let bent = &bud.flower.templates[0];
+    // A wider petal made for the bent template follows the same vein.
+    let wider = test_petal(8.0, 3.0, 9, 17);
+    let reshaped = bent.shaped(wider.clone()).unwrap();
+    let organ = &bud.flower.organs[0];
+    let side = bud_stroke(2.0, 1.0, 1.0).side_points();
+    for (p, uv) in reshaped.positions.iter().zip(&reshaped.uvs) {
+        if (uv.x - 0.5).abs() < 1e-9 {
+            let w = organ.placement.world_from_template(*p, 0.0);
+            assert!(distance_to(&side, DVec2::new(w.x.hypot(w.z), w.y)) < 0.02);
+        }
+    }
+    // Without a vein the shape is used as it is.
+    assert_eq!(flower.templates[0].shaped(wider.clone()).unwrap(), wider);
+}
