@@ -565,12 +565,18 @@ pub fn pde_ui(
             {
                 let mut edited = flower.clone();
                 let template = &mut edited.templates[index];
-                template.mesh = wound_like(bud.mesh.clone(), &template.mesh);
-                template.source = Some(TemplateSource::Pde { sweep, edge });
-                commands.push(Command::Edit {
-                    label: format!("PDE surface of {name}"),
-                    edit: ProjectEdit::Flower(Box::new(edited)),
-                });
+                // A sketched bud's bend stays.
+                match template.shaped(wound_like(bud.mesh.clone(), &template.mesh)) {
+                    Ok(mesh) => {
+                        template.mesh = mesh;
+                        template.source = Some(TemplateSource::Pde { sweep, edge });
+                        commands.push(Command::Edit {
+                            label: format!("PDE surface of {name}"),
+                            edit: ProjectEdit::Flower(Box::new(edited)),
+                        });
+                    }
+                    Err(e) => state.error = Some(format!("cannot bend the surface: {e}")),
+                }
             }
         }
         Some(Err(e)) => {

@@ -350,16 +350,22 @@ pub fn sketch_ui(
                 } else {
                     bud.mesh
                 };
-                let mut edited = flower.clone();
-                edited.templates[index].mesh = mesh;
-                edited.templates[index].source = Some(TemplateSource::Sketch {
-                    sketch: sketch.clone(),
-                    edge,
-                });
-                commands.push(Command::Edit {
-                    label: format!("sketched shape of {name}"),
-                    edit: ProjectEdit::Flower(Box::new(edited)),
-                });
+                // A sketched bud's bend stays.
+                match template.shaped(mesh) {
+                    Ok(mesh) => {
+                        let mut edited = flower.clone();
+                        edited.templates[index].mesh = mesh;
+                        edited.templates[index].source = Some(TemplateSource::Sketch {
+                            sketch: sketch.clone(),
+                            edge,
+                        });
+                        commands.push(Command::Edit {
+                            label: format!("sketched shape of {name}"),
+                            edit: ProjectEdit::Flower(Box::new(edited)),
+                        });
+                    }
+                    Err(e) => state.apply_error = Some(format!("cannot bend the sketch: {e}")),
+                }
             }
             Err(e) => state.apply_error = Some(format!("cannot mesh the sketch: {e}")),
         }
