@@ -45,8 +45,8 @@ pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use net::mirrored;
 pub use quality::{MeshQuality, find_self_intersection, quality};
 pub use scan::{
-    ScanCorners, ScanError, ScanFit, ScanFitOptions, ScanOutline, fit_scan, midrib_length,
-    reversed_across,
+    ScanCorners, ScanError, ScanFit, ScanFitOptions, ScanOutline, fit_scan, middle_length,
+    midrib_length, reversed_across,
 };
 pub use sketch::{
     PetalSketch, SKETCH_COLUMNS, SKETCH_ROWS, SketchError, SketchFrame, SketchTool, SketchedPetal,

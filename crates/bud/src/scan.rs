@@ -34,8 +34,8 @@
 //! 5. **Errors** ([`ScanFit`]): RMS (area-weighted) and maximum distance
 //!    scan→surface at the scan's vertices, and surface→scan sampled on a
 //!    41×41 grid of parameters against the scan's triangles, each also as a
-//!    fraction of the petal's length (the fitted midrib's arc length, base to
-//!    tip along the surface).
+//!    fraction of the petal's length (base to tip along the fitted surface,
+//!    through the middle of each row: [`middle_length`]).
 //! 6. **Placement** : base (`S(0.5, 0)`) at the origin, the base→tip chord
 //!    along +Y, the inner side to −Z. The inner side is by default the side
 //!    the scan is concave to (the side its outline lies on, seen from the
@@ -126,7 +126,9 @@ pub struct ScanFitOptions {
     /// The seed's `k_s / k_b`; `None` tries a few (0, 2, 10) and keeps the
     /// best.
     pub stretch_to_bend: Option<f64>,
-    /// Rounds of parameter correction after the first fit.
+    /// The most rounds of parameter correction after the first fit (they
+    /// stop when a round lowers the mean squared distance by less than
+    /// 0.5 %).
     pub rounds: usize,
     /// Take the side the scan is convex to as the inner one.
     pub flip_inner_side: bool,
@@ -136,7 +138,7 @@ impl Default for ScanFitOptions {
     fn default() -> Self {
         ScanFitOptions {
             stretch_to_bend: None,
-            rounds: 6,
+            rounds: 60,
             flip_inner_side: false,
         }
     }
@@ -147,7 +149,9 @@ impl Default for ScanFitOptions {
 pub struct ScanFit {
     /// The fitted surface, in the organ template frame.
     pub sweep: PdeSweep,
-    /// The petal's length: the fitted midrib's arc length, base to tip.
+    /// The petal's length along the surface, base to tip: the arc length
+    /// of the curve through the middle of each of its rows
+    /// ([`middle_length`]).
     pub length: f64,
     /// Scan→surface at the scan's vertices: RMS (area-weighted) and
     /// maximum distance, in the scan's units.
@@ -307,7 +311,7 @@ impl ScanOutline {
             let second = sharpest(center, reach, Some(first)).unwrap_or((first + 1) % n);
             let pointed =
                 turn[first] >= std::f64::consts::FRAC_PI_2 && turn[second] < 0.5 * turn[first];
-            (first, ordered(first, second), pointed)
+            (first, ordered(first, second), pointed, center)
         };
         let (far, near) = (end(tip), end(base));
         // A pointed end is the tip; otherwise the base is the end whose
@@ -320,10 +324,29 @@ impl ScanOutline {
         };
         let (tip_end, base_end) = if far_is_tip { (far, near) } else { (near, far) };
         let base_corners = base_end.1;
+        // A tip that is a span: its ends are the sharpest turns on either
+        // side of the end's middle (a rounded top turns most at its
+        // corners, but its middle may turn too), away from the base.
+        let side = |forwards: bool| {
+            let center = tip_end.3;
+            (0..n)
+                .filter(|&k| {
+                    let along = if forwards {
+                        self.span(center, k)
+                    } else {
+                        self.span(k, center)
+                    };
+                    along > window && along <= reach && apart(k, base_end.3) > reach
+                })
+                .max_by(|&a, &b| turn[a].total_cmp(&turn[b]))
+        };
         let tip_ends = if tip_end.2 {
             [tip_end.0, tip_end.0]
         } else {
-            tip_end.1
+            match (side(false), side(true)) {
+                (Some(before), Some(after)) => [before, after],
+                _ => tip_end.1,
+            }
         };
         ScanCorners {
             base: base_corners,
@@ -497,11 +520,19 @@ fn parameterise(
             let v = outline.vertex(k) as usize;
             domain[v] = a.lerp(b, t);
             fixed[v] = true;
-            let (hu, hv) = hold(t);
+            // The span's first vertex is a corner: held where it is.
+            let (hu, hv) = if step == 0 {
+                (Some(a.x), Some(a.y))
+            } else {
+                hold(t)
+            };
             held_u[v] = hu;
             held_v[v] = hv;
         }
     };
+    // The base and the tip span keep their arc-length parameters (free,
+    // their few points let the base row's parameters drift); margin points
+    // slide along their side.
     walk(b0, b1, DVec2::ZERO, DVec2::X, &|t| (Some(t), Some(0.0)));
     walk(b1, t0, DVec2::X, top_right, &|_| (Some(1.0), None));
     if !pointed {
@@ -867,17 +898,6 @@ pub fn fit_scan(
         Some(lambda) => vec![lambda],
         None => vec![0.0, 2.0, 10.0],
     };
-    // Rounds of projecting the scan's points to their closest parameters
-    // and solving again.
-    let improve = |mut sweep: PdeSweep, mut uv: Vec<DVec2>, rounds: usize, lambda: f64| {
-        for _ in 0..rounds {
-            for (k, p) in mesh.positions.iter().enumerate() {
-                uv[k] = project(&sweep, *p, uv[k], start.held_u[k], start.held_v[k]);
-            }
-            sweep = solve(&mesh.positions, &uv, &weight, &slots, lambda)?;
-        }
-        Ok::<_, ScanError>((sweep, uv))
-    };
     let total: f64 = weight.iter().sum::<f64>().max(1e-300);
     let cost = |sweep: &PdeSweep, uv: &[DVec2]| {
         mesh.positions
@@ -887,6 +907,24 @@ pub fn fit_scan(
             .map(|((p, q), w)| w * sweep.point(*q).distance_squared(*p))
             .sum::<f64>()
             / total
+    };
+    // Rounds of projecting the scan's points to their closest parameters
+    // and solving again, until a round lowers the cost by less than 0.5 %
+    // (or `rounds` were made).
+    let improve = |mut sweep: PdeSweep, mut uv: Vec<DVec2>, rounds: usize, lambda: f64| {
+        let mut last = f64::INFINITY;
+        for _ in 0..rounds {
+            for (k, p) in mesh.positions.iter().enumerate() {
+                uv[k] = project(&sweep, *p, uv[k], start.held_u[k], start.held_v[k]);
+            }
+            let now = cost(&sweep, &uv);
+            if now > last * 0.995 {
+                break;
+            }
+            last = now;
+            sweep = solve(&mesh.positions, &uv, &weight, &slots, lambda)?;
+        }
+        Ok::<_, ScanError>((sweep, uv))
     };
     // Each k_s/k_b gets two rounds; the best goes on.
     let screening = options.rounds.min(2);
@@ -977,7 +1015,7 @@ pub fn fit_scan(
     if across.x > 0.0 {
         placed = reversed_across(&placed);
     }
-    let length = midrib_length(&placed);
+    let length = middle_length(&placed);
     Ok(ScanFit {
         sweep: placed,
         length,
@@ -1011,6 +1049,36 @@ pub fn midrib_length(surface: &dyn Surface) -> f64 {
             a.distance(b)
         })
         .sum()
+}
+
+/// The petal's length along the surface, whatever its parameters: the
+/// arc length of the curve through the middle (by arc length across) of
+/// each line of constant `v`, from the base to the tip.
+pub fn middle_length(surface: &dyn Surface) -> f64 {
+    let (rows, across) = (200, 64);
+    let middle = |v: f64| {
+        let points: Vec<DVec3> = (0..=across)
+            .map(|i| surface.point(DVec2::new(i as f64 / across as f64, v)))
+            .collect();
+        let lengths: Vec<f64> = points.windows(2).map(|w| w[0].distance(w[1])).collect();
+        let half = lengths.iter().sum::<f64>() / 2.0;
+        let mut walked = 0.0;
+        for (k, l) in lengths.iter().enumerate() {
+            if walked + l >= half && *l > 0.0 {
+                return points[k].lerp(points[k + 1], (half - walked) / l);
+            }
+            walked += l;
+        }
+        points[across / 2]
+    };
+    let mut previous = middle(0.0);
+    let mut length = 0.0;
+    for j in 1..=rows {
+        let next = middle(j as f64 / rows as f64);
+        length += previous.distance(next);
+        previous = next;
+    }
+    length
 }
 
 /// RMS and maximum distance from a 41×41 grid of the surface's parameters

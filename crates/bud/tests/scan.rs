@@ -210,29 +210,42 @@ fn a_scan_with_a_hole_or_a_non_manifold_edge_is_refused_with_its_message() {
 
 #[test]
 fn a_shipped_eustoma_petal_with_a_rounded_top_is_fitted_back_too() {
-    let (scan, rotation, shift, length, true_tip) =
+    let (scan, rotation, shift, length, _) =
         scanned("flowers/eustoma-pinocchio/meshes/petal.obj", 0.003);
     let outline = ScanOutline::of(&scan).unwrap();
     let corners = outline.detect_corners(&scan);
     let at = |k: usize| rotation.transpose() * (scan.positions[outline.vertex(k) as usize] - shift);
-    println!(
-        "eustoma corners {corners:?}: base {} {}, tip {} {} (true tip {true_tip}, length {length})",
-        at(corners.base[0]),
-        at(corners.base[1]),
-        at(corners.tip[0]),
-        at(corners.tip[1])
-    );
     // The base is found (the claw's corners are closer together than the
-    // top's); the rounded top has no sharp corners, so where its span
-    // starts and ends is a guess the user may correct.
+    // top's).
     let base_middle = (at(corners.base[0]) + at(corners.base[1])) * 0.5;
     assert!(
         base_middle.length() < 0.03 * length,
         "base found at {base_middle}"
     );
+    // The top is a span whose ends are the template's UV corners (0, 1) and
+    // (1, 1): the sharpest turns on either side of the top's middle.
     assert!(!corners.pointed());
+    let template =
+        anthesis_mesh::load_obj(&asset("flowers/eustoma-pinocchio/meshes/petal.obj")).unwrap();
+    let surface = anthesis_bud::MeshSurface::new(&template).unwrap();
+    let mut found = corners.tip.map(at);
+    found.sort_by(|a, b| a.x.total_cmp(&b.x));
+    let mut truth = [0.0, 1.0].map(|u| surface.point(glam::DVec2::new(u, 1.0)));
+    truth.sort_by(|a, b| a.x.total_cmp(&b.x));
+    for (f, t) in found.iter().zip(&truth) {
+        assert!(
+            f.distance(*t) < 0.03 * length,
+            "top corner found at {f}, not {t}"
+        );
+    }
     let fit = fit_scan(&scan, None, &ScanFitOptions::default()).unwrap();
     println!("eustoma scan (noise 0.3 % of length): {}", fit.summary());
-    let [rms, _] = fit.relative_scan_to_surface();
+    let [rms, max] = fit.relative_scan_to_surface();
     assert!(rms < 0.02, "RMS {:.2} % of the length", 100.0 * rms);
+    assert!(max < 0.05, "max {:.2} % of the length", 100.0 * max);
+    assert!(
+        (fit.length / length - 1.0).abs() < 0.05,
+        "{} vs {length}",
+        fit.length
+    );
 }
