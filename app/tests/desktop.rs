@@ -3152,7 +3152,8 @@ fn a_pde_petal_is_made_its_margin_dragged_applied_in_one_undo_step_and_saved_wit
     );
 
     // Drag the upper tangent handle of margin 2 up: the tangent turns
-    // (three times the handle's move) and its mirror follows.
+    // (three times the handle's move; that handle is C1 − T1/3, so T1
+    // turns down) and its mirror follows.
     let handle = harness
         .state()
         .flower_panel()
@@ -3169,7 +3170,7 @@ fn a_pde_petal_is_made_its_margin_dragged_applied_in_one_undo_step_and_saved_wit
         .sweep("pde petal")
         .expect("sweep");
     assert!(
-        turned.tangent1.control[2].y > 0.5,
+        turned.tangent1.control[2].y < -0.5,
         "{}",
         turned.tangent1.control[2]
     );
@@ -3185,7 +3186,12 @@ fn a_pde_petal_is_made_its_margin_dragged_applied_in_one_undo_step_and_saved_wit
         .expect("built")
         .expect("meshes");
     harness.get_by_label_contains(&format!("surface meshed: {} particles", quality.vertices));
-    harness.get_by_label("Apply surface").scroll_to_me();
+    // The view just above the point chooser: both in sight.
+    harness
+        .get_all_by_label("point")
+        .next()
+        .expect("the point chooser")
+        .scroll_to_me();
     harness.remove_cursor();
     settle(&mut harness);
     harness.snapshot("flower_panel_pde");

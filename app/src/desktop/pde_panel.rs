@@ -6,9 +6,10 @@
 //! across-tangents are cubic Bézier curves. Like Blender's curve tools, the
 //! margins are drawn with their control polygons and draggable control
 //! points, and each tangent as a handle: an arrow from the margin's control
-//! point to the point a third of the tangent away (where a Bézier handle of
-//! that tangent would sit); dragging the arrow's head turns and stretches
-//! the tangent. The 2D view looks from the front (x, y) or the side (z, y);
+//! point into the surface, to where the generator's Bézier control point
+//! sits (`C0 + T0/3` at margin 1, `C1 − T1/3` at margin 2, since `u` runs
+//! from margin 1 to margin 2); dragging the arrow's head turns and
+//! stretches the tangent. The 2D view looks from the front (x, y) or the side (z, y);
 //! the chosen point's numbers can be typed. Symmetric editing about the
 //! midrib is on by default. The surface (eq. 12 of `pde-surfaces-lily.txt`,
 //! closed form, so cheap) is drawn live as iso-lines, and the mesh it would
@@ -340,7 +341,10 @@ pub fn pde_ui(
         } else {
             &sweep.tangent1
         };
-        margin.control[k] + t.control[k] / 3.0
+        // The generator's inner Bézier control points: both handles
+        // point into the surface.
+        let sign = if c == 2 { 1.0 } else { -1.0 };
+        margin.control[k] + sign * t.control[k] / 3.0
     };
     let handled: [[DVec3; 4]; 4] = [
         sweep.curve0.control,
@@ -464,11 +468,12 @@ pub fn pde_ui(
     state.on_screen = Some(points);
     if let Some((c, k, shift)) = moved {
         let curve = SweepCurve::ALL[c];
-        // A handle's head moves the tangent three times as far.
-        let value = if curve.is_margin() {
-            sweep.curve(curve).control[k] + shift
-        } else {
-            sweep.curve(curve).control[k] + 3.0 * shift
+        // A handle's head moves the tangent three times as far (the other
+        // way at margin 2, whose handle is C1 − T1/3).
+        let value = match curve {
+            SweepCurve::Margin0 | SweepCurve::Margin1 => sweep.curve(curve).control[k] + shift,
+            SweepCurve::Tangent0 => sweep.curve(curve).control[k] + 3.0 * shift,
+            SweepCurve::Tangent1 => sweep.curve(curve).control[k] - 3.0 * shift,
         };
         sweep = sweep.with_point(curve, k, value, symmetric);
     }
@@ -514,7 +519,8 @@ pub fn pde_ui(
     .on_hover_text(if curve.is_margin() {
         "The margin's control point, in the template frame"
     } else {
-        "The across-tangent dS/du at that control point (a vector; the handle shows a third of it)"
+        "The across-tangent dS/du at that control point (a vector; the handle shows a third of it, \
+         into the surface)"
     });
     if typed {
         sweep = sweep.with_point(curve, k, p, symmetric);
