@@ -3073,6 +3073,32 @@ fn a_bezier_petal_is_made_its_control_points_dragged_and_typed_and_applied_in_on
         anthesis_bud::build_organ(&start, &anthesis_bud::RemeshOptions::new(edge)).expect("meshes");
     assert_eq!(mesh, &anthesis_bud::with_inner_side_flipped(&again.mesh));
     assert_eq!(anthesis_bud::inner_side_faces_minus_z(mesh), Some(false));
+
+    // Remeshing the patch's template at another edge saves that edge with
+    // the net, in the same undo step.
+    click_settled(&mut harness, "remesh edge");
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    harness.get_by_label("remesh edge").type_text("0.9");
+    settle(&mut harness);
+    harness.key_press(egui::Key::Enter);
+    wait_for_remesh_preview(&mut harness).expect("remeshes at 0.9");
+    let before_remesh = harness.state().project().flower.templates[index].clone();
+    click_settled(&mut harness, "Remesh");
+    let remeshed = &harness.state().project().flower.templates[index];
+    assert_ne!(remeshed.mesh, before_remesh.mesh);
+    assert_eq!(
+        remeshed.source,
+        Some(anthesis_flower::TemplateSource::Bezier {
+            net: start,
+            edge: 0.9
+        })
+    );
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(
+        harness.state().project().flower.templates[index],
+        before_remesh
+    );
 }
 
 /// Drags from `from` by `by` in three steps, settling between them.

@@ -286,13 +286,22 @@ fn shape_rows(
                 .on_hover_text("Use this mesh for the template (its maps stay; one undo step)")
                 .clicked()
             {
-                commands.push(Command::Edit {
-                    label: format!("remesh {} at edge {edge}", template.name),
-                    edit: ProjectEdit::Mesh {
+                let label = format!("remesh {} at edge {edge}", template.name);
+                let edit = match &template.source {
+                    // A shape made in the app remembers the edge it is
+                    // meshed at, so editing it again keeps that.
+                    Some(source) => {
+                        let mut edited = flower.clone();
+                        edited.templates[index].mesh = bud.mesh.clone();
+                        edited.templates[index].source = Some(source.with_edge(edge));
+                        ProjectEdit::Flower(Box::new(edited))
+                    }
+                    None => ProjectEdit::Mesh {
                         template: index,
                         mesh: Box::new(bud.mesh.clone()),
                     },
-                });
+                };
+                commands.push(Command::Edit { label, edit });
             }
         }
         Some(Preview::Done(Err(e))) => {

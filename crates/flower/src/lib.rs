@@ -125,6 +125,29 @@ pub enum TemplateSource {
     },
 }
 
+impl TemplateSource {
+    /// The mean edge the source was meshed at.
+    pub fn edge(&self) -> f64 {
+        match self {
+            TemplateSource::Bezier { edge, .. }
+            | TemplateSource::Sketch { edge, .. }
+            | TemplateSource::Pde { edge, .. } => *edge,
+        }
+    }
+
+    /// The same source, meshed at mean edge `edge` (a template remeshed
+    /// in the Shape section).
+    pub fn with_edge(&self, edge: f64) -> TemplateSource {
+        let mut source = self.clone();
+        match &mut source {
+            TemplateSource::Bezier { edge: e, .. }
+            | TemplateSource::Sketch { edge: e, .. }
+            | TemplateSource::Pde { edge: e, .. } => *e = edge,
+        }
+        source
+    }
+}
+
 /// A two-state animation (`sketch-based-floral-blossom.txt` §4): the
 /// template's organs go from the bud (the template mesh) to `open` along
 /// the growth function G(t; g, T) and the velocity curve, instead of
