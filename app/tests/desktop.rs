@@ -2828,6 +2828,18 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 9/3\n",
     )
     .expect("write obj");
+    // A valid OBJ whose UV layout is a half ring (a line of constant v
+    // crosses its outline four times): not a template's layout.
+    let mut folded = petal.clone();
+    for uv in &mut folded.uvs {
+        let (angle, radius) = (std::f64::consts::PI * uv.x, 0.2 + 0.3 * uv.y);
+        *uv = glam::DVec2::new(0.5 + radius * angle.cos(), radius * angle.sin());
+    }
+    std::fs::write(
+        dir.path().join("folded.obj"),
+        anthesis_mesh::obj_string(&folded),
+    )
+    .expect("write obj");
     let mut harness = harness_with_file_browser(&dir.path().join("flower.anthesis.toml"));
     harness.get_by_label("Flower").click();
     settle(&mut harness);
@@ -2944,6 +2956,18 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
     assert!(refused.contains("line 7"), "names the line: {refused}");
     // In the Flower panel and the log's banner.
     assert_eq!(harness.get_all_by_label(&refused).count(), 2);
+
+    // A mesh whose UVs cannot be a template's is refused at import, saying
+    // what the convention is and where such a mesh can come in.
+    import_obj(&mut harness, "folded.obj");
+    assert_eq!(harness.state().project(), &now);
+    let refused = harness.state().flower_panel().refused().expect("refused");
+    assert!(
+        refused.contains("folded.obj")
+            && refused.contains("UV")
+            && refused.contains("Import scanned petal"),
+        "{refused}"
+    );
 }
 
 #[test]

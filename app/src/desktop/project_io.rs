@@ -299,6 +299,19 @@ impl AnthesisApp {
         let result = anthesis_mesh::load_obj(path)
             .map_err(|e| e.to_string())
             .and_then(|mesh| {
+                // Painting, remeshing and the simulation read the organ
+                // through its UVs: a layout that breaks the convention is
+                // refused now rather than at the first remesh.
+                if let Err(e) = anthesis_bud::MeshSurface::new(&mesh) {
+                    return Err(format!(
+                        "its UV layout cannot be a template's (u across the organ, v from the \
+                         base at 0 to the tip at 1, not overlapping): {e}; a mesh without \
+                         usable UVs can come in through Import scanned petal…"
+                    ));
+                }
+                Ok(mesh)
+            })
+            .and_then(|mesh| {
                 let template = anthesis_garden::five_petal::simple_template_of_mesh(&name, mesh);
                 self.project()
                     .flower
