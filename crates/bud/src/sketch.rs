@@ -15,14 +15,20 @@
 //! has its base at the end where the strokes come closer together (where
 //! strokes meet is no rule for an upright petal: a pointed tip is where
 //! they meet best). The petal is then put in the template frame: the
-//! vein's base at the origin and its chord (base to tip) along +Y.
+//! middle of its base at the origin and its midrib's chord (base to tip)
+//! along +Y.
 //!
 //! **The flat surface.** [`SKETCH_ROWS`] rows of [`SKETCH_COLUMNS`] control
-//! points, row `j` at the arc-length fraction `j / (rows - 1)` of every
-//! stroke, its points spaced evenly from the left margin to the vein and
-//! from the vein to the right margin (the vein is the middle column, so
-//! the midrib is at `u = 0.5` by the UV convention; the left margin at
-//! `u = 0` is on the −X side). A petal attaches by a base, not a point:
+//! points. Row `j` runs straight from the left margin to the right one at
+//! the arc-length fraction `j / (rows - 1)` of each; its middle point is
+//! where the vein crosses that line, and its points are spaced evenly from
+//! the left margin to the middle and from the middle to the right margin
+//! (the vein is the middle column, so the midrib is at `u = 0.5` by the UV
+//! convention; the left margin at `u = 0` is on the −X side). Where the
+//! vein does not cross a row (drawn a little short of the margins' ends or
+//! past them) the vein's point at that fraction is put on the row: a
+//! vein's ends make no notch in the base or the tip. A petal attaches by a
+//! base, not a point:
 //! when the margins start closer together than a tenth of the petal's
 //! widest row, the base row is widened to that about the vein's start.
 //!
@@ -229,13 +235,14 @@ pub enum SketchError {
 }
 
 /// The rigid map between the sketch plane and the template frame's base
-/// plane: the vein's base goes to the origin, its chord along +Y.
+/// plane: the middle of the petal's base goes to the origin, the midrib's
+/// chord along +Y.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SketchFrame {
-    /// The vein's base, in the sketch plane.
+    /// The middle of the petal's base, in the sketch plane.
     pub origin: DVec2,
-    /// The unit direction from the vein's base to its tip, in the sketch
-    /// plane.
+    /// The unit direction from the base's middle to the tip's, in the
+    /// sketch plane.
     pub axis: DVec2,
 }
 
@@ -502,32 +509,47 @@ impl PetalSketch {
                 });
             }
         }
-        // The rows, in the sketch plane: left, vein, right at each fraction.
-        let mut rows: Vec<[DVec2; 3]> = (0..SKETCH_ROWS)
+        // The rows, in the sketch plane: straight from the left margin to
+        // the right one at each arc-length fraction, their middle point
+        // where the vein crosses that line (or, where it does not, as a
+        // vein drawn a little short of or past the margins' ends: the
+        // point of the vein at that fraction, put on the line).
+        let rows: Vec<[DVec2; 3]> = (0..SKETCH_ROWS)
             .map(|j| {
                 let f = j as f64 / (SKETCH_ROWS - 1) as f64;
-                [
-                    at_fraction(&strokes[0], f),
-                    at_fraction(&strokes[2], f),
-                    at_fraction(&strokes[1], f),
-                ]
+                let (l, r) = (at_fraction(&strokes[0], f), at_fraction(&strokes[1], f));
+                let d = r - l;
+                let crossing = strokes[2]
+                    .windows(2)
+                    .find_map(|w| segment_crossing(l, r, w[0], w[1]))
+                    .map(|(t, _)| t.clamp(0.1, 0.9));
+                let along = crossing.unwrap_or_else(|| {
+                    if d.length_squared() > 0.0 {
+                        ((at_fraction(&strokes[2], f) - l).dot(d) / d.length_squared())
+                            .clamp(0.25, 0.75)
+                    } else {
+                        0.5
+                    }
+                });
+                [l, l + d * along, r]
             })
             .collect();
-        let vein = &strokes[2];
-        let chord = vein[vein.len() - 1] - vein[0];
+        let last = rows.len() - 1;
+        let chord = rows[last][1] - rows[0][1];
         let axis = if chord.length() > 1e-12 * longest.max(1e-300) {
             chord.normalize()
         } else {
             DVec2::Y
         };
         let frame = SketchFrame {
-            origin: vein[0],
+            origin: rows[0][1],
             axis,
         };
         let widest = rows
             .iter()
             .map(|[l, _, r]| l.distance(*r))
             .fold(0.0, f64::max);
+        let mut rows = rows;
         let [l0, v0, r0] = rows[0];
         let min_base = MIN_BASE_WIDTH * widest;
         if l0.distance(r0) < min_base {

@@ -508,3 +508,33 @@ fn the_new_petal_sketch_is_symmetric_cupped_and_meshes_at_the_simple_petals_edge
     assert!(bud.quality.edge_spread <= 0.15, "{:?}", bud.quality);
     assert_eq!(crate::inner_side_faces_minus_z(&bud.mesh), Some(true));
 }
+
+#[test]
+fn a_vein_drawn_short_of_or_past_the_margins_ends_leaves_the_base_and_tip_straight() {
+    let mut sketch = petal(3.0, 3.0, 16.0, 0.0);
+    // The vein starts 1.5 above where the margins start and ends 1 past
+    // their meeting point at the tip.
+    sketch.vein = stroke(30, |t| DVec2::new(0.0, 1.5 + 15.5 * t));
+    let built = sketch.build().unwrap();
+    let control = &built.surface.control;
+    // Base row on one line through the base, the middle at the origin.
+    for p in &control[0] {
+        assert!(p.y.abs() < 1e-9, "{p}");
+    }
+    assert!(control[0][3].length() < 1e-9);
+    // The tip row collapses to the margins' meeting point.
+    for p in &control[SKETCH_ROWS - 1] {
+        assert!((*p - DVec3::new(0.0, 16.0, 0.0)).length() < 1e-9, "{p}");
+    }
+    // It meshes as well as the same petal with the vein from base to tip
+    // (its smallest angle is the sharp tip's).
+    let bud = build_organ(&built.surface, &RemeshOptions::new(0.6)).unwrap();
+    let exact = petal(3.0, 3.0, 16.0, 0.0).build().unwrap();
+    let reference = build_organ(&exact.surface, &RemeshOptions::new(0.6)).unwrap();
+    assert!(
+        bud.quality.min_angle_deg >= reference.quality.min_angle_deg - 2.0,
+        "{:?} vs {:?}",
+        bud.quality,
+        reference.quality
+    );
+}
