@@ -268,6 +268,16 @@ pub fn sketch_ui(
         }
     });
     let built = sketch.build();
+    let before = sketch.clone();
+    canvas(ui, template, &mut sketch, built.as_ref().ok(), state);
+    let built = if sketch == before {
+        built
+    } else {
+        // A stroke was drawn: shown from the next frame.
+        ui.ctx().request_repaint();
+        sketch.build()
+    };
+    // Under the canvas, so the canvas does not move when it changes.
     match &built {
         Ok(_) => {}
         Err(SketchError::Missing(_)) => {
@@ -289,15 +299,6 @@ pub fn sketch_ui(
             ui.label(RichText::new(e.to_string()).color(ui.visuals().error_fg_color));
         }
     }
-    let before = sketch.clone();
-    canvas(ui, template, &mut sketch, built.as_ref().ok(), state);
-    let built = if sketch == before {
-        built
-    } else {
-        // A stroke was drawn: shown from the next frame.
-        ui.ctx().request_repaint();
-        sketch.build()
-    };
     if let Ok(petal) = &built {
         side_view(ui, petal);
     }
