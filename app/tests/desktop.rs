@@ -2284,9 +2284,59 @@ fn a_bud_is_sketched_with_one_stroke_and_applied_in_one_undo_step() {
         "{:?}",
         app.document().undo_label()
     );
+    let bud = harness.state().project().clone();
+
+    // The opened flower: a second stroke, out and down, is the open
+    // petal's vein; the petals then open to it by the two-state blossom.
+    click_settled(&mut harness, "the opened flower");
+    let open: Vec<DVec2> = (0..=24)
+        .map(|k| {
+            let t = k as f64 / 24.0;
+            DVec2::new(4.0 + 16.0 * t, 6.0 * (std::f64::consts::PI * t).sin())
+        })
+        .collect();
+    stroke_in_bud_view(&mut harness, &open);
+    let section = harness.state().flower_panel().bud_sketch();
+    assert_eq!(section.problem(), None);
+    assert!(section.opening().is_some());
+    assert_eq!(
+        harness.state().project(),
+        &bud,
+        "nothing changes until Apply"
+    );
+    harness.get_by_label("bud side view").scroll_to_me();
+    harness.hover_at(egui::pos2(600.0, 300.0));
+    settle(&mut harness);
+    harness.snapshot("flower_panel_sketched_opening");
+    click_settled(&mut harness, "Apply opening");
+    let app = harness.state();
+    let template = &app.project().flower.templates[0];
+    assert_eq!(template.mesh, bud.flower.templates[0].mesh, "the bud stays");
+    let animation = template.two_state.as_ref().expect("opens by two states");
+    assert_eq!(
+        animation.growth.duration,
+        f64::from(app.project().settings.keyframes)
+    );
+    // The open petal's tip is out where the stroke ends, not up.
+    let organ = &app.project().flower.organs[0];
+    let tip = animation
+        .open
+        .iter()
+        .map(|p| organ.placement.world_from_template(*p, 0.0))
+        .max_by(|a, b| a.x.hypot(a.z).total_cmp(&b.x.hypot(b.z)))
+        .expect("points");
+    assert!(tip.x.hypot(tip.z) > 15.0 && tip.y < 3.0, "{tip}");
+    assert_eq!(
+        app.document().undo_label(),
+        Some("sketched opening of petal")
+    );
+
     harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut harness);
-    assert_eq!(harness.state().project(), &before, "one undo step");
+    assert_eq!(harness.state().project(), &bud);
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut harness);
+    assert_eq!(harness.state().project(), &before, "one undo step each");
 
     // A stroke across the axis is refused, saying why.
     let across: Vec<DVec2> = (0..=10)

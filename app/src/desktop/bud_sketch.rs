@@ -33,15 +33,25 @@ pub struct BudSketchState {
     spiral: bool,
     /// Petals on the spiral.
     count: usize,
-    /// What the finished stroke makes, and what it was made of (template,
-    /// spiral, count, flower fingerprint).
-    result: Option<(Key, Result<SketchedBud, String>)>,
+    /// The stroke is the opened flower's vein (§3.2), not the bud's.
+    opening: bool,
+    /// What the finished stroke makes, and what it was made of.
+    result: Option<(Key, Result<Made, String>)>,
     /// The view's side-view rectangle and its screen rectangle, last frame.
     view: Option<(Frame, egui::Rect)>,
 }
 
-/// What a result was made of.
-type Key = (usize, bool, usize, usize);
+/// What a result was made of: template, spiral, count, opening, flower.
+type Key = (usize, bool, usize, bool, usize);
+
+/// What a finished stroke makes.
+#[derive(Debug)]
+enum Made {
+    /// A bud.
+    Bud(SketchedBud),
+    /// The flower opening to the stroke, and which organs cross when open.
+    Opening(Flower, Option<(String, String)>),
+}
 
 /// How the side view maps to the screen.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,6 +68,7 @@ impl Default for BudSketchState {
             stroke: Vec::new(),
             spiral: true,
             count: 5,
+            opening: false,
             result: None,
             view: None,
         }
@@ -80,7 +91,8 @@ impl BudSketchState {
     pub fn problem(&self) -> Option<String> {
         match &self.result {
             Some((_, Err(e))) => Some(e.clone()),
-            Some((_, Ok(bud))) => bud.crossing.as_ref().map(crossing_text),
+            Some((_, Ok(Made::Bud(bud)))) => bud.crossing.as_ref().map(crossing_text),
+            Some((_, Ok(Made::Opening(_, crossing)))) => crossing.as_ref().map(crossing_text),
             None => None,
         }
     }
@@ -88,7 +100,16 @@ impl BudSketchState {
     /// The bud the stroke makes, when it makes one.
     pub fn bud(&self) -> Option<&SketchedBud> {
         match &self.result {
-            Some((_, Ok(bud))) => Some(bud),
+            Some((_, Ok(Made::Bud(bud)))) => Some(bud),
+            _ => None,
+        }
+    }
+
+    /// The flower opening to the stroke's shape, when the stroke is the
+    /// opened flower's and makes one.
+    pub fn opening(&self) -> Option<&Flower> {
+        match &self.result {
+            Some((_, Ok(Made::Opening(flower, _)))) => Some(flower),
             _ => None,
         }
     }
@@ -156,7 +177,7 @@ fn first_base(flower: &Flower, template: usize) -> Option<DVec2> {
 /// The section; pushes the edit chosen onto `commands`.
 pub fn bud_sketch_ui(
     ui: &mut egui::Ui,
-    flower: &Flower,
+    (flower, keyframes): (&Flower, u32),
     state: &mut BudSketchState,
     commands: &mut Vec<Command>,
 ) {
@@ -165,7 +186,7 @@ pub fn bud_sketch_ui(
     }
     egui::CollapsingHeader::new("Sketched bud")
         .id_salt("sketched bud")
-        .show(ui, |ui| rows(ui, flower, state, commands))
+        .show(ui, |ui| rows(ui, (flower, keyframes), state, commands))
         .header_response
         .on_hover_text(
             "Draw one curved stroke in the side view: the primary vein of a petal in the bud. \
@@ -176,7 +197,7 @@ pub fn bud_sketch_ui(
 
 fn rows(
     ui: &mut egui::Ui,
-    flower: &Flower,
+    (flower, keyframes): (&Flower, u32),
     state: &mut BudSketchState,
     commands: &mut Vec<Command>,
 ) {
@@ -195,8 +216,26 @@ fn rows(
             .response
             .labelled_by(label);
     });
+    let has_bud = flower.templates[index].vein.is_some();
     ui.horizontal(|ui| {
-        ui.add_enabled_ui(!others, |ui| {
+        let label = ui.label("draw").id;
+        ui.radio_value(&mut state.opening, false, "the bud")
+            .labelled_by(label)
+            .on_hover_text("The stroke is a petal's vein in the bud");
+        ui.add_enabled_ui(has_bud, |ui| {
+            ui.radio_value(&mut state.opening, true, "the opened flower")
+                .on_hover_text(
+                    "The stroke is a petal's vein in the open flower: the petals then open \
+                     from the bud to it by the two-state blossom instead of growing",
+                )
+                .on_disabled_hover_text("Sketch and apply the bud first");
+        });
+    });
+    if !has_bud {
+        state.opening = false;
+    }
+    ui.horizontal(|ui| {
+        ui.add_enabled_ui(!others && !state.opening, |ui| {
             ui.radio_value(&mut state.spiral, true, "golden-angle spiral")
                 .on_hover_text("Petals 137.5° apart, each later one nested inside")
                 .on_disabled_hover_text(
@@ -209,7 +248,7 @@ fn rows(
     if others {
         state.spiral = false;
     }
-    if state.spiral {
+    if state.spiral && !state.opening {
         ui.horizontal(|ui| {
             let label = ui.label("petals").id;
             ui.add(egui::DragValue::new(&mut state.count).range(1..=40))
@@ -317,13 +356,25 @@ fn rows(
     ));
 
     // What the stroke makes.
-    let key = (index, state.spiral, state.count, fingerprint(flower));
+    let key = (
+        index,
+        state.spiral,
+        state.count,
+        state.opening,
+        fingerprint(flower),
+    );
     let stale = state.result.as_ref().is_none_or(|(k, _)| *k != key);
     if !response.dragged() && state.stroke.len() > 1 && stale {
         let minimum = SHORTEST_STROKE * 1.1 * extent;
         let result = SideStroke::new(&state.stroke, minimum)
             .map_err(|e| e.to_string())
             .and_then(|stroke| {
+                if state.opening {
+                    return flower
+                        .with_sketched_opening(index, &stroke.vein, keyframes)
+                        .map(|(flower, crossing)| Made::Opening(flower, crossing))
+                        .map_err(|e| e.to_string());
+                }
                 let placement = if state.spiral {
                     BudPlacement::GoldenSpiral { count: state.count }
                 } else {
@@ -331,11 +382,35 @@ fn rows(
                 };
                 flower
                     .with_sketched_bud(index, &stroke, placement)
+                    .map(Made::Bud)
                     .map_err(|e| e.to_string())
             });
         state.result = Some((key, result));
     }
-    if let Some((_, Ok(bud))) = &state.result {
+    if let Some(opened) = state.opening() {
+        // The open shape's midrib from the organ's base.
+        if let (Some(organ), Some(animation)) = (
+            opened.organs.iter().find(|o| o.template == index),
+            &opened.templates[index].two_state,
+        ) {
+            let mut midrib: Vec<(f64, egui::Pos2)> = animation
+                .open
+                .iter()
+                .zip(&opened.templates[index].mesh.uvs)
+                .filter(|(_, uv)| (uv.x - 0.5).abs() < 0.02)
+                .map(|(p, uv)| {
+                    let w = organ.placement.world_from_template(*p, 0.0);
+                    (uv.y, to_screen(DVec2::new(w.x.hypot(w.z), w.y)))
+                })
+                .collect();
+            midrib.sort_by(|a, b| a.0.total_cmp(&b.0));
+            painter.add(egui::Shape::line(
+                midrib.into_iter().map(|(_, p)| p).collect(),
+                egui::Stroke::new(2.5, Color32::from_rgb(255, 170, 40)),
+            ));
+        }
+    }
+    if let Some((_, Ok(Made::Bud(bud)))) = &state.result {
         if let Some(vein) = &bud.flower.templates[index].vein {
             // The vein as it will be: smoothed, from the base.
             if let Some(base) = first_base(&bud.flower, index) {
@@ -370,6 +445,26 @@ fn rows(
     }
     if let Some(problem) = state.problem() {
         ui.label(RichText::new(problem).color(ui.visuals().error_fg_color));
+    }
+    if state.opening {
+        let crossing = matches!(&state.result, Some((_, Ok(Made::Opening(_, Some(_))))));
+        let ready = state.opening().filter(|_| !crossing);
+        let apply = ui
+            .add_enabled(ready.is_some(), egui::Button::new("Apply opening"))
+            .on_hover_text(
+                "The petals open from the bud to the stroke's shape by the two-state blossom \
+                 over the project's keyframes (one undo step)",
+            )
+            .on_disabled_hover_text("Draw a stroke whose open petals do not cross");
+        if apply.clicked()
+            && let Some(opened) = ready
+        {
+            commands.push(Command::Edit {
+                label: format!("sketched opening of {}", flower.templates[index].name),
+                edit: ProjectEdit::Flower(Box::new(opened.clone())),
+            });
+        }
+        return;
     }
     let ready = state.bud().filter(|b| b.crossing.is_none());
     let apply = ui

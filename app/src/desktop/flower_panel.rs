@@ -781,7 +781,12 @@ pub fn flower_ui(
 
     // The shape of one template.
     shape_ui(ui, flower, &mut state.shape, &mut commands_early);
-    bud_sketch_ui(ui, flower, &mut state.bud, &mut commands_early);
+    bud_sketch_ui(
+        ui,
+        (flower, project.settings.keyframes),
+        &mut state.bud,
+        &mut commands_early,
+    );
     ui.separator();
 
     // Arrangement.

@@ -129,6 +129,35 @@ impl Flower {
         }
     }
 
+    /// The flower whose template `template` opens from its bud to the
+    /// petal bent along `open` (§3.2's opened flower: a free-form stroke
+    /// "treated as the terminal form of the primary vein"), by the
+    /// two-state blossom, reaching it at keyframe `keyframes`: the organs
+    /// then no longer grow from their maps but go from one shape to the
+    /// other ([`crate::TwoStateAnimation`]). Also which organs cross in the
+    /// open flower, if any do.
+    pub fn with_sketched_opening(
+        &self,
+        template: usize,
+        open: &anthesis_bud::Vein,
+        keyframes: u32,
+    ) -> Result<(Flower, Option<(String, String)>), EditError> {
+        let bud = self.templates.get(template).ok_or(EditError::Missing {
+            what: "template",
+            index: template,
+        })?;
+        let opened = bend_along_vein(&bud.mesh, open).map_err(EditError::Shape)?;
+        let mut flower = self.clone();
+        flower.templates[template].two_state = Some(crate::TwoStateAnimation::new(
+            opened.positions.clone(),
+            keyframes,
+        ));
+        let mut open_flower = flower.clone();
+        open_flower.templates[template].mesh = opened;
+        let crossing = first_crossing(&open_flower);
+        Ok((flower, crossing))
+    }
+
     /// The flower with template `template`'s organs based at distance `r`
     /// from the axis and height `h`, joint angle zero, spanning `half_span`
     /// degrees either side (whorls, a spiral, listed organs; an L-system's

@@ -254,3 +254,56 @@ fn a_new_shape_for_a_template_with_a_vein_is_bent_along_it() {
     // Without a vein the shape is used as it is.
     assert_eq!(flower.templates[0].shaped(wider.clone()).unwrap(), wider);
 }
+
+#[test]
+fn an_opened_flower_stroke_makes_the_template_open_to_the_petal_bent_along_it() {
+    let flower = five_petals(2.0);
+    let bud = flower
+        .with_sketched_bud(0, &bud_stroke(2.0, 1.0, 1.0), BudPlacement::Arrangement)
+        .unwrap()
+        .flower;
+    // Out and down: an open flower's petal.
+    let open_stroke: Vec<DVec2> = (0..=30)
+        .map(|k| {
+            let t = k as f64 / 30.0;
+            DVec2::new(2.0 + 9.0 * t, 4.0 * (std::f64::consts::PI * t).sin())
+        })
+        .collect();
+    let open = SideStroke::new(&open_stroke, 1.0).unwrap();
+    let (opened, crossing) = bud.with_sketched_opening(0, &open.vein, 60).unwrap();
+    assert_eq!(crossing, None);
+    let template = &opened.templates[0];
+    assert_eq!(template.mesh, bud.templates[0].mesh, "the bud stays");
+    let animation = template.two_state.as_ref().expect("two-state");
+    assert_eq!(animation.growth.duration, 60.0);
+    assert_eq!(animation.open.len(), template.mesh.positions.len());
+    // The open shape's midrib follows the open stroke from the organ's base.
+    let organ = &opened.organs[0];
+    let side = open.side_points();
+    let shift = side[0]
+        - DVec2::new(
+            organ.placement.position.x.hypot(organ.placement.position.z),
+            organ.placement.position.y,
+        );
+    for (p, uv) in animation.open.iter().zip(&template.mesh.uvs) {
+        if (uv.x - 0.5).abs() < 1e-9 {
+            let w = organ.placement.world_from_template(*p, 0.0);
+            let q = DVec2::new(w.x.hypot(w.z), w.y) + shift;
+            assert!(distance_to(&side, q) < 0.02, "{q}");
+        }
+    }
+    // It passes the project's checks and is saved.
+    let project = crate::Project {
+        name: "opening".to_string(),
+        flower: opened,
+        settings: crate::SimulationSettings::default(),
+    };
+    let folder = tempfile::tempdir().unwrap();
+    let path = folder.path().join("o.anthesis.toml");
+    crate::project::save_project(&project, &path).unwrap();
+    let loaded = crate::project::load_project(&path).unwrap();
+    assert_eq!(
+        loaded.flower.templates[0].two_state,
+        project.flower.templates[0].two_state
+    );
+}
