@@ -1878,6 +1878,19 @@ fn double_click(harness: &mut Harness<'_, AnthesisApp>, label: &str) {
     in_one_frame(harness, events);
 }
 
+/// Runs frames until a widget labelled `label` is shown (the file browser
+/// lists a folder it enters a frame or more later; under load, later).
+fn wait_for_label(harness: &mut Harness<'_, AnthesisApp>, label: &str) {
+    for _ in 0..200 {
+        harness.run();
+        if harness.query_by_label(label).is_some() {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("\"{label}\" was not shown");
+}
+
 /// The app on `project` saved at `path`, using the in-app file browser.
 fn harness_with_file_browser(path: &std::path::Path) -> Harness<'static, AnthesisApp> {
     let project = small_flower();
@@ -1935,12 +1948,11 @@ fn the_in_app_file_browser_navigates_filters_and_opens_saves_and_exports() {
     harness.snapshot("file_browser_open");
     // Into the folder, up again, into it again and pick the project there.
     double_click(&mut harness, "🗀 other flowers");
-    harness.run();
-    harness.get_by_label("🗋 theirs.anthesis.toml");
+    wait_for_label(&mut harness, "🗋 theirs.anthesis.toml");
     harness.get_by_label("⬆").click();
-    harness.run();
+    wait_for_label(&mut harness, "🗀 other flowers");
     double_click(&mut harness, "🗀 other flowers");
-    harness.run();
+    wait_for_label(&mut harness, "🗋 theirs.anthesis.toml");
     harness.get_by_label("🗋 theirs.anthesis.toml").click();
     harness.run();
     harness.get_by_label("Open").click();
