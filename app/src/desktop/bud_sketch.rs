@@ -174,6 +174,26 @@ fn first_base(flower: &Flower, template: usize) -> Option<DVec2> {
         })
 }
 
+/// The side-view points `(r, h)` of the midrib (vertices near u = 0.5,
+/// base to tip) of a template shape `positions` placed as `organ`.
+fn side_midrib(
+    positions: &[glam::DVec3],
+    uvs: &[DVec2],
+    organ: &anthesis_flower::Organ,
+) -> Vec<DVec2> {
+    let mut midrib: Vec<(f64, DVec2)> = positions
+        .iter()
+        .zip(uvs)
+        .filter(|(_, uv)| (uv.x - 0.5).abs() < 0.02)
+        .map(|(p, uv)| {
+            let w = organ.placement.world_from_template(*p, 0.0);
+            (uv.y, DVec2::new(w.x.hypot(w.z), w.y))
+        })
+        .collect();
+    midrib.sort_by(|a, b| a.0.total_cmp(&b.0));
+    midrib.into_iter().map(|(_, p)| p).collect()
+}
+
 /// The section; pushes the edit chosen onto `commands`.
 pub fn bud_sketch_ui(
     ui: &mut egui::Ui,
@@ -313,20 +333,11 @@ fn rows(
     );
     // The template's midrib as it is now, at its first organ, for scale.
     if let Some(organ) = flower.organs.iter().find(|o| o.template == index) {
-        let mut midrib: Vec<(f64, egui::Pos2)> = template
-            .mesh
-            .positions
-            .iter()
-            .zip(&template.mesh.uvs)
-            .filter(|(_, uv)| (uv.x - 0.5).abs() < 0.02)
-            .map(|(p, uv)| {
-                let w = organ.placement.world_from_template(*p, 0.0);
-                (uv.y, to_screen(DVec2::new(w.x.hypot(w.z), w.y)))
-            })
-            .collect();
-        midrib.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let points: Vec<egui::Pos2> = midrib.into_iter().map(|(_, p)| p).collect();
-        painter.add(egui::Shape::line(points, faint));
+        let points = side_midrib(&template.mesh.positions, &template.mesh.uvs, organ);
+        painter.add(egui::Shape::line(
+            points.into_iter().map(to_screen).collect(),
+            faint,
+        ));
     }
 
     // Drawing.
@@ -393,19 +404,9 @@ fn rows(
             opened.organs.iter().find(|o| o.template == index),
             &opened.templates[index].two_state,
         ) {
-            let mut midrib: Vec<(f64, egui::Pos2)> = animation
-                .open
-                .iter()
-                .zip(&opened.templates[index].mesh.uvs)
-                .filter(|(_, uv)| (uv.x - 0.5).abs() < 0.02)
-                .map(|(p, uv)| {
-                    let w = organ.placement.world_from_template(*p, 0.0);
-                    (uv.y, to_screen(DVec2::new(w.x.hypot(w.z), w.y)))
-                })
-                .collect();
-            midrib.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let points = side_midrib(&animation.open, &opened.templates[index].mesh.uvs, organ);
             painter.add(egui::Shape::line(
-                midrib.into_iter().map(|(_, p)| p).collect(),
+                points.into_iter().map(to_screen).collect(),
                 egui::Stroke::new(2.5, Color32::from_rgb(255, 170, 40)),
             ));
         }
