@@ -407,6 +407,28 @@ pub struct Project {
     pub settings: SimulationSettings,
 }
 
+/// A template for tests: `mesh` with uniform maps, dg 0.01, thickness
+/// 0.2, stiffness scales 20, no joint schedule, white.
+#[cfg(test)]
+pub(crate) fn test_template(name: &str, mesh: Mesh) -> Template {
+    Template {
+        name: name.to_string(),
+        mesh,
+        maps: KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
+        dg: 0.01,
+        thickness: 0.2,
+        stretch_stiffness: 20.0,
+        bend_stiffness: 20.0,
+        base_region: BaseRegion::default(),
+        joint_schedule: Vec::new(),
+        color: [1.0; 4],
+        colouring: None,
+        two_state: None,
+        source: None,
+        vein: None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -179,26 +179,10 @@ pub fn predicted_size(mesh: &Mesh, mean_edge: f64) -> (usize, usize) {
 mod tests {
     use super::*;
     use crate::{BaseRegion, Flower, Organ, Placement, SimulationSettings};
-    use anthesis_maps::KeyedMaps;
     use anthesis_mesh::generate::test_petal;
 
     fn template(mesh: Mesh) -> Template {
-        Template {
-            name: "petal".to_string(),
-            mesh,
-            maps: KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
-            dg: 0.01,
-            thickness: 0.2,
-            stretch_stiffness: 20.0,
-            bend_stiffness: 20.0,
-            base_region: BaseRegion::default(),
-            joint_schedule: Vec::new(),
-            color: [1.0; 4],
-            colouring: None,
-            two_state: None,
-            source: None,
-            vein: None,
-        }
+        crate::test_template("petal", mesh)
     }
 
     fn project(mesh: Mesh, resolution: Resolution) -> Project {

@@ -369,7 +369,6 @@ pub fn check_flower(flower: &Flower) -> Vec<ScaleMismatch> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use anthesis_maps::{GrowthMaps, KeyedMaps};
 
     #[test]
     fn a_mesh_a_power_of_ten_off_the_one_it_replaces_is_caught_and_converted_back() {
@@ -420,20 +419,9 @@ mod tests {
             *p *= scale;
         }
         Template {
-            name: "petal".to_string(),
-            mesh,
-            maps: KeyedMaps::single(GrowthMaps::uniform()),
             dg: 0.003,
             thickness,
-            stretch_stiffness: 20.0,
-            bend_stiffness: 20.0,
-            base_region: Default::default(),
-            joint_schedule: Vec::new(),
-            color: [1.0; 4],
-            colouring: None,
-            two_state: None,
-            source: None,
-            vein: None,
+            ..crate::test_template("petal", mesh)
         }
     }
 

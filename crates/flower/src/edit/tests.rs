@@ -1,28 +1,12 @@
 use glam::DVec3;
 
 use super::*;
+use crate::Placement;
 use crate::structure::lsystem::LSystemError;
-use crate::{BaseRegion, Placement};
-use anthesis_maps::KeyedMaps;
 use anthesis_mesh::generate::test_petal;
 
 fn template(name: &str) -> Template {
-    Template {
-        name: name.to_string(),
-        mesh: test_petal(4.0, 2.0, 4, 6),
-        maps: KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
-        dg: 0.01,
-        thickness: 0.2,
-        stretch_stiffness: 20.0,
-        bend_stiffness: 20.0,
-        base_region: BaseRegion::default(),
-        joint_schedule: Vec::new(),
-        color: [1.0; 4],
-        colouring: None,
-        two_state: None,
-        source: None,
-        vein: None,
-    }
+    crate::test_template(name, test_petal(4.0, 2.0, 4, 6))
 }
 
 fn whorl(name: &str, template: usize, count: usize, offset_deg: f64, radius: f64) -> Whorl {

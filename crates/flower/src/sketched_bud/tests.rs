@@ -1,27 +1,14 @@
 use glam::DVec2;
 
 use super::*;
+use crate::Template;
 use crate::structure::Whorl;
-use crate::{BaseRegion, Template};
-use anthesis_maps::KeyedMaps;
 use anthesis_mesh::generate::test_petal;
 
 fn template(name: &str, width: f64) -> Template {
     Template {
-        name: name.to_string(),
-        mesh: test_petal(8.0, width, 9, 17),
-        maps: KeyedMaps::single(anthesis_maps::GrowthMaps::uniform()),
-        dg: 0.01,
         thickness: 0.1,
-        stretch_stiffness: 20.0,
-        bend_stiffness: 20.0,
-        base_region: BaseRegion::default(),
-        joint_schedule: Vec::new(),
-        color: [1.0; 4],
-        colouring: None,
-        two_state: None,
-        source: None,
-        vein: None,
+        ..crate::test_template(name, test_petal(8.0, width, 9, 17))
     }
 }
 
