@@ -3580,6 +3580,21 @@ fn a_petal_is_sketched_with_the_pointer_and_applied_in_one_undo_step_keeping_its
         DVec2::new(-reach + 2.0 * reach * t, 9.0 - 5.0 * t * (1.0 - t))
     });
     draw_stroke(&mut harness, &section);
+    // Undo stroke takes it back; drawn again, it is there again.
+    harness.get_by_label("Undo stroke").click();
+    settle(&mut harness);
+    assert_eq!(
+        harness
+            .state()
+            .flower_panel()
+            .shape()
+            .sketch()
+            .sketch(&name),
+        Some(&drawn)
+    );
+    harness.get_by_label("sketch canvas").scroll_to_me();
+    settle(&mut harness);
+    draw_stroke(&mut harness, &section);
     let sketch = harness
         .state()
         .flower_panel()

@@ -76,7 +76,13 @@ const TOOLS: [(SketchTool, &str, &str); 5] = [
 struct Draft {
     saved: Option<PetalSketch>,
     sketch: PetalSketch,
+    /// The sketches before each change, for "Undo stroke" (the last
+    /// [`UNDO_STROKES`]).
+    undo: Vec<PetalSketch>,
 }
+
+/// How many changes of a draft "Undo stroke" goes back.
+const UNDO_STROKES: usize = 50;
 
 /// The map from the sketch plane to the canvas.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -206,6 +212,7 @@ pub fn sketch_ui(
                     Draft {
                         saved: saved.clone(),
                         sketch: sketch.clone(),
+                        undo: Vec::new(),
                     },
                 );
             }
@@ -228,6 +235,7 @@ pub fn sketch_ui(
                 Draft {
                     saved: None,
                     sketch: PetalSketch::default(),
+                    undo: Vec::new(),
                 },
             );
         }
@@ -248,7 +256,17 @@ pub fn sketch_ui(
         }
     });
     let mut sketch = draft.sketch.clone();
+    let mut undone = false;
     ui.horizontal(|ui| {
+        if ui
+            .add_enabled(!draft.undo.is_empty(), egui::Button::new("Undo stroke"))
+            .on_hover_text("Take back the last stroke (or Clear strokes, or Remove cross-sections)")
+            .clicked()
+            && let Some(previous) = draft.undo.last()
+        {
+            sketch = previous.clone();
+            undone = true;
+        }
         if ui
             .add_enabled(
                 !sketch.sections.is_empty(),
@@ -260,7 +278,10 @@ pub fn sketch_ui(
             sketch.sections.clear();
         }
         if ui
-            .add_enabled(sketch != PetalSketch::default(), egui::Button::new("Clear"))
+            .add_enabled(
+                sketch != PetalSketch::default(),
+                egui::Button::new("Clear strokes"),
+            )
             .on_hover_text("Start again from an empty canvas")
             .clicked()
         {
@@ -375,6 +396,14 @@ pub fn sketch_ui(
         ui.label(RichText::new(error).color(ui.visuals().error_fg_color));
     }
     if let Some(d) = state.drafts.get_mut(name) {
+        if undone {
+            d.undo.pop();
+        } else if sketch != d.sketch {
+            d.undo.push(std::mem::take(&mut d.sketch));
+            if d.undo.len() > UNDO_STROKES {
+                d.undo.remove(0);
+            }
+        }
         d.sketch = sketch;
     }
 }
