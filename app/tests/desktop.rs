@@ -3511,6 +3511,22 @@ fn draw_stroke(harness: &mut Harness<'_, AnthesisApp>, points: &[glam::DVec2]) {
     settle(harness);
 }
 
+/// The sketch editor's preview once its thread has answered.
+fn wait_for_sketch_preview(
+    harness: &mut Harness<'_, AnthesisApp>,
+) -> Result<anthesis_bud::MeshQuality, String> {
+    for _ in 0..1000 {
+        harness.step();
+        if let Some(preview) = harness.state().flower_panel().shape().sketch().preview() {
+            let preview = preview.copied().map_err(str::to_string);
+            settle(harness);
+            return preview;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    panic!("the sketch preview did not come");
+}
+
 /// `count + 1` points along `f` over [0, 1].
 fn along(count: usize, f: impl Fn(f64) -> glam::DVec2) -> Vec<glam::DVec2> {
     (0..=count).map(|k| f(k as f64 / count as f64)).collect()
@@ -3627,15 +3643,7 @@ fn a_petal_is_sketched_with_the_pointer_and_applied_in_one_undo_step_keeping_its
     let expected =
         anthesis_bud::build_organ(&petal.surface, &anthesis_bud::RemeshOptions::new(edge))
             .expect("meshes");
-    let shown = harness
-        .state()
-        .flower_panel()
-        .shape()
-        .sketch()
-        .preview()
-        .expect("a preview")
-        .copied()
-        .expect("meshes");
+    let shown = wait_for_sketch_preview(&mut harness).expect("meshes");
     assert_eq!(shown, expected.quality);
     harness.get_by_label(&format!(
         "sketched: {} particles, mean edge {:.3}, smallest angle {:.1}°, edge spread {:.0} %",

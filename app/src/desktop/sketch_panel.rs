@@ -13,9 +13,10 @@
 //! template's mesh shown faintly behind it.
 
 use std::collections::BTreeMap;
+use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_bud::{
-    MeshQuality, PetalSketch, RemeshOptions, SketchError, SketchTool, SketchedPetal, Surface,
+    Bud, MeshQuality, PetalSketch, RemeshOptions, SketchError, SketchTool, SketchedPetal, Surface,
 };
 use anthesis_flower::{Flower, TemplateSource};
 use eframe::egui::{self, Color32, Pos2, RichText, Stroke};
@@ -84,6 +85,14 @@ struct Draft {
 /// How many changes of a draft "Undo stroke" goes back.
 const UNDO_STROKES: usize = 50;
 
+/// The petal meshed for the preview.
+#[derive(Debug)]
+enum Preview {
+    /// Still meshing.
+    Waiting(Receiver<Result<Bud, String>>),
+    Done(Result<Bud, String>),
+}
+
 /// The map from the sketch plane to the canvas.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct View {
@@ -122,9 +131,9 @@ pub struct SketchState {
     /// The canvas's map while a stroke is drawn (the view does not move
     /// under the pointer) and as last drawn.
     view: Option<View>,
-    /// The petal's mesh numbers at the section's edge, for the sketch and
-    /// edge they were made of.
-    preview: Option<(u64, Result<MeshQuality, String>)>,
+    /// The petal meshed at the section's edge (on a thread of its own), for
+    /// the sketch and edge it was made of.
+    preview: Option<(u64, Preview)>,
     /// Why Apply could not mesh the petal.
     apply_error: Option<String>,
 }
@@ -140,11 +149,18 @@ impl SketchState {
         self.view.map(|v| v.to_screen(p))
     }
 
-    /// The previewed mesh numbers, or why the sketch cannot be meshed.
+    /// The previewed mesh numbers, or why the sketch cannot be meshed;
+    /// `None` while it is being meshed.
     pub fn preview(&self) -> Option<Result<&MeshQuality, &str>> {
-        self.preview
-            .as_ref()
-            .map(|(_, p)| p.as_ref().map_err(String::as_str))
+        match &self.preview {
+            Some((_, Preview::Done(result))) => Some(
+                result
+                    .as_ref()
+                    .map(|bud| &bud.quality)
+                    .map_err(String::as_str),
+            ),
+            _ => None,
+        }
     }
 
     /// Chooses the drawing tool (as clicking it).
@@ -324,7 +340,8 @@ pub fn sketch_ui(
         side_view(ui, petal);
     }
 
-    // The preview at the section's edge.
+    // The preview at the section's edge, meshed on a thread of its own
+    // (no spinner: the thread asks for a frame when it is done).
     let k = key(&sketch, edge);
     if state.preview.as_ref().is_none_or(|(old, _)| *old != k) {
         let preview = match &built {
@@ -333,23 +350,49 @@ pub fn sketch_ui(
                     max_vertices: PREVIEW_MAX_VERTICES,
                     ..RemeshOptions::new(edge)
                 };
-                anthesis_bud::build_organ(&petal.surface, &options)
-                    .map(|bud| bud.quality)
-                    .map_err(|e| e.to_string())
+                let surface = petal.surface.clone();
+                let (send, receive) = sync_channel(1);
+                let ctx = ui.ctx().clone();
+                let spawned = std::thread::Builder::new()
+                    .name("anthesis-sketch-preview".into())
+                    .spawn(move || {
+                        let bud = anthesis_bud::build_organ(&surface, &options)
+                            .map_err(|e| e.to_string());
+                        let _ = send.send(bud);
+                        ctx.request_repaint();
+                    });
+                match spawned {
+                    Ok(_) => Preview::Waiting(receive),
+                    Err(e) => Preview::Done(Err(format!("cannot start the mesher: {e}"))),
+                }
             }
-            Err(e) => Err(e.to_string()),
+            Err(e) => Preview::Done(Err(e.to_string())),
         };
         state.preview = Some((k, preview));
     }
-    if let (Ok(_), Some((_, preview))) = (&built, &state.preview) {
-        match preview {
-            Ok(q) => {
-                ui.label(format!("sketched: {}", quality_text(q)));
+    if let Some((_, preview)) = &mut state.preview
+        && let Preview::Waiting(receive) = preview
+    {
+        match receive.try_recv() {
+            Ok(result) => *preview = Preview::Done(result),
+            Err(TryRecvError::Empty) => {}
+            Err(TryRecvError::Disconnected) => {
+                *preview = Preview::Done(Err("the mesher stopped".to_string()));
             }
-            Err(e) => {
+        }
+    }
+    if built.is_ok() {
+        match state.preview.as_ref().map(|(_, p)| p) {
+            Some(Preview::Done(Ok(bud))) => {
+                ui.label(format!("sketched: {}", quality_text(&bud.quality)));
+            }
+            Some(Preview::Done(Err(e))) => {
                 ui.label(
                     RichText::new(format!("cannot mesh: {e}")).color(ui.visuals().error_fg_color),
                 );
+            }
+            Some(Preview::Waiting(_)) | None => {
+                ui.label("meshing…");
             }
         }
     }
@@ -362,7 +405,14 @@ pub fn sketch_ui(
         .clicked()
         && let Ok(petal) = &built
     {
-        match anthesis_bud::build_organ(&petal.surface, &RemeshOptions::new(edge)) {
+        // The preview's mesh when it is of these strokes and this edge (the
+        // mesher is deterministic), else meshed now.
+        let meshed = match &state.preview {
+            Some((made_of, Preview::Done(Ok(bud)))) if *made_of == k => Ok(bud.clone()),
+            _ => anthesis_bud::build_organ(&petal.surface, &RemeshOptions::new(edge))
+                .map_err(|e| e.to_string()),
+        };
+        match meshed {
             Ok(bud) => {
                 state.apply_error = None;
                 // The inner side stays where the template has it.
