@@ -33,7 +33,7 @@ use crate::collide::{
     Surface, Tracker, Violated, contacts_against, contacts_of, max_violation, push_back,
 };
 use crate::obstacle::ObstacleSim;
-use crate::organ::{OrganSim, OrganState};
+use crate::organ::{OrganSim, OrganState, Settle, Settled};
 use crate::resume::{Edit, edit_between};
 
 /// Which organs to simulate.
@@ -463,7 +463,7 @@ impl Simulation {
     /// before stay good, and every later call returns the same error.
     pub fn step(
         &mut self,
-        cancel: &dyn Fn() -> bool,
+        cancel: &(dyn Fn() -> bool + Sync),
         progress: &mut dyn FnMut(IterationProgress),
     ) -> Result<Keyframe, SimError> {
         let step = self.next_step;
@@ -491,7 +491,7 @@ impl Simulation {
 
     fn step_unguarded(
         &mut self,
-        cancel: &dyn Fn() -> bool,
+        cancel: &(dyn Fn() -> bool + Sync),
         progress: &mut dyn FnMut(IterationProgress),
     ) -> Result<Keyframe, SimError> {
         let started = Instant::now();
@@ -512,7 +512,7 @@ impl Simulation {
         }
         let solver = self.settings.solver;
         let mut iterations = 0;
-        let mut gradient = 0.0;
+        let mut gradient;
         // Contacts are found right after growth and held while the organs
         // relax: rebuilt every iteration from organs that all move at once,
         // they made neighbours bounce off each other instead of settling.
@@ -530,42 +530,71 @@ impl Simulation {
         let mut round = 1;
         let mut pressed = Vec::new();
         let pushed = loop {
-            let mut round_iterations = 0;
-            let mut converged = false;
-            while round_iterations < solver.max_iterations {
-                if cancel() {
-                    return Err(SimError::Cancelled);
-                }
-                let reports: Vec<_> = self
-                    .organs
-                    .par_iter_mut()
-                    .zip(contacts.par_iter())
-                    .map(|(o, c)| o.iterate(step, c, &solver))
-                    .collect();
-                let mut all_converged = true;
-                gradient = 0.0f64;
-                for (organ, report) in self.organs.iter().zip(reports) {
-                    let report = report.map_err(|error| SimError::Diverged {
-                        keyframe: step,
-                        organ: organ.name.clone(),
-                        error,
-                    })?;
-                    all_converged &= report.converged;
-                    gradient = gradient.max(report.relative_gradient);
-                }
+            // Within a round the contacts are fixed, so each organ settles
+            // on its own: its iterations read nothing of the others. Each
+            // runs to convergence on its own thread instead of all moving in
+            // lockstep, where the organ that needed the most iterations kept
+            // the other core idle. The keyframes, counts and progress are
+            // those of the lockstep loop (an organ that had converged only
+            // repeated its converged report there).
+            let settled: Vec<Settled> = self
+                .organs
+                .par_iter_mut()
+                .zip(contacts.par_iter())
+                .map(|(o, c)| o.settle(step, c, &solver, cancel))
+                .collect();
+            // The first failure in lockstep order: the earliest iteration,
+            // then the first organ.
+            let failure = settled
+                .iter()
+                .enumerate()
+                .filter_map(|(i, s)| match &s.outcome {
+                    Settle::Failed(error) => Some((s.gradients.len(), i, error)),
+                    _ => None,
+                })
+                .min_by_key(|&(at, i, _)| (at, i));
+            let not_converged = settled
+                .iter()
+                .any(|s| matches!(s.outcome, Settle::NotConverged));
+            // Lockstep iterations that reported progress in this round.
+            let reported = match failure {
+                Some((at, _, _)) => at,
+                None if not_converged => solver.max_iterations as usize,
+                None => settled.iter().map(|s| s.gradients.len()).max().unwrap_or(0),
+            };
+            // An organ that stopped earlier repeats its last gradient.
+            let gradient_at = |i: usize| {
+                settled
+                    .iter()
+                    .filter_map(|s| s.gradients.get(i).or(s.gradients.last()))
+                    .fold(0.0f64, |a, &b| a.max(b))
+            };
+            // Cancelled: the iterations every organ had done are reported.
+            let cancelled = settled
+                .iter()
+                .filter(|s| matches!(s.outcome, Settle::Cancelled))
+                .map(|s| s.gradients.len())
+                .min();
+            let reported = cancelled.map_or(reported, |done| done.min(reported));
+            for i in 0..reported {
                 progress(IterationProgress {
                     keyframe: step,
-                    iteration: iterations,
-                    relative_gradient: gradient,
+                    iteration: iterations + i as u32,
+                    relative_gradient: gradient_at(i),
                 });
-                if all_converged {
-                    converged = true;
-                    break;
-                }
-                iterations += 1;
-                round_iterations += 1;
             }
-            if !converged {
+            if cancelled.is_some() {
+                return Err(SimError::Cancelled);
+            }
+            if let Some((_, organ, error)) = failure {
+                return Err(SimError::Diverged {
+                    keyframe: step,
+                    organ: self.organs[organ].name.clone(),
+                    error: error.clone(),
+                });
+            }
+            if not_converged {
+                iterations += solver.max_iterations;
                 let (organ, relative_gradient) = self.worst_organ(&contacts);
                 return Err(SimError::NotConverged {
                     keyframe: step,
@@ -574,6 +603,8 @@ impl Simulation {
                     relative_gradient,
                 });
             }
+            iterations += reported.saturating_sub(1) as u32;
+            gradient = gradient_at(reported.saturating_sub(1));
             for organ in &mut self.organs {
                 organ.attach(step);
             }
@@ -606,8 +637,8 @@ impl Simulation {
         };
 
         let mut energy = 0.0;
-        for (i, organ) in self.organs.iter().enumerate() {
-            let e = organ.energy();
+        let energies: Vec<f64> = self.organs.par_iter().map(OrganSim::energy).collect();
+        for (i, (organ, &e)) in self.organs.iter().zip(&energies).enumerate() {
             if !e.is_finite()
                 || (self.previous_energy[i] > 0.0
                     && e > 1e6 * self.previous_energy[i].max(organ.energy_floor()))
@@ -709,20 +740,27 @@ impl Simulation {
             .map(|s| Tracker::new(s.positions, 2.0 * s.mean_edge))
             .collect();
         let offset = self.settings.collision_offset;
-        for &(inner, outer) in &self.overlaps {
-            // Inner particles stay on the outer organ's inner side, outer
-            // particles on the inner organ's outer side. A kinematic organ
-            // (two-state) gets no contacts and never gives way, so the
-            // organ against it moves all the way, as against a part.
-            for (moving, other, side) in [(inner, outer, 1.0), (outer, inner, -1.0)] {
-                if self.organs[moving].is_kinematic() {
-                    continue;
-                }
+        // Inner particles stay on the outer organ's inner side, outer
+        // particles on the inner organ's outer side. A kinematic organ
+        // (two-state) gets no contacts and never gives way, so the organ
+        // against it moves all the way, as against a part.
+        let sides: Vec<(usize, usize, f64)> = self
+            .overlaps
+            .iter()
+            .flat_map(|&(inner, outer)| [(inner, outer, 1.0), (outer, inner, -1.0)])
+            .filter(|&(moving, _, _)| !self.organs[moving].is_kinematic())
+            .collect();
+        // Each side's contacts on its own thread, appended in the order of
+        // the sides: the same lists as one after the other.
+        let found: Vec<Vec<Contact>> = sides
+            .par_iter()
+            .map(|&(moving, other, side)| {
                 let violated = if self.organs[other].is_kinematic() {
                     Violated::MoveAll
                 } else {
                     violated
                 };
+                let mut list = Vec::new();
                 contacts_against(
                     &surfaces[moving],
                     &surfaces[other],
@@ -730,9 +768,13 @@ impl Simulation {
                     side,
                     offset,
                     violated,
-                    &mut contacts[moving],
+                    &mut list,
                 );
-            }
+                list
+            })
+            .collect();
+        for (&(moving, _, _), list) in sides.iter().zip(found) {
+            contacts[moving].extend(list);
         }
         self.drop_base_contacts(&mut contacts);
         contacts
@@ -750,28 +792,35 @@ impl Simulation {
     /// be put all the way out (a part does not move aside).
     fn obstacle_contacts(&self, contacts: &mut [Vec<Contact>]) {
         let offset = self.settings.collision_offset;
-        for (organ, list) in self.organs.iter().zip(contacts) {
-            if organ.is_kinematic() {
-                continue;
-            }
-            for obstacle in &self.obstacles {
-                let near = organ
-                    .positions
-                    .iter()
-                    .copied()
-                    .enumerate()
-                    .filter(|&(_, p)| obstacle.reaches(p));
-                contacts_of(
-                    near,
-                    &obstacle.surface(),
-                    obstacle.tracker(),
-                    1.0,
-                    offset,
-                    Violated::MoveAll,
-                    list,
-                );
-            }
+        let obstacles = &self.obstacles;
+        if obstacles.is_empty() {
+            return;
         }
+        self.organs
+            .par_iter()
+            .zip(contacts)
+            .for_each(|(organ, list)| {
+                if organ.is_kinematic() {
+                    return;
+                }
+                for obstacle in obstacles {
+                    let near = organ
+                        .positions
+                        .iter()
+                        .copied()
+                        .enumerate()
+                        .filter(|&(_, p)| obstacle.reaches(p));
+                    contacts_of(
+                        near,
+                        &obstacle.surface(),
+                        obstacle.tracker(),
+                        1.0,
+                        offset,
+                        Violated::MoveAll,
+                        list,
+                    );
+                }
+            });
     }
 
     /// The paper's push-back: nobody ends on the wrong side. Organs are

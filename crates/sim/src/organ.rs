@@ -102,6 +102,22 @@ fn key_growth_scales(template: &Template) -> Vec<f64> {
         .collect()
 }
 
+/// How [`OrganSim::settle`] ended.
+pub(crate) enum Settle {
+    Converged,
+    NotConverged,
+    Cancelled,
+    /// The solver failed at the iteration after the last gradient.
+    Failed(SolverError),
+}
+
+/// What [`OrganSim::settle`] did: the relative gradient at the start of
+/// each iteration (the last one where it converged), and how it ended.
+pub(crate) struct Settled {
+    pub gradients: Vec<f64>,
+    pub outcome: Settle,
+}
+
 pub(crate) struct OrganSim {
     pub name: String,
     pub color: [f32; 4],
@@ -459,6 +475,48 @@ impl OrganSim {
         self.hold_base(step);
         self.solver
             .step(&self.elastic, contacts, &mut self.positions, settings)
+    }
+
+    /// Newton iterations against the fixed `contacts` until this organ
+    /// converges, fails, has taken `settings.max_iterations`, or `cancel`
+    /// says stop (polled before each iteration).
+    pub fn settle(
+        &mut self,
+        step: u32,
+        contacts: &[Contact],
+        settings: &SolverSettings,
+        cancel: &(dyn Fn() -> bool + Sync),
+    ) -> Settled {
+        let mut gradients = Vec::new();
+        for _ in 0..settings.max_iterations {
+            if cancel() {
+                return Settled {
+                    gradients,
+                    outcome: Settle::Cancelled,
+                };
+            }
+            match self.iterate(step, contacts, settings) {
+                Err(error) => {
+                    return Settled {
+                        gradients,
+                        outcome: Settle::Failed(error),
+                    };
+                }
+                Ok(report) => {
+                    gradients.push(report.relative_gradient);
+                    if report.converged {
+                        return Settled {
+                            gradients,
+                            outcome: Settle::Converged,
+                        };
+                    }
+                }
+            }
+        }
+        Settled {
+            gradients,
+            outcome: Settle::NotConverged,
+        }
     }
 
     /// Anchors each base particle where the receptacle and the joint

@@ -84,13 +84,11 @@ fn cancelling_stops_the_step_with_cancelled() {
 
     // Cancelled while iterating: the progress seen before stops there.
     let mut sim = Simulation::new(&project, &Selection::All).expect("valid project");
-    let polls = std::cell::Cell::new(0);
+    // The cancel check is polled from the threads the organs settle on.
+    let polls = std::sync::atomic::AtomicU32::new(0);
     let mut reports = Vec::new();
     let result = sim.step(
-        &|| {
-            polls.set(polls.get() + 1);
-            polls.get() > 1
-        },
+        &|| polls.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1 > 1,
         &mut |p| reports.push(p),
     );
     assert!(matches!(result, Err(SimError::Cancelled)), "{result:?}");
