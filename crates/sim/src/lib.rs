@@ -529,6 +529,7 @@ impl Simulation {
         }
         let mut round = 1;
         let mut pressed = Vec::new();
+        let mut unmoved_contacts = None;
         let pushed = loop {
             // Within a round the contacts are fixed, so each organ settles
             // on its own: its iterations read nothing of the others. Each
@@ -626,6 +627,11 @@ impl Simulation {
                 .map(|(o, c)| max_violation(&o.positions, c) / o.mean_edge)
                 .fold(0.0, f64::max);
             if deepest == 0.0 {
+                // Nothing violated: these are the contacts the statistics
+                // look for (moving a violated contact half way is the only
+                // difference to `Violated::MoveAll`), and nothing moves
+                // before they are counted.
+                unmoved_contacts = Some(fresh);
                 break 0;
             }
             if deepest <= RESETTLE_DEPTH || round == MAX_CONTACT_ROUNDS {
@@ -668,7 +674,7 @@ impl Simulation {
                 relative_gradient: gradient,
                 seconds: started.elapsed().as_secs_f64(),
                 pushed_particles: pushed as u32,
-                contact_particles: self.particles_in_contact(&pressed),
+                contact_particles: self.particles_in_contact(&pressed, unmoved_contacts),
             },
         })
     }
@@ -694,10 +700,16 @@ impl Simulation {
     /// How many particles touch a neighbouring organ: `pressed` (held off
     /// it by a contact force while the organs settled), or their contact
     /// is violated or short of it by less than the collision offset now (a
-    /// particle with several neighbours counts once).
-    fn particles_in_contact(&self, pressed: &[Vec<bool>]) -> u32 {
+    /// particle with several neighbours counts once). `contacts` are those
+    /// of the organs where they are, when known.
+    fn particles_in_contact(
+        &self,
+        pressed: &[Vec<bool>],
+        contacts: Option<Vec<Vec<Contact>>>,
+    ) -> u32 {
         let offset = self.settings.collision_offset;
-        self.contacts(Violated::MoveAll)
+        contacts
+            .unwrap_or_else(|| self.contacts(Violated::MoveAll))
             .iter()
             .zip(&self.organs)
             .enumerate()
