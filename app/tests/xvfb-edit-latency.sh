@@ -18,7 +18,9 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 strokes="${1:-7}"
 cargo build --release --bin anthesis
-binary="$(pwd)/${CARGO_TARGET_DIR:-target}/release/anthesis"
+target_dir="${CARGO_TARGET_DIR:-target}"
+case "$target_dir" in /*) ;; *) target_dir="$(pwd)/$target_dir" ;; esac
+binary="$target_dir/release/anthesis"
 
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
