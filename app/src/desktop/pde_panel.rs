@@ -287,15 +287,6 @@ fn quality_text(q: &anthesis_bud::MeshQuality) -> String {
     )
 }
 
-/// The template's mesh wound like `like` (a flipped inner side is kept).
-fn wound_like(mesh: Mesh, like: &Mesh) -> Mesh {
-    if anthesis_bud::inner_side_faces_minus_z(like) == Some(false) {
-        anthesis_bud::with_inner_side_flipped(&mesh)
-    } else {
-        mesh
-    }
-}
-
 /// The PDE editor of template `index` whose saved sweep is `saved`; `edge`
 /// is the Shape section's remesh edge.
 pub fn pde_ui(
@@ -569,19 +560,13 @@ pub fn pde_ui(
                 )
                 .clicked()
             {
-                let mut edited = flower.clone();
-                let template = &mut edited.templates[index];
-                // A sketched bud's bend stays.
-                match template.shaped(wound_like(bud.mesh.clone(), &template.mesh)) {
-                    Ok(mesh) => {
-                        template.mesh = mesh;
-                        template.source = Some(TemplateSource::Pde { sweep, edge });
-                        commands.push(Command::Edit {
-                            label: format!("PDE surface of {name}"),
-                            edit: ProjectEdit::Flower(Box::new(edited)),
-                        });
-                    }
-                    Err(e) => state.error = Some(format!("cannot bend the surface: {e}")),
+                let source = TemplateSource::Pde { sweep, edge };
+                match flower.with_shape(index, bud.mesh.clone(), source) {
+                    Ok(edited) => commands.push(Command::Edit {
+                        label: format!("PDE surface of {name}"),
+                        edit: ProjectEdit::Flower(Box::new(edited)),
+                    }),
+                    Err(e) => state.error = Some(format!("cannot use the surface: {e}")),
                 }
             }
         }

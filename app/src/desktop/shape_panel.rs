@@ -501,29 +501,16 @@ fn bezier_ui(
     {
         match anthesis_bud::build_organ(&net, &RemeshOptions::new(edge)) {
             Ok(bud) => {
-                state.net_error = None;
                 // The mesh and the net it was made of, in one step.
-                // The inner side stays where the template has it (a flip
-                // made before is kept).
-                let flipped = anthesis_bud::inner_side_faces_minus_z(&flower.templates[index].mesh)
-                    == Some(false);
-                let mesh = if flipped {
-                    anthesis_bud::with_inner_side_flipped(&bud.mesh)
-                } else {
-                    bud.mesh
-                };
-                // A sketched bud's bend stays.
-                match flower.templates[index].shaped(mesh) {
-                    Ok(mesh) => {
-                        let mut edited = flower.clone();
-                        edited.templates[index].mesh = mesh;
-                        edited.templates[index].source = Some(TemplateSource::Bezier { net, edge });
+                match flower.with_shape(index, bud.mesh, TemplateSource::Bezier { net, edge }) {
+                    Ok(edited) => {
+                        state.net_error = None;
                         commands.push(Command::Edit {
                             label: format!("Bézier net of {name}"),
                             edit: ProjectEdit::Flower(Box::new(edited)),
                         });
                     }
-                    Err(e) => state.net_error = Some(format!("cannot bend the net: {e}")),
+                    Err(e) => state.net_error = Some(format!("cannot use the net: {e}")),
                 }
             }
             Err(e) => state.net_error = Some(format!("cannot mesh the net: {e}")),

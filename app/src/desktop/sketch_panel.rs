@@ -415,28 +415,16 @@ pub fn sketch_ui(
         match meshed {
             Ok(bud) => {
                 state.apply_error = None;
-                // The inner side stays where the template has it.
-                let flipped = anthesis_bud::inner_side_faces_minus_z(&template.mesh) == Some(false);
-                let mesh = if flipped {
-                    anthesis_bud::with_inner_side_flipped(&bud.mesh)
-                } else {
-                    bud.mesh
+                let source = TemplateSource::Sketch {
+                    sketch: sketch.clone(),
+                    edge,
                 };
-                // A sketched bud's bend stays.
-                match template.shaped(mesh) {
-                    Ok(mesh) => {
-                        let mut edited = flower.clone();
-                        edited.templates[index].mesh = mesh;
-                        edited.templates[index].source = Some(TemplateSource::Sketch {
-                            sketch: sketch.clone(),
-                            edge,
-                        });
-                        commands.push(Command::Edit {
-                            label: format!("sketched shape of {name}"),
-                            edit: ProjectEdit::Flower(Box::new(edited)),
-                        });
-                    }
-                    Err(e) => state.apply_error = Some(format!("cannot bend the sketch: {e}")),
+                match flower.with_shape(index, bud.mesh, source) {
+                    Ok(edited) => commands.push(Command::Edit {
+                        label: format!("sketched shape of {name}"),
+                        edit: ProjectEdit::Flower(Box::new(edited)),
+                    }),
+                    Err(e) => state.apply_error = Some(format!("cannot use the sketch: {e}")),
                 }
             }
             Err(e) => state.apply_error = Some(format!("cannot mesh the sketch: {e}")),

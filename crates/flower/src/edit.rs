@@ -239,6 +239,33 @@ impl Flower {
         added.with_organ(organ)
     }
 
+    /// The flower with template `index` given a new shape: `mesh`, made
+    /// from `source` in an editor, wound like the mesh it replaces (a
+    /// flipped inner side stays flipped) and bent along the template's
+    /// vein when it has one ([`Template::shaped`]: a sketched bud keeps
+    /// its bend). The maps stay: they live in UV space.
+    pub fn with_shape(
+        &self,
+        index: usize,
+        mesh: anthesis_mesh::Mesh,
+        source: crate::TemplateSource,
+    ) -> Result<Flower, EditError> {
+        let template = self.templates.get(index).ok_or(EditError::Missing {
+            what: "template",
+            index,
+        })?;
+        let mesh = if anthesis_bud::inner_side_faces_minus_z(&template.mesh) == Some(false) {
+            anthesis_bud::with_inner_side_flipped(&mesh)
+        } else {
+            mesh
+        };
+        let mesh = template.shaped(mesh).map_err(EditError::Shape)?;
+        let mut flower = self.clone();
+        flower.templates[index].mesh = mesh;
+        flower.templates[index].source = Some(source);
+        Ok(flower)
+    }
+
     /// The flower with template `index` called `name`. Organs an L-system
     /// names after their template are renamed with it, and the listed
     /// rules that name them follow.

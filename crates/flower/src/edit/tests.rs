@@ -431,3 +431,54 @@ fn a_template_made_in_the_app_comes_with_one_organ_unless_its_mesh_is_in_another
         other => panic!("expected a unit mismatch, got {other:?}"),
     }
 }
+
+#[test]
+fn a_new_shape_keeps_the_maps_a_flipped_inner_side_and_the_vein_and_records_its_source() {
+    let base = flower();
+    let net = anthesis_bud::BezierPatch::petal();
+    let made = anthesis_bud::build_organ(&net, &anthesis_bud::RemeshOptions::new(1.5))
+        .unwrap()
+        .mesh;
+    let source = crate::TemplateSource::Bezier { net, edge: 1.5 };
+    let reshaped = base.with_shape(0, made.clone(), source.clone()).unwrap();
+    let template = &reshaped.templates[0];
+    assert_eq!(template.mesh, made);
+    assert_eq!(template.source, Some(source.clone()));
+    assert_eq!(template.maps, base.templates[0].maps);
+    assert_eq!(reshaped.templates[1], base.templates[1]);
+
+    // A template whose inner side was flipped gets the new shape flipped.
+    let mut flipped = base.clone();
+    flipped.templates[0].mesh = anthesis_bud::with_inner_side_flipped(&base.templates[0].mesh);
+    let reshaped = flipped.with_shape(0, made.clone(), source.clone()).unwrap();
+    assert_eq!(
+        reshaped.templates[0].mesh,
+        anthesis_bud::with_inner_side_flipped(&made)
+    );
+
+    // A template with a vein gets the new shape bent along it.
+    let mut veined = base.clone();
+    let vein = anthesis_bud::Vein::new(
+        &[
+            glam::DVec2::ZERO,
+            glam::DVec2::new(10.0, 3.0),
+            glam::DVec2::new(18.0, 8.0),
+        ],
+        1.0,
+    )
+    .unwrap();
+    veined.templates[0].vein = Some(vein.clone());
+    let reshaped = veined.with_shape(0, made.clone(), source.clone()).unwrap();
+    assert_eq!(
+        reshaped.templates[0].mesh,
+        anthesis_bud::bend_along_vein(&made, &vein).unwrap()
+    );
+
+    assert_eq!(
+        base.with_shape(7, made, source).unwrap_err(),
+        EditError::Missing {
+            what: "template",
+            index: 7
+        }
+    );
+}
