@@ -46,9 +46,12 @@ pub fn import_scan(args: &ImportScanArgs) -> Result<()> {
     {
         bail!("--stretch-to-bend must be from 0 to 100, got {k}");
     }
-    let mesh = anthesis_mesh::load_obj_shape(&args.scan)
-        .with_context(|| format!("cannot read the scan {}", args.scan.display()))?
-        .mesh;
+    let file = anthesis_mesh::load_obj_shape(&args.scan)
+        .with_context(|| format!("cannot read the scan {}", args.scan.display()))?;
+    for warning in &file.warnings {
+        eprintln!("{}: {warning}", args.scan.display());
+    }
+    let mesh = file.mesh;
     let outline = ScanOutline::of(&mesh)
         .with_context(|| format!("cannot use {} as a petal", args.scan.display()))?;
     let corners = outline.detect_corners(&mesh);

@@ -147,10 +147,12 @@ impl ScanReview {
     /// Reads the scan at `path` and finds its outline and corners; the
     /// fit is made on a thread of its own once the review is shown.
     /// `edge` is the edge offered until the fit gives the petal's length.
-    pub fn read(path: &Path, edge: f64) -> Result<ScanReview, String> {
-        let mesh = anthesis_mesh::load_obj_shape(path)
-            .map_err(|e| e.to_string())?
-            .mesh;
+    /// Also what the reader said about the file (statements read past,
+    /// vertices joined).
+    pub fn read(path: &Path, edge: f64) -> Result<(ScanReview, Vec<String>), String> {
+        let file = anthesis_mesh::load_obj_shape(path).map_err(|e| e.to_string())?;
+        let notes = file.warnings.iter().map(|w| w.to_string()).collect();
+        let mesh = file.mesh;
         let outline = ScanOutline::of(&mesh).map_err(|e| e.to_string())?;
         let detected = outline.detect_corners(&mesh);
         let name = path
@@ -158,24 +160,27 @@ impl ScanReview {
             .map(|s| s.to_string_lossy().trim().to_string())
             .filter(|s| !s.is_empty())
             .unwrap_or_else(|| "scanned".to_string());
-        Ok(ScanReview {
-            path: path.to_path_buf(),
-            name,
-            mesh: Arc::new(mesh),
-            outline,
-            corners: detected,
-            detected,
-            flip: false,
-            edge,
-            edge_set: false,
-            moving: 0,
-            fit: Err("not fitted yet".to_string()),
-            fit_needed: true,
-            fitting: None,
-            built: None,
-            view: None,
-            on_screen: Vec::new(),
-        })
+        Ok((
+            ScanReview {
+                path: path.to_path_buf(),
+                name,
+                mesh: Arc::new(mesh),
+                outline,
+                corners: detected,
+                detected,
+                flip: false,
+                edge,
+                edge_set: false,
+                moving: 0,
+                fit: Err("not fitted yet".to_string()),
+                fit_needed: true,
+                fitting: None,
+                built: None,
+                view: None,
+                on_screen: Vec::new(),
+            },
+            notes,
+        ))
     }
 
     /// Fits again with the current corners and inner side (on the next

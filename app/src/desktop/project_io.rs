@@ -349,12 +349,15 @@ impl AnthesisApp {
     /// the reason, in the log and the Flower panel.
     pub(super) fn import_scan(&mut self, path: &Path) {
         match super::pde_panel::ScanReview::read(path, 1.0) {
-            Ok(review) => {
+            Ok((review, notes)) => {
                 self.flower_panel.scan_read(review);
                 // The review starts its fit when it is next drawn.
                 self.ctx.request_repaint();
                 self.log
                     .info(format!("scanned petal {} read", path.display()));
+                for note in notes {
+                    self.log.info(format!("{}: {note}", path.display()));
+                }
             }
             Err(e) => {
                 let message = format!("cannot import {} as a scanned petal: {e}", path.display());

@@ -249,3 +249,32 @@ fn a_shipped_eustoma_petal_with_a_rounded_top_is_fitted_back_too() {
         fit.length
     );
 }
+
+#[test]
+fn a_scan_exported_with_its_vertices_split_per_face_is_joined_and_fitted() {
+    // The same scan, written as an STL-like export writes it: three `v`
+    // statements for every face.
+    let (scan, ..) = scanned_lily(0.003);
+    let mut text = String::new();
+    for (k, t) in scan.triangles.iter().enumerate() {
+        for &v in t {
+            let p = scan.positions[v as usize];
+            text.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+        }
+        text.push_str(&format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3));
+    }
+    let file = anthesis_mesh::parse_obj_shape(&text).expect("a shape");
+    assert_eq!(file.mesh.vertex_count(), scan.vertex_count());
+    assert_eq!(file.mesh.triangles.len(), scan.triangles.len());
+    assert_eq!(file.warnings.len(), 1, "{:?}", file.warnings);
+    let joined = &file.mesh;
+    let fit = fit_scan(joined, None, &ScanFitOptions::default()).expect("fits as one outline");
+    let welded = fit_scan(&scan, None, &ScanFitOptions::default()).expect("fits");
+    let [rms, _] = fit.relative_scan_to_surface();
+    let [welded_rms, _] = welded.relative_scan_to_surface();
+    assert!(rms < 0.02, "{rms}");
+    assert!(
+        (rms - welded_rms).abs() < 1e-3,
+        "{rms} against {welded_rms}"
+    );
+}

@@ -53,6 +53,20 @@ pub struct ObjWarning {
 
 impl fmt::Display for ObjWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.keyword == "v" {
+            let plural = if self.count == 1 { "" } else { "s" };
+            let (what, verb) = if plural.is_empty() {
+                ("vertex", "was")
+            } else {
+                ("vertices", "were")
+            };
+            return write!(
+                f,
+                "OBJ line {}: {} {what} at the same place as an earlier one {verb} joined to \
+                 it (a mesh exported with its vertices split per face)",
+                self.first_line, self.count
+            );
+        }
         let what = match self.keyword {
             "l" => "line (`l`)",
             _ => "point (`p`)",
@@ -129,9 +143,12 @@ pub fn load_obj_shape(path: &Path) -> Result<ObjFile, MeshError> {
     parse_obj_shape(&text)
 }
 
-/// Parses OBJ text as a bare shape (see [`load_obj_shape`]).
+/// Parses OBJ text as a bare shape (see [`load_obj_shape`]). Vertices at
+/// exactly the same place are joined into one (exports that split every
+/// vertex per face, or along normal or texture seams, would otherwise read
+/// as loose triangles), with a warning saying how many.
 pub fn parse_obj_shape(text: &str) -> Result<ObjFile, MeshError> {
-    let parsed = parse(text, false)?;
+    let parsed = parse(text, false)?.welded();
     if let Err(error) = validate::validate_shape(&parsed.mesh) {
         return Err(parsed.locate(error));
     }
@@ -256,6 +273,51 @@ struct Parsed {
 }
 
 impl Parsed {
+    /// The mesh with vertices at exactly the same position joined (the
+    /// first one kept, with its `v` statement's number and line for error
+    /// messages), and a warning when any were.
+    fn welded(mut self) -> Parsed {
+        let key = |p: glam::DVec3| {
+            // +0 and -0 are the same place.
+            p.to_array()
+                .map(|c| if c == 0.0 { 0u64 } else { c.to_bits() })
+        };
+        let mut first: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
+        let mut kept: Vec<usize> = Vec::new();
+        let mut new_index: Vec<u32> = Vec::with_capacity(self.mesh.positions.len());
+        let mut joined = 0;
+        let mut first_joined_line = None;
+        for (v, p) in self.mesh.positions.iter().enumerate() {
+            let index = *first.entry(key(*p)).or_insert_with(|| {
+                kept.push(v);
+                (kept.len() - 1) as u32
+            });
+            if kept.last() != Some(&v) {
+                joined += 1;
+                first_joined_line.get_or_insert(self.vertex_line[v]);
+            }
+            new_index.push(index);
+        }
+        if joined == 0 {
+            return self;
+        }
+        let pick = |values: &[usize]| kept.iter().map(|&v| values[v]).collect::<Vec<_>>();
+        self.vertex_number = pick(&self.vertex_number);
+        self.vertex_line = pick(&self.vertex_line);
+        self.texcoord_line = pick(&self.texcoord_line);
+        self.mesh.positions = kept.iter().map(|&v| self.mesh.positions[v]).collect();
+        self.mesh.uvs = kept.iter().map(|&v| self.mesh.uvs[v]).collect();
+        for t in &mut self.mesh.triangles {
+            *t = t.map(|v| new_index[v as usize]);
+        }
+        self.warnings.push(ObjWarning {
+            keyword: "v",
+            count: joined,
+            first_line: first_joined_line.unwrap_or(0),
+        });
+        self
+    }
+
     /// `error`, found by validating the mesh, in the OBJ's numbers and with
     /// the line of the statement at fault.
     fn locate(&self, error: MeshError) -> MeshError {
@@ -728,6 +790,37 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
             parse_obj(&object_text(&second, None).unwrap()).unwrap(),
             square
         );
+    }
+
+    #[test]
+    fn a_shape_exported_with_split_vertices_is_joined_into_one_surface() {
+        // Two triangles sharing the edge (1, 0, 0)-(0, 1, 0), each with its
+        // own three vertices (as STL-like exports write them), one of them
+        // at -0.
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 1 1 0\nv -0 1 -0\nf 1 2 3\nf 4 5 6\n";
+        let file = parse_obj_shape(text).expect("a shape");
+        assert_eq!(file.mesh.positions.len(), 4);
+        assert_eq!(file.mesh.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+        assert_eq!(
+            file.warnings,
+            vec![ObjWarning {
+                keyword: "v",
+                count: 2,
+                first_line: 4
+            }]
+        );
+        assert!(
+            file.warnings[0].to_string().starts_with(
+                "OBJ line 4: 2 vertices at the same place as an earlier one were joined"
+            ),
+            "{}",
+            file.warnings[0]
+        );
+        // An error still names the file's own vertex numbers: a NaN in the
+        // fifth `v` statement.
+        let bad = text.replace("v 1 1 0", "v nan 1 0");
+        let error = parse_obj_shape(&bad).unwrap_err().to_string();
+        assert!(error.contains("line 5"), "{error}");
     }
 
     #[test]
