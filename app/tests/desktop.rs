@@ -2220,6 +2220,16 @@ fn stroke_in_bud_view(harness: &mut Harness<'_, AnthesisApp>, points: &[glam::DV
 }
 
 #[test]
+fn the_sketched_bud_says_when_an_l_system_places_the_organs() {
+    // The apple's organs are placed by its L-system, in its turtle's frames.
+    let mut harness = harness(builtin("apple"));
+    harness.get_by_label("Flower").click();
+    settle(&mut harness);
+    click_settled(&mut harness, "Sketched bud");
+    harness.get_by_label_contains("The L-system places these organs in its turtle's frames");
+}
+
+#[test]
 fn a_bud_is_sketched_with_one_stroke_and_applied_in_one_undo_step() {
     use anthesis_flower::structure::{GOLDEN_ANGLE_DEG, Structure};
     use glam::DVec2;

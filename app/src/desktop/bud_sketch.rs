@@ -268,6 +268,22 @@ fn rows(
     if others {
         state.spiral = false;
     }
+    let turtle_placed = matches!(
+        flower.structure,
+        Some(anthesis_flower::structure::Structure::LSystem { .. })
+    ) && flower.organs[..flower.made_organ_count()]
+        .iter()
+        .any(|o| o.template == index);
+    if turtle_placed && !state.spiral {
+        ui.label(
+            RichText::new(
+                "The L-system places these organs in its turtle's frames: the stroke bends the \
+                 petal as seen in its own frame (its base at the stroke's start) and does not \
+                 move the organs.",
+            )
+            .color(ui.visuals().warn_fg_color),
+        );
+    }
     if state.spiral && !state.opening {
         ui.horizontal(|ui| {
             let label = ui.label("petals").id;
