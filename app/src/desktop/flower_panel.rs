@@ -222,6 +222,45 @@ enum Outcome {
     Refused(String),
 }
 
+/// The mean edge a new Bézier, PDE or sketched petal is meshed at (the
+/// simple petal's).
+fn new_shape_edge() -> f64 {
+    anthesis_garden::five_petal::SIMPLE_PETAL_EDGE * anthesis_garden::flowers::EDGE_SCALE
+}
+
+/// A new template of [`BezierPatch::petal`](anthesis_bud::BezierPatch::petal)
+/// meshed at [`new_shape_edge`], with uniform maps.
+fn new_bezier_template() -> Result<anthesis_flower::Template, String> {
+    let net = anthesis_bud::BezierPatch::petal();
+    let edge = new_shape_edge();
+    let bud = anthesis_bud::build_organ(&net, &anthesis_bud::RemeshOptions::new(edge))
+        .map_err(|e| e.to_string())?;
+    let mut template =
+        anthesis_garden::five_petal::simple_template_of_mesh("bezier petal", bud.mesh);
+    template.source = Some(anthesis_flower::TemplateSource::Bezier { net, edge });
+    Ok(template)
+}
+
+/// A template made by one of the "New … petal" buttons added with one
+/// organ of it, and shown in the Shape section; or why it was not.
+fn with_new_shape(
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    made: Result<anthesis_flower::Template, String>,
+) -> Outcome {
+    match made.and_then(|t| flower.with_template_and_organ(t).map_err(|e| e.to_string())) {
+        Ok(added) => {
+            let index = added.templates.len() - 1;
+            let name = added.templates[index].name.clone();
+            state.shape.template = index;
+            state.shape.edge = None;
+            state.shape.open_now = true;
+            Outcome::Edit(format!("add template {name}"), added)
+        }
+        Err(error) => Outcome::Refused(error),
+    }
+}
+
 fn outcome(
     label: impl Into<String>,
     result: Result<Flower, anthesis_flower::edit::EditError>,
@@ -659,30 +698,7 @@ pub fn flower_ui(
             )
             .clicked()
         {
-            let net = anthesis_bud::BezierPatch::petal();
-            let edge = anthesis_garden::five_petal::SIMPLE_PETAL_EDGE
-                * anthesis_garden::flowers::EDGE_SCALE;
-            match anthesis_bud::build_organ(&net, &anthesis_bud::RemeshOptions::new(edge)) {
-                Ok(bud) => {
-                    let mut template = anthesis_garden::five_petal::simple_template_of_mesh(
-                        "bezier petal",
-                        bud.mesh,
-                    );
-                    template.source = Some(anthesis_flower::TemplateSource::Bezier { net, edge });
-                    match flower.with_template_and_organ(template) {
-                        Ok(added) => {
-                            let index = added.templates.len() - 1;
-                            let name = added.templates[index].name.clone();
-                            state.shape.template = index;
-                            state.shape.edge = None;
-                            state.shape.open_now = true;
-                            outcomes.push(Outcome::Edit(format!("add template {name}"), added));
-                        }
-                        Err(error) => outcomes.push(Outcome::Refused(error.to_string())),
-                    }
-                }
-                Err(error) => outcomes.push(Outcome::Refused(error.to_string())),
-            }
+            outcomes.push(with_new_shape(flower, state, new_bezier_template()));
         }
         if ui
             .button("New PDE petal")
@@ -692,19 +708,8 @@ pub fn flower_ui(
             )
             .clicked()
         {
-            let edge = anthesis_garden::five_petal::SIMPLE_PETAL_EDGE
-                * anthesis_garden::flowers::EDGE_SCALE;
-            match super::pde_panel::new_pde_petal(flower, edge) {
-                Ok(added) => {
-                    let index = added.templates.len() - 1;
-                    let name = added.templates[index].name.clone();
-                    state.shape.template = index;
-                    state.shape.edge = None;
-                    state.shape.open_now = true;
-                    outcomes.push(Outcome::Edit(format!("add template {name}"), added));
-                }
-                Err(error) => outcomes.push(Outcome::Refused(error)),
-            }
+            let made = super::pde_panel::new_pde_template(new_shape_edge());
+            outcomes.push(with_new_shape(flower, state, made));
         }
         if ui
             .button("New sketched petal")
@@ -715,21 +720,8 @@ pub fn flower_ui(
             )
             .clicked()
         {
-            let edge = anthesis_garden::five_petal::SIMPLE_PETAL_EDGE
-                * anthesis_garden::flowers::EDGE_SCALE;
-            let added = super::sketch_panel::new_sketched_template(edge)
-                .and_then(|t| flower.with_template_and_organ(t).map_err(|e| e.to_string()));
-            match added {
-                Ok(added) => {
-                    let index = added.templates.len() - 1;
-                    let name = added.templates[index].name.clone();
-                    state.shape.template = index;
-                    state.shape.edge = None;
-                    state.shape.open_now = true;
-                    outcomes.push(Outcome::Edit(format!("add template {name}"), added));
-                }
-                Err(error) => outcomes.push(Outcome::Refused(error)),
-            }
+            let made = super::sketch_panel::new_sketched_template(new_shape_edge());
+            outcomes.push(with_new_shape(flower, state, made));
         }
         let source = state
             .new_organ_template

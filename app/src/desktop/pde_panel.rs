@@ -42,6 +42,7 @@ use eframe::egui::{self, Color32, DragValue, RichText};
 use glam::{DVec2, DVec3};
 
 use super::command::{Command, ProjectEdit};
+use super::shape_panel::quality_text;
 
 /// The names of a curve's control points, base to tip.
 const POINT_NAMES: [&str; 4] = ["base", "lower", "upper", "tip"];
@@ -264,32 +265,19 @@ impl ScanReview {
 }
 
 /// A new template of [`PdeSweep::petal`] meshed at `edge`, with uniform
-/// maps (like the simple petal) and one organ: the flower with it.
-pub fn new_pde_petal(flower: &Flower, edge: f64) -> Result<Flower, String> {
+/// maps (like the simple petal).
+pub fn new_pde_template(edge: f64) -> Result<anthesis_flower::Template, String> {
     let sweep = PdeSweep::petal();
     let bud =
         anthesis_bud::build_organ(&sweep, &RemeshOptions::new(edge)).map_err(|e| e.to_string())?;
     let mut template = anthesis_garden::five_petal::simple_template_of_mesh("pde petal", bud.mesh);
     template.source = Some(TemplateSource::Pde { sweep, edge });
-    flower
-        .with_template_and_organ(template)
-        .map_err(|e| e.to_string())
+    Ok(template)
 }
 
 /// A key for what a mesh was built from.
 fn edge_bits(edge: f64) -> u64 {
     edge.to_bits()
-}
-
-/// One row of mesh numbers.
-fn quality_text(q: &anthesis_bud::MeshQuality) -> String {
-    format!(
-        "{} particles, mean edge {:.3}, smallest angle {:.1}°, edge spread {:.0} %",
-        q.vertices,
-        q.mean_edge,
-        q.min_angle_deg,
-        100.0 * q.edge_spread
-    )
 }
 
 /// The PDE editor of template `index` whose saved sweep is `saved`; `edge`
