@@ -3045,24 +3045,15 @@ fn an_obj_becomes_a_template_and_is_remeshed_at_a_chosen_edge_keeping_its_maps()
 #[test]
 fn a_bezier_petal_is_made_its_control_points_dragged_and_typed_and_applied_in_one_undo_step() {
     use anthesis_bud::BezierPatch;
-    let mut harness = opened_small_flower();
-    harness.get_by_label("Flower").click();
-    settle(&mut harness);
-    let before = harness.state().project().clone();
-
     // A new template of the starting net, with one organ, its net in the
     // Shape section.
-    click_settled(&mut harness, "New Bézier petal");
+    let (mut harness, index) = new_shape_template("New Bézier petal", "bezier petal");
     let app = harness.state();
-    let flower = &app.project().flower;
-    let index = flower.templates.len() - 1;
-    assert_eq!(index, before.flower.templates.len());
-    assert_eq!(flower.templates[index].name, "bezier petal");
-    assert_eq!(flower.organs.len(), before.flower.organs.len() + 1);
-    let shape = app.flower_panel().shape();
-    assert_eq!(shape.template(), index);
-    assert_eq!(shape.net("bezier petal"), Some(&BezierPatch::petal()));
-    let made = flower.templates[index].clone();
+    assert_eq!(
+        app.flower_panel().shape().net("bezier petal"),
+        Some(&BezierPatch::petal())
+    );
+    let made = app.project().flower.templates[index].clone();
     wait_for_remesh_preview(&mut harness).expect("the new petal remeshes");
 
     // Drag the tip's right-hand point 30 pixels to the right in the front
@@ -3197,6 +3188,26 @@ fn a_bezier_petal_is_made_its_control_points_dragged_and_typed_and_applied_in_on
     );
 }
 
+/// The small flower with the Flower tab open and `button` ("New … petal")
+/// clicked: the harness and the new template's index,
+/// checked to be named `name`, to come with one organ and to be the one
+/// the Shape section shows.
+fn new_shape_template(button: &str, name: &str) -> (Harness<'static, AnthesisApp>, usize) {
+    let mut harness = opened_small_flower();
+    harness.get_by_label("Flower").click();
+    settle(&mut harness);
+    let before = harness.state().project().clone();
+    click_settled(&mut harness, button);
+    let app = harness.state();
+    let flower = &app.project().flower;
+    let index = flower.templates.len() - 1;
+    assert_eq!(index, before.flower.templates.len());
+    assert_eq!(flower.templates[index].name, name);
+    assert_eq!(flower.organs.len(), before.flower.organs.len() + 1);
+    assert_eq!(app.flower_panel().shape().template(), index);
+    (harness, index)
+}
+
 /// Drags from `from` by `by` in three steps, settling between them.
 fn drag_by(harness: &mut Harness<'_, AnthesisApp>, from: egui::Pos2, by: egui::Vec2) {
     harness.hover_at(from);
@@ -3214,22 +3225,12 @@ fn drag_by(harness: &mut Harness<'_, AnthesisApp>, from: egui::Pos2, by: egui::V
 #[test]
 fn a_pde_petal_is_made_its_margin_dragged_applied_in_one_undo_step_and_saved_with_its_curves() {
     use anthesis_bud::{PdeSweep, SweepCurve};
-    let mut harness = opened_small_flower();
-    harness.get_by_label("Flower").click();
-    settle(&mut harness);
-    let before = harness.state().project().clone();
-
     // A new template of the starting sweep, with one organ, its curves in
     // the Shape section.
-    click_settled(&mut harness, "New PDE petal");
+    let (mut harness, index) = new_shape_template("New PDE petal", "pde petal");
     let app = harness.state();
     let flower = &app.project().flower;
-    let index = flower.templates.len() - 1;
-    assert_eq!(index, before.flower.templates.len());
-    assert_eq!(flower.templates[index].name, "pde petal");
-    assert_eq!(flower.organs.len(), before.flower.organs.len() + 1);
     let shape = app.flower_panel().shape();
-    assert_eq!(shape.template(), index);
     let start = PdeSweep::petal();
     assert_eq!(shape.pde().sweep("pde petal"), Some(&start));
     let made = flower.templates[index].clone();
