@@ -17,10 +17,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 strokes="${1:-7}"
-cargo build --release --bin anthesis
-target_dir="${CARGO_TARGET_DIR:-target}"
-case "$target_dir" in /*) ;; *) target_dir="$(pwd)/$target_dir" ;; esac
-binary="$target_dir/release/anthesis"
+. app/tests/xvfb-window.sh
+binary="$(release_binary)"
 
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT

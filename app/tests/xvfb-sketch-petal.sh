@@ -21,10 +21,8 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 out="${1:-target/screenshots}"
 mkdir -p "$out"
-cargo build --release --bin anthesis
-target_dir="${CARGO_TARGET_DIR:-target}"
-case "$target_dir" in /*) ;; *) target_dir="$(pwd)/$target_dir" ;; esac
-binary="$target_dir/release/anthesis"
+. app/tests/xvfb-window.sh
+binary="$(release_binary)"
 import=/usr/bin/import   # ImageMagick's own, not a stand-in earlier on PATH
 
 work="$(mktemp -d)"

@@ -1,5 +1,15 @@
-# Sourced by the app/tests/xvfb-*.sh scripts inside their xvfb-run shell:
-# what each of them needs to drive the real Anthesis window.
+# Sourced by the app/tests/xvfb-*.sh scripts (from the repository root,
+# and inside their xvfb-run shell): what each of them needs to drive the
+# real Anthesis window.
+
+# Builds the release binary and prints its absolute path (under
+# CARGO_TARGET_DIR when that is set, absolute or relative).
+release_binary() {
+  cargo build --release --bin anthesis >&2
+  local target_dir="${CARGO_TARGET_DIR:-target}"
+  case "$target_dir" in /*) ;; *) target_dir="$(pwd)/$target_dir" ;; esac
+  echo "$target_dir/release/anthesis"
+}
 
 # Waits (up to 2 minutes) for the Anthesis window, then sizes it to
 # 1600x1000 at the screen's corner, where the scripts' pointer positions
