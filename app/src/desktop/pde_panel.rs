@@ -420,22 +420,11 @@ pub fn pde_ui(
     for (c, curve_points) in points.iter().enumerate() {
         for (k, at) in curve_points.iter().enumerate() {
             let id = ui.scope_id().with(("pde point", c, k));
-            let hit = ui.interact(
-                egui::Rect::from_center_size(*at, egui::vec2(12.0, 12.0)),
-                id,
-                egui::Sense::click_and_drag(),
-            );
-            if hit.clicked() || hit.drag_started() {
+            let (picked, shift) = super::shape_panel::view_point(ui, id, *at, 12.0, (scale, side));
+            if picked {
                 state.point = (c, k);
             }
-            if hit.dragged() {
-                let d = hit.drag_delta();
-                let delta = DVec2::new(f64::from(d.x), -f64::from(d.y)) / scale;
-                let shift = if side {
-                    DVec3::new(0.0, delta.y, delta.x)
-                } else {
-                    DVec3::new(delta.x, delta.y, 0.0)
-                };
+            if let Some(shift) = shift {
                 moved = Some((c, k, shift));
             }
             let chosen = state.point == (c, k);

@@ -132,6 +132,34 @@ pub(super) fn quality_text(q: &MeshQuality) -> String {
     )
 }
 
+/// A control point drawn at `at` (a square of `size` pixels) in a 2D view
+/// of the template frame, front (x, y) or `side` (z, y), at `scale` pixels
+/// per unit: whether it was picked (clicked, or a drag started on it), and
+/// while it is dragged, how far it moved in the template frame.
+pub(super) fn view_point(
+    ui: &egui::Ui,
+    id: egui::Id,
+    at: egui::Pos2,
+    size: f32,
+    (scale, side): (f64, bool),
+) -> (bool, Option<DVec3>) {
+    let hit = ui.interact(
+        egui::Rect::from_center_size(at, egui::vec2(size, size)),
+        id,
+        egui::Sense::click_and_drag(),
+    );
+    let shift = hit.dragged().then(|| {
+        let d = hit.drag_delta();
+        let (across, up) = (f64::from(d.x) / scale, -f64::from(d.y) / scale);
+        if side {
+            DVec3::new(0.0, up, across)
+        } else {
+            DVec3::new(across, up, 0.0)
+        }
+    });
+    (hit.clicked() || hit.drag_started(), shift)
+}
+
 /// The Shape section for the flower's templates; pushes the edits chosen
 /// onto `commands`.
 pub fn shape_ui(
@@ -419,24 +447,12 @@ fn bezier_ui(
     for (j, r) in points.iter().enumerate() {
         for (i, at) in r.iter().enumerate() {
             let id = ui.scope_id().with(("bezier point", j, i));
-            let hit = ui.interact(
-                egui::Rect::from_center_size(*at, egui::vec2(14.0, 14.0)),
-                id,
-                egui::Sense::click_and_drag(),
-            );
-            if hit.clicked() || hit.drag_started() {
+            let (picked, shift) = view_point(ui, id, *at, 14.0, (scale, side));
+            if picked {
                 state.point = (j, i);
             }
-            if hit.dragged() {
-                let d = hit.drag_delta();
-                let delta = glam::DVec2::new(f64::from(d.x), -f64::from(d.y)) / scale;
-                let p = net.control[j][i];
-                let q = if side {
-                    DVec3::new(p.x, p.y + delta.y, p.z + delta.x)
-                } else {
-                    DVec3::new(p.x + delta.x, p.y + delta.y, p.z)
-                };
-                moved = Some((j, i, q));
+            if let Some(shift) = shift {
+                moved = Some((j, i, net.control[j][i] + shift));
             }
             let chosen = state.point == (j, i);
             let colour = if chosen {
