@@ -82,11 +82,6 @@ impl BudSketchState {
         Some(frame.to_screen(rect, side))
     }
 
-    /// The stroke as drawn, `(r, h)`.
-    pub fn stroke(&self) -> &[DVec2] {
-        &self.stroke
-    }
-
     /// Why the stroke makes no bud, or which organs cross, as shown.
     pub fn problem(&self) -> Option<String> {
         match &self.result {

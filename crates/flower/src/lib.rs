@@ -126,15 +126,6 @@ pub enum TemplateSource {
 }
 
 impl TemplateSource {
-    /// The mean edge the source was meshed at.
-    pub fn edge(&self) -> f64 {
-        match self {
-            TemplateSource::Bezier { edge, .. }
-            | TemplateSource::Sketch { edge, .. }
-            | TemplateSource::Pde { edge, .. } => *edge,
-        }
-    }
-
     /// The same source, meshed at mean edge `edge` (a template remeshed
     /// in the Shape section).
     pub fn with_edge(&self, edge: f64) -> TemplateSource {
