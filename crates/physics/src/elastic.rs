@@ -124,6 +124,33 @@ impl Elastic {
         edge_pairs.chain(wing_pairs)
     }
 
+    /// The Hessian's sparsity pattern over `particles` particles (the
+    /// blocks of [`Elastic::coupled_pairs`]), with the blocks of every
+    /// edge's stencil `[i, j, k, l]` looked up once for assembly.
+    pub fn pattern(&self, particles: usize) -> BlockPattern {
+        BlockPattern::new(particles, self.coupled_pairs()).with_stencils(self.edge_stencils())
+    }
+
+    /// Per edge, the particles its membrane domain, spring or hinge couples:
+    /// the edge's ends, then the opposite particles the domain or hinge
+    /// has (`u32::MAX` for none).
+    fn edge_stencils(&self) -> Vec<[u32; 4]> {
+        let mut stencils: Vec<[u32; 4]> = match &self.membrane {
+            Some(m) => m.stencils().collect(),
+            None => self
+                .edges
+                .iter()
+                .map(|&[a, b]| [a, b, u32::MAX, u32::MAX])
+                .collect(),
+        };
+        for &(stencil, edge) in &self.hinges {
+            if let Some(s) = stencils.get_mut(edge as usize) {
+                *s = stencil;
+            }
+        }
+        stencils
+    }
+
     /// A force that sets the scale of the convergence test: the mean over
     /// edges of `ks * L0`, the force an edge exerts at 100 % strain.
     pub fn force_scale(&self) -> f64 {
@@ -243,17 +270,19 @@ impl Elastic {
             let nn = outer(n, n);
             let transverse = (1.0 - self.rest_lengths[idx] / len).max(0.0);
             let block = (nn + (DMat3::IDENTITY - nn) * transverse) * self.stretch_stiffness[idx];
-            pattern.add_block(values, a, a, &block);
-            pattern.add_block(values, b, b, &block);
-            pattern.add_block(values, a, b, &(-block));
+            let slots = pattern.stencil(idx, [a, b, u32::MAX, u32::MAX]);
+            BlockPattern::add_at(values, slots.slot(0, 0), &block);
+            BlockPattern::add_at(values, slots.slot(1, 1), &block);
+            BlockPattern::add_at(values, slots.slot(0, 1), &(-block));
         }
         for &(stencil, edge) in &self.hinges {
             let dtheta = dihedral_gradient(stencil.map(|p| x[p as usize]));
             let k = self.bend_stiffness[edge as usize];
+            let slots = pattern.stencil(edge as usize, stencil);
             for r in 0..4 {
                 for c in r..4 {
                     let block = outer(dtheta[r], dtheta[c]) * k;
-                    pattern.add_block(values, stencil[r], stencil[c], &block);
+                    BlockPattern::add_at(values, slots.slot(r, c), &block);
                 }
             }
         }

@@ -236,41 +236,67 @@ impl EdgeSmoothedMembrane {
         pattern: &BlockPattern,
         values: &mut [f64],
     ) {
-        for d in &self.domains {
+        for (e, d) in self.domains.iter().enumerate() {
             let (s, v) = Self::strains(d, x, rest_lengths);
             let r = Self::stresses(d, &s);
             // Summed per pair of the domain's (three or four) particles
             // first, then added to the sparse matrix once per pair.
             let particles = d.count.div_ceil(2) + 1;
+            // Only the blocks p <= q are added to the (symmetric) matrix.
             let mut local = [[DMat3::ZERO; 4]; 4];
+            let mut add = |p: usize, q: usize, block: &DMat3, minus: bool| {
+                if p <= q {
+                    if minus {
+                        local[p][q] -= *block;
+                    } else {
+                        local[p][q] += *block;
+                    }
+                }
+            };
             for a in 0..d.count {
                 let [la, lb] = SLOT_PARTICLES[a];
                 if r[a] > 0.0 {
                     let block = DMat3::IDENTITY * r[a];
-                    local[la][la] += block;
-                    local[lb][lb] += block;
-                    local[la][lb] -= block;
-                    local[lb][la] -= block;
+                    add(la, la, &block, false);
+                    add(lb, lb, &block, false);
+                    add(la, lb, &block, true);
+                    add(lb, la, &block, true);
                 }
                 for b in 0..d.count {
                     let [qa, qb] = SLOT_PARTICLES[b];
                     // ∇s_a is +v_a at la and −v_a at lb.
                     let block = outer(v[a], v[b]) * d.q[a][b];
-                    local[la][qa] += block;
-                    local[la][qb] -= block;
-                    local[lb][qa] -= block;
-                    local[lb][qb] += block;
+                    add(la, qa, &block, false);
+                    add(la, qb, &block, true);
+                    add(lb, qa, &block, true);
+                    add(lb, qb, &block, false);
                 }
             }
-            let ids = [d.pairs[0][0], d.pairs[0][1], d.pairs[1][1], d.pairs[3][1]];
+            let stencil = pattern.stencil(e, Self::stencil(d));
             for p in 0..particles {
                 for q in p..particles {
-                    // add_block mirrors (p, q) to (q, p); for p == q only
+                    // The slot mirrors (p, q) to (q, p); for p == q only
                     // the upper triangle of the (symmetric) block is used.
-                    pattern.add_block(values, ids[p], ids[q], &local[p][q]);
+                    BlockPattern::add_at(values, stencil.slot(p, q), &local[p][q]);
                 }
             }
         }
+    }
+
+    /// The particles `[i, j, k, l]` of each domain (`l` is `u32::MAX` at a
+    /// boundary edge), in the topology's edge order: the stencils the
+    /// Hessian adds blocks to.
+    pub fn stencils(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
+        self.domains.iter().map(Self::stencil)
+    }
+
+    fn stencil(d: &Domain) -> [u32; 4] {
+        let l = if d.count == 5 {
+            d.pairs[3][1]
+        } else {
+            u32::MAX
+        };
+        [d.pairs[0][0], d.pairs[0][1], d.pairs[1][1], l]
     }
 }
 

@@ -12,6 +12,49 @@ pub struct BlockPattern {
     upper_neighbours: Vec<Vec<u32>>,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
+    /// Where the blocks of each registered stencil live (see
+    /// [`BlockPattern::with_stencils`]).
+    stencils: Vec<StencilSlots>,
+}
+
+/// Where one 3x3 block between two particles lives in the values array:
+/// its first column starts at `start`, the next two follow at `stride` and
+/// `2 * stride + 1` (an upper column of block column `b` holds the blocks
+/// above the diagonal, then its diagonal entries, one more per column).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BlockSlot {
+    start: usize,
+    stride: usize,
+    kind: SlotKind,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+enum SlotKind {
+    /// A diagonal block: only its upper triangle is stored.
+    #[default]
+    Diagonal,
+    /// Block row below block column: stored as it is.
+    Upper,
+    /// Block row above block column: its transpose is stored.
+    Transposed,
+}
+
+/// The slots of every block between the (up to four) particles of a
+/// stencil, e.g. an edge with its two opposite particles: `slots[p][q]` for
+/// local particles `p <= q` holds the block of rows `p`, columns `q`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StencilSlots {
+    /// The stencil's particles; `u32::MAX` where it has fewer than four.
+    pub particles: [u32; 4],
+    slots: [[BlockSlot; 4]; 4],
+}
+
+impl StencilSlots {
+    /// The slot of local block `(p, q)`, `p <= q`.
+    #[inline]
+    pub fn slot(&self, p: usize, q: usize) -> &BlockSlot {
+        &self.slots[p][q]
+    }
 }
 
 impl BlockPattern {
@@ -46,6 +89,106 @@ impl BlockPattern {
             upper_neighbours,
             col_ptr,
             row_idx,
+            stencils: Vec::new(),
+        }
+    }
+
+    /// Registers stencils (up to four particles each, `u32::MAX` for the
+    /// missing ones; every pair of a stencil must be coupled) whose blocks
+    /// are looked up once here, so that assembly adds them with
+    /// [`BlockPattern::add_at`] without searching the pattern per block.
+    pub fn with_stencils(mut self, stencils: impl IntoIterator<Item = [u32; 4]>) -> Self {
+        self.stencils = stencils
+            .into_iter()
+            .map(|ids| self.stencil_slots(ids))
+            .collect();
+        self
+    }
+
+    /// The slots of the stencil `ids`: the `index`-th registered stencil if
+    /// it starts with the same particles (it may have more), otherwise
+    /// looked up now.
+    pub fn stencil(&self, index: usize, ids: [u32; 4]) -> std::borrow::Cow<'_, StencilSlots> {
+        let starts_with =
+            |s: &StencilSlots| (0..4).all(|p| ids[p] == u32::MAX || ids[p] == s.particles[p]);
+        match self.stencils.get(index) {
+            Some(s) if starts_with(s) => std::borrow::Cow::Borrowed(s),
+            _ => std::borrow::Cow::Owned(self.stencil_slots(ids)),
+        }
+    }
+
+    fn stencil_slots(&self, particles: [u32; 4]) -> StencilSlots {
+        let mut slots = [[BlockSlot::default(); 4]; 4];
+        let count = particles.iter().take_while(|&&p| p != u32::MAX).count();
+        for p in 0..count {
+            for q in p..count {
+                slots[p][q] = self.slot(particles[p], particles[q]);
+            }
+        }
+        StencilSlots { particles, slots }
+    }
+
+    /// The slot of the block at block row `a`, block column `b`.
+    pub fn slot(&self, a: u32, b: u32) -> BlockSlot {
+        let (low, high) = (a.min(b) as usize, a.max(b) as usize);
+        let neighbours = &self.upper_neighbours[high];
+        let stride = 3 * neighbours.len() + 1;
+        let (position, kind) = match a.cmp(&b) {
+            std::cmp::Ordering::Equal => (neighbours.len(), SlotKind::Diagonal),
+            ordering => {
+                let position = neighbours.binary_search(&(low as u32)).unwrap_or_else(|_| {
+                    panic!("particles {a} and {b} are not coupled in the pattern")
+                });
+                let kind = if ordering == std::cmp::Ordering::Less {
+                    SlotKind::Upper
+                } else {
+                    SlotKind::Transposed
+                };
+                (position, kind)
+            }
+        };
+        BlockSlot {
+            start: self.col_ptr[3 * high] + 3 * position,
+            stride,
+            kind,
+        }
+    }
+
+    /// Adds the block `m` at `slot` (and, by symmetry, its transpose at
+    /// the mirrored block) into `values`. For a diagonal block only the
+    /// upper triangle of `m` is read.
+    #[inline]
+    pub fn add_at(values: &mut [f64], slot: &BlockSlot, m: &DMat3) {
+        let starts = [
+            slot.start,
+            slot.start + slot.stride,
+            slot.start + 2 * slot.stride + 1,
+        ];
+        let m = m.to_cols_array_2d();
+        match slot.kind {
+            SlotKind::Diagonal => {
+                for c in 0..3 {
+                    for r in 0..=c {
+                        values[starts[c] + r] += m[c][r];
+                    }
+                }
+            }
+            SlotKind::Upper => {
+                for c in 0..3 {
+                    let column = &mut values[starts[c]..starts[c] + 3];
+                    for r in 0..3 {
+                        column[r] += m[c][r];
+                    }
+                }
+            }
+            SlotKind::Transposed => {
+                for c in 0..3 {
+                    let column = &mut values[starts[c]..starts[c] + 3];
+                    for r in 0..3 {
+                        column[r] += m[r][c];
+                    }
+                }
+            }
         }
     }
 
@@ -73,34 +216,7 @@ impl BlockPattern {
     /// Adds the block `m` at block row `a`, block column `b` (and, by
     /// symmetry, its transpose at `(b, a)`) into `values`.
     pub fn add_block(&self, values: &mut [f64], a: u32, b: u32, m: &DMat3) {
-        use std::cmp::Ordering;
-        match a.cmp(&b) {
-            Ordering::Equal => {
-                let b = b as usize;
-                let diag_offset = 3 * self.upper_neighbours[b].len();
-                for c in 0..3 {
-                    let start = self.col_ptr[3 * b + c] + diag_offset;
-                    for r in 0..=c {
-                        values[start + r] += m.col(c)[r];
-                    }
-                }
-            }
-            Ordering::Less => self.add_off_diagonal(values, a, b, m, false),
-            Ordering::Greater => self.add_off_diagonal(values, b, a, m, true),
-        }
-    }
-
-    fn add_off_diagonal(&self, values: &mut [f64], a: u32, b: u32, m: &DMat3, transpose: bool) {
-        let b = b as usize;
-        let slot = self.upper_neighbours[b]
-            .binary_search(&a)
-            .unwrap_or_else(|_| panic!("particles {a} and {b} are not coupled in the pattern"));
-        for c in 0..3 {
-            let start = self.col_ptr[3 * b + c] + 3 * slot;
-            for r in 0..3 {
-                values[start + r] += if transpose { m.col(r)[c] } else { m.col(c)[r] };
-            }
-        }
+        Self::add_at(values, &self.slot(a, b), m);
     }
 
     /// Adds `value` to every diagonal entry.
@@ -168,5 +284,31 @@ mod tests {
                 y[r]
             );
         }
+    }
+
+    #[test]
+    fn stencil_slots_add_where_add_block_does() {
+        // Two triangles sharing the edge (1, 3), numbered so that the
+        // stencil's local order differs from the particle order.
+        let stencil = [3, 1, 0, 2];
+        let pairs = [(3, 1), (1, 0), (0, 3), (3, 2), (2, 1), (0, 2)];
+        let pattern = BlockPattern::new(4, pairs).with_stencils([stencil]);
+        let slots = pattern.stencil(0, stencil);
+        let mut by_slot = vec![0.0; pattern.nonzeros()];
+        let mut by_block = vec![0.0; pattern.nonzeros()];
+        for p in 0..4 {
+            for q in p..4 {
+                let m = DMat3::from_cols_array(&std::array::from_fn(|k| {
+                    (10 * p + q) as f64 + 0.1 * k as f64
+                }));
+                let m = if p == q { m + m.transpose() } else { m };
+                BlockPattern::add_at(&mut by_slot, slots.slot(p, q), &m);
+                pattern.add_block(&mut by_block, stencil[p], stencil[q], &m);
+            }
+        }
+        assert_eq!(by_slot, by_block);
+        // A stencil that is not the registered one is looked up.
+        let other = pattern.stencil(0, [2, 0, u32::MAX, u32::MAX]);
+        assert_eq!(*other.slot(0, 1), pattern.slot(2, 0));
     }
 }

@@ -128,7 +128,7 @@ impl std::fmt::Debug for NewtonSolver {
 impl NewtonSolver {
     /// Analyses the sparsity of `elastic` over `particles` particles.
     pub fn new(particles: usize, elastic: &Elastic) -> Result<NewtonSolver, SolverError> {
-        let pattern = BlockPattern::new(particles, elastic.coupled_pairs());
+        let pattern = elastic.pattern(particles);
         let n = pattern.dimension();
         let structure =
             SymbolicSparseColMatRef::new_checked(n, n, pattern.col_ptr(), None, pattern.row_idx());
