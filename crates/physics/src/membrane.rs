@@ -147,15 +147,16 @@ impl EdgeSmoothedMembrane {
             // The rest triangles unfolded flat about the edge: the left one
             // (i, j, k) above it, the right one (i, l, j) below. Each is
             // (side slots of its edges, corners).
-            let mut triangles = vec![([0, 1, 2], [pi, pj, apex(base, length[2], length[1], 1.0)])];
-            if d.count == 5 {
-                triangles.push(([3, 4, 0], [pi, apex(base, length[3], length[4], -1.0), pj]));
-            }
-            let total: f64 = triangles.iter().map(|(_, p)| area(*p)).sum();
+            let left = ([0, 1, 2], [pi, pj, apex(base, length[2], length[1], 1.0)]);
+            let right = (d.count == 5)
+                .then(|| ([3, 4, 0], [pi, apex(base, length[3], length[4], -1.0), pj]));
+            let triangles = [Some(left), right];
+            let triangles = triangles.iter().flatten();
+            let total: f64 = triangles.clone().map(|(_, p)| area(*p)).sum();
             // The mean strain as (E_xx, E_xy, E_yy) per unit strain of each
             // edge slot.
             let mut per_slot = [[0.0; 3]; 5];
-            for (slots, corners) in &triangles {
+            for (slots, corners) in triangles {
                 let Some(coefficients) = strain_coefficients(*corners) else {
                     continue;
                 };
