@@ -10,6 +10,13 @@
 //!
 //! `stroke` paints the petals' late key after a full run and digests the
 //! rerun from the first keyframe it changes (as the stroke benchmarks do).
+//!
+//! To measure how far a change that alters keyframes moves the shapes:
+//! `DIGEST_DUMP=FILE` writes the positions of keyframes 50 and 100 of the
+//! full run (`DIGEST_TOLERANCE=1e-7` runs with a tighter solver tolerance,
+//! for scale); `digest compare FILE FILE` prints the largest particle
+//! displacement between two dumps, relative to each organ's size (the
+//! diagonal of its bounding box).
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::time::Instant;
 
@@ -19,14 +26,23 @@ use anthesis_sim::{Keyframe, Selection, Simulation};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args.get(1).is_some_and(|a| a == "compare") {
+        compare(&args[2], &args[3]);
+        return;
+    }
     let whole = args.get(1).is_none_or(|a| a == "whole");
     let scale: f64 = args
         .get(2)
         .map_or(0.6, |a| a.parse().expect("an edge scale"));
     let stroke = args.get(3).is_some_and(|a| a == "stroke");
-    let project = flower_at_resolution("lily", scale)
+    let mut project = flower_at_resolution("lily", scale)
         .expect("the lily has a builder")
         .expect("the lily builds");
+    if let Ok(tolerance) = std::env::var("DIGEST_TOLERANCE") {
+        project.settings.solver.relative_tolerance = tolerance.parse().expect("a tolerance");
+    }
+    let dump = std::env::var("DIGEST_DUMP").ok();
+    let mut dumped = Vec::new();
     let selection = if whole {
         Selection::All
     } else {
@@ -56,6 +72,9 @@ fn main() {
         if !stroke {
             digest(&k);
         }
+        if k.index == 50 || k.index == 100 {
+            dumped.push(k.positions_in_world.clone());
+        }
     }
     if stroke {
         let template = project.flower.organs[0].template;
@@ -77,4 +96,74 @@ fn main() {
         sim.factorisations(),
         started.elapsed().as_secs_f64()
     );
+    if let Some(path) = dump {
+        let text: String = dumped
+            .iter()
+            .map(|keyframe| {
+                keyframe
+                    .iter()
+                    .map(|organ| {
+                        organ
+                            .iter()
+                            .map(|p| format!("{:e} {:e} {:e}", p.x, p.y, p.z))
+                            .collect::<Vec<_>>()
+                            .join(",")
+                    })
+                    .collect::<Vec<_>>()
+                    .join(";")
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        std::fs::write(path, text).expect("a writable dump");
+    }
+}
+
+/// The largest particle displacement between two dumps, per keyframe,
+/// relative to the organ's bounding-box diagonal.
+fn compare(a: &str, b: &str) {
+    let read = |path: &str| -> Vec<Vec<Vec<[f64; 3]>>> {
+        std::fs::read_to_string(path)
+            .expect("a dump")
+            .lines()
+            .map(|keyframe| {
+                keyframe
+                    .split(';')
+                    .map(|organ| {
+                        organ
+                            .split(',')
+                            .map(|p| {
+                                let v: Vec<f64> =
+                                    p.split(' ').map(|c| c.parse().expect("a number")).collect();
+                                [v[0], v[1], v[2]]
+                            })
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    let (a, b) = (read(a), read(b));
+    for (keyframe, (ka, kb)) in [50, 100].iter().zip(a.iter().zip(&b)) {
+        let worst = ka
+            .iter()
+            .zip(kb)
+            .map(|(oa, ob)| {
+                let (mut low, mut high) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for p in oa {
+                    for c in 0..3 {
+                        low[c] = low[c].min(p[c]);
+                        high[c] = high[c].max(p[c]);
+                    }
+                }
+                let size = (0..3).map(|c| (high[c] - low[c]).powi(2)).sum::<f64>().sqrt();
+                let moved = oa
+                    .iter()
+                    .zip(ob)
+                    .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).powi(2)).sum::<f64>().sqrt())
+                    .fold(0.0, f64::max);
+                moved / size
+            })
+            .fold(0.0, f64::max);
+        println!("keyframe {keyframe}: largest displacement {worst:.3e} of the organ's size");
+    }
 }
