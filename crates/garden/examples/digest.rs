@@ -155,7 +155,10 @@ fn compare(a: &str, b: &str) {
                         high[c] = high[c].max(p[c]);
                     }
                 }
-                let size = (0..3).map(|c| (high[c] - low[c]).powi(2)).sum::<f64>().sqrt();
+                let size = (0..3)
+                    .map(|c| (high[c] - low[c]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
                 let moved = oa
                     .iter()
                     .zip(ob)

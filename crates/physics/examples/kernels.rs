@@ -1,0 +1,85 @@
+//! Times one organ's kernels (energy, energy and gradient, Hessian
+//! assembly, membrane update) on a test petal with the edge-smoothed
+//! membrane, the fastest of several batches (robust on a shared machine).
+//!
+//! ```text
+//! cargo run --release -p anthesis-physics --example kernels -- [COLUMNS ROWS]
+//! ```
+
+use std::time::Instant;
+
+use anthesis_mesh::Topology;
+use anthesis_mesh::generate::test_petal;
+use anthesis_physics::Elastic;
+use anthesis_physics::membrane::EdgeSmoothedMembrane;
+use glam::DVec3;
+
+fn fastest(label: &str, mut work: impl FnMut()) {
+    let (batches, calls) = (9, 20);
+    let best = (0..batches)
+        .map(|_| {
+            let start = Instant::now();
+            for _ in 0..calls {
+                work();
+            }
+            start.elapsed().as_secs_f64() / calls as f64
+        })
+        .fold(f64::INFINITY, f64::min);
+    println!("{label:<20} {:8.1} µs", best * 1e6);
+}
+
+fn main() {
+    let args: Vec<usize> = std::env::args()
+        .skip(1)
+        .map(|a| a.parse().expect("a count"))
+        .collect();
+    let (columns, rows) = (
+        args.first().copied().unwrap_or(22),
+        args.get(1).copied().unwrap_or(46),
+    );
+    let mesh = test_petal(30.0, 12.0, columns, rows);
+    let topology = Topology::build(&mesh).expect("a manifold petal");
+    let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
+    let mut seed = 12345u64;
+    let mut random = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    let edge = 30.0 / rows as f64;
+    let x: Vec<DVec3> = mesh
+        .positions
+        .iter()
+        .map(|p| *p + DVec3::new(random(), random(), random()) * (0.1 * edge))
+        .collect();
+    for l in &mut elastic.rest_lengths {
+        *l *= 0.95;
+    }
+    let modulus: Vec<f64> = elastic
+        .rest_lengths
+        .iter()
+        .map(|_| 1.0 + random())
+        .collect();
+    let mut membrane = EdgeSmoothedMembrane::new(&mesh.triangles, &topology);
+    membrane.update(&elastic.rest_lengths, &modulus);
+    elastic.membrane = Some(membrane.clone());
+    let pattern = elastic.pattern(x.len());
+    println!("{} particles, {} edges", x.len(), elastic.edges.len());
+    let mut g = vec![DVec3::ZERO; x.len()];
+    let mut values = vec![0.0; pattern.nonzeros()];
+    fastest("energy", || {
+        std::hint::black_box(elastic.energy(&x, &[]));
+    });
+    fastest("energy_and_gradient", || {
+        std::hint::black_box(elastic.energy_and_gradient(&x, &[], &mut g));
+    });
+    fastest("hessian", || {
+        elastic.hessian(&x, &[], &pattern, &mut values);
+        std::hint::black_box(&values);
+    });
+    fastest("membrane update", || {
+        membrane.update(&elastic.rest_lengths, &modulus);
+        std::hint::black_box(&membrane);
+    });
+}
