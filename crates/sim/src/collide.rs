@@ -45,6 +45,10 @@ pub struct Tracker {
     /// `cell_start[c]..cell_start[c + 1]` indexes `items` for cell `c`.
     cell_start: Vec<u32>,
     items: Vec<u32>,
+    /// Whether a cell or one of its 26 neighbours holds a particle: most
+    /// particles of a neighbouring organ are nowhere near this one, and
+    /// their queries end with one look-up.
+    near: Vec<bool>,
 }
 
 /// Grids with more cells than this use coarser cells (same answers, more
@@ -80,6 +84,7 @@ impl Tracker {
             dims,
             cell_start: Vec::new(),
             items: Vec::new(),
+            near: Vec::new(),
         };
         // Counting sort of particles by cell.
         let cells = (dims[0] * dims[1] * dims[2]) as usize;
@@ -100,8 +105,30 @@ impl Tracker {
             items[next[c] as usize] = i as u32;
             next[c] += 1;
         }
+        let mut near = vec![false; cells];
+        for c in 0..cells {
+            if counts[c + 1] == counts[c] {
+                continue;
+            }
+            let c = c as i64;
+            let (x, y, z) = (
+                c % dims[0],
+                (c / dims[0]) % dims[1],
+                c / (dims[0] * dims[1]),
+            );
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        if let Some(n) = tracker.flat([x + dx, y + dy, z + dz]) {
+                            near[n] = true;
+                        }
+                    }
+                }
+            }
+        }
         tracker.cell_start = counts;
         tracker.items = items;
+        tracker.near = near;
         tracker
     }
 
@@ -119,23 +146,34 @@ impl Tracker {
     /// the lower index).
     pub fn nearest(&self, x: DVec3, positions: &[DVec3]) -> Option<u32> {
         let [cx, cy, cz] = self.cell_of(x);
+        if let Some(c) = self.flat([cx, cy, cz])
+            && !self.near[c]
+        {
+            return None;
+        }
         let mut best: Option<(f64, u32)> = None;
+        // The three cells of a row along x are stored one after the other.
+        let (first, last) = ((cx - 1).max(0), (cx + 1).min(self.dims[0] - 1));
+        if first > last {
+            return None;
+        }
         for dz in -1..=1 {
             for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let Some(c) = self.flat([cx + dx, cy + dy, cz + dz]) else {
-                        continue;
+                let (Some(a), Some(b)) = (
+                    self.flat([first, cy + dy, cz + dz]),
+                    self.flat([last, cy + dy, cz + dz]),
+                ) else {
+                    continue;
+                };
+                let range = self.cell_start[a] as usize..self.cell_start[b + 1] as usize;
+                for &i in &self.items[range] {
+                    let d = (positions[i as usize] - x).length_squared();
+                    let better = match best {
+                        None => true,
+                        Some((bd, bi)) => d < bd || (d == bd && i < bi),
                     };
-                    let range = self.cell_start[c] as usize..self.cell_start[c + 1] as usize;
-                    for &i in &self.items[range] {
-                        let d = (positions[i as usize] - x).length_squared();
-                        let better = match best {
-                            None => true,
-                            Some((bd, bi)) => d < bd || (d == bd && i < bi),
-                        };
-                        if better {
-                            best = Some((d, i));
-                        }
+                    if better {
+                        best = Some((d, i));
                     }
                 }
             }
@@ -351,6 +389,57 @@ mod tests {
                     let d = (points[brute.expect("nonempty") as usize] - x).length();
                     assert!(d > 0.8, "missed a point at distance {d}");
                 }
+            }
+        }
+    }
+
+    /// The nearest particle by brute force: the lowest index among the
+    /// nearest, if within `radius`.
+    fn brute_nearest(points: &[DVec3], x: DVec3, radius: f64) -> Option<u32> {
+        let mut best: Option<(f64, u32)> = None;
+        for (i, p) in points.iter().enumerate() {
+            let d = (*p - x).length_squared();
+            if best.is_none_or(|(bd, _)| d < bd) {
+                best = Some((d, i as u32));
+            }
+        }
+        best.filter(|(d, _)| *d <= radius * radius).map(|(_, i)| i)
+    }
+
+    #[test]
+    fn nearest_matches_brute_force_on_a_lattice_with_ties_and_outside_the_grid() {
+        // Points on a lattice of the cell size (on cell borders, many at the
+        // same distance from a query) and jittered copies; queries on the
+        // lattice, between it and far outside it.
+        let mut points = Vec::new();
+        for i in 0..6 {
+            for j in 0..5 {
+                for k in 0..3 {
+                    let p = DVec3::new(i as f64, j as f64, k as f64) * 0.5;
+                    points.push(p);
+                    let t = (i * 31 + j * 7 + k) as f64;
+                    points.push(p + DVec3::new(t.sin(), t.cos(), (1.7 * t).sin()) * 0.2);
+                }
+            }
+        }
+        for radius in [0.5, 0.3, 1.1] {
+            let tracker = Tracker::new(&points, radius);
+            for q in 0..2000 {
+                let t = q as f64;
+                let x = match q % 3 {
+                    0 => DVec3::new((q % 13) as f64, (q % 11) as f64, (q % 7) as f64) * 0.25,
+                    1 => DVec3::new(
+                        1.3 + 2.0 * t.sin(),
+                        1.0 + 1.5 * (0.7 * t).cos(),
+                        0.5 + (0.3 * t).sin(),
+                    ),
+                    _ => DVec3::new(4.0 * t.sin(), 4.0 * (1.3 * t).cos(), 3.0 * (0.9 * t).sin()),
+                };
+                assert_eq!(
+                    tracker.nearest(x, &points),
+                    brute_nearest(&points, x, radius),
+                    "query {x} radius {radius}"
+                );
             }
         }
     }

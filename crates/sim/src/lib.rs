@@ -516,16 +516,19 @@ impl Simulation {
         // Contacts are found right after growth and held while the organs
         // relax: rebuilt every iteration from organs that all move at once,
         // they made neighbours bounce off each other instead of settling.
-        let mut contacts = self.contacts(Violated::MoveHalf);
+        let mut geometry = unknown_geometry(self.organs.len());
+        let mut contacts = self.contacts(Violated::MoveHalf, &mut geometry);
         // Growth and the joint schedule may have carried particles onto the
         // wrong side. Newton's method started there sees deep, stiff
         // penalties and its first steps crumpled organs (a tip folded until
         // a triangle collapsed); put them on their side first, each pair of
         // particles meeting in the middle, and let the organs relax around
         // the dents.
-        for (organ, c) in self.organs.iter_mut().zip(&contacts) {
+        for ((organ, c), known) in self.organs.iter_mut().zip(&contacts).zip(&mut geometry) {
             let mut moved = vec![false; organ.positions.len()];
-            push_back(&mut organ.positions, c, &mut moved);
+            if push_back(&mut organ.positions, c, &mut moved) > 0 {
+                *known = None;
+            }
         }
         let mut round = 1;
         let mut pressed = Vec::new();
@@ -609,6 +612,8 @@ impl Simulation {
             for organ in &mut self.organs {
                 organ.attach(step);
             }
+            // Every organ moved.
+            geometry = unknown_geometry(self.organs.len());
             if self.overlaps.is_empty() && self.obstacles.is_empty() {
                 break 0;
             }
@@ -619,7 +624,7 @@ impl Simulation {
             // there, particles jumped and left spikes; instead, while some
             // particle lies deep on the wrong side, the organs settle again
             // against contacts found where they are now.
-            let fresh = self.contacts(Violated::MoveHalf);
+            let fresh = self.contacts(Violated::MoveHalf, &mut geometry);
             let deepest = self
                 .organs
                 .iter()
@@ -636,7 +641,7 @@ impl Simulation {
             }
             if deepest <= RESETTLE_DEPTH || round == MAX_CONTACT_ROUNDS {
                 // The paper's push-back: nobody ends on the wrong side.
-                break self.push_back();
+                break self.push_back(&mut geometry);
             }
             contacts = fresh;
             round += 1;
@@ -674,7 +679,11 @@ impl Simulation {
                 relative_gradient: gradient,
                 seconds: started.elapsed().as_secs_f64(),
                 pushed_particles: pushed as u32,
-                contact_particles: self.particles_in_contact(&pressed, unmoved_contacts),
+                contact_particles: self.particles_in_contact(
+                    &pressed,
+                    unmoved_contacts,
+                    &mut geometry,
+                ),
             },
         })
     }
@@ -706,10 +715,11 @@ impl Simulation {
         &self,
         pressed: &[Vec<bool>],
         contacts: Option<Vec<Vec<Contact>>>,
+        geometry: &mut [Option<Geometry>],
     ) -> u32 {
         let offset = self.settings.collision_offset;
         contacts
-            .unwrap_or_else(|| self.contacts(Violated::MoveAll))
+            .unwrap_or_else(|| self.contacts(Violated::MoveAll, geometry))
             .iter()
             .zip(&self.organs)
             .enumerate()
@@ -728,28 +738,27 @@ impl Simulation {
     }
 
     /// Contacts of every organ against the organs it overlaps, from the
-    /// current positions.
-    fn contacts(&self, violated: Violated) -> Vec<Vec<Contact>> {
+    /// current positions (`geometry`: what is known of them, completed
+    /// here).
+    fn contacts(&self, violated: Violated, geometry: &mut [Option<Geometry>]) -> Vec<Vec<Contact>> {
         let mut contacts = vec![Vec::new(); self.organs.len()];
-        self.obstacle_contacts(&mut contacts);
+        self.obstacle_contacts(&mut contacts, &vec![true; self.organs.len()]);
         if self.overlaps.is_empty() {
             self.drop_base_contacts(&mut contacts);
             return contacts;
         }
-        let normals: Vec<Vec<DVec3>> = self
-            .organs
-            .par_iter()
-            .map(|o| anthesis_mesh::vertex_normals(&o.positions, &o.mesh.triangles))
-            .collect();
+        geometry
+            .par_iter_mut()
+            .zip(&self.organs)
+            .for_each(|(known, organ)| {
+                known.get_or_insert_with(|| Geometry::of(organ));
+            });
+        let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
         let surfaces: Vec<Surface> = self
             .organs
             .iter()
-            .zip(&normals)
-            .map(|(o, n)| o.surface(n))
-            .collect();
-        let trackers: Vec<Tracker> = surfaces
-            .par_iter()
-            .map(|s| Tracker::new(s.positions, 2.0 * s.mean_edge))
+            .zip(&geometry)
+            .map(|(o, g)| o.surface(&g.normals))
             .collect();
         let offset = self.settings.collision_offset;
         // Inner particles stay on the outer organ's inner side, outer
@@ -776,7 +785,7 @@ impl Simulation {
                 contacts_against(
                     &surfaces[moving],
                     &surfaces[other],
-                    &trackers[other],
+                    &geometry[other].tracker,
                     side,
                     offset,
                     violated,
@@ -800,9 +809,9 @@ impl Simulation {
         }
     }
 
-    /// Contacts keeping every organ's particles outside the parts, each to
-    /// be put all the way out (a part does not move aside).
-    fn obstacle_contacts(&self, contacts: &mut [Vec<Contact>]) {
+    /// Contacts keeping the particles of every organ `wanted` outside the
+    /// parts, each to be put all the way out (a part does not move aside).
+    fn obstacle_contacts(&self, contacts: &mut [Vec<Contact>], wanted: &[bool]) {
         let offset = self.settings.collision_offset;
         let obstacles = &self.obstacles;
         if obstacles.is_empty() {
@@ -811,8 +820,9 @@ impl Simulation {
         self.organs
             .par_iter()
             .zip(contacts)
-            .for_each(|(organ, list)| {
-                if organ.is_kinematic() {
+            .zip(wanted)
+            .for_each(|((organ, list), &wanted)| {
+                if organ.is_kinematic() || !wanted {
                     return;
                 }
                 for obstacle in obstacles {
@@ -839,36 +849,72 @@ impl Simulation {
     /// pushed one overlap side at a time, each against where the other is
     /// now (pushed both at once, two particles on the wrong side of each
     /// other would swap places and stay wrong). Returns how many particles
-    /// moved.
-    fn push_back(&mut self) -> usize {
+    /// moved. `geometry` is what is known of the organs where they are, and
+    /// is kept up to date.
+    fn push_back(&mut self, geometry: &mut [Option<Geometry>]) -> usize {
         let mut moved: Vec<Vec<bool>> = self
             .organs
             .iter()
             .map(|o| vec![false; o.positions.len()])
             .collect();
+        // How often each organ has been pushed. A search that pushed
+        // nothing finds the same again until one of its organs is pushed,
+        // so it is not made again before (against the parts: per organ; of
+        // an overlap side: per side).
+        let mut pushes = vec![0u32; self.organs.len()];
+        let mut parts_clear: Vec<Option<u32>> = vec![None; self.organs.len()];
+        let mut side_clear: Vec<Option<(u32, u32)>> = vec![None; 2 * self.overlaps.len()];
         // A pushed particle turns its neighbours' normals a little, which
         // can leave a particle of the other organ just short of its side:
         // pass again while that happens.
         for _ in 0..PUSH_BACK_PASSES {
             let mut pushed_in_pass = 0;
             let mut outside = vec![Vec::new(); self.organs.len()];
-            self.obstacle_contacts(&mut outside);
+            let wanted: Vec<bool> = parts_clear
+                .iter()
+                .zip(&pushes)
+                .map(|(clear, &n)| *clear != Some(n))
+                .collect();
+            self.obstacle_contacts(&mut outside, &wanted);
             self.drop_base_contacts(&mut outside);
-            for ((organ, list), moved) in self.organs.iter_mut().zip(&outside).zip(&mut moved) {
-                pushed_in_pass += push_back(&mut organ.positions, list, moved);
+            for (i, (organ, list)) in self.organs.iter_mut().zip(&outside).enumerate() {
+                if !wanted[i] {
+                    continue;
+                }
+                let pushed = push_back(&mut organ.positions, list, &mut moved[i]);
+                if pushed > 0 {
+                    pushes[i] += 1;
+                    geometry[i] = None;
+                } else {
+                    parts_clear[i] = Some(pushes[i]);
+                }
+                pushed_in_pass += pushed;
             }
             for index in 0..self.overlaps.len() {
                 let (inner, outer) = self.overlaps[index];
-                for (moving, other, side) in [(inner, outer, 1.0), (outer, inner, -1.0)] {
-                    if self.organs[moving].is_kinematic() {
+                let sides = [(inner, outer, 1.0), (outer, inner, -1.0)];
+                for (key, (moving, other, side)) in sides.into_iter().enumerate() {
+                    let key = 2 * index + key;
+                    if self.organs[moving].is_kinematic()
+                        || side_clear[key] == Some((pushes[moving], pushes[other]))
+                    {
                         continue;
                     }
-                    let contacts = self.contacts_between(moving, other, side);
-                    pushed_in_pass += push_back(
+                    let known =
+                        geometry[other].get_or_insert_with(|| Geometry::of(&self.organs[other]));
+                    let contacts = self.contacts_between(moving, other, side, known);
+                    let pushed = push_back(
                         &mut self.organs[moving].positions,
                         &contacts,
                         &mut moved[moving],
                     );
+                    if pushed > 0 {
+                        pushes[moving] += 1;
+                        geometry[moving] = None;
+                    } else {
+                        side_clear[key] = Some((pushes[moving], pushes[other]));
+                    }
+                    pushed_in_pass += pushed;
                 }
             }
             if pushed_in_pass == 0 {
@@ -878,20 +924,25 @@ impl Simulation {
         moved.iter().flatten().filter(|&&m| m).count()
     }
 
-    /// Contacts of organ `moving` against organ `other` from the current
-    /// positions, each moving particle to be put all the way on its side
-    /// (`side` as in [`contacts_against`]).
-    fn contacts_between(&self, moving: usize, other: usize, side: f64) -> Vec<Contact> {
+    /// Contacts of organ `moving` against organ `other` (`known`: its
+    /// normals and tracker where it is) from the current positions, each
+    /// moving particle to be put all the way on its side (`side` as in
+    /// [`contacts_against`]).
+    fn contacts_between(
+        &self,
+        moving: usize,
+        other: usize,
+        side: f64,
+        known: &Geometry,
+    ) -> Vec<Contact> {
         let (m, o) = (&self.organs[moving], &self.organs[other]);
-        let normals = anthesis_mesh::vertex_normals(&o.positions, &o.mesh.triangles);
-        let other_surface = o.surface(&normals);
+        let other_surface = o.surface(&known.normals);
         let moving_surface = m.surface(&[]);
-        let tracker = Tracker::new(&o.positions, 2.0 * o.mean_edge);
         let mut contacts = Vec::new();
         contacts_against(
             &moving_surface,
             &other_surface,
-            &tracker,
+            &known.tracker,
             side,
             self.settings.collision_offset,
             Violated::MoveAll,
@@ -911,6 +962,28 @@ impl Simulation {
         }
         worst
     }
+}
+
+/// One organ's unit normals and nearest-particle lookup where it is:
+/// every collision search needs them, and an organ that has not moved
+/// since keeps them.
+struct Geometry {
+    normals: Vec<DVec3>,
+    tracker: Tracker,
+}
+
+impl Geometry {
+    fn of(organ: &OrganSim) -> Geometry {
+        Geometry {
+            normals: anthesis_mesh::vertex_normals(&organ.positions, &organ.mesh.triangles),
+            tracker: Tracker::new(&organ.positions, 2.0 * organ.mean_edge),
+        }
+    }
+}
+
+/// Nothing known yet of `organs` organs' geometry.
+fn unknown_geometry(organs: usize) -> Vec<Option<Geometry>> {
+    (0..organs).map(|_| None).collect()
 }
 
 /// Runs a whole project to the end, calling `on_keyframe` for the bud and
