@@ -82,6 +82,7 @@ fn main() {
         let mut painted = project.clone();
         stroke_near_tip(&mut painted, template, late);
         iterations = 0;
+        let rerun = Instant::now();
         let first = sim.edit(&project, &painted).expect("an edit");
         println!("rerun from keyframe {first}");
         while !sim.finished() {
@@ -89,6 +90,7 @@ fn main() {
             iterations += k.stats.iterations;
             digest(&k);
         }
+        println!("rerun {:.3} s", rerun.elapsed().as_secs_f64());
     }
     println!(
         "digest {:016x}  iterations {iterations}  factorisations {}  {:.2} s",
