@@ -31,6 +31,7 @@ use rayon::prelude::*;
 
 use crate::collide::{
     Surface, Tracker, Violated, contacts_against, contacts_of, max_violation, push_back,
+    start_on_contacts,
 };
 use crate::obstacle::ObstacleSim;
 use crate::organ::{OrganSim, OrganState, Settle, Settled};
@@ -222,6 +223,16 @@ const MAX_CONTACT_ROUNDS: u32 = 4;
 /// then moves particles by about this at most (unless the rounds ran out),
 /// too little to show as a dent.
 const RESETTLE_DEPTH: f64 = 0.01;
+
+/// A keyframe's contact search finds particles that rest on a neighbour a
+/// hair off their contact's side or past it (the penalty's give, about
+/// 1e-7 mean edges, and the start's extrapolation, 1e-6 on the lily):
+/// those less than this short of it (in mean edges of their organ) start
+/// the keyframe [`START_INSIDE`] past it (see `start_on_contacts`).
+const START_REACH: f64 = 1e-4;
+/// How far past its contact a particle on it starts a keyframe, in mean
+/// edges of its organ: enough that rounding cannot leave it outside.
+const START_INSIDE: f64 = 1e-6;
 
 /// Passes of the final push-back at most.
 const PUSH_BACK_PASSES: u32 = 3;
@@ -516,20 +527,26 @@ impl Simulation {
         // Contacts are found right after growth and held while the organs
         // relax: rebuilt every iteration from organs that all move at once,
         // they made neighbours bounce off each other instead of settling.
-        let mut geometry = unknown_geometry(self.organs.len());
-        let mut contacts = self.contacts(Violated::MoveHalf, &mut geometry);
+        let mut contacts =
+            self.contacts(Violated::MoveHalf, &mut unknown_geometry(self.organs.len()));
         // Growth and the joint schedule may have carried particles onto the
         // wrong side. Newton's method started there sees deep, stiff
         // penalties and its first steps crumpled organs (a tip folded until
         // a triangle collapsed); put them on their side first, each pair of
         // particles meeting in the middle, and let the organs relax around
-        // the dents.
-        for ((organ, c), known) in self.organs.iter_mut().zip(&contacts).zip(&mut geometry) {
-            let mut moved = vec![false; organ.positions.len()];
-            if push_back(&mut organ.positions, c, &mut moved) > 0 {
-                *known = None;
-            }
+        // the dents. They, and the particles resting on a neighbour, start
+        // a hair inside their contact, so Newton's first step holds it (see
+        // `start_on_contacts`).
+        for (organ, c) in self.organs.iter_mut().zip(&contacts) {
+            let edge = organ.mean_edge;
+            start_on_contacts(
+                &mut organ.positions,
+                c,
+                START_REACH * edge,
+                START_INSIDE * edge,
+            );
         }
+        let mut geometry;
         let mut round = 1;
         let mut pressed = Vec::new();
         let mut unmoved_contacts = None;
