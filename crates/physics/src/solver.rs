@@ -239,9 +239,15 @@ impl NewtonSolver {
     /// but its stale directions made Newton converge linearly: measured on
     /// the default lily (`anthesis simulate`, 100 keyframes), one petal took
     /// 267 iterations and 116 factorisations with it and 115 and 103
-    /// without; the whole flower 446 and 1098 against 255 and 929. With
-    /// nothing kept, a keyframe's work depends only on the organ's state at
-    /// its start, so a run can resume from any keyframe bit for bit.
+    /// without; the whole flower 446 and 1098 against 255 and 929. As the
+    /// preconditioner of conjugate gradients on the current Hessian it did
+    /// not pay either: a factor one keyframe old already needs about seven
+    /// iterations (each a triangular solve and a mat-vec, a sixth of a
+    /// factorisation at 4k particles) to reach the tolerance (4k petal:
+    /// 67 factorisations and 606 iterations, 5.8 s CPU, against 105
+    /// factorisations, 4.9 s). With nothing kept, a keyframe's work depends
+    /// only on the organ's state at its start, so a run can resume from any
+    /// keyframe bit for bit.
     pub fn begin_keyframe(&mut self) {
         self.previous_gradient = None;
         self.factor_valid = false;
