@@ -549,7 +549,9 @@ impl Simulation {
         let mut geometry;
         let mut round = 1;
         let mut pressed = Vec::new();
-        let mut unmoved_contacts = None;
+        // The contacts where the organs end the keyframe, when a search
+        // already found them (for the statistics).
+        let mut contacts_now = None;
         let pushed = loop {
             // Within a round the contacts are fixed, so each organ settles
             // on its own: its iterations read nothing of the others. Each
@@ -653,12 +655,14 @@ impl Simulation {
                 // look for (moving a violated contact half way is the only
                 // difference to `Violated::MoveAll`), and nothing moves
                 // before they are counted.
-                unmoved_contacts = Some(fresh);
+                contacts_now = Some(fresh);
                 break 0;
             }
             if deepest <= RESETTLE_DEPTH || round == MAX_CONTACT_ROUNDS {
                 // The paper's push-back: nobody ends on the wrong side.
-                break self.push_back(&mut geometry);
+                let (pushed, found) = self.push_back(&mut geometry);
+                contacts_now = found;
+                break pushed;
             }
             contacts = fresh;
             round += 1;
@@ -696,11 +700,7 @@ impl Simulation {
                 relative_gradient: gradient,
                 seconds: started.elapsed().as_secs_f64(),
                 pushed_particles: pushed as u32,
-                contact_particles: self.particles_in_contact(
-                    &pressed,
-                    unmoved_contacts,
-                    &mut geometry,
-                ),
+                contact_particles: self.particles_in_contact(&pressed, contacts_now, &mut geometry),
             },
         })
     }
@@ -866,9 +866,14 @@ impl Simulation {
     /// pushed one overlap side at a time, each against where the other is
     /// now (pushed both at once, two particles on the wrong side of each
     /// other would swap places and stay wrong). Returns how many particles
-    /// moved. `geometry` is what is known of the organs where they are, and
+    /// moved, and, unless the passes ran out, every organ's contacts where
+    /// it now is (as `Violated::MoveAll` finds them: its last searches are
+    /// those). `geometry` is what is known of the organs where they are, and
     /// is kept up to date.
-    fn push_back(&mut self, geometry: &mut [Option<Geometry>]) -> usize {
+    fn push_back(
+        &mut self,
+        geometry: &mut [Option<Geometry>],
+    ) -> (usize, Option<Vec<Vec<Contact>>>) {
         let mut moved: Vec<Vec<bool>> = self
             .organs
             .iter()
@@ -881,6 +886,10 @@ impl Simulation {
         let mut pushes = vec![0u32; self.organs.len()];
         let mut parts_clear: Vec<Option<u32>> = vec![None; self.organs.len()];
         let mut side_clear: Vec<Option<(u32, u32)>> = vec![None; 2 * self.overlaps.len()];
+        // The last search against the parts, per organ, and per side.
+        let mut parts_found = vec![Vec::new(); self.organs.len()];
+        let mut side_found = vec![Vec::new(); 2 * self.overlaps.len()];
+        let mut settled = false;
         // A pushed particle turns its neighbours' normals a little, which
         // can leave a particle of the other organ just short of its side:
         // pass again while that happens.
@@ -894,17 +903,18 @@ impl Simulation {
                 .collect();
             self.obstacle_contacts(&mut outside, &wanted);
             self.drop_base_contacts(&mut outside);
-            for (i, (organ, list)) in self.organs.iter_mut().zip(&outside).enumerate() {
+            for (i, (organ, list)) in self.organs.iter_mut().zip(outside).enumerate() {
                 if !wanted[i] {
                     continue;
                 }
-                let pushed = push_back(&mut organ.positions, list, &mut moved[i]);
+                let pushed = push_back(&mut organ.positions, &list, &mut moved[i]);
                 if pushed > 0 {
                     pushes[i] += 1;
                     geometry[i] = None;
                 } else {
                     parts_clear[i] = Some(pushes[i]);
                 }
+                parts_found[i] = list;
                 pushed_in_pass += pushed;
             }
             for index in 0..self.overlaps.len() {
@@ -931,14 +941,27 @@ impl Simulation {
                     } else {
                         side_clear[key] = Some((pushes[moving], pushes[other]));
                     }
+                    side_found[key] = contacts;
                     pushed_in_pass += pushed;
                 }
             }
             if pushed_in_pass == 0 {
+                settled = true;
                 break;
             }
         }
-        moved.iter().flatten().filter(|&&m| m).count()
+        let pushed = moved.iter().flatten().filter(|&&m| m).count();
+        // Every search of the last pass, or the earlier one it skipped,
+        // was made where the organs are now, and found nothing to push.
+        let found = settled.then(|| {
+            let mut contacts = parts_found;
+            for (index, &(inner, outer)) in self.overlaps.iter().enumerate() {
+                contacts[inner].extend_from_slice(&side_found[2 * index]);
+                contacts[outer].extend_from_slice(&side_found[2 * index + 1]);
+            }
+            contacts
+        });
+        (pushed, found)
     }
 
     /// Contacts of organ `moving` against organ `other` (`known`: its
