@@ -62,6 +62,23 @@ pub fn flat_sheet(width: f64, height: f64, columns: usize, rows: usize) -> Mesh 
     })
 }
 
+/// `positions` each moved by a fixed pseudo-random offset of up to
+/// `amplitude / 2` per axis, the same for the same `seed`: an irregular but
+/// reproducible state for benchmarks and examples.
+pub fn jittered(positions: &[DVec3], amplitude: f64, seed: u64) -> Vec<DVec3> {
+    let mut state = seed;
+    let mut random = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    positions
+        .iter()
+        .map(|p| *p + DVec3::new(random(), random(), random()) * amplitude)
+        .collect()
+}
+
 /// A petal-like test surface in the organ's template frame: base at the
 /// origin, growing along +Y, cupped around -Z (the inner side faces -Z,
 /// towards a flower axis placed behind the organ), width tapering to the

@@ -17,7 +17,7 @@
 //! `cargo bench -p anthesis-physics --bench cholesky`
 
 use anthesis_mesh::Topology;
-use anthesis_mesh::generate::test_petal;
+use anthesis_mesh::generate::{jittered, test_petal};
 use anthesis_physics::Elastic;
 use anthesis_physics::pattern::BlockPattern;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -30,7 +30,6 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
-use glam::DVec3;
 use nalgebra_sparse::factorization::CscCholesky;
 use nalgebra_sparse::na::DVector;
 use nalgebra_sparse::{CooMatrix, CscMatrix};
@@ -50,19 +49,7 @@ impl Hessian {
         };
         let elastic = Elastic::at_rest(&mesh.positions, &topology);
         // A fixed pseudo-random perturbation of a tenth of an edge.
-        let mut seed = 12345u64;
-        let mut random = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let edge = 30.0 / rows as f64;
-        let moved: Vec<DVec3> = mesh
-            .positions
-            .iter()
-            .map(|p| *p + DVec3::new(random(), random(), random()) * (0.1 * edge))
-            .collect();
+        let moved = jittered(&mesh.positions, 0.1 * 30.0 / rows as f64, 12345);
         let pattern = BlockPattern::new(moved.len(), elastic.coupled_pairs());
         let mut values = vec![0.0; pattern.nonzeros()];
         elastic.hessian(&moved, &[], &pattern, &mut values);

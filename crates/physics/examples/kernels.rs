@@ -9,7 +9,7 @@
 use std::time::Instant;
 
 use anthesis_mesh::Topology;
-use anthesis_mesh::generate::test_petal;
+use anthesis_mesh::generate::{jittered, test_petal};
 use anthesis_physics::Elastic;
 use anthesis_physics::membrane::EdgeSmoothedMembrane;
 use glam::DVec3;
@@ -40,26 +40,13 @@ fn main() {
     let mesh = test_petal(30.0, 12.0, columns, rows);
     let topology = Topology::build(&mesh).expect("a manifold petal");
     let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
-    let mut seed = 12345u64;
-    let mut random = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-    };
-    let edge = 30.0 / rows as f64;
-    let x: Vec<DVec3> = mesh
-        .positions
-        .iter()
-        .map(|p| *p + DVec3::new(random(), random(), random()) * (0.1 * edge))
-        .collect();
+    let x = jittered(&mesh.positions, 0.1 * 30.0 / rows as f64, 12345);
     for l in &mut elastic.rest_lengths {
         *l *= 0.95;
     }
-    let modulus: Vec<f64> = elastic
-        .rest_lengths
-        .iter()
-        .map(|_| 1.0 + random())
+    // Moduli spread between 0.5 and 1.5 without a pattern.
+    let modulus: Vec<f64> = (0..elastic.rest_lengths.len())
+        .map(|e| 1.0 + 0.5 * (e as f64 * 0.618_034).fract().mul_add(2.0, -1.0))
         .collect();
     let mut membrane = EdgeSmoothedMembrane::new(&mesh.triangles, &topology);
     membrane.update(&elastic.rest_lengths, &modulus);
