@@ -11,6 +11,7 @@
 //! project files and export are the engine crates'.
 
 pub mod autosave;
+mod background;
 pub mod bud_sketch;
 pub mod command;
 pub mod document;

@@ -30,7 +30,6 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_bud::{
     Bud, PdeSweep, RemeshOptions, ScanCorners, ScanFit, ScanFitOptions, ScanOutline, Surface,
@@ -41,6 +40,7 @@ use anthesis_mesh::Mesh;
 use eframe::egui::{self, Color32, DragValue, RichText};
 use glam::{DVec2, DVec3};
 
+use super::background::Background;
 use super::command::{Command, ProjectEdit};
 use super::shape_panel::quality_text;
 
@@ -135,7 +135,7 @@ pub struct ScanReview {
     /// A fit to start (the corners or the inner side changed).
     fit_needed: bool,
     /// The fit being made on its own thread.
-    fitting: Option<Receiver<Result<ScanFit, String>>>,
+    fitting: Option<Background<ScanFit, String>>,
     /// The mesh of the fit at the edge.
     built: Option<(u64, Result<Bud, String>)>,
     /// The frame the view draws in (the last fit's).
@@ -200,28 +200,24 @@ impl ScanReview {
                 flip_inner_side: self.flip,
                 ..ScanFitOptions::default()
             };
-            let (mesh, corners, ctx) = (Arc::clone(&self.mesh), self.corners, ctx.clone());
-            let (send, receive) = sync_channel(1);
-            let spawned = std::thread::Builder::new()
-                .name("anthesis-scan-fit".into())
-                .spawn(move || {
-                    let fit = anthesis_bud::fit_scan(&mesh, Some(corners), &options)
-                        .map_err(|e| e.to_string());
-                    let _ = send.send(fit);
-                    ctx.request_repaint();
-                });
-            match spawned {
-                Ok(_) => self.fitting = Some(receive),
-                Err(e) => self.fit = Err(format!("cannot start the fit: {e}")),
-            }
+            let (mesh, corners) = (Arc::clone(&self.mesh), self.corners);
+            self.fitting = Some(Background::start(
+                "anthesis-scan-fit",
+                "the fit",
+                |message| message,
+                ctx,
+                move || {
+                    anthesis_bud::fit_scan(&mesh, Some(corners), &options)
+                        .map_err(|e| e.to_string())
+                },
+            ));
         }
-        if let Some(receive) = &self.fitting {
-            let answer = match receive.try_recv() {
-                Ok(fit) => fit,
-                Err(TryRecvError::Empty) => return,
-                Err(TryRecvError::Disconnected) => Err("the fit stopped".to_string()),
+        if let Some(fitting) = &mut self.fitting {
+            fitting.poll();
+            let Some(Background::Done(answer)) = self.fitting.take_if(|f| f.answer().is_some())
+            else {
+                return;
             };
-            self.fitting = None;
             if let Ok(fit) = &answer {
                 self.view = Some((fit.rotation, fit.origin));
                 // An edge for about 36 rows along the petal (the lily's

@@ -9,7 +9,6 @@
 //! Accepting is one [`ProjectEdit::Mesh`].
 
 use std::collections::BTreeMap;
-use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_bud::{BezierPatch, Bud, BudError, MeshQuality, RemeshOptions};
 use anthesis_flower::{Flower, TemplateSource};
@@ -17,14 +16,15 @@ use anthesis_mesh::Mesh;
 use eframe::egui::{self, Color32, DragValue, RichText};
 use glam::DVec3;
 
+use super::background::Background;
 use super::command::{Command, ProjectEdit};
 
 /// What the remesher said about one template at one edge.
-#[derive(Debug)]
-enum Preview {
-    /// Still remeshing.
-    Waiting(Receiver<Result<Bud, BudError>>),
-    Done(Result<Bud, BudError>),
+type Preview = Background<Bud, BudError>;
+
+/// A remesh that could not give a mesh, as the remesher's error.
+fn remesh_failed(message: String) -> BudError {
+    BudError::InvalidMesh(anthesis_mesh::MeshError::Io(message))
 }
 
 /// The Shape section's state.
@@ -99,10 +99,9 @@ impl ShapeState {
     /// shape cannot be meshed; `None` while it is being computed or when
     /// there is none.
     pub fn preview(&self) -> Option<Result<&MeshQuality, String>> {
-        match &self.preview {
-            Some((_, Preview::Done(Ok(bud)))) => Some(Ok(&bud.quality)),
-            Some((_, Preview::Done(Err(e)))) => Some(Err(e.to_string())),
-            _ => None,
+        match self.preview.as_ref().and_then(|(_, p)| p.answer())? {
+            Ok(bud) => Some(Ok(&bud.quality)),
+            Err(e) => Some(Err(e.to_string())),
         }
     }
 }
@@ -276,38 +275,21 @@ fn shape_rows(
     });
     let key = (index, edge.to_bits(), print);
     if state.preview.as_ref().is_none_or(|(k, _)| *k != key) {
-        let (send, receive) = sync_channel(1);
         let owned = mesh.clone();
-        let ctx = ui.ctx().clone();
-        let spawned = std::thread::Builder::new()
-            .name("anthesis-remesh-preview".into())
-            .spawn(move || {
-                let _ = send.send(anthesis_bud::remesh_mesh(&owned, &RemeshOptions::new(edge)));
-                ctx.request_repaint();
-            });
-        let preview = match spawned {
-            Ok(_) => Preview::Waiting(receive),
-            Err(e) => Preview::Done(Err(BudError::InvalidMesh(anthesis_mesh::MeshError::Io(
-                format!("cannot start the remesher: {e}"),
-            )))),
-        };
+        let preview = Background::start(
+            "anthesis-remesh-preview",
+            "the remesher",
+            remesh_failed,
+            ui.ctx(),
+            move || anthesis_bud::remesh_mesh(&owned, &RemeshOptions::new(edge)),
+        );
         state.preview = Some((key, preview));
     }
-    if let Some((_, preview)) = &mut state.preview
-        && let Preview::Waiting(receive) = preview
-    {
-        match receive.try_recv() {
-            Ok(result) => *preview = Preview::Done(result),
-            Err(TryRecvError::Empty) => {}
-            Err(TryRecvError::Disconnected) => {
-                *preview = Preview::Done(Err(BudError::InvalidMesh(anthesis_mesh::MeshError::Io(
-                    "the remesher stopped".to_string(),
-                ))));
-            }
-        }
+    if let Some((_, preview)) = &mut state.preview {
+        preview.poll();
     }
-    match state.preview.as_ref().map(|(_, p)| p) {
-        Some(Preview::Done(Ok(bud))) => {
+    match state.preview.as_ref().and_then(|(_, p)| p.answer()) {
+        Some(Ok(bud)) => {
             ui.label(format!("remeshed: {}", quality_text(&bud.quality)));
             if ui
                 .button("Remesh")
@@ -332,14 +314,14 @@ fn shape_rows(
                 commands.push(Command::Edit { label, edit });
             }
         }
-        Some(Preview::Done(Err(e))) => {
+        Some(Err(e)) => {
             ui.label(
                 RichText::new(format!("cannot remesh: {e}")).color(ui.visuals().error_fg_color),
             );
         }
         // No spinner: it would ask for frames all the time; the remesher's
         // thread asks for one when it is done.
-        Some(Preview::Waiting(_)) | None => {
+        None => {
             ui.label("remeshing…");
         }
     }

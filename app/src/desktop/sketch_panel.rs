@@ -13,7 +13,6 @@
 //! template's mesh shown faintly behind it.
 
 use std::collections::BTreeMap;
-use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_bud::{
     Bud, MeshQuality, PetalSketch, RemeshOptions, SketchError, SketchTool, SketchedPetal, Surface,
@@ -22,6 +21,7 @@ use anthesis_flower::{Flower, TemplateSource};
 use eframe::egui::{self, Color32, Pos2, RichText, Stroke};
 use glam::{DVec2, DVec3};
 
+use super::background::Background;
 use super::command::{Command, ProjectEdit};
 use super::shape_panel::quality_text;
 
@@ -86,12 +86,7 @@ struct Draft {
 const UNDO_STROKES: usize = 50;
 
 /// The petal meshed for the preview.
-#[derive(Debug)]
-enum Preview {
-    /// Still meshing.
-    Waiting(Receiver<Result<Bud, String>>),
-    Done(Result<Bud, String>),
-}
+type Preview = Background<Bud, String>;
 
 /// The map from the sketch plane to the canvas.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -152,15 +147,13 @@ impl SketchState {
     /// The previewed mesh numbers, or why the sketch cannot be meshed;
     /// `None` while it is being meshed.
     pub fn preview(&self) -> Option<Result<&MeshQuality, &str>> {
-        match &self.preview {
-            Some((_, Preview::Done(result))) => Some(
-                result
-                    .as_ref()
-                    .map(|bud| &bud.quality)
-                    .map_err(String::as_str),
-            ),
-            _ => None,
-        }
+        let answer = self.preview.as_ref().and_then(|(_, p)| p.answer())?;
+        Some(
+            answer
+                .as_ref()
+                .map(|bud| &bud.quality)
+                .map_err(String::as_str),
+        )
     }
 
     /// Chooses the drawing tool (as clicking it).
@@ -351,47 +344,34 @@ pub fn sketch_ui(
                     ..RemeshOptions::new(edge)
                 };
                 let surface = petal.surface.clone();
-                let (send, receive) = sync_channel(1);
-                let ctx = ui.ctx().clone();
-                let spawned = std::thread::Builder::new()
-                    .name("anthesis-sketch-preview".into())
-                    .spawn(move || {
-                        let bud = anthesis_bud::build_organ(&surface, &options)
-                            .map_err(|e| e.to_string());
-                        let _ = send.send(bud);
-                        ctx.request_repaint();
-                    });
-                match spawned {
-                    Ok(_) => Preview::Waiting(receive),
-                    Err(e) => Preview::Done(Err(format!("cannot start the mesher: {e}"))),
-                }
+                Background::start(
+                    "anthesis-sketch-preview",
+                    "the mesher",
+                    |message| message,
+                    ui.ctx(),
+                    move || {
+                        anthesis_bud::build_organ(&surface, &options).map_err(|e| e.to_string())
+                    },
+                )
             }
             Err(e) => Preview::Done(Err(e.to_string())),
         };
         state.preview = Some((k, preview));
     }
-    if let Some((_, preview)) = &mut state.preview
-        && let Preview::Waiting(receive) = preview
-    {
-        match receive.try_recv() {
-            Ok(result) => *preview = Preview::Done(result),
-            Err(TryRecvError::Empty) => {}
-            Err(TryRecvError::Disconnected) => {
-                *preview = Preview::Done(Err("the mesher stopped".to_string()));
-            }
-        }
+    if let Some((_, preview)) = &mut state.preview {
+        preview.poll();
     }
     if built.is_ok() {
-        match state.preview.as_ref().map(|(_, p)| p) {
-            Some(Preview::Done(Ok(bud))) => {
+        match state.preview.as_ref().and_then(|(_, p)| p.answer()) {
+            Some(Ok(bud)) => {
                 ui.label(format!("sketched: {}", quality_text(&bud.quality)));
             }
-            Some(Preview::Done(Err(e))) => {
+            Some(Err(e)) => {
                 ui.label(
                     RichText::new(format!("cannot mesh: {e}")).color(ui.visuals().error_fg_color),
                 );
             }
-            Some(Preview::Waiting(_)) | None => {
+            None => {
                 ui.label("meshing…");
             }
         }
@@ -408,7 +388,7 @@ pub fn sketch_ui(
         // The preview's mesh when it is of these strokes and this edge (the
         // mesher is deterministic), else meshed now.
         let meshed = match &state.preview {
-            Some((made_of, Preview::Done(Ok(bud)))) if *made_of == k => Ok(bud.clone()),
+            Some((made_of, Background::Done(Ok(bud)))) if *made_of == k => Ok(bud.clone()),
             _ => anthesis_bud::build_organ(&petal.surface, &RemeshOptions::new(edge))
                 .map_err(|e| e.to_string()),
         };
