@@ -2219,6 +2219,26 @@ fn stroke_in_bud_view(harness: &mut Harness<'_, AnthesisApp>, points: &[glam::DV
     settle(harness);
 }
 
+/// Draws the curve `at(t)`, `t` from 0 to 1, as a stroke of 25 points in
+/// the Sketched bud section's view, and returns the points.
+fn stroke_curve_in_bud_view(
+    harness: &mut Harness<'_, AnthesisApp>,
+    at: impl Fn(f64) -> glam::DVec2,
+) -> Vec<glam::DVec2> {
+    let points: Vec<glam::DVec2> = (0..=24).map(|k| at(k as f64 / 24.0)).collect();
+    stroke_in_bud_view(harness, &points);
+    points
+}
+
+/// Scrolls the bud side view into the window, moves the pointer off it
+/// and takes the snapshot `name`.
+fn snapshot_bud_view(harness: &mut Harness<'_, AnthesisApp>, name: &str) {
+    harness.get_by_label("bud side view").scroll_to_me();
+    harness.hover_at(egui::pos2(600.0, 300.0));
+    settle(harness);
+    harness.snapshot(name);
+}
+
 #[test]
 fn the_sketched_bud_says_when_an_l_system_places_the_organs() {
     // The apple's organs are placed by its L-system, in its turtle's frames.
@@ -2240,13 +2260,9 @@ fn a_bud_is_sketched_with_one_stroke_and_applied_in_one_undo_step() {
     let before = harness.state().project().clone();
 
     // A vase: out from the five petals' bases and up, turning back in.
-    let stroke: Vec<DVec2> = (0..=24)
-        .map(|k| {
-            let t = k as f64 / 24.0;
-            DVec2::new(4.0 + 6.0 * (1.4 * t).sin(), 22.0 * t)
-        })
-        .collect();
-    stroke_in_bud_view(&mut harness, &stroke);
+    let stroke = stroke_curve_in_bud_view(&mut harness, |t| {
+        DVec2::new(4.0 + 6.0 * (1.4 * t).sin(), 22.0 * t)
+    });
     let app = harness.state();
     let section = app.flower_panel().bud_sketch();
     assert_eq!(section.problem(), None);
@@ -2257,10 +2273,7 @@ fn a_bud_is_sketched_with_one_stroke_and_applied_in_one_undo_step() {
         &before,
         "nothing changes until Apply"
     );
-    harness.get_by_label("bud side view").scroll_to_me();
-    harness.hover_at(egui::pos2(600.0, 300.0));
-    settle(&mut harness);
-    harness.snapshot("flower_panel_sketched_bud");
+    snapshot_bud_view(&mut harness, "flower_panel_sketched_bud");
 
     click_settled(&mut harness, "Apply bud");
     let app = harness.state();
@@ -2311,13 +2324,9 @@ fn a_bud_is_sketched_with_one_stroke_and_applied_in_one_undo_step() {
     // The opened flower: a second stroke, out and down, is the open
     // petal's vein; the petals then open to it by the two-state blossom.
     click_settled(&mut harness, "the opened flower");
-    let open: Vec<DVec2> = (0..=24)
-        .map(|k| {
-            let t = k as f64 / 24.0;
-            DVec2::new(4.0 + 16.0 * t, 6.0 * (std::f64::consts::PI * t).sin())
-        })
-        .collect();
-    stroke_in_bud_view(&mut harness, &open);
+    stroke_curve_in_bud_view(&mut harness, |t| {
+        DVec2::new(4.0 + 16.0 * t, 6.0 * (std::f64::consts::PI * t).sin())
+    });
     let section = harness.state().flower_panel().bud_sketch();
     assert_eq!(section.problem(), None);
     assert!(section.opening().is_some());
@@ -2326,10 +2335,7 @@ fn a_bud_is_sketched_with_one_stroke_and_applied_in_one_undo_step() {
         &bud,
         "nothing changes until Apply"
     );
-    harness.get_by_label("bud side view").scroll_to_me();
-    harness.hover_at(egui::pos2(600.0, 300.0));
-    settle(&mut harness);
-    harness.snapshot("flower_panel_sketched_opening");
+    snapshot_bud_view(&mut harness, "flower_panel_sketched_opening");
     click_settled(&mut harness, "Apply opening");
     let app = harness.state();
     let template = &app.project().flower.templates[0];

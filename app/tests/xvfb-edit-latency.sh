@@ -32,13 +32,6 @@ xvfb-run -a -s "-screen 0 1600x1000x24" bash -c '
   "$binary" > "$log" 2>&1 & app=$!
   trap "kill $app 2>/dev/null || true" EXIT
   wait_window
-  # CPU ticks (1/100 s) the app used in the last second: the solver
-  # thread keeps it near 100 while a run computes.
-  ticks() { awk "{ print \$14 + \$15 }" /proc/$app/stat; }
-  busy() {
-    local before; before=$(ticks); sleep 1
-    [ $(( $(ticks) - before )) -gt 50 ]
-  }
   # Until the first run has finished (the status line is not readable
   # from here: wait for the solver thread to go quiet).
   sleep 5

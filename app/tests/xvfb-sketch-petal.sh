@@ -37,11 +37,6 @@ xvfb-run -a -s "-screen 0 1600x1000x24" bash -c '
   "$binary" builtin:five-petal > "$log" 2>&1 & app=$!
   trap "kill $app 2>/dev/null || true" EXIT
   wait_window
-  ticks() { awk "{ print \$14 + \$15 }" /proc/$app/stat; }
-  busy() {
-    local before; before=$(ticks); sleep 1
-    [ $(( $(ticks) - before )) -gt 50 ]
-  }
   settle() { sleep 2; while busy; do :; done; }
   settle
   "$import" -window root "$out/before.png"

@@ -24,3 +24,11 @@ wait_window() {
   [ -n "$window" ] || { echo "no Anthesis window" >&2; exit 1; }
   xdotool windowsize "$window" 1600 1000 windowmove "$window" 0 0
 }
+
+# Whether the app (process id in `app`) used more than half a core in the
+# next second: its solver thread keeps it near a whole core while a run
+# computes. Takes that second to answer.
+busy() {
+  local before; before=$(awk '{ print $14 + $15 }' /proc/$app/stat); sleep 1
+  [ $(( $(awk '{ print $14 + $15 }' /proc/$app/stat) - before )) -gt 50 ]
+}
