@@ -11,14 +11,16 @@
 //!
 //! `--scales`: mesh edge as a fraction of Table 1's (the default flowers use
 //! `EDGE_SCALE`; half of it is four times the particles). `--keyframes N`:
-//! the same opening in N steps (dg, time keys and joint schedule scaled so
-//! that dg·N and the keys' place in the opening stay fixed). `--tolerances`:
+//! the same opening in N steps (`anthesis_garden::retime::in_keyframes`:
+//! dg, time keys, joint and part schedules scaled so that dg·N and their
+//! place in the opening stay fixed). `--tolerances`:
 //! the solver's relative tolerance. Add `--whole` for the whole flower
 //! (organ 0 is measured), `--paper` for the paper's model.
 use std::time::Instant;
 
 use anthesis_flower::Project;
 use anthesis_garden::flowers::{EDGE_SCALE, flower_at_resolution};
+use anthesis_garden::retime::in_keyframes;
 use anthesis_garden::shape::{UvSampler, organ_shape};
 use anthesis_sim::{Selection, run};
 use glam::{DVec2, DVec3};
@@ -40,24 +42,6 @@ fn list(args: &[String], flag: &str) -> Option<Vec<f64>> {
     )
 }
 
-/// The same opening in `keyframes` steps instead of the project's.
-fn in_steps(mut project: Project, keyframes: u32) -> Project {
-    let factor = f64::from(keyframes) / f64::from(project.settings.keyframes);
-    let scale = |step: u32| (f64::from(step) * factor).round() as u32;
-    project.settings.keyframes = keyframes;
-    for template in &mut project.flower.templates {
-        template.dg /= factor;
-        for key in template.maps.keys_mut() {
-            key.step = scale(key.step);
-        }
-        for ramp in &mut template.joint_schedule {
-            ramp.from_step = scale(ramp.from_step);
-            ramp.to_step = scale(ramp.to_step);
-        }
-    }
-    project
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let name = args.first().map_or("lily", String::as_str);
@@ -76,7 +60,7 @@ fn main() {
             .map(|&n| {
                 (
                     format!("{n:4} keyframes"),
-                    in_steps(build(EDGE_SCALE), n as u32),
+                    in_keyframes(build(EDGE_SCALE), n as u32),
                 )
             })
             .collect()
@@ -107,8 +91,13 @@ fn main() {
         let mesh = project.flower.templates[0].mesh.clone();
         let started = Instant::now();
         let mut last = Vec::new();
+        // Keyframes in which a particle touches a neighbour or a part
+        // (stamens, pistil), and the particles the push-back moved.
+        let (mut touching, mut pushed) = (0u32, 0u64);
         if let Err(e) = run(project, &selection, &mut |_, k| {
             last.clone_from(&k.positions_in_world[0]);
+            touching += u32::from(k.stats.contact_particles > 0);
+            pushed += u64::from(k.stats.pushed_particles);
         }) {
             println!("{label}: {e}");
             continue;
@@ -125,7 +114,7 @@ fn main() {
             })
             .collect();
         println!(
-            "{label}: {:5} particles {:6.2} s  turning {:6.1}°  angles {:5.1} {:5.1} {:5.1}  cupping {:+.3}",
+            "{label}: {:5} particles {:6.2} s  turning {:6.1}°  angles {:5.1} {:5.1} {:5.1}  cupping {:+.3}  touching in {touching} keyframes, {pushed} pushed",
             mesh.vertex_count(),
             seconds,
             shape.midrib_turning_deg,

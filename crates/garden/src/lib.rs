@@ -14,6 +14,8 @@
 //! - [`decay`]: the lily, bloom and decay (negative growth in late keys);
 //! - [`five_petal`]: the empty starting point, one whorl of five simple
 //!   petals with uniform maps;
+//! - [`retime`]: the same opening in another number of keyframes (the
+//!   time step of a convergence study);
 //! - [`shape`]: numeric shape descriptors (opening angles, turning,
 //!   cupping, corolla profile) that tests use to check each flower's
 //!   character;
@@ -34,6 +36,7 @@ pub mod five_petal;
 pub mod flowers;
 pub mod paint;
 pub mod parts;
+pub mod retime;
 pub mod shape;
 
 use std::io;
