@@ -91,8 +91,9 @@ fn main() {
         let mesh = project.flower.templates[0].mesh.clone();
         let started = Instant::now();
         let mut last = Vec::new();
-        // Keyframes in which a particle touches a neighbour or a part
-        // (stamens, pistil), and the particles the push-back moved.
+        // Keyframes in which a particle of a simulated organ touches a
+        // neighbour or a part (stamens, pistil), and the particles the
+        // push-back moved.
         let (mut touching, mut pushed) = (0u32, 0u64);
         if let Err(e) = run(project, &selection, &mut |_, k| {
             last.clone_from(&k.positions_in_world[0]);
@@ -129,7 +130,7 @@ fn main() {
         return;
     };
     println!(
-        "distance to the {reference} run at keyframe 100, over its midrib length {length:.1}:"
+        "distance to the {reference} run at its last keyframe, over its midrib length {length:.1}:"
     );
     println!("| run | tip | midrib middle | lamina | lamina |\n|---|---|---|---|---|");
     for (label, probes, _) in &results {
