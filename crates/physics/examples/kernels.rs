@@ -1,5 +1,5 @@
 //! Times one organ's kernels (energy, energy and gradient, Hessian
-//! assembly, membrane update) on a test petal with the edge-smoothed
+//! assembly, membrane update, regional growth) on a test petal with the edge-smoothed
 //! membrane, the fastest of several batches (robust on a shared machine).
 //!
 //! ```text
@@ -10,9 +10,9 @@ use std::time::Instant;
 
 use anthesis_mesh::Topology;
 use anthesis_mesh::generate::{jittered, test_petal};
-use anthesis_physics::Elastic;
 use anthesis_physics::membrane::EdgeSmoothedMembrane;
-use glam::DVec3;
+use anthesis_physics::{Elastic, GrowthModel, GrowthRates, RegionalGrowth};
+use glam::{DVec2, DVec3};
 
 fn fastest(label: &str, mut work: impl FnMut()) {
     let (batches, calls) = (9, 20);
@@ -68,5 +68,35 @@ fn main() {
     fastest("membrane update", || {
         membrane.update(&elastic.rest_lengths, &modulus);
         std::hint::black_box(&membrane);
+    });
+    // Growth of a few percent per step without a pattern, the inner layer
+    // mostly faster, directions turning across the petal.
+    let rates: Vec<GrowthRates> = (0..mesh.triangles.len())
+        .map(|t| {
+            let r = (t as f64 * 0.618_034).fract();
+            GrowthRates {
+                e: 1.0 + 0.02 * r,
+                w: 1.0 + 0.01 * r,
+                e_in: 1.0 + 0.03 * r,
+                w_in: 1.0 + 0.015 * (1.0 - r),
+                direction_in_uv: DVec2::new(r - 0.5, 1.0),
+            }
+        })
+        .collect();
+    let model = GrowthModel::new(0.3);
+    let mut growth = RegionalGrowth::default();
+    let (mut lengths, mut angles) = (elastic.rest_lengths.clone(), elastic.rest_angles.clone());
+    fastest("regional growth", || {
+        growth.grow(
+            &x,
+            &mesh.uvs,
+            &mesh.triangles,
+            &topology,
+            &rates,
+            &model,
+            &mut lengths,
+            &mut angles,
+        );
+        std::hint::black_box((&lengths, &angles));
     });
 }

@@ -117,13 +117,13 @@ impl GrowthModel {
 /// beyond it `tan` explodes (a fold of nearly 180° between two triangles).
 const MAX_HALF_ANGLE: f64 = 1.4;
 
-/// What the curvature rule needs of one triangle: its frame and its
-/// curvature increment along and across the growth direction, and the
-/// inner rates that carry existing bends.
+/// What the curvature rule needs of one triangle: its unit normal (inner
+/// side) and growth direction, its curvature increment along and across the
+/// growth direction, and the inner rates that carry existing bends.
 #[derive(Debug, Clone, Copy, Default)]
 struct TriangleBend {
+    normal: DVec3,
     along: DVec3,
-    across: DVec3,
     kappa_along: f64,
     kappa_across: f64,
     e_in: f64,
@@ -162,77 +162,99 @@ impl RegionalGrowth {
         self.length_sum.resize(edges, 0.0);
         self.length_count.clear();
         self.length_count.resize(edges, 0);
-        self.angle_sum.clear();
-        self.angle_sum.resize(edges, 0.0);
-        self.angle_from.clear();
-        self.angle_from
-            .extend(topology.edges.iter().enumerate().map(|(e, edge)| {
-                match (edge.hinge(), model.bend_base) {
-                    (None, _) => 0.0,
-                    (Some(h), BendBase::Dihedral) => {
-                        dihedral_angle(h.map(|p| positions[p as usize]))
-                    }
-                    (Some(_), BendBase::RestAngle) => rest_angles[e],
-                }
-            }));
-        self.bends.clear();
-
-        for (t, tri) in triangles.iter().enumerate() {
-            let x = tri.map(|i| positions[i as usize]);
-            let uv = tri.map(|i| uvs[i as usize]);
-            let edge_ids = topology.triangle_edges[t];
-            let rates = &rates[t];
-            match model.bend_rule {
-                BendRule::Curvature => {
-                    let frame = TriangleFrame::new(x, uv, rates.direction_in_uv);
+        match model.bend_rule {
+            BendRule::Curvature => {
+                self.bends.clear();
+                for (t, tri) in triangles.iter().enumerate() {
+                    let x = corners(positions, *tri);
+                    let rates = &rates[t];
+                    let frame = TriangleFrame::new(x, corners(uvs, *tri), rates.direction_in_uv);
                     let lengths = frame.grown_lengths(x, rates.e, rates.w);
-                    for k in 0..3 {
-                        let e = edge_ids[k] as usize;
-                        self.length_sum[e] += lengths[k];
-                        self.length_count[e] += 1;
-                    }
+                    self.add_lengths(topology.triangle_edges[t], lengths);
                     self.bends.push(TriangleBend {
+                        normal: frame.normal,
                         along: frame.along,
-                        across: frame.across,
                         kappa_along: (rates.e_in - rates.e) / model.thickness,
                         kappa_across: (rates.w_in - rates.w) / model.thickness,
                         e_in: rates.e_in,
                         w_in: rates.w_in,
                     });
                 }
-                BendRule::InnerTriangle => {
+                for (e, edge) in topology.edges.iter().enumerate() {
+                    rest_lengths[e] = self.mean_length(e);
+                    rest_angles[e] = match (edge.hinge(), edge.right) {
+                        (Some(stencil), Some(right)) => curvature_hinge_angle(
+                            corners(positions, stencil),
+                            [
+                                &self.bends[edge.left.triangle as usize],
+                                &self.bends[right.triangle as usize],
+                            ],
+                            match model.bend_base {
+                                BendBase::Dihedral => None,
+                                BendBase::RestAngle => Some(rest_angles[e]),
+                            },
+                        ),
+                        _ => 0.0,
+                    };
+                }
+            }
+            BendRule::InnerTriangle => {
+                self.angle_sum.clear();
+                self.angle_sum.resize(edges, 0.0);
+                self.angle_from.clear();
+                self.angle_from
+                    .extend(topology.edges.iter().enumerate().map(|(e, edge)| {
+                        match (edge.hinge(), model.bend_base) {
+                            (None, _) => 0.0,
+                            (Some(h), BendBase::Dihedral) => dihedral_angle(corners(positions, h)),
+                            (Some(_), BendBase::RestAngle) => rest_angles[e],
+                        }
+                    }));
+                for (t, tri) in triangles.iter().enumerate() {
+                    let edge_ids = topology.triangle_edges[t];
                     let theta0 = edge_ids.map(|e| self.angle_from[e as usize]);
-                    let grown = grow_triangle(x, uv, rates, model.thickness, theta0);
+                    let grown = grow_triangle(
+                        corners(positions, *tri),
+                        corners(uvs, *tri),
+                        &rates[t],
+                        model.thickness,
+                        theta0,
+                    );
+                    self.add_lengths(edge_ids, grown.lengths);
                     for k in 0..3 {
-                        let e = edge_ids[k] as usize;
-                        self.length_sum[e] += grown.lengths[k];
-                        self.length_count[e] += 1;
-                        self.angle_sum[e] += grown.half_angles[k];
+                        self.angle_sum[edge_ids[k] as usize] += grown.half_angles[k];
                     }
+                }
+                for (e, edge) in topology.edges.iter().enumerate() {
+                    rest_lengths[e] = self.mean_length(e);
+                    rest_angles[e] = match edge.right {
+                        Some(_) => self.angle_sum[e],
+                        None => 0.0,
+                    };
                 }
             }
         }
-        for (e, edge) in topology.edges.iter().enumerate() {
-            rest_lengths[e] = self.length_sum[e] / f64::from(self.length_count[e].max(1));
-            rest_angles[e] = match (edge.hinge(), edge.right) {
-                (Some(stencil), Some(right)) => match model.bend_rule {
-                    BendRule::InnerTriangle => self.angle_sum[e],
-                    BendRule::Curvature => {
-                        let sides = [
-                            &self.bends[edge.left.triangle as usize],
-                            &self.bends[right.triangle as usize],
-                        ];
-                        curvature_hinge_angle(
-                            stencil.map(|p| positions[p as usize]),
-                            sides,
-                            self.angle_from[e],
-                        )
-                    }
-                },
-                _ => 0.0,
-            };
+    }
+
+    /// Adds one triangle's grown lengths of its sides `edge_ids`.
+    fn add_lengths(&mut self, edge_ids: [u32; 3], lengths: [f64; 3]) {
+        for k in 0..3 {
+            let e = edge_ids[k] as usize;
+            self.length_sum[e] += lengths[k];
+            self.length_count[e] += 1;
         }
     }
+
+    /// Edge `e`'s new rest length: the mean of its triangles' grown lengths.
+    fn mean_length(&self, e: usize) -> f64 {
+        self.length_sum[e] / f64::from(self.length_count[e].max(1))
+    }
+}
+
+/// `values` at `indices`.
+#[inline]
+fn corners<T: Copy, const N: usize>(values: &[T], indices: [u32; N]) -> [T; N] {
+    std::array::from_fn(|k| values[indices[k] as usize])
 }
 
 /// A triangle's growth frame: unit normal (inner side), growth direction
@@ -267,67 +289,83 @@ impl TriangleFrame {
         })
     }
 
-    /// Lengths of the edges `(x0,x1)`, `(x1,x2)`, `(x2,x0)` of the grown
-    /// triangle.
+    /// Lengths of the sides `(x0,x1)`, `(x1,x2)`, `(x2,x0)` of the triangle
+    /// scaled by `e` along the growth direction and `w` across it: each side
+    /// lies in the triangle's plane, so its grown vector has the components
+    /// `e (v·D)` and `w (v·W)` (the same lengths as [`TriangleFrame::scale`]
+    /// gives, without moving the corners).
     fn grown_lengths(&self, x: [DVec3; 3], e: f64, w: f64) -> [f64; 3] {
-        let grown = self.scale(x, e, w);
-        [0, 1, 2].map(|k| (grown[(k + 1) % 3] - grown[k]).length())
+        let grown = |v: DVec3| DVec2::new(e * v.dot(self.along), w * v.dot(self.across)).length();
+        [grown(x[1] - x[0]), grown(x[2] - x[1]), grown(x[0] - x[2])]
     }
 }
 
 /// The new rest angle of the hinge `[xi, xj, xk, xl]` under the curvature
-/// rule: `angle_from` carried by the inner growth across the edge, plus the
-/// dihedral angle the hinge takes on the height field of the mean of its
-/// triangles' curvature increments (see the module documentation).
-fn curvature_hinge_angle(x: [DVec3; 4], sides: [&TriangleBend; 2], angle_from: f64) -> f64 {
+/// rule: the angle it grows from (`rest_angle`, or its dihedral angle when
+/// `None`) carried by the inner growth across the edge, plus the dihedral
+/// angle the hinge takes on the height field of the mean of its triangles'
+/// curvature increments (see the module documentation).
+///
+/// Everything is in the hinge unfolded flat: the edge along `+x` from `xi`,
+/// the left triangle on `+y`, the right one on `−y`, each triangle's plane
+/// spanned by the edge and its own in-plane `y`. On the height field
+/// `h(p) = −½ pᵀ K p` the edge's ends lie at the same height, so each lifted
+/// triangle rises (or falls) only away from the edge, by `h(k) − h(i)` over
+/// the height `y_k` of its opposite corner, and the angle between the two
+/// lifted planes is `atan2(h_k y_l − h_l y_k, −y_k y_l − h_k h_l)` (the
+/// angle between their normals `(0, −h_k, y_k)` and `(0, h_l, −y_l)`, both
+/// scaled by the edge length).
+fn curvature_hinge_angle(x: [DVec3; 4], sides: [&TriangleBend; 2], rest_angle: Option<f64>) -> f64 {
     let [xi, xj, xk, xl] = x;
+    let [left, right] = sides;
     let edge = xj - xi;
-    let edge_length = edge.length();
-    if edge_length == 0.0 {
-        return angle_from;
+    let length = edge.length();
+    if length == 0.0 {
+        // A collapsed edge has no angle; it keeps the one it grows from, or none.
+        return rest_angle.unwrap_or(0.0);
     }
-    let along_edge = edge / edge_length;
-    let n_left = edge.cross(xk - xi).normalize_or_zero();
-    let n_right = (xi - xj).cross(xl - xj).normalize_or_zero();
+    let along_edge = edge / length;
     // Each triangle's in-plane direction away from the edge towards its own
     // side: the left triangle lies on +y, the right one, unfolded, on −y.
-    let y_left = n_left.cross(along_edge);
-    let y_right = n_right.cross(along_edge);
-    // The hinge unfolded flat, edge midpoint at the origin, edge along +x.
-    let mid = 0.5 * (xi + xj);
-    let flat = |p: DVec3, y: DVec3| DVec2::new((p - mid).dot(along_edge), (p - mid).dot(y));
-    let points = [
-        flat(xi, y_left),
-        flat(xj, y_left),
-        flat(xk, y_left),
-        flat(xl, y_right),
-    ];
-    // Each side's curvature tensor in the unfolded frame, and the mean.
-    let tensor = |b: &TriangleBend, y: DVec3| {
-        let d = DVec2::new(b.along.dot(along_edge), b.along.dot(y));
-        let w = DVec2::new(b.across.dot(along_edge), b.across.dot(y));
+    let y_left = left.normal.cross(along_edge);
+    let y_right = right.normal.cross(along_edge);
+    // The dihedral angle from the two normals: its sine is the right normal
+    // against the left triangle's y, its cosine their dot product.
+    let angle_from = rest_angle
+        .unwrap_or_else(|| (-right.normal.dot(y_left)).atan2(left.normal.dot(right.normal)));
+    // Each side's growth direction in the unfolded frame; the direction
+    // across it is its perpendicular, so its curvature tensor is
+    // `κ_D d dᵀ + κ_W d⊥ d⊥ᵀ`.
+    let d_left = DVec2::new(left.along.dot(along_edge), left.along.dot(y_left));
+    let d_right = DVec2::new(right.along.dot(along_edge), right.along.dot(y_right));
+    let tensor = |b: &TriangleBend, d: DVec2| {
         [
-            b.kappa_along * d.x * d.x + b.kappa_across * w.x * w.x,
-            b.kappa_along * d.x * d.y + b.kappa_across * w.x * w.y,
-            b.kappa_along * d.y * d.y + b.kappa_across * w.y * w.y,
+            b.kappa_along * d.x * d.x + b.kappa_across * d.y * d.y,
+            (b.kappa_along - b.kappa_across) * d.x * d.y,
+            b.kappa_along * d.y * d.y + b.kappa_across * d.x * d.x,
         ]
     };
-    let (kl, kr) = (tensor(sides[0], y_left), tensor(sides[1], y_right));
-    let k = [0, 1, 2].map(|c| 0.5 * (kl[c] + kr[c]));
-    // Height along the inner normal: positive curvature makes the inner
-    // side convex, so the surface falls away from it.
-    let lift =
-        |p: DVec2| p.extend(-0.5 * (k[0] * p.x * p.x + 2.0 * k[1] * p.x * p.y + k[2] * p.y * p.y));
-    let increment = dihedral_angle(points.map(|p| {
-        let q = lift(p);
-        DVec3::new(q.x, q.y, q.z)
-    }));
-    // The inner growth across the edge (perpendicular to it, in each
-    // triangle's plane) carries the bend the hinge already has.
-    let carry = |b: &TriangleBend, y: DVec3| {
-        DVec2::new(b.e_in * y.dot(b.along), b.w_in * y.dot(b.across)).length()
+    let (kl, kr) = (tensor(left, d_left), tensor(right, d_right));
+    let k = [
+        0.5 * (kl[0] + kr[0]),
+        0.5 * (kl[1] + kr[1]),
+        0.5 * (kl[2] + kr[2]),
+    ];
+    // The opposite corners: distance along the edge from xi, height over it.
+    let (a_k, y_k) = ((xk - xi).dot(along_edge), (xk - xi).dot(y_left));
+    let (a_l, y_l) = ((xl - xi).dot(along_edge), (xl - xi).dot(y_right));
+    // h(p) − h(xi) at a corner: with p.x = a − length/2 from the edge's
+    // midpoint, p.x² − length²/4 = a (a − length).
+    let rise = |a: f64, y: f64| {
+        -0.5 * (k[0] * a * (a - length) + k[1] * (2.0 * a - length) * y + k[2] * y * y)
     };
-    let carried = 0.5 * (carry(sides[0], y_left) + carry(sides[1], y_right));
+    let (h_k, h_l) = (rise(a_k, y_k), rise(a_l, y_l));
+    let increment = (h_k * y_l - h_l * y_k).atan2(-y_k * y_l - h_k * h_l);
+    // The inner growth across the edge (perpendicular to it, in each
+    // triangle's plane: `d.y` along the growth direction, `d.x` across it)
+    // carries the bend the hinge already has.
+    let carry = |b: &TriangleBend, d: DVec2| DVec2::new(b.e_in * d.y, b.w_in * d.x).length();
+    let carried = 0.5 * (carry(left, d_left) + carry(right, d_right));
     angle_from * carried + increment
 }
 
@@ -560,6 +598,131 @@ mod tests {
             worst_paper > 0.1,
             "the paper's rule is off by {worst_paper} at most here"
         );
+    }
+
+    #[test]
+    fn grown_lengths_are_those_of_the_scaled_triangle() {
+        let mut seed = 5u64;
+        let mut rand = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for _ in 0..100 {
+            let x = [0; 3].map(|_| DVec3::new(rand(), rand(), rand()));
+            let uv = [0; 3].map(|_| DVec2::new(rand(), rand()));
+            let frame = TriangleFrame::new(x, uv, DVec2::new(rand(), rand()));
+            let (e, w) = (1.0 + rand(), 1.0 + rand());
+            let scaled = frame.scale(x, e, w);
+            let lengths = frame.grown_lengths(x, e, w);
+            for k in 0..3 {
+                let expected = (scaled[(k + 1) % 3] - scaled[k]).length();
+                assert!(
+                    (lengths[k] - expected).abs() < 1e-12 * expected,
+                    "side {k}: {} vs {expected}",
+                    lengths[k]
+                );
+            }
+        }
+    }
+
+    /// The curvature rule's hinge angle as first written: the hinge
+    /// unfolded flat about the edge's midpoint, each corner lifted onto the
+    /// height field, and the dihedral angle of the lifted hinge measured
+    /// like any other (`dihedral_angle`); `curvature_hinge_angle` is its
+    /// closed form.
+    fn lifted_hinge_angle(x: [DVec3; 4], sides: [&TriangleBend; 2], angle_from: f64) -> f64 {
+        let [xi, xj, xk, xl] = x;
+        let edge = xj - xi;
+        let along_edge = edge / edge.length();
+        let n_left = edge.cross(xk - xi).normalize();
+        let n_right = (xi - xj).cross(xl - xj).normalize();
+        let y_left = n_left.cross(along_edge);
+        let y_right = n_right.cross(along_edge);
+        let mid = 0.5 * (xi + xj);
+        let flat = |p: DVec3, y: DVec3| DVec2::new((p - mid).dot(along_edge), (p - mid).dot(y));
+        let points = [
+            flat(xi, y_left),
+            flat(xj, y_left),
+            flat(xk, y_left),
+            flat(xl, y_right),
+        ];
+        let tensor = |b: &TriangleBend, y: DVec3| {
+            let across = b.normal.cross(b.along);
+            let d = DVec2::new(b.along.dot(along_edge), b.along.dot(y));
+            let w = DVec2::new(across.dot(along_edge), across.dot(y));
+            [
+                b.kappa_along * d.x * d.x + b.kappa_across * w.x * w.x,
+                b.kappa_along * d.x * d.y + b.kappa_across * w.x * w.y,
+                b.kappa_along * d.y * d.y + b.kappa_across * w.y * w.y,
+            ]
+        };
+        let (kl, kr) = (tensor(sides[0], y_left), tensor(sides[1], y_right));
+        let k = [0, 1, 2].map(|c| 0.5 * (kl[c] + kr[c]));
+        let increment = dihedral_angle(points.map(|p| {
+            p.extend(-0.5 * (k[0] * p.x * p.x + 2.0 * k[1] * p.x * p.y + k[2] * p.y * p.y))
+        }));
+        let carry = |b: &TriangleBend, y: DVec3| {
+            let across = b.normal.cross(b.along);
+            DVec2::new(b.e_in * y.dot(b.along), b.w_in * y.dot(across)).length()
+        };
+        let carried = 0.5 * (carry(sides[0], y_left) + carry(sides[1], y_right));
+        angle_from * carried + increment
+    }
+
+    #[test]
+    fn hinge_angle_closed_form_matches_the_lifted_hinge() {
+        let mut seed = 11u64;
+        let mut rand = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let mut checked = 0;
+        for case in 0..400 {
+            // A hinge bent by up to ±2.5 rad, corners jittered, the edge
+            // anywhere along x.
+            let bend = 5.0 * rand();
+            let x = [
+                DVec3::new(rand(), rand(), rand()) * 0.3,
+                DVec3::new(1.0 + rand(), rand(), rand()) * 0.3 + DVec3::X,
+                DVec3::new(0.5 + rand(), 1.0, 0.3 * rand()),
+                DVec3::new(0.5 + rand(), -bend.cos(), -bend.sin()),
+            ];
+            let side =
+                |n: DVec3, r: DVec3, scale: f64, rand: &mut dyn FnMut() -> f64| TriangleBend {
+                    normal: n,
+                    along: (r - n * r.dot(n)).normalize(),
+                    kappa_along: scale * rand(),
+                    kappa_across: scale * rand(),
+                    e_in: 1.0 + 0.2 * rand(),
+                    w_in: 1.0 + 0.2 * rand(),
+                };
+            let [xi, xj, xk, xl] = x;
+            let n_left = (xj - xi).cross(xk - xi).normalize();
+            let n_right = (xi - xj).cross(xl - xj).normalize();
+            // Small curvatures like growth's and large ones, where the
+            // lifted hinge is far from flat.
+            let scale = if case % 2 == 0 { 0.05 } else { 3.0 };
+            let r1 = DVec3::new(rand(), rand(), rand());
+            let left = side(n_left, r1, scale, &mut rand);
+            let r2 = DVec3::new(rand(), rand(), rand());
+            let right = side(n_right, r2, scale, &mut rand);
+            let sides = [&left, &right];
+            let dihedral = dihedral_angle(x);
+            for (from, rest) in [(dihedral, None), (0.4, Some(0.4))] {
+                let closed = curvature_hinge_angle(x, sides, rest);
+                let lifted = lifted_hinge_angle(x, sides, from);
+                assert!(
+                    (closed - lifted).abs() < 1e-12 * (1.0 + lifted.abs()),
+                    "case {case}: closed form {closed}, lifted hinge {lifted}"
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 800);
     }
 
     #[test]
