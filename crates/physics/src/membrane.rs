@@ -140,27 +140,28 @@ impl EdgeSmoothedMembrane {
     /// topology's edges).
     pub fn update(&mut self, rest_lengths: &[f64], modulus: &[f64]) {
         for d in &mut self.domains {
-            let length = d.edges.map(|e| rest_lengths[e as usize]);
-            let base = length[0];
+            let [e0, e1, e2, e3, e4] = d.edges.map(|e| e as usize);
+            let base = rest_lengths[e0];
             let (pi, pj) = (DVec2::new(-0.5 * base, 0.0), DVec2::new(0.5 * base, 0.0));
             let area = |p: [DVec2; 3]| 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
             // The rest triangles unfolded flat about the edge: the left one
             // (i, j, k) above it, the right one (i, l, j) below. Each is
-            // (side slots of its edges, corners).
-            let left = ([0, 1, 2], [pi, pj, apex(base, length[2], length[1], 1.0)]);
-            let right = (d.count == 5)
-                .then(|| ([3, 4, 0], [pi, apex(base, length[3], length[4], -1.0), pj]));
-            let triangles = [Some(left), right];
-            let triangles = triangles.iter().flatten();
-            let total: f64 = triangles.clone().map(|(_, p)| area(*p)).sum();
+            // (side slots of its edges, corners, area).
+            let corners = [pi, pj, apex(base, rest_lengths[e2], rest_lengths[e1], 1.0)];
+            let left = ([0, 1, 2], corners, area(corners));
+            let right = (d.count == 5).then(|| {
+                let corners = [pi, apex(base, rest_lengths[e3], rest_lengths[e4], -1.0), pj];
+                ([3, 4, 0], corners, area(corners))
+            });
+            let total = left.2 + right.map_or(0.0, |r| r.2);
             // The mean strain as (E_xx, E_xy, E_yy) per unit strain of each
             // edge slot.
             let mut per_slot = [[0.0; 3]; 5];
-            for (slots, corners) in triangles {
-                let Some(coefficients) = strain_coefficients(*corners) else {
+            for (slots, corners, area) in std::iter::once(left).chain(right) {
+                let Some(coefficients) = strain_coefficients(corners) else {
                     continue;
                 };
-                let weight = area(*corners) / total.max(f64::MIN_POSITIVE);
+                let weight = area / total.max(f64::MIN_POSITIVE);
                 for (side, &slot) in slots.iter().enumerate() {
                     for c in 0..3 {
                         per_slot[slot][c] += weight * coefficients[side][c];
@@ -168,14 +169,16 @@ impl EdgeSmoothedMembrane {
                 }
             }
             let domain_area = total / 3.0;
-            let mu = modulus[d.edges[0] as usize];
+            let mu = modulus[e0];
             let lambda = mu;
+            // Q is symmetric: each pair once.
             for a in 0..d.count {
-                for b in 0..d.count {
+                for b in a..d.count {
                     let (x, y) = (per_slot[a], per_slot[b]);
                     let traces = (x[0] + x[2]) * (y[0] + y[2]);
                     let contraction = x[0] * y[0] + 2.0 * x[1] * y[1] + x[2] * y[2];
                     d.q[a][b] = domain_area * (lambda * traces + 2.0 * mu * contraction);
+                    d.q[b][a] = d.q[a][b];
                 }
             }
         }
