@@ -315,6 +315,11 @@ impl TriangleFrame {
 /// lifted planes is `atan2(h_k y_l − h_l y_k, −y_k y_l − h_k h_l)` (the
 /// angle between their normals `(0, −h_k, y_k)` and `(0, h_l, −y_l)`, both
 /// scaled by the edge length).
+///
+/// Always inlined: called with its four corners copied to the stack, the
+/// regional growth step took 0.35 instead of 0.23 ms on the kernels
+/// example's 1k petal.
+#[inline(always)]
 fn curvature_hinge_angle(x: [DVec3; 4], sides: [&TriangleBend; 2], rest_angle: Option<f64>) -> f64 {
     let [xi, xj, xk, xl] = x;
     let [left, right] = sides;
