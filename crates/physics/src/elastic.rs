@@ -315,16 +315,35 @@ pub(crate) fn outer(u: DVec3, v: DVec3) -> DMat3 {
 /// triangles. Stiffness is this area times the user's K times the map value
 /// (paper §5.1).
 pub fn edge_areas(positions: &[DVec3], triangles: &[[u32; 3]], topology: &Topology) -> Vec<f64> {
-    let triangle_area = |t: u32| {
-        let [a, b, c] = triangles[t as usize].map(|i| positions[i as usize]);
+    let mut areas = Vec::new();
+    edge_areas_into(positions, triangles, topology, &mut Vec::new(), &mut areas);
+    areas
+}
+
+/// [`edge_areas`] into `areas`, with each triangle's area computed once into
+/// `triangle_areas` (both buffers reused from call to call).
+pub fn edge_areas_into(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    topology: &Topology,
+    triangle_areas: &mut Vec<f64>,
+    areas: &mut Vec<f64>,
+) {
+    triangle_areas.clear();
+    triangle_areas.extend(triangles.iter().map(|&[a, b, c]| {
+        let (a, b, c) = (
+            positions[a as usize],
+            positions[b as usize],
+            positions[c as usize],
+        );
         0.5 * (b - a).cross(c - a).length()
-    };
-    topology
-        .edges
-        .iter()
-        .map(|e| match e.right {
-            Some(r) => 0.5 * (triangle_area(e.left.triangle) + triangle_area(r.triangle)),
-            None => triangle_area(e.left.triangle),
-        })
-        .collect()
+    }));
+    areas.clear();
+    areas.extend(topology.edges.iter().map(|e| {
+        let left = triangle_areas[e.left.triangle as usize];
+        match e.right {
+            Some(r) => 0.5 * (left + triangle_areas[r.triangle as usize]),
+            None => left,
+        }
+    }));
 }

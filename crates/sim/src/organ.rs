@@ -5,7 +5,7 @@ use crate::collide::Surface;
 use anthesis_flower::{Organ, Placement, Template, joint_angle_after};
 use anthesis_maps::{KeySchedule, ScalarMap};
 use anthesis_mesh::{Mesh, Topology};
-use anthesis_physics::elastic::edge_areas;
+use anthesis_physics::elastic::edge_areas_into;
 use anthesis_physics::membrane::EdgeSmoothedMembrane;
 use anthesis_physics::shape_match::match_shape;
 use anthesis_physics::{
@@ -152,6 +152,10 @@ pub(crate) struct OrganSim {
     growth_model: GrowthModel,
     /// The membrane's Lamé parameter per edge (consistent model).
     modulus: Vec<f64>,
+    /// Each triangle's and each edge's area at the last growth step
+    /// (buffers kept from step to step).
+    triangle_areas: Vec<f64>,
+    edge_areas: Vec<f64>,
     stretch_stiffness: f64,
     bend_stiffness: f64,
     elastic: Elastic,
@@ -279,6 +283,8 @@ impl OrganSim {
                 bend_base: settings.bend_base,
             },
             modulus: Vec::new(),
+            triangle_areas: Vec::new(),
+            edge_areas: Vec::new(),
             stretch_stiffness: template.stretch_stiffness,
             bend_stiffness: template.bend_stiffness,
             elastic,
@@ -306,24 +312,22 @@ impl OrganSim {
         let weights = self.key_schedule.weights_at(f64::from(step));
         // Each key's growth values times its growth scale, blended: a key
         // with its own (negative) dg shrinks the organ as it takes over.
-        let blend = |values: fn(&SampledKey) -> &Vec<f64>, t: usize| -> f64 {
-            weights
-                .iter()
-                .map(|&(k, w)| w * self.key_dg[k] * values(&self.keys[k])[t])
-                .sum()
-        };
-        self.rates = (0..self.mesh.triangles.len())
-            .map(|t| GrowthRates {
-                e: 1.0 + blend(|k| &k.e, t),
-                w: 1.0 + blend(|k| &k.w, t),
-                e_in: 1.0 + blend(|k| &k.e_in, t),
-                w_in: 1.0 + blend(|k| &k.w_in, t),
-                direction_in_uv: weights
-                    .iter()
-                    .map(|&(k, w)| self.keys[k].direction[t] * w)
-                    .sum(),
-            })
-            .collect();
+        let keys = weights.map(|(k, w)| (&self.keys[k], w * self.key_dg[k], w));
+        self.rates.clear();
+        self.rates.extend((0..self.mesh.triangles.len()).map(|t| {
+            let blend = |values: fn(&SampledKey) -> &Vec<f64>| -> f64 {
+                keys.iter()
+                    .map(|&(key, scale, _)| scale * values(key)[t])
+                    .sum()
+            };
+            GrowthRates {
+                e: 1.0 + blend(|k| &k.e),
+                w: 1.0 + blend(|k| &k.w),
+                e_in: 1.0 + blend(|k| &k.e_in),
+                w_in: 1.0 + blend(|k| &k.w_in),
+                direction_in_uv: keys.iter().map(|&(key, _, w)| key.direction[t] * w).sum(),
+            }
+        }));
         self.growth.grow(
             &self.positions,
             &self.mesh.uvs,
@@ -416,9 +420,15 @@ impl OrganSim {
 
     fn update_stiffness(&mut self, step: u32) {
         let weights = self.key_schedule.weights_at(f64::from(step.max(1)));
-        let areas = edge_areas(&self.positions, &self.mesh.triangles, &self.topology);
-        self.modulus.resize(areas.len(), 0.0);
-        for (e, area) in areas.iter().enumerate() {
+        edge_areas_into(
+            &self.positions,
+            &self.mesh.triangles,
+            &self.topology,
+            &mut self.triangle_areas,
+            &mut self.edge_areas,
+        );
+        self.modulus.resize(self.edge_areas.len(), 0.0);
+        for (e, area) in self.edge_areas.iter().enumerate() {
             let stretch: f64 = weights
                 .iter()
                 .map(|&(k, w)| w * self.keys[k].stretch[e])
