@@ -122,6 +122,9 @@ pub struct NewtonSolver {
     gradient: Vec<DVec3>,
     trial: Vec<DVec3>,
     factor_valid: bool,
+    /// The contacts whose penalty the factorised Hessian holds (those that
+    /// were violated where it was assembled), in `contacts` order.
+    held: Vec<Contact>,
     last_step_cut: bool,
     previous_gradient: Option<f64>,
     factorisations: u64,
@@ -225,6 +228,7 @@ impl NewtonSolver {
             gradient: vec![DVec3::ZERO; particles],
             trial: vec![DVec3::ZERO; particles],
             factor_valid: false,
+            held: Vec::new(),
             last_step_cut: false,
             previous_gradient: None,
             factorisations: 0,
@@ -302,12 +306,19 @@ impl NewtonSolver {
         // works. The Hessian changes little between iterations, so an old
         // factor still gives a good descent direction; refactorise when there
         // is none (a new keyframe), when the
-        // last step was cut by the line search, or when the gradient fell by
-        // less than REFACTOR_RATIO since the previous iteration.
+        // last step was cut by the line search, when the gradient fell by
+        // less than REFACTOR_RATIO since the previous iteration, or when
+        // the contacts violated now are not those the factor holds. A
+        // contact's penalty is a thousand times stiffer than an edge, so a
+        // factor that holds a contact the last step left (or misses one it
+        // entered) all but pins that particle (or lets it run through):
+        // on the default lily every such step (40 in the late-key stroke's
+        // rerun) left the gradient where it was, and the next iteration
+        // refactorised anyway.
         let slow = self
             .previous_gradient
             .is_some_and(|previous| relative_gradient > REFACTOR_RATIO * previous);
-        if !self.factor_valid || slow || self.last_step_cut {
+        if !self.factor_valid || slow || self.last_step_cut || !self.holds(contacts, positions) {
             self.factorize(elastic, contacts, positions)?;
         }
         self.previous_gradient = Some(relative_gradient);
@@ -382,7 +393,9 @@ impl NewtonSolver {
         positions: &[DVec3],
     ) -> Result<(), SolverError> {
         self.factor_valid = false;
-        elastic.hessian(positions, contacts, &self.pattern, &mut self.hessian);
+        self.held.clear();
+        self.held.extend(violated(contacts, positions));
+        elastic.hessian(positions, &self.held, &self.pattern, &mut self.hessian);
         let n = self.pattern.dimension();
         let mean_diagonal = self.pattern.diagonal(&self.hessian).sum::<f64>() / n as f64;
         if !mean_diagonal.is_finite() {
@@ -435,6 +448,12 @@ impl NewtonSolver {
         Err(SolverError::Factorisation {
             regularisation: extra,
         })
+    }
+
+    /// Whether the factorised Hessian holds the penalty of exactly the
+    /// contacts violated at `positions`.
+    fn holds(&self, contacts: &[Contact], positions: &[DVec3]) -> bool {
+        violated(contacts, positions).eq(self.held.iter())
     }
 
     /// Fills `self.direction` with `-K^-1 g` for the factorised matrix `K`
@@ -688,6 +707,17 @@ fn first_fraction(
     high
 }
 
+/// The contacts of `contacts` violated at `positions` (those whose penalty
+/// acts, and so is in the Hessian), in order.
+fn violated<'a>(
+    contacts: &'a [Contact],
+    positions: &'a [DVec3],
+) -> impl Iterator<Item = &'a Contact> {
+    contacts
+        .iter()
+        .filter(|c| c.violation(positions[c.particle as usize]) > 0.0)
+}
+
 fn max_norm(g: &[DVec3]) -> f64 {
     g.iter().map(|v| v.length()).fold(0.0, f64::max)
 }
@@ -797,6 +827,103 @@ mod tests {
             normal: DVec3::Y,
             offset: 0.0,
         }
+    }
+
+    #[test]
+    fn the_factor_holds_the_contacts_violated_where_it_was_made() {
+        let mesh = test_petal(30.0, 12.0, 9, 17);
+        let topology = Topology::build(&mesh).expect("manifold");
+        let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
+        elastic.contact_stiffness = 1000.0;
+        let mut positions = mesh.positions.clone();
+        // A plane through particle 0 with particle 0 a hair on its wrong
+        // side, and one through particle 1 with particle 1 on its side.
+        let plane = |p: u32, offset: f64| Contact {
+            particle: p,
+            point: positions[p as usize],
+            normal: DVec3::Z,
+            offset,
+        };
+        let contacts = [plane(0, 1e-3), plane(1, -1e-3)];
+        let mut solver = NewtonSolver::new(positions.len(), &elastic).expect("analysis");
+        solver
+            .factorize(&elastic, &contacts, &positions)
+            .expect("positive definite");
+        assert_eq!(solver.held, vec![contacts[0]], "the violated one only");
+        assert!(solver.holds(&contacts, &positions));
+        // Each particle moving within its side keeps the factor ...
+        positions[0].z -= 1e-4;
+        positions[1].z += 1e-4;
+        assert!(solver.holds(&contacts, &positions));
+        // ... particle 0 leaving its contact makes it stale ...
+        positions[0].z += 2e-3;
+        assert!(!solver.holds(&contacts, &positions));
+        // ... and so does particle 1 entering its own.
+        positions[0].z -= 2e-3;
+        positions[1].z -= 3e-3;
+        assert!(!solver.holds(&contacts, &positions));
+    }
+
+    #[test]
+    fn a_step_refactorises_when_the_last_one_left_a_contact() {
+        // A petal held at rest by weak springs on every particle (anchors),
+        // one of them pulled a tenth of an edge away, and its tip particle a hair
+        // inside a contact that a twentieth of that pull draws it off.
+        // The first step (fresh factor, contact held) brings the largest
+        // force down twentyfold but barely moves the tip, which leaves the
+        // contact: modified Newton would keep that factor (the gradient
+        // fell more than tenfold), whose stiff penalty pins the tip, for a
+        // step that leaves its force as it is.
+        let mesh = test_petal(30.0, 12.0, 9, 17);
+        let topology = Topology::build(&mesh).expect("manifold");
+        let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
+        elastic.contact_stiffness = 1000.0;
+        elastic.anchor_stiffness = 1.0;
+        let by_y = |a: &usize, b: &usize| mesh.positions[*a].y.total_cmp(&mesh.positions[*b].y);
+        let tip = (0..mesh.positions.len()).max_by(by_y).expect("particles");
+        let base = (0..mesh.positions.len()).min_by(by_y).expect("particles");
+        let mut positions = mesh.positions.clone();
+        for (i, p) in positions.iter().enumerate() {
+            let pull = match i {
+                _ if i == tip => DVec3::Z * 0.01,
+                _ if i == base => DVec3::X * 0.2,
+                _ => DVec3::ZERO,
+            };
+            elastic.anchors.push((i as u32, *p + pull));
+        }
+        let contacts = [Contact {
+            particle: tip as u32,
+            point: positions[tip],
+            normal: DVec3::Z,
+            offset: 1e-6,
+        }];
+        assert!(contacts[0].violation(positions[tip]) > 0.0);
+        let settings = SolverSettings::default();
+        let mut solver = NewtonSolver::new(positions.len(), &elastic).expect("analysis");
+        solver.begin_keyframe();
+        let first = solver
+            .step(&elastic, &contacts, &mut positions, &settings)
+            .expect("a step");
+        assert!(contacts[0].violation(positions[tip]) < 0.0, "the tip left");
+        let second = solver
+            .step(&elastic, &contacts, &mut positions, &settings)
+            .expect("a step");
+        assert!(
+            second.relative_gradient < 0.1 * first.relative_gradient,
+            "{} after {}: a fall that keeps an unchanged factor",
+            second.relative_gradient,
+            first.relative_gradient
+        );
+        assert_eq!(solver.factorisations(), 2, "a fresh factor without it");
+        let third = solver
+            .step(&elastic, &contacts, &mut positions, &settings)
+            .expect("a step");
+        assert!(
+            third.relative_gradient < 0.1 * second.relative_gradient,
+            "{} after {}: the tip moved",
+            third.relative_gradient,
+            second.relative_gradient
+        );
     }
 
     #[test]
