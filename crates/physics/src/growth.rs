@@ -317,7 +317,7 @@ impl TriangleFrame {
 /// scaled by the edge length).
 ///
 /// Always inlined: called with its four corners copied to the stack, the
-/// regional growth step took 0.35 instead of 0.23 ms on the kernels
+/// regional growth step took 0.36 instead of 0.26 ms on the kernels
 /// example's 1k petal.
 #[inline(always)]
 fn curvature_hinge_angle(x: [DVec3; 4], sides: [&TriangleBend; 2], rest_angle: Option<f64>) -> f64 {
