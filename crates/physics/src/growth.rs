@@ -731,6 +731,21 @@ mod tests {
     }
 
     #[test]
+    fn a_collapsed_edge_keeps_the_angle_it_grows_from() {
+        let side = TriangleBend {
+            normal: DVec3::Z,
+            along: DVec3::Y,
+            kappa_along: 0.1,
+            kappa_across: 0.1,
+            e_in: 1.1,
+            w_in: 1.1,
+        };
+        let x = [DVec3::X, DVec3::X, DVec3::Y, -DVec3::Y];
+        assert_eq!(curvature_hinge_angle(x, [&side, &side], Some(0.3)), 0.3);
+        assert_eq!(curvature_hinge_angle(x, [&side, &side], None), 0.0);
+    }
+
+    #[test]
     fn faster_inner_growth_bends_outwards() {
         let (x, uv) = right_triangle();
         let g = grow_triangle(x, uv, &rates(1.0, 1.0, 1.1, 1.1, DVec2::Y), 0.2, [0.0; 3]);
