@@ -157,7 +157,7 @@ impl BlockPattern {
     /// Adds the block `m` at `slot` (and, by symmetry, its transpose at
     /// the mirrored block) into `values`. For a diagonal block only the
     /// upper triangle of `m` is read.
-    #[inline]
+    #[inline(always)]
     pub fn add_at(values: &mut [f64], slot: &BlockSlot, m: &DMat3) {
         let starts = [
             slot.start,
