@@ -462,6 +462,7 @@ pub fn growth_direction(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rng::TestRng;
 
     fn right_triangle() -> ([DVec3; 3], [DVec2; 3]) {
         (
@@ -541,17 +542,10 @@ mod tests {
         // order). The paper's rule uses the barycentres instead and is off by
         // tens of percent on such triangles.
         let mut mesh = anthesis_mesh::generate::flat_sheet(4.0, 5.0, 6, 7);
-        let mut seed = 3u64;
+        let mut rng = TestRng(3);
         for (p, uv) in mesh.positions.iter_mut().zip(&mut mesh.uvs) {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let a = (seed >> 11) as f64 / (1u64 << 53) as f64;
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let b = (seed >> 11) as f64 / (1u64 << 53) as f64;
-            *p += DVec3::new(a - 0.5, b - 0.5, 0.0) * 0.4;
+            let (a, b) = (rng.centred(), rng.centred());
+            *p += DVec3::new(a, b, 0.0) * 0.4;
             *uv = DVec2::new(p.x / 4.0, p.y / 5.0);
         }
         let topology = Topology::build(&mesh).expect("manifold");
@@ -607,13 +601,8 @@ mod tests {
 
     #[test]
     fn grown_lengths_are_those_of_the_scaled_triangle() {
-        let mut seed = 5u64;
-        let mut rand = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = TestRng(5);
+        let mut rand = || rng.centred();
         for _ in 0..100 {
             let x = [0; 3].map(|_| DVec3::new(rand(), rand(), rand()));
             let uv = [0; 3].map(|_| DVec2::new(rand(), rand()));
@@ -678,13 +667,8 @@ mod tests {
 
     #[test]
     fn hinge_angle_closed_form_matches_the_lifted_hinge() {
-        let mut seed = 11u64;
-        let mut rand = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = TestRng(11);
+        let mut rand = || rng.centred();
         let mut checked = 0;
         for case in 0..400 {
             // A hinge bent by up to ±2.5 rad, corners jittered, the edge

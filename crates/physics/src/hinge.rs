@@ -58,6 +58,7 @@ pub fn dihedral_gradient(x: [DVec3; 4]) -> [DVec3; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rng::TestRng;
 
     fn hinge(angle: f64) -> [DVec3; 4] {
         // Edge along +X, left triangle in the XY plane (normal +Z), right
@@ -82,13 +83,8 @@ mod tests {
 
     #[test]
     fn gradient_matches_central_differences() {
-        let mut seed = 7u64;
-        let mut rand = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut rng = TestRng(7);
+        let mut rand = || rng.centred();
         for a in [0.0, 0.4, -1.1, 2.0] {
             let mut x = hinge(a);
             for p in &mut x {

@@ -13,6 +13,8 @@ pub mod model;
 pub mod pattern;
 pub mod shape_match;
 pub mod solver;
+#[cfg(test)]
+mod test_rng;
 
 pub use elastic::{Contact, Elastic};
 pub use growth::{BendBase, BendRule, GrowthModel, GrowthRates, RegionalGrowth};
