@@ -728,14 +728,19 @@ mod tests {
     use anthesis_mesh::Topology;
     use anthesis_mesh::generate::test_petal;
 
-    /// A petal's Hessian away from rest (springs and hinges both bent),
-    /// factorised, and a gradient.
-    fn factorised_petal() -> (NewtonSolver, Elastic) {
+    /// A test petal's particles and its elastic model at rest there.
+    fn petal_at_rest() -> (Vec<DVec3>, Elastic) {
         let mesh = test_petal(30.0, 12.0, 9, 17);
         let topology = Topology::build(&mesh).expect("manifold");
         let elastic = Elastic::at_rest(&mesh.positions, &topology);
-        let moved: Vec<DVec3> = mesh
-            .positions
+        (mesh.positions, elastic)
+    }
+
+    /// A petal's Hessian away from rest (springs and hinges both bent),
+    /// factorised, and a gradient.
+    fn factorised_petal() -> (NewtonSolver, Elastic) {
+        let (positions, elastic) = petal_at_rest();
+        let moved: Vec<DVec3> = positions
             .iter()
             .enumerate()
             .map(|(i, p)| {
@@ -831,11 +836,8 @@ mod tests {
 
     #[test]
     fn the_factor_holds_the_contacts_violated_where_it_was_made() {
-        let mesh = test_petal(30.0, 12.0, 9, 17);
-        let topology = Topology::build(&mesh).expect("manifold");
-        let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
+        let (mut positions, mut elastic) = petal_at_rest();
         elastic.contact_stiffness = 1000.0;
-        let mut positions = mesh.positions.clone();
         // A plane through particle 0 with particle 0 a hair on its wrong
         // side, and one through particle 1 with particle 1 on its side.
         let plane = |p: u32, offset: f64| Contact {
@@ -874,15 +876,13 @@ mod tests {
         // contact: modified Newton would keep that factor (the gradient
         // fell more than tenfold), whose stiff penalty pins the tip, for a
         // step that leaves its force as it is.
-        let mesh = test_petal(30.0, 12.0, 9, 17);
-        let topology = Topology::build(&mesh).expect("manifold");
-        let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
+        let (bud, mut elastic) = petal_at_rest();
         elastic.contact_stiffness = 1000.0;
         elastic.anchor_stiffness = 1.0;
-        let by_y = |a: &usize, b: &usize| mesh.positions[*a].y.total_cmp(&mesh.positions[*b].y);
-        let tip = (0..mesh.positions.len()).max_by(by_y).expect("particles");
-        let base = (0..mesh.positions.len()).min_by(by_y).expect("particles");
-        let mut positions = mesh.positions.clone();
+        let by_y = |a: &usize, b: &usize| bud[*a].y.total_cmp(&bud[*b].y);
+        let tip = (0..bud.len()).max_by(by_y).expect("particles");
+        let base = (0..bud.len()).min_by(by_y).expect("particles");
+        let mut positions = bud.clone();
         for (i, p) in positions.iter().enumerate() {
             let pull = match i {
                 _ if i == tip => DVec3::Z * 0.01,
