@@ -167,6 +167,18 @@ impl Elastic {
     /// The total energy `E` (springs or membrane, hinges, anchors and the
     /// `contacts`' penalties) at particle positions `x`.
     pub fn energy(&self, x: &[DVec3], contacts: &[Contact]) -> f64 {
+        let e = self.elastic_energy(x);
+        if e == f64::INFINITY {
+            return e;
+        }
+        self.add_penalty_energy(x, contacts, e)
+    }
+
+    /// The energy of the membrane or springs and the hinges alone (no
+    /// contacts, no anchors): the first part of [`Elastic::energy`], and
+    /// the energy [`Elastic::elastic_energy_and_gradient`] computes, bit
+    /// for bit.
+    pub fn elastic_energy(&self, x: &[DVec3]) -> f64 {
         let mut e = 0.0;
         if let Some(m) = &self.membrane {
             e += m.energy(x, &self.rest_lengths, None);
@@ -185,6 +197,13 @@ impl Elastic {
             let d = angle_difference(dihedral_angle(xs), self.rest_angles[edge as usize]);
             e += 0.5 * self.bend_stiffness[edge as usize] * d * d;
         }
+        e
+    }
+
+    /// Adds the `contacts`' penalties and the anchors to `energy` at `x`
+    /// (the rest of [`Elastic::energy`]).
+    fn add_penalty_energy(&self, x: &[DVec3], contacts: &[Contact], energy: f64) -> f64 {
+        let mut e = energy;
         for c in contacts {
             let v = c.violation(x[c.particle as usize]);
             if v > 0.0 {
@@ -208,6 +227,16 @@ impl Elastic {
     /// [`Elastic::energy`], when a triangle has collapsed; `g` is then
     /// meaningless.
     pub fn energy_and_gradient(&self, x: &[DVec3], contacts: &[Contact], g: &mut [DVec3]) -> f64 {
+        let elastic = self.elastic_energy_and_gradient(x, g);
+        self.add_penalties(x, contacts, elastic, g)
+    }
+
+    /// The first part of [`Elastic::energy_and_gradient`]: the energy of
+    /// the membrane or springs and the hinges alone (no contacts, no
+    /// anchors), with its gradient written into `g`; infinite when a
+    /// triangle has collapsed. [`Elastic::add_penalties`] completes it, to
+    /// the same bits as one call of [`Elastic::energy_and_gradient`].
+    pub fn elastic_energy_and_gradient(&self, x: &[DVec3], g: &mut [DVec3]) -> f64 {
         g.iter_mut().for_each(|v| *v = DVec3::ZERO);
         let mut e = 0.0;
         if let Some(m) = &self.membrane {
@@ -235,6 +264,20 @@ impl Elastic {
                 g[*p as usize] += grad * (k * d);
             }
         }
+        if degenerate { f64::INFINITY } else { e }
+    }
+
+    /// Adds the `contacts`' penalties and the anchors to `energy` and to
+    /// the gradient `g` at `x`, in the order [`Elastic::energy_and_gradient`]
+    /// adds them after [`Elastic::elastic_energy_and_gradient`].
+    pub fn add_penalties(
+        &self,
+        x: &[DVec3],
+        contacts: &[Contact],
+        energy: f64,
+        g: &mut [DVec3],
+    ) -> f64 {
+        let mut e = energy;
         for c in contacts {
             let v = c.violation(x[c.particle as usize]);
             if v > 0.0 {
@@ -247,7 +290,8 @@ impl Elastic {
             e += 0.5 * self.anchor_stiffness * offset.length_squared();
             g[p as usize] += offset * self.anchor_stiffness;
         }
-        if degenerate { f64::INFINITY } else { e }
+        // A collapsed triangle's infinity stays (a NaN penalty must not hide it).
+        if energy == f64::INFINITY { energy } else { e }
     }
 
     /// Writes the PSD Hessian approximation into `values` (upper CSC layout

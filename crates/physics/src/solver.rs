@@ -122,6 +122,13 @@ pub struct NewtonSolver {
     gradient: Vec<DVec3>,
     trial: Vec<DVec3>,
     factor_valid: bool,
+    /// The elastic energy [`NewtonSolver::evaluate_start`] evaluated at
+    /// the positions kept in `trial`, and whether its gradient is kept in
+    /// `gradient`, for the step that starts there.
+    start: Option<(f64, bool)>,
+    /// Whether the last keyframe's first step started where
+    /// [`NewtonSolver::evaluate_start`] evaluated.
+    started_there: bool,
     /// The contacts whose penalty the factorised Hessian holds (those that
     /// were violated where it was assembled), in `contacts` order.
     held: Vec<Contact>,
@@ -228,6 +235,8 @@ impl NewtonSolver {
             gradient: vec![DVec3::ZERO; particles],
             trial: vec![DVec3::ZERO; particles],
             factor_valid: false,
+            start: None,
+            started_there: true,
             held: Vec::new(),
             last_step_cut: false,
             previous_gradient: None,
@@ -253,6 +262,7 @@ impl NewtonSolver {
     /// only on the organ's state at its start, so a run can resume from any
     /// keyframe bit for bit.
     pub fn begin_keyframe(&mut self) {
+        self.start = None;
         self.previous_gradient = None;
         self.factor_valid = false;
         self.last_step_cut = false;
@@ -270,8 +280,30 @@ impl NewtonSolver {
         contacts: &[Contact],
         positions: &[DVec3],
     ) -> f64 {
+        self.start = None;
         elastic.gradient(positions, contacts, &mut self.gradient);
         max_norm(&self.gradient) / elastic.force_scale()
+    }
+
+    /// The elastic energy at `positions` without contacts and anchors
+    /// ([`Elastic::elastic_energy`]), for a keyframe's start. Its gradient
+    /// is kept with it: the next [`NewtonSolver::step`], if it starts at
+    /// exactly these positions (same bits) with `elastic` unchanged but
+    /// for its anchors, only adds the penalties instead of evaluating
+    /// energy and gradient again. Where the contacts move the start
+    /// (`start_on_contacts` in the simulation) the step must evaluate
+    /// anyway; the gradient is computed here only if the last keyframe's
+    /// first step did start here, so such a run of keyframes pays for it
+    /// once. Either way the energy has the same bits.
+    pub fn evaluate_start(&mut self, elastic: &Elastic, positions: &[DVec3]) -> f64 {
+        let energy = if self.started_there {
+            elastic.elastic_energy_and_gradient(positions, &mut self.gradient)
+        } else {
+            elastic.elastic_energy(positions)
+        };
+        self.trial.copy_from_slice(positions);
+        self.start = Some((energy, self.started_there));
+        energy
     }
 
     /// One Newton iteration from `positions`: if the gradient already meets
@@ -285,7 +317,16 @@ impl NewtonSolver {
         positions: &mut [DVec3],
         settings: &SolverSettings,
     ) -> Result<StepReport, SolverError> {
-        let energy_before = elastic.energy_and_gradient(positions, contacts, &mut self.gradient);
+        let start = self.start.take();
+        if start.is_some() {
+            self.started_there = same_bits(&self.trial, positions);
+        }
+        let energy_before = match start {
+            Some((energy, true)) if self.started_there => {
+                elastic.add_penalties(positions, contacts, energy, &mut self.gradient)
+            }
+            _ => elastic.energy_and_gradient(positions, contacts, &mut self.gradient),
+        };
         if !energy_before.is_finite() {
             return Err(SolverError::NonFinite);
         }
@@ -548,6 +589,14 @@ fn apply_inverse(
     for (v, &s) in z.iter_mut().zip(single.iter()) {
         *v = f64::from(s);
     }
+}
+
+/// Whether `a` and `b` hold the same positions, bit for bit.
+fn same_bits(a: &[DVec3], b: &[DVec3]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits))
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -924,6 +973,67 @@ mod tests {
             third.relative_gradient,
             second.relative_gradient
         );
+    }
+
+    #[test]
+    fn a_step_from_an_evaluated_start_is_the_step_that_evaluates_it() {
+        // A bent petal with its base anchored and a contact violated: steps
+        // from a start evaluated by `evaluate_start` (elastic part kept,
+        // penalties added by the step) give the bits of plain steps, also
+        // when the positions moved in between (the start is not used) and
+        // in the keyframe after that (no gradient kept).
+        let (bud, mut elastic) = petal_at_rest();
+        elastic.contact_stiffness = 1000.0;
+        elastic.anchor_stiffness = 100.0;
+        elastic.anchors = (0..9).map(|i| (i, bud[i as usize])).collect();
+        let bent: Vec<DVec3> = bud
+            .iter()
+            .map(|p| *p + DVec3::Z * (0.002 * p.y * p.y))
+            .collect();
+        let tip = bent.len() - 1;
+        let contacts = [Contact {
+            particle: tip as u32,
+            point: bent[tip] + DVec3::Z * 0.01,
+            normal: DVec3::Z,
+            offset: 0.0,
+        }];
+        let settings = SolverSettings::default();
+        let bits = |x: &[DVec3]| {
+            x.iter()
+                .map(|p| p.to_array().map(f64::to_bits))
+                .collect::<Vec<_>>()
+        };
+        let mut plain = NewtonSolver::new(bud.len(), &elastic).expect("analysis");
+        let mut started = NewtonSolver::new(bud.len(), &elastic).expect("analysis");
+        // Keyframes starting where the start was evaluated, one starting
+        // elsewhere, then two more (the first without a kept gradient).
+        for (keyframe, moved) in [(0, false), (1, false), (2, true), (3, false), (4, false)] {
+            let mut start = bent.clone();
+            start[tip].z -= 0.001 * keyframe as f64;
+            let (mut x, mut y) = (start.clone(), start.clone());
+            plain.begin_keyframe();
+            started.begin_keyframe();
+            let energy = started.evaluate_start(&elastic, &y);
+            assert_eq!(energy.to_bits(), elastic.elastic_energy(&y).to_bits());
+            let kept = started.start.map(|(_, gradient)| gradient);
+            assert_eq!(
+                kept,
+                Some(keyframe != 3),
+                "keyframe {keyframe}: gradient kept"
+            );
+            if moved {
+                x[3].x += 1e-3;
+                y[3].x += 1e-3;
+            }
+            for _ in 0..3 {
+                let a = plain.step(&elastic, &contacts, &mut x, &settings);
+                let b = started.step(&elastic, &contacts, &mut y, &settings);
+                assert_eq!(a, b, "keyframe {keyframe}");
+                assert_eq!(bits(&x), bits(&y), "keyframe {keyframe}");
+            }
+            assert_eq!(started.started_there, !moved, "keyframe {keyframe}");
+            assert_eq!(started.factorisations(), plain.factorisations());
+        }
     }
 
     #[test]

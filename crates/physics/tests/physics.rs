@@ -134,6 +134,57 @@ fn gradient_matches_finite_differences_on_random_meshes() {
 }
 
 #[test]
+fn the_elastic_part_and_the_penalties_make_the_energy_bit_for_bit() {
+    // The solver's first step of a keyframe adds the penalties to the
+    // elastic part evaluated when the start was chosen: both parts must
+    // give exactly the bits of the one-call evaluations.
+    for seed in 1..=4 {
+        let mut rng = Lcg(seed);
+        let (mesh, topology) = random_petal(&mut rng);
+        let mut elastic = random_elastic(&mut rng, &mesh, &topology, false);
+        if seed % 2 == 0 {
+            with_membrane(&mut rng, &mut elastic, &mesh, &topology);
+        }
+        elastic.anchor_stiffness = 50.0;
+        elastic.anchors = vec![
+            (0, mesh.positions[0] + DVec3::X * 0.1),
+            (5, mesh.positions[5]),
+        ];
+        let contacts = [Contact {
+            particle: 3,
+            point: mesh.positions[3] + DVec3::Z * 0.05,
+            normal: DVec3::Z,
+            offset: 0.01,
+        }];
+        let x: Vec<DVec3> = mesh
+            .positions
+            .iter()
+            .map(|p| *p + rng.vec3() * 0.05)
+            .collect();
+        let mut whole = vec![DVec3::ZERO; x.len()];
+        let energy = elastic.energy_and_gradient(&x, &contacts, &mut whole);
+        let mut parts = vec![DVec3::ZERO; x.len()];
+        let elastic_part = elastic.elastic_energy_and_gradient(&x, &mut parts);
+        assert_eq!(
+            elastic_part.to_bits(),
+            elastic.elastic_energy(&x).to_bits(),
+            "seed {seed}: the elastic part with and without its gradient"
+        );
+        let completed = elastic.add_penalties(&x, &contacts, elastic_part, &mut parts);
+        assert_eq!(completed.to_bits(), energy.to_bits(), "seed {seed}");
+        assert_eq!(flatten(&parts), flatten(&whole), "seed {seed}");
+        assert!(energy > elastic_part, "seed {seed}: the penalties count");
+        // Without penalties the elastic part is the energy.
+        elastic.anchors.clear();
+        assert_eq!(
+            elastic.energy(&x, &[]).to_bits(),
+            elastic_part.to_bits(),
+            "seed {seed}"
+        );
+    }
+}
+
+#[test]
 fn hessian_matches_finite_differences_where_it_is_exact() {
     // The Hessian is exact for stretched springs and for hinges at their rest
     // angle (the Gauss–Newton term is then the whole second derivative), and

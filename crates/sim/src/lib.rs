@@ -514,8 +514,8 @@ impl Simulation {
             if _i == 0 && fault == Some(fault::Fault::PanicAtKeyframe(step)) {
                 panic!("forced fault at keyframe {step} (test hook)");
             }
+            // Growth attaches the organ too (see `OrganSim::predict`).
             o.grow(step);
-            o.attach(step);
         });
 
         for obstacle in &mut self.obstacles {

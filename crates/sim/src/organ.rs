@@ -301,7 +301,9 @@ impl OrganSim {
     }
 
     /// Regional growth for `step`: new rest lengths, rest angles and
-    /// stiffness from the current shape and the maps blended at `step`.
+    /// stiffness from the current shape and the maps blended at `step`;
+    /// then the keyframe's start (see [`OrganSim::predict`]), attached to
+    /// the receptacle at `step`.
     pub fn grow(&mut self, step: u32) {
         if self.two_state.is_some() {
             self.move_to(step);
@@ -340,7 +342,7 @@ impl OrganSim {
         );
         self.update_stiffness(step);
         self.solver.begin_keyframe();
-        self.predict();
+        self.predict(step);
     }
 
     /// Whether this organ is kinematic (a two-state template): its
@@ -388,7 +390,12 @@ impl OrganSim {
     /// the last keyframe is of the size a tenfold tighter tolerance makes.
     /// A prediction that has more energy than the last keyframe's shape (a
     /// snap-through extrapolated too far, a collapsed triangle) is dropped.
-    fn predict(&mut self) {
+    /// Either start is then attached ([`OrganSim::attach`]); the prediction
+    /// is weighed where it will be attached, so that the solver's first
+    /// step, which starts there, takes its energy and gradient from this
+    /// evaluation ([`NewtonSolver::evaluate_start`]; the elastic energy
+    /// does not see the rigid motion).
+    fn predict(&mut self, step: u32) {
         let latest = self
             .saved
             .take()
@@ -405,16 +412,21 @@ impl OrganSim {
             2 => (0..self.positions.len())
                 .map(|i| 2.0 * h[1][i] - h[0][i])
                 .collect(),
-            _ => return,
+            _ => {
+                self.attach(step);
+                return;
+            }
         };
         // Elastic energy only: the anchors still hold last keyframe's
-        // targets, and attachment moves the organ rigidly afterwards.
-        let anchors = std::mem::take(&mut self.elastic.anchors);
-        let now = self.elastic.energy(&self.positions, &[]);
-        let guess = self.elastic.energy(&predicted, &[]);
-        self.elastic.anchors = anchors;
+        // targets.
+        let now = self.elastic.elastic_energy(&self.positions);
+        let (attached, rotation) = self.attached(predicted, step);
+        let guess = self.solver.evaluate_start(&self.elastic, &attached);
         if guess <= now {
-            self.positions = predicted;
+            self.positions = attached;
+            self.rotation_guess = rotation;
+        } else {
+            self.attach(step);
         }
     }
 
@@ -548,21 +560,28 @@ impl OrganSim {
         if self.is_kinematic() {
             return;
         }
+        let positions = std::mem::take(&mut self.positions);
+        (self.positions, self.rotation_guess) = self.attached(positions, step);
+    }
+
+    /// `positions` moved as [`OrganSim::attach`] moves the organ's, with
+    /// the rotation found (the next rotation guess).
+    fn attached(&mut self, mut positions: Vec<DVec3>, step: u32) -> (Vec<DVec3>, DQuat) {
         let extra = joint_angle_after(&self.schedule, step);
         self.base_current.clear();
         self.base_target.clear();
         for &b in &self.base {
-            self.base_current.push(self.positions[b as usize]);
+            self.base_current.push(positions[b as usize]);
             self.base_target.push(
                 self.placement
                     .world_from_template(self.mesh.positions[b as usize], extra),
             );
         }
         let transform = match_shape(&self.base_current, &self.base_target, self.rotation_guess);
-        self.rotation_guess = transform.rotation;
-        for p in &mut self.positions {
+        for p in &mut positions {
             *p = transform.apply(*p);
         }
+        (positions, transform.rotation)
     }
 
     pub fn factorisations(&self) -> u64 {
