@@ -1,5 +1,6 @@
 //! Times one organ's kernels (energy, energy and gradient, Hessian
-//! assembly, membrane update, regional growth) on a test petal with the edge-smoothed
+//! assembly, both in one pass as a keyframe's start, membrane update,
+//! regional growth) on a test petal with the edge-smoothed
 //! membrane, the fastest of several batches (robust on a shared machine).
 //!
 //! ```text
@@ -64,6 +65,14 @@ fn main() {
     fastest("hessian", || {
         elastic.hessian(&x, &[], &pattern, &mut values);
         std::hint::black_box(&values);
+    });
+    fastest("e+g and hessian", || {
+        std::hint::black_box(elastic.elastic_energy_gradient_and_hessian(
+            &x,
+            &mut g,
+            &pattern,
+            &mut values,
+        ));
     });
     fastest("membrane update", || {
         membrane.update(&elastic.rest_lengths, &modulus);

@@ -242,16 +242,7 @@ impl Elastic {
         if let Some(m) = &self.membrane {
             e += m.energy(x, &self.rest_lengths, Some(g));
         }
-        for (idx, &[a, b]) in self.springs() {
-            let d = x[a as usize] - x[b as usize];
-            let len = d.length();
-            let stretch = len - self.rest_lengths[idx];
-            let k = self.stretch_stiffness[idx];
-            e += 0.5 * k * stretch * stretch;
-            let f = d * (k * stretch / len);
-            g[a as usize] += f;
-            g[b as usize] -= f;
-        }
+        self.add_spring_energy_and_gradient(x, &mut e, g);
         let mut degenerate = false;
         for &(stencil, edge) in &self.hinges {
             let xs = stencil.map(|p| x[p as usize]);
@@ -307,6 +298,69 @@ impl Elastic {
         if let Some(m) = &self.membrane {
             m.hessian(x, &self.rest_lengths, pattern, values);
         }
+        self.add_spring_hessian(x, pattern, values);
+        for &(stencil, edge) in &self.hinges {
+            let dtheta = dihedral_gradient(stencil.map(|p| x[p as usize]));
+            self.add_hinge_hessian(stencil, edge, &dtheta, pattern, values);
+        }
+        self.add_penalty_hessian(x, contacts, pattern, values);
+    }
+
+    /// [`Elastic::elastic_energy_and_gradient`] and the elastic part of
+    /// [`Elastic::hessian`] (no contacts, no anchors; `values` overwritten)
+    /// in one pass: the membrane's strains and stresses and the hinges'
+    /// angle gradients computed once for both, the same bits as the
+    /// separate calls. [`Elastic::add_penalties`] and
+    /// [`Elastic::add_penalty_hessian`] complete them.
+    pub fn elastic_energy_gradient_and_hessian(
+        &self,
+        x: &[DVec3],
+        g: &mut [DVec3],
+        pattern: &BlockPattern,
+        values: &mut [f64],
+    ) -> f64 {
+        g.iter_mut().for_each(|v| *v = DVec3::ZERO);
+        values.iter_mut().for_each(|v| *v = 0.0);
+        let mut e = 0.0;
+        if let Some(m) = &self.membrane {
+            e += m.energy_gradient_and_hessian(x, &self.rest_lengths, g, pattern, values);
+        }
+        self.add_spring_energy_and_gradient(x, &mut e, g);
+        self.add_spring_hessian(x, pattern, values);
+        let mut degenerate = false;
+        for &(stencil, edge) in &self.hinges {
+            let xs = stencil.map(|p| x[p as usize]);
+            degenerate |= hinge_is_degenerate(xs);
+            let k = self.bend_stiffness[edge as usize];
+            let d = angle_difference(dihedral_angle(xs), self.rest_angles[edge as usize]);
+            e += 0.5 * k * d * d;
+            let dtheta = dihedral_gradient(xs);
+            for (p, grad) in stencil.iter().zip(dtheta) {
+                g[*p as usize] += grad * (k * d);
+            }
+            self.add_hinge_hessian(stencil, edge, &dtheta, pattern, values);
+        }
+        if degenerate { f64::INFINITY } else { e }
+    }
+
+    /// Adds the springs' energy to `e` (one spring at a time) and their
+    /// gradient to `g` (none with the membrane).
+    #[inline(always)]
+    fn add_spring_energy_and_gradient(&self, x: &[DVec3], e: &mut f64, g: &mut [DVec3]) {
+        for (idx, &[a, b]) in self.springs() {
+            let d = x[a as usize] - x[b as usize];
+            let len = d.length();
+            let stretch = len - self.rest_lengths[idx];
+            let k = self.stretch_stiffness[idx];
+            *e += 0.5 * k * stretch * stretch;
+            let f = d * (k * stretch / len);
+            g[a as usize] += f;
+            g[b as usize] -= f;
+        }
+    }
+
+    /// The springs' Hessian blocks (none with the membrane).
+    fn add_spring_hessian(&self, x: &[DVec3], pattern: &BlockPattern, values: &mut [f64]) {
         for (idx, &[a, b]) in self.springs() {
             let d = x[a as usize] - x[b as usize];
             let len = d.length();
@@ -319,17 +373,38 @@ impl Elastic {
             BlockPattern::add_at(values, slots.slot(1, 1), &block);
             BlockPattern::add_at(values, slots.slot(0, 1), &(-block));
         }
-        for &(stencil, edge) in &self.hinges {
-            let dtheta = dihedral_gradient(stencil.map(|p| x[p as usize]));
-            let k = self.bend_stiffness[edge as usize];
-            let slots = pattern.stencil(edge as usize, stencil);
-            for r in 0..4 {
-                for c in r..4 {
-                    let block = outer(dtheta[r], dtheta[c]) * k;
-                    BlockPattern::add_at(values, slots.slot(r, c), &block);
-                }
+    }
+
+    /// The Gauss–Newton blocks `kb ∇θ ∇θᵀ` of the hinge `stencil` of edge
+    /// `edge`, with its angle's gradient `dtheta`.
+    #[inline(always)]
+    fn add_hinge_hessian(
+        &self,
+        stencil: [u32; 4],
+        edge: u32,
+        dtheta: &[DVec3; 4],
+        pattern: &BlockPattern,
+        values: &mut [f64],
+    ) {
+        let k = self.bend_stiffness[edge as usize];
+        let slots = pattern.stencil(edge as usize, stencil);
+        for r in 0..4 {
+            for c in r..4 {
+                let block = outer(dtheta[r], dtheta[c]) * k;
+                BlockPattern::add_at(values, slots.slot(r, c), &block);
             }
         }
+    }
+
+    /// Adds the Hessian blocks of the violated `contacts`' penalties and
+    /// of the anchors (the rest of [`Elastic::hessian`]).
+    pub fn add_penalty_hessian(
+        &self,
+        x: &[DVec3],
+        contacts: &[Contact],
+        pattern: &BlockPattern,
+        values: &mut [f64],
+    ) {
         for c in contacts {
             if c.violation(x[c.particle as usize]) > 0.0 {
                 let block = outer(c.normal, c.normal) * self.contact_stiffness;

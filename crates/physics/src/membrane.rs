@@ -243,46 +243,87 @@ impl EdgeSmoothedMembrane {
         for (e, d) in self.domains.iter().enumerate() {
             let (s, v) = Self::strains(d, x, rest_lengths);
             let r = Self::stresses(d, &s);
-            // Summed per pair of the domain's (three or four) particles
-            // first, then added to the sparse matrix once per pair.
-            let particles = d.count.div_ceil(2) + 1;
-            // Only the blocks p <= q are added to the (symmetric) matrix.
-            let mut local = [[DMat3::ZERO; 4]; 4];
-            let mut add = |p: usize, q: usize, block: &DMat3, minus: bool| {
-                if p <= q {
-                    if minus {
-                        local[p][q] -= *block;
-                    } else {
-                        local[p][q] += *block;
-                    }
-                }
-            };
-            for a in 0..d.count {
-                let [la, lb] = SLOT_PARTICLES[a];
-                if r[a] > 0.0 {
-                    let block = DMat3::IDENTITY * r[a];
-                    add(la, la, &block, false);
-                    add(lb, lb, &block, false);
-                    add(la, lb, &block, true);
-                    add(lb, la, &block, true);
-                }
-                for b in 0..d.count {
-                    let [qa, qb] = SLOT_PARTICLES[b];
-                    // ∇s_a is +v_a at la and −v_a at lb.
-                    let block = outer(v[a], v[b]) * d.q[a][b];
-                    add(la, qa, &block, false);
-                    add(la, qb, &block, true);
-                    add(lb, qa, &block, true);
-                    add(lb, qb, &block, false);
+            Self::add_domain_hessian(e, d, &v, &r, pattern, values);
+        }
+    }
+
+    /// [`EdgeSmoothedMembrane::energy`] with its gradient added to
+    /// `gradient` and [`EdgeSmoothedMembrane::hessian`] added to `values`,
+    /// in one pass: each domain's strains and stresses computed once for
+    /// all three, the same bits as the two calls.
+    pub fn energy_gradient_and_hessian(
+        &self,
+        x: &[DVec3],
+        rest_lengths: &[f64],
+        gradient: &mut [DVec3],
+        pattern: &BlockPattern,
+        values: &mut [f64],
+    ) -> f64 {
+        let mut energy = 0.0;
+        for (e, d) in self.domains.iter().enumerate() {
+            let (s, v) = Self::strains(d, x, rest_lengths);
+            let r = Self::stresses(d, &s);
+            energy += 0.5 * (0..d.count).map(|k| s[k] * r[k]).sum::<f64>();
+            for k in 0..d.count {
+                let [a, b] = d.pairs[k];
+                gradient[a as usize] += v[k] * r[k];
+                gradient[b as usize] -= v[k] * r[k];
+            }
+            Self::add_domain_hessian(e, d, &v, &r, pattern, values);
+        }
+        energy
+    }
+
+    /// Adds domain `e`'s Hessian blocks for edge vectors `v` and stresses
+    /// `r` into `values`.
+    #[inline(always)]
+    fn add_domain_hessian(
+        e: usize,
+        d: &Domain,
+        v: &[DVec3; 5],
+        r: &[f64; 5],
+        pattern: &BlockPattern,
+        values: &mut [f64],
+    ) {
+        // Summed per pair of the domain's (three or four) particles
+        // first, then added to the sparse matrix once per pair.
+        let particles = d.count.div_ceil(2) + 1;
+        // Only the blocks p <= q are added to the (symmetric) matrix.
+        let mut local = [[DMat3::ZERO; 4]; 4];
+        let mut add = |p: usize, q: usize, block: &DMat3, minus: bool| {
+            if p <= q {
+                if minus {
+                    local[p][q] -= *block;
+                } else {
+                    local[p][q] += *block;
                 }
             }
-            let stencil = pattern.stencil(e, Self::stencil(d));
-            for p in 0..particles {
-                for q in p..particles {
-                    // The slot mirrors (p, q) to (q, p); for p == q only
-                    // the upper triangle of the (symmetric) block is used.
-                    BlockPattern::add_at(values, stencil.slot(p, q), &local[p][q]);
-                }
+        };
+        for a in 0..d.count {
+            let [la, lb] = SLOT_PARTICLES[a];
+            if r[a] > 0.0 {
+                let block = DMat3::IDENTITY * r[a];
+                add(la, la, &block, false);
+                add(lb, lb, &block, false);
+                add(la, lb, &block, true);
+                add(lb, la, &block, true);
+            }
+            for b in 0..d.count {
+                let [qa, qb] = SLOT_PARTICLES[b];
+                // ∇s_a is +v_a at la and −v_a at lb.
+                let block = outer(v[a], v[b]) * d.q[a][b];
+                add(la, qa, &block, false);
+                add(la, qb, &block, true);
+                add(lb, qa, &block, true);
+                add(lb, qb, &block, false);
+            }
+        }
+        let stencil = pattern.stencil(e, Self::stencil(d));
+        for p in 0..particles {
+            for q in p..particles {
+                // The slot mirrors (p, q) to (q, p); for p == q only
+                // the upper triangle of the (symmetric) block is used.
+                BlockPattern::add_at(values, stencil.slot(p, q), &local[p][q]);
             }
         }
     }

@@ -129,6 +129,9 @@ pub struct NewtonSolver {
     /// Whether the last keyframe's first step started where
     /// [`NewtonSolver::evaluate_start`] evaluated.
     started_there: bool,
+    /// Whether `hessian` holds the elastic part of the Hessian at the
+    /// positions of this step (assembled with the start's gradient).
+    hessian_at_start: bool,
     /// The contacts whose penalty the factorised Hessian holds (those that
     /// were violated where it was assembled), in `contacts` order.
     held: Vec<Contact>,
@@ -237,6 +240,7 @@ impl NewtonSolver {
             factor_valid: false,
             start: None,
             started_there: true,
+            hessian_at_start: false,
             held: Vec::new(),
             last_step_cut: false,
             previous_gradient: None,
@@ -294,10 +298,18 @@ impl NewtonSolver {
     /// (`start_on_contacts` in the simulation) the step must evaluate
     /// anyway; the gradient is computed here only if the last keyframe's
     /// first step did start here, so such a run of keyframes pays for it
-    /// once. Either way the energy has the same bits.
+    /// once. Either way the energy has the same bits. With the gradient,
+    /// the elastic part of the Hessian is assembled in the same pass (the
+    /// first step of a keyframe factorises: the solver keeps no factor
+    /// across keyframes).
     pub fn evaluate_start(&mut self, elastic: &Elastic, positions: &[DVec3]) -> f64 {
         let energy = if self.started_there {
-            elastic.elastic_energy_and_gradient(positions, &mut self.gradient)
+            elastic.elastic_energy_gradient_and_hessian(
+                positions,
+                &mut self.gradient,
+                &self.pattern,
+                &mut self.hessian,
+            )
         } else {
             elastic.elastic_energy(positions)
         };
@@ -321,6 +333,7 @@ impl NewtonSolver {
         if start.is_some() {
             self.started_there = same_bits(&self.trial, positions);
         }
+        self.hessian_at_start = matches!(start, Some((_, true))) && self.started_there;
         let energy_before = match start {
             Some((energy, true)) if self.started_there => {
                 elastic.add_penalties(positions, contacts, energy, &mut self.gradient)
@@ -436,7 +449,11 @@ impl NewtonSolver {
         self.factor_valid = false;
         self.held.clear();
         self.held.extend(violated(contacts, positions));
-        elastic.hessian(positions, &self.held, &self.pattern, &mut self.hessian);
+        if std::mem::take(&mut self.hessian_at_start) {
+            elastic.add_penalty_hessian(positions, &self.held, &self.pattern, &mut self.hessian);
+        } else {
+            elastic.hessian(positions, &self.held, &self.pattern, &mut self.hessian);
+        }
         let n = self.pattern.dimension();
         let mean_diagonal = self.pattern.diagonal(&self.hessian).sum::<f64>() / n as f64;
         if !mean_diagonal.is_finite() {
@@ -978,8 +995,9 @@ mod tests {
     #[test]
     fn a_step_from_an_evaluated_start_is_the_step_that_evaluates_it() {
         // A bent petal with its base anchored and a contact violated: steps
-        // from a start evaluated by `evaluate_start` (elastic part kept,
-        // penalties added by the step) give the bits of plain steps, also
+        // from a start evaluated by `evaluate_start` (the elastic energy,
+        // gradient and Hessian kept, the penalties added by the step and
+        // its factorisation) give the bits of plain steps, also
         // when the positions moved in between (the start is not used) and
         // in the keyframe after that (no gradient kept).
         let (bud, mut elastic) = petal_at_rest();

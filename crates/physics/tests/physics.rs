@@ -134,7 +134,7 @@ fn gradient_matches_finite_differences_on_random_meshes() {
 }
 
 #[test]
-fn the_elastic_part_and_the_penalties_make_the_energy_bit_for_bit() {
+fn the_elastic_part_and_the_penalties_make_energy_gradient_and_hessian_bit_for_bit() {
     // The solver's first step of a keyframe adds the penalties to the
     // elastic part evaluated when the start was chosen: both parts must
     // give exactly the bits of the one-call evaluations.
@@ -174,6 +174,25 @@ fn the_elastic_part_and_the_penalties_make_the_energy_bit_for_bit() {
         assert_eq!(completed.to_bits(), energy.to_bits(), "seed {seed}");
         assert_eq!(flatten(&parts), flatten(&whole), "seed {seed}");
         assert!(energy > elastic_part, "seed {seed}: the penalties count");
+        // The Hessian's elastic part assembled in the same pass, then the
+        // penalties' blocks: the bits of one Hessian call.
+        let pattern = elastic.pattern(x.len());
+        let mut hessian = vec![0.0; pattern.nonzeros()];
+        elastic.hessian(&x, &contacts, &pattern, &mut hessian);
+        let mut fused = vec![1.0; pattern.nonzeros()];
+        let mut fused_g = vec![DVec3::ONE; x.len()];
+        let fused_energy =
+            elastic.elastic_energy_gradient_and_hessian(&x, &mut fused_g, &pattern, &mut fused);
+        assert_eq!(
+            fused_energy.to_bits(),
+            elastic_part.to_bits(),
+            "seed {seed}"
+        );
+        elastic.add_penalty_hessian(&x, &contacts, &pattern, &mut fused);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&fused), bits(&hessian), "seed {seed}");
+        elastic.add_penalties(&x, &contacts, fused_energy, &mut fused_g);
+        assert_eq!(flatten(&fused_g), flatten(&whole), "seed {seed}");
         // Without penalties the elastic part is the energy.
         elastic.anchors.clear();
         assert_eq!(
