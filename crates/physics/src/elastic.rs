@@ -202,7 +202,7 @@ impl Elastic {
 
     /// Adds the `contacts`' penalties and the anchors to `energy` at `x`
     /// (the rest of [`Elastic::energy`]).
-    fn add_penalty_energy(&self, x: &[DVec3], contacts: &[Contact], energy: f64) -> f64 {
+    pub fn add_penalty_energy(&self, x: &[DVec3], contacts: &[Contact], energy: f64) -> f64 {
         let mut e = energy;
         for c in contacts {
             let v = c.violation(x[c.particle as usize]);

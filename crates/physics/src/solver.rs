@@ -132,6 +132,11 @@ pub struct NewtonSolver {
     /// Whether `hessian` holds the elastic part of the Hessian at the
     /// positions of this step (assembled with the start's gradient).
     hessian_at_start: bool,
+    /// The elastic energy (without contacts and anchors) at the positions
+    /// where the last step found the keyframe converged, kept in
+    /// `converged`; `None` after a step that did not converge.
+    converged_elastic_energy: Option<f64>,
+    converged: Vec<DVec3>,
     /// The contacts whose penalty the factorised Hessian holds (those that
     /// were violated where it was assembled), in `contacts` order.
     held: Vec<Contact>,
@@ -241,6 +246,8 @@ impl NewtonSolver {
             start: None,
             started_there: true,
             hessian_at_start: false,
+            converged_elastic_energy: None,
+            converged: vec![DVec3::ZERO; particles],
             held: Vec::new(),
             last_step_cut: false,
             previous_gradient: None,
@@ -267,9 +274,18 @@ impl NewtonSolver {
     /// keyframe bit for bit.
     pub fn begin_keyframe(&mut self) {
         self.start = None;
+        self.converged_elastic_energy = None;
         self.previous_gradient = None;
         self.factor_valid = false;
         self.last_step_cut = false;
+    }
+
+    /// The elastic energy (without contacts and anchors) at `positions`,
+    /// if the last [`NewtonSolver::step`] found the keyframe converged at
+    /// exactly these positions (same bits) and evaluated it there.
+    pub fn converged_elastic_energy(&self, positions: &[DVec3]) -> Option<f64> {
+        self.converged_elastic_energy
+            .filter(|_| same_bits(&self.converged, positions))
     }
 
     /// How many numeric factorisations this solver has done.
@@ -334,12 +350,14 @@ impl NewtonSolver {
             self.started_there = same_bits(&self.trial, positions);
         }
         self.hessian_at_start = matches!(start, Some((_, true))) && self.started_there;
-        let energy_before = match start {
-            Some((energy, true)) if self.started_there => {
-                elastic.add_penalties(positions, contacts, energy, &mut self.gradient)
-            }
-            _ => elastic.energy_and_gradient(positions, contacts, &mut self.gradient),
+        self.converged_elastic_energy = None;
+        // `energy_and_gradient` in its two parts, the elastic one kept.
+        let elastic_energy = match start {
+            Some((energy, true)) if self.started_there => energy,
+            _ => elastic.elastic_energy_and_gradient(positions, &mut self.gradient),
         };
+        let energy_before =
+            elastic.add_penalties(positions, contacts, elastic_energy, &mut self.gradient);
         if !energy_before.is_finite() {
             return Err(SolverError::NonFinite);
         }
@@ -348,6 +366,8 @@ impl NewtonSolver {
             return Err(SolverError::NonFinite);
         }
         if relative_gradient <= settings.relative_tolerance {
+            self.converged_elastic_energy = Some(elastic_energy);
+            self.converged.copy_from_slice(positions);
             return Ok(StepReport {
                 energy_before,
                 energy_after: energy_before,
@@ -394,6 +414,8 @@ impl NewtonSolver {
             // The best possible decrease is below what the energy can
             // resolve in floating point: this is a minimum to machine
             // precision, even if the gradient is above the tolerance.
+            self.converged_elastic_energy = Some(elastic_energy);
+            self.converged.copy_from_slice(positions);
             return Ok(StepReport {
                 energy_before,
                 energy_after: energy_before,
