@@ -130,8 +130,8 @@ pub struct NewtonSolver {
     /// [`NewtonSolver::evaluate_start`] evaluated.
     started_there: bool,
     /// Whether `hessian` holds the elastic part of the Hessian at the
-    /// positions of this step (assembled with the start's gradient).
-    hessian_at_start: bool,
+    /// positions of this step (assembled with its gradient).
+    hessian_here: bool,
     /// The elastic energy (without contacts and anchors) at the positions
     /// where the last step found the keyframe converged, kept in
     /// `converged`; `None` after a step that did not converge.
@@ -245,7 +245,7 @@ impl NewtonSolver {
             factor_valid: false,
             start: None,
             started_there: true,
-            hessian_at_start: false,
+            hessian_here: false,
             converged_elastic_energy: None,
             converged: vec![DVec3::ZERO; particles],
             held: Vec::new(),
@@ -349,11 +349,22 @@ impl NewtonSolver {
         if start.is_some() {
             self.started_there = same_bits(&self.trial, positions);
         }
-        self.hessian_at_start = matches!(start, Some((_, true))) && self.started_there;
+        self.hessian_here = matches!(start, Some((_, true))) && self.started_there;
         self.converged_elastic_energy = None;
         // `energy_and_gradient` in its two parts, the elastic one kept.
         let elastic_energy = match start {
             Some((energy, true)) if self.started_there => energy,
+            // This step factorises (unless the keyframe has converged
+            // already): the Hessian's elastic part in the same pass.
+            _ if !self.factor_valid => {
+                self.hessian_here = true;
+                elastic.elastic_energy_gradient_and_hessian(
+                    positions,
+                    &mut self.gradient,
+                    &self.pattern,
+                    &mut self.hessian,
+                )
+            }
             _ => elastic.elastic_energy_and_gradient(positions, &mut self.gradient),
         };
         let energy_before =
@@ -471,7 +482,7 @@ impl NewtonSolver {
         self.factor_valid = false;
         self.held.clear();
         self.held.extend(violated(contacts, positions));
-        if std::mem::take(&mut self.hessian_at_start) {
+        if std::mem::take(&mut self.hessian_here) {
             elastic.add_penalty_hessian(positions, &self.held, &self.pattern, &mut self.hessian);
         } else {
             elastic.hessian(positions, &self.held, &self.pattern, &mut self.hessian);
