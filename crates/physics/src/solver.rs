@@ -9,7 +9,7 @@
 //! Newton direction is then solved by conjugate gradients on the
 //! double-precision matrix that was factorised, preconditioned with the
 //! factor, until its residual lies far below the convergence tolerance
-//! (one or two iterations), so Newton goes as with the exact solve.
+//! (one to three iterations), so Newton goes as with the exact solve.
 //!
 //! The paper takes implicit-Euler steps `(I/h + H) dx = -grad E` with CG; a
 //! Newton step is the limit `h -> infinity`, regularised just enough to be
@@ -169,8 +169,8 @@ const REFACTOR_RATIO: f64 = 0.1;
 const CG_TOLERANCE: f64 = 0.05;
 
 /// Conjugate-gradient iterations allowed per direction; with the factor of
-/// the same matrix one or two suffice on the lily, up to eight in the
-/// bending-strip tests.
+/// the same matrix one to three suffice on the lily, up to about ten in
+/// the bending-strip tests.
 const MAX_CG: usize = 20;
 
 /// Buffers of the conjugate-gradient refinement, in `Ordered`'s order.
