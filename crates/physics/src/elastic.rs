@@ -245,17 +245,33 @@ impl Elastic {
         self.add_spring_energy_and_gradient(x, &mut e, g);
         let mut degenerate = false;
         for &(stencil, edge) in &self.hinges {
-            let xs = stencil.map(|p| x[p as usize]);
-            degenerate |= hinge_is_degenerate(xs);
-            let k = self.bend_stiffness[edge as usize];
-            let d = angle_difference(dihedral_angle(xs), self.rest_angles[edge as usize]);
-            e += 0.5 * k * d * d;
-            let dtheta = dihedral_gradient(xs);
-            for (p, grad) in stencil.iter().zip(dtheta) {
-                g[*p as usize] += grad * (k * d);
-            }
+            self.add_hinge_energy_and_gradient(x, stencil, edge, &mut e, g, &mut degenerate);
         }
         if degenerate { f64::INFINITY } else { e }
+    }
+
+    /// Adds one hinge's bending energy to `e` and its gradient to `g`
+    /// (`degenerate` set if either triangle has collapsed); returns the
+    /// angle's gradient for the Hessian.
+    fn add_hinge_energy_and_gradient(
+        &self,
+        x: &[DVec3],
+        stencil: [u32; 4],
+        edge: u32,
+        e: &mut f64,
+        g: &mut [DVec3],
+        degenerate: &mut bool,
+    ) -> [DVec3; 4] {
+        let xs = stencil.map(|p| x[p as usize]);
+        *degenerate |= hinge_is_degenerate(xs);
+        let k = self.bend_stiffness[edge as usize];
+        let d = angle_difference(dihedral_angle(xs), self.rest_angles[edge as usize]);
+        *e += 0.5 * k * d * d;
+        let dtheta = dihedral_gradient(xs);
+        for (p, grad) in stencil.iter().zip(dtheta) {
+            g[*p as usize] += grad * (k * d);
+        }
+        dtheta
     }
 
     /// Adds the `contacts`' penalties and the anchors to `energy` and to
@@ -329,15 +345,8 @@ impl Elastic {
         self.add_spring_hessian(x, pattern, values);
         let mut degenerate = false;
         for &(stencil, edge) in &self.hinges {
-            let xs = stencil.map(|p| x[p as usize]);
-            degenerate |= hinge_is_degenerate(xs);
-            let k = self.bend_stiffness[edge as usize];
-            let d = angle_difference(dihedral_angle(xs), self.rest_angles[edge as usize]);
-            e += 0.5 * k * d * d;
-            let dtheta = dihedral_gradient(xs);
-            for (p, grad) in stencil.iter().zip(dtheta) {
-                g[*p as usize] += grad * (k * d);
-            }
+            let dtheta =
+                self.add_hinge_energy_and_gradient(x, stencil, edge, &mut e, g, &mut degenerate);
             self.add_hinge_hessian(stencil, edge, &dtheta, pattern, values);
         }
         if degenerate { f64::INFINITY } else { e }
