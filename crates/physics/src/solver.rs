@@ -649,8 +649,9 @@ fn apply_inverse(
     }
 }
 
-/// Whether `a` and `b` hold the same positions, bit for bit.
-fn same_bits(a: &[DVec3], b: &[DVec3]) -> bool {
+/// Whether `a` and `b` hold the same positions, bit for bit (a value
+/// computed at `a` may then be reused at `b`).
+pub fn same_bits(a: &[DVec3], b: &[DVec3]) -> bool {
     a.len() == b.len()
         && a.iter()
             .zip(b)

@@ -8,6 +8,7 @@ use anthesis_mesh::{Mesh, Topology};
 use anthesis_physics::elastic::edge_areas_into;
 use anthesis_physics::membrane::EdgeSmoothedMembrane;
 use anthesis_physics::shape_match::match_shape;
+use anthesis_physics::solver::same_bits;
 use anthesis_physics::{
     Contact, Elastic, GrowthModel, GrowthRates, Model, NewtonSolver, RegionalGrowth, SolverError,
     SolverSettings, StepReport,
@@ -690,19 +691,11 @@ impl OrganSim {
     }
 }
 
-/// Whether `a` and `b` hold the same positions, bit for bit.
-fn same_bits(a: &[DVec3], b: &[DVec3]) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits))
-}
-
 #[cfg(test)]
 mod tests {
-    use super::same_bits;
     use crate::fixtures::whorl;
     use crate::{Selection, Simulation};
+    use anthesis_physics::solver::same_bits;
 
     #[test]
     fn a_settled_organs_energy_is_its_solvers_up_to_rounding() {
