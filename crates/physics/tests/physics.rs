@@ -75,6 +75,18 @@ fn with_membrane(rng: &mut Lcg, elastic: &mut Elastic, mesh: &Mesh, topology: &T
     elastic.membrane = Some(membrane);
 }
 
+/// A random petal and elastic model for `seed` (springs for odd seeds, the
+/// membrane for even ones), with the generator to go on drawing from.
+fn random_case(seed: u64) -> (Lcg, Mesh, Elastic) {
+    let mut rng = Lcg(seed);
+    let (mesh, topology) = random_petal(&mut rng);
+    let mut elastic = random_elastic(&mut rng, &mesh, &topology, false);
+    if seed.is_multiple_of(2) {
+        with_membrane(&mut rng, &mut elastic, &mesh, &topology);
+    }
+    (rng, mesh, elastic)
+}
+
 fn flatten(v: &[DVec3]) -> Vec<f64> {
     v.iter().flat_map(|p| p.to_array()).collect()
 }
@@ -82,12 +94,7 @@ fn flatten(v: &[DVec3]) -> Vec<f64> {
 #[test]
 fn gradient_matches_finite_differences_on_random_meshes() {
     for seed in 1..=4 {
-        let mut rng = Lcg(seed);
-        let (mesh, topology) = random_petal(&mut rng);
-        let mut elastic = random_elastic(&mut rng, &mesh, &topology, false);
-        if seed % 2 == 0 {
-            with_membrane(&mut rng, &mut elastic, &mesh, &topology);
-        }
+        let (_, mesh, elastic) = random_case(seed);
         // Two contacts, one violated and one satisfied.
         let contacts = [
             Contact {
@@ -139,12 +146,7 @@ fn the_elastic_part_and_the_penalties_make_energy_gradient_and_hessian_bit_for_b
     // elastic part evaluated when the start was chosen: both parts must
     // give exactly the bits of the one-call evaluations.
     for seed in 1..=4 {
-        let mut rng = Lcg(seed);
-        let (mesh, topology) = random_petal(&mut rng);
-        let mut elastic = random_elastic(&mut rng, &mesh, &topology, false);
-        if seed % 2 == 0 {
-            with_membrane(&mut rng, &mut elastic, &mesh, &topology);
-        }
+        let (mut rng, mesh, mut elastic) = random_case(seed);
         elastic.anchor_stiffness = 50.0;
         elastic.anchors = vec![
             (0, mesh.positions[0] + DVec3::X * 0.1),
