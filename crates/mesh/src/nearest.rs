@@ -64,6 +64,64 @@ pub fn triangles_around(triangles: &[[u32; 3]], vertex_count: usize) -> Vec<Vec<
     around
 }
 
+/// The triangles around each vertex of a mesh, and the ring of triangles
+/// just beyond them: what the nearest point on a surface is looked for
+/// among, near the nearest vertex. Both depend only on the triangles, so
+/// an organ builds them once; looking the outer ring up in every contact
+/// search (collecting, sorting and deduplicating the triangles around the
+/// corners) was a tenth of that search's time.
+#[derive(Debug, Clone, Default)]
+pub struct TriangleRings {
+    /// Vertex `v`'s triangles are `triangles[start[v]..beyond[v]]`, the
+    /// ring beyond them `triangles[beyond[v]..start[v + 1]]`.
+    start: Vec<u32>,
+    beyond: Vec<u32>,
+    triangles: Vec<u32>,
+}
+
+impl TriangleRings {
+    /// The rings of `triangles` over `vertex_count` vertices.
+    pub fn new(triangles: &[[u32; 3]], vertex_count: usize) -> TriangleRings {
+        let around = triangles_around(triangles, vertex_count);
+        let mut rings = TriangleRings {
+            start: Vec::with_capacity(vertex_count + 1),
+            beyond: Vec::with_capacity(vertex_count),
+            triangles: Vec::new(),
+        };
+        let mut ring = Vec::new();
+        for own in &around {
+            rings.start.push(rings.triangles.len() as u32);
+            rings.triangles.extend_from_slice(own);
+            rings.beyond.push(rings.triangles.len() as u32);
+            ring.clear();
+            ring.extend(
+                own.iter()
+                    .flat_map(|&t| triangles[t as usize])
+                    .flat_map(|v| around[v as usize].iter().copied())
+                    .filter(|t| own.binary_search(t).is_err()),
+            );
+            ring.sort_unstable();
+            ring.dedup();
+            rings.triangles.extend_from_slice(&ring);
+        }
+        rings.start.push(rings.triangles.len() as u32);
+        rings
+    }
+
+    /// The triangles around vertex `v` (ascending).
+    pub fn around(&self, v: u32) -> &[u32] {
+        let v = v as usize;
+        &self.triangles[self.start[v] as usize..self.beyond[v] as usize]
+    }
+
+    /// The triangles around the corners of `v`'s triangles that are not
+    /// around `v` itself (ascending): the next ring out.
+    pub fn beyond(&self, v: u32) -> &[u32] {
+        let v = v as usize;
+        &self.triangles[self.beyond[v] as usize..self.start[v + 1] as usize]
+    }
+}
+
 /// A point of the curved surface that Phong tessellation puts through a
 /// triangle from its corners' unit normals: the flat point with
 /// barycentric `weights`, moved half way towards the blend (same weights)
@@ -145,6 +203,23 @@ mod tests {
             around,
             vec![vec![0], vec![0, 1], vec![0, 1], vec![1], vec![]]
         );
+    }
+
+    #[test]
+    fn the_ring_beyond_a_vertex_holds_the_triangles_around_its_neighbours_only() {
+        // A strip of four triangles over vertices 0..6:
+        // 0-2-4
+        // |/|/|
+        // 1-3-5
+        let triangles = [[0, 1, 2], [2, 1, 3], [2, 3, 4], [4, 3, 5]];
+        let rings = TriangleRings::new(&triangles, 7);
+        assert_eq!(rings.around(0), &[0]);
+        assert_eq!(rings.beyond(0), &[1, 2]);
+        assert_eq!(rings.around(2), &[0, 1, 2]);
+        assert_eq!(rings.beyond(2), &[3]);
+        assert_eq!(rings.around(5), &[3]);
+        assert_eq!(rings.beyond(5), &[1, 2]);
+        assert!(rings.around(6).is_empty() && rings.beyond(6).is_empty());
     }
 
     #[test]

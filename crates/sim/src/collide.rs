@@ -13,7 +13,7 @@
 //! converges; after convergence the paper's push-back moves every particle
 //! still short of its side onto it, `offset` past the neighbour.
 
-use anthesis_mesh::nearest::{closest_point_on_triangle, on_rim, phong_point};
+use anthesis_mesh::nearest::{TriangleRings, closest_point_on_triangle, on_rim, phong_point};
 use anthesis_physics::Contact;
 use glam::DVec3;
 
@@ -25,8 +25,8 @@ pub struct Surface<'a> {
     pub normals: &'a [DVec3],
     /// The organ's triangles, as indices into `positions`.
     pub triangles: &'a [[u32; 3]],
-    /// The triangles around each particle.
-    pub triangles_around: &'a [Vec<u32>],
+    /// The triangles around each particle, and the ring beyond them.
+    pub rings: &'a TriangleRings,
     /// Whether each particle is on the organ's rim (its boundary).
     pub rim: &'a [bool],
     /// Mean edge length, which sets the search radius.
@@ -280,37 +280,33 @@ struct Nearest {
 /// `q` (the normal blended from the corners' normals with the point's
 /// barycentric weights). `None` when `q` has no triangles or a zero normal.
 fn nearest_on_surface(x: DVec3, surface: &Surface, q: u32) -> Option<Nearest> {
-    let around = &surface.triangles_around;
-    let nearest_among = |triangles: &mut dyn Iterator<Item = u32>| {
-        let mut best: Option<(f64, [u32; 3], [f64; 3])> = None;
-        for t in triangles {
-            let tri = surface.triangles[t as usize];
-            let [a, b, c] = tri.map(|k| surface.positions[k as usize]);
-            let (flat, weights) = closest_point_on_triangle(x, a, b, c);
-            let d2 = flat.distance_squared(x);
-            if best.is_none_or(|(bd, ..)| d2 < bd) {
-                best = Some((d2, tri, weights));
-            }
+    // The nearest point on triangle `t`, kept if it is nearer than the best
+    // so far (on a tie the lower triangle index wins, so the answer does not
+    // depend on the order the triangles are looked at in).
+    let consider = |best: &mut Option<(f64, u32, [f64; 3])>, t: u32| {
+        let [a, b, c] = surface.triangles[t as usize].map(|k| surface.positions[k as usize]);
+        let (flat, weights) = closest_point_on_triangle(x, a, b, c);
+        let d2 = flat.distance_squared(x);
+        if best.is_none_or(|(bd, bt, _)| d2 < bd || (d2 == bd && t < bt)) {
+            *best = Some((d2, t, weights));
         }
-        best
     };
-    let mut best = nearest_among(&mut around[q as usize].iter().copied());
+    let mut best = None;
+    for &t in surface.rings.around(q) {
+        consider(&mut best, t);
+    }
     // Inside a triangle around `q` it is the nearest point near `q`. On
     // an edge or corner it may lie on the next ring (the nearest particle's
     // own triangles can miss the nearest point where the mesh is
     // stretched, and a particle by a margin then looked beside it): look
     // at the triangles around their corners too.
     if best.is_some_and(|(_, _, w)| w.iter().any(|&w| w <= 0.0)) {
-        let mut ring: Vec<u32> = around[q as usize]
-            .iter()
-            .flat_map(|&t| surface.triangles[t as usize])
-            .flat_map(|v| around[v as usize].iter().copied())
-            .collect();
-        ring.sort_unstable();
-        ring.dedup();
-        best = nearest_among(&mut ring.into_iter());
+        for &t in surface.rings.beyond(q) {
+            consider(&mut best, t);
+        }
     }
-    let (_, tri, weights) = best?;
+    let (_, t, weights) = best?;
+    let tri = surface.triangles[t as usize];
     let corners = tri.map(|k| surface.positions[k as usize]);
     let normals = tri.map(|k| surface.normals[k as usize]);
     let normal = (0..3)
@@ -483,13 +479,13 @@ mod tests {
         if normals[0].dot(mesh.positions[0]) > 0.0 {
             normals.iter_mut().for_each(|n| *n = -*n);
         }
-        let around = anthesis_mesh::nearest::triangles_around(&mesh.triangles, mesh.vertex_count());
+        let rings = TriangleRings::new(&mesh.triangles, mesh.vertex_count());
         let mean_edge = radius * std::f64::consts::FRAC_PI_2 / cells as f64;
         let other = Surface {
             positions: &mesh.positions,
             normals: &normals,
             triangles: &mesh.triangles,
-            triangles_around: &around,
+            rings: &rings,
             rim: &vec![false; mesh.vertex_count()],
             mean_edge,
         };
@@ -497,7 +493,7 @@ mod tests {
             positions: &[x],
             normals: &[],
             triangles: &[],
-            triangles_around: &[],
+            rings: &TriangleRings::default(),
             rim: &[],
             mean_edge,
         };

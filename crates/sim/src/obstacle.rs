@@ -7,6 +7,7 @@
 //! than an organ's edges can pass between its particles.
 
 use anthesis_flower::parts::PartPiece;
+use anthesis_mesh::nearest::TriangleRings;
 use glam::DVec3;
 
 use crate::collide::{Surface, Tracker};
@@ -19,7 +20,7 @@ pub(crate) struct ObstacleSim {
     positions: Vec<DVec3>,
     /// Outward unit normals (the side organs belong on).
     normals: Vec<DVec3>,
-    triangles_around: Vec<Vec<u32>>,
+    rings: TriangleRings,
     rim: Vec<bool>,
     mean_edge: f64,
     tracker: Tracker,
@@ -31,8 +32,7 @@ pub(crate) struct ObstacleSim {
 impl ObstacleSim {
     pub(crate) fn new(source: PartPiece) -> ObstacleSim {
         let mesh = &source.mesh;
-        let triangles_around =
-            anthesis_mesh::nearest::triangles_around(&mesh.triangles, mesh.vertex_count());
+        let rings = TriangleRings::new(&mesh.triangles, mesh.vertex_count());
         let (sum, count) = mesh
             .triangles
             .iter()
@@ -48,7 +48,7 @@ impl ObstacleSim {
             step: None,
             positions: Vec::new(),
             normals: Vec::new(),
-            triangles_around,
+            rings,
             rim,
             mean_edge,
             tracker: Tracker::new(&[], 1.0),
@@ -91,7 +91,7 @@ impl ObstacleSim {
             positions: &self.positions,
             normals: &self.normals,
             triangles: &self.source.mesh.triangles,
-            triangles_around: &self.triangles_around,
+            rings: &self.rings,
             rim: &self.rim,
             mean_edge: self.mean_edge,
         }

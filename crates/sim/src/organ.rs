@@ -4,6 +4,7 @@
 use crate::collide::Surface;
 use anthesis_flower::{Organ, Placement, Template, joint_angle_after};
 use anthesis_maps::{KeySchedule, ScalarMap};
+use anthesis_mesh::nearest::TriangleRings;
 use anthesis_mesh::{Mesh, Topology};
 use anthesis_physics::elastic::edge_areas_into;
 use anthesis_physics::membrane::EdgeSmoothedMembrane;
@@ -135,9 +136,9 @@ pub(crate) struct OrganSim {
     bud_edge: f64,
     /// Whether each particle is a base particle.
     pub is_base: Vec<bool>,
-    /// The triangles around each particle, where collisions look for the
-    /// nearest point of this organ's surface.
-    triangles_around: Vec<Vec<u32>>,
+    /// The triangles around each particle and the ring beyond them, where
+    /// collisions look for the nearest point of this organ's surface.
+    rings: TriangleRings,
     /// Whether each particle is on the organ's rim.
     rim: Vec<bool>,
     placement: Placement,
@@ -269,10 +270,7 @@ impl OrganSim {
             is_base: (0..template.mesh.vertex_count() as u32)
                 .map(|i| base.contains(&i))
                 .collect(),
-            triangles_around: anthesis_mesh::nearest::triangles_around(
-                &template.mesh.triangles,
-                template.mesh.vertex_count(),
-            ),
+            rings: TriangleRings::new(&template.mesh.triangles, template.mesh.vertex_count()),
             rim: topology.boundary_vertices(template.mesh.vertex_count()),
             placement: organ.placement,
             schedule: template.joint_schedule.clone(),
@@ -480,7 +478,7 @@ impl OrganSim {
             positions: &self.positions,
             normals,
             triangles: &self.mesh.triangles,
-            triangles_around: &self.triangles_around,
+            rings: &self.rings,
             rim: &self.rim,
             mean_edge: self.mean_edge,
         }
