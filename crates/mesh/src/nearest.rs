@@ -6,6 +6,7 @@ use glam::DVec3;
 /// The point of triangle `abc` nearest `p` and its barycentric weights
 /// (the standard region test over the triangle's corners, edges and face;
 /// small enough to write here rather than pull in a geometry crate).
+#[inline]
 pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, [f64; 3]) {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
@@ -48,6 +49,7 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVe
 /// vertex. A point inside the triangle, or on an edge with an interior
 /// corner, is not (an edge between two rim vertices across the mesh is
 /// taken as rim: meshes here do not have them).
+#[inline]
 pub fn on_rim(corners: [u32; 3], weights: [f64; 3], rim: &[bool]) -> bool {
     weights.iter().any(|&w| w <= 0.0)
         && (0..3).all(|k| weights[k] <= 0.0 || rim[corners[k] as usize])
@@ -109,6 +111,7 @@ impl TriangleRings {
     }
 
     /// The triangles around vertex `v` (ascending).
+    #[inline]
     pub fn around(&self, v: u32) -> &[u32] {
         let v = v as usize;
         &self.triangles[self.start[v] as usize..self.beyond[v] as usize]
@@ -116,6 +119,7 @@ impl TriangleRings {
 
     /// The triangles around the corners of `v`'s triangles that are not
     /// around `v` itself (ascending): the next ring out.
+    #[inline]
     pub fn beyond(&self, v: u32) -> &[u32] {
         let v = v as usize;
         &self.triangles[self.beyond[v] as usize..self.start[v + 1] as usize]
@@ -133,6 +137,7 @@ impl TriangleRings {
 /// triangle (checked on a sphere in the tests), and it still passes
 /// through the corners. Collisions use it so that when organs meet does
 /// not depend on how coarse their meshes are.
+#[inline]
 pub fn phong_point(corners: [DVec3; 3], normals: [DVec3; 3], weights: [f64; 3]) -> DVec3 {
     let flat: DVec3 = (0..3).map(|k| corners[k] * weights[k]).sum();
     let projected: DVec3 = (0..3)
