@@ -253,18 +253,28 @@ pub fn contacts_of(
                 continue;
             }
         }
-        let mut contact = Contact {
+        let contact = Contact {
             particle: i as u32,
             point: nearest.point,
             normal,
             offset,
         };
-        let violation = contact.violation(x);
-        if violation > 0.0 && violated == Violated::MoveHalf {
-            contact.point -= normal * (0.5 * violation);
-        }
-        out.push(contact);
+        out.push(match violated {
+            Violated::MoveAll => contact,
+            Violated::MoveHalf => move_half(contact, x),
+        });
     }
+}
+
+/// `contact` for a particle at `x` that the other organ's particle meets
+/// half way ([`Violated::MoveHalf`]): moved half way to the particle if it
+/// is violated.
+pub fn move_half(mut contact: Contact, x: DVec3) -> Contact {
+    let violation = contact.violation(x);
+    if violation > 0.0 {
+        contact.point -= contact.normal * (0.5 * violation);
+    }
+    contact
 }
 
 /// The point of an organ's surface nearest a particle.

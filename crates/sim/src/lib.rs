@@ -30,7 +30,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::collide::{
-    Surface, Tracker, Violated, contacts_against, contacts_of, max_violation, push_back,
+    Surface, Tracker, Violated, contacts_against, contacts_of, max_violation, move_half, push_back,
     start_on_contacts,
 };
 use crate::obstacle::ObstacleSim;
@@ -527,8 +527,8 @@ impl Simulation {
         // Contacts are found right after growth and held while the organs
         // relax: rebuilt every iteration from organs that all move at once,
         // they made neighbours bounce off each other instead of settling.
-        let mut contacts =
-            self.contacts(Violated::MoveHalf, &mut unknown_geometry(self.organs.len()));
+        let found = self.search(&mut unknown_geometry(self.organs.len()));
+        let mut contacts = self.contacts(&found, Violated::MoveHalf);
         // Growth and the joint schedule may have carried particles onto the
         // wrong side. Newton's method started there sees deep, stiff
         // penalties and its first steps crumpled organs (a tip folded until
@@ -643,7 +643,8 @@ impl Simulation {
             // there, particles jumped and left spikes; instead, while some
             // particle lies deep on the wrong side, the organs settle again
             // against contacts found where they are now.
-            let fresh = self.contacts(Violated::MoveHalf, &mut geometry);
+            let found = self.search(&mut geometry);
+            let fresh = self.contacts(&found, Violated::MoveHalf);
             let deepest = self
                 .organs
                 .iter()
@@ -660,8 +661,8 @@ impl Simulation {
             }
             if deepest <= RESETTLE_DEPTH || round == MAX_CONTACT_ROUNDS {
                 // The paper's push-back: nobody ends on the wrong side.
-                let (pushed, found) = self.push_back(&mut geometry);
-                contacts_now = found;
+                let (pushed, after) = self.push_back(&mut geometry, found);
+                contacts_now = after;
                 break pushed;
             }
             contacts = fresh;
@@ -736,7 +737,7 @@ impl Simulation {
     ) -> u32 {
         let offset = self.settings.collision_offset;
         contacts
-            .unwrap_or_else(|| self.contacts(Violated::MoveAll, geometry))
+            .unwrap_or_else(|| self.contacts(&self.search(geometry), Violated::MoveAll))
             .iter()
             .zip(&self.organs)
             .enumerate()
@@ -754,15 +755,18 @@ impl Simulation {
             .sum()
     }
 
-    /// Contacts of every organ against the organs it overlaps, from the
-    /// current positions (`geometry`: what is known of them, completed
-    /// here).
-    fn contacts(&self, violated: Violated, geometry: &mut [Option<Geometry>]) -> Vec<Vec<Contact>> {
-        let mut contacts = vec![Vec::new(); self.organs.len()];
-        self.obstacle_contacts(&mut contacts, &vec![true; self.organs.len()]);
+    /// Every overlap side's contacts and every organ's against the parts,
+    /// from the current positions (`geometry`: what is known of the organs
+    /// there, completed here), each to be put all the way
+    /// ([`Violated::MoveAll`]; [`Simulation::contacts`] gives each organ's
+    /// list, moved half way where both organs give way).
+    fn search(&self, geometry: &mut [Option<Geometry>]) -> Found {
+        let mut parts = vec![Vec::new(); self.organs.len()];
+        self.obstacle_contacts(&mut parts, &vec![true; self.organs.len()]);
+        self.drop_base_contacts(&mut parts);
+        let mut sides = vec![Vec::new(); 2 * self.overlaps.len()];
         if self.overlaps.is_empty() {
-            self.drop_base_contacts(&mut contacts);
-            return contacts;
+            return Found { parts, sides };
         }
         geometry
             .par_iter_mut()
@@ -779,25 +783,24 @@ impl Simulation {
             .collect();
         let offset = self.settings.collision_offset;
         // Inner particles stay on the outer organ's inner side, outer
-        // particles on the inner organ's outer side. A kinematic organ
-        // (two-state) gets no contacts and never gives way, so the organ
-        // against it moves all the way, as against a part.
-        let sides: Vec<(usize, usize, f64)> = self
+        // particles on the inner organ's outer side (side `2 * overlap` and
+        // `2 * overlap + 1`). A kinematic organ (two-state) gets no contacts.
+        let keys: Vec<(usize, usize, usize, f64)> = self
             .overlaps
             .iter()
-            .flat_map(|&(inner, outer)| [(inner, outer, 1.0), (outer, inner, -1.0)])
-            .filter(|&(moving, _, _)| !self.organs[moving].is_kinematic())
+            .enumerate()
+            .flat_map(|(index, &(inner, outer))| {
+                [
+                    (2 * index, inner, outer, 1.0),
+                    (2 * index + 1, outer, inner, -1.0),
+                ]
+            })
+            .filter(|&(_, moving, _, _)| !self.organs[moving].is_kinematic())
             .collect();
-        // Each side's contacts on its own thread, appended in the order of
-        // the sides: the same lists as one after the other.
-        let found: Vec<Vec<Contact>> = sides
+        // Each side's contacts on its own thread.
+        let found: Vec<Vec<Contact>> = keys
             .par_iter()
-            .map(|&(moving, other, side)| {
-                let violated = if self.organs[other].is_kinematic() {
-                    Violated::MoveAll
-                } else {
-                    violated
-                };
+            .map(|&(_, moving, other, side)| {
                 let mut list = Vec::new();
                 contacts_against(
                     &surfaces[moving],
@@ -805,16 +808,40 @@ impl Simulation {
                     &geometry[other].tracker,
                     side,
                     offset,
-                    violated,
+                    Violated::MoveAll,
                     &mut list,
                 );
+                let is_base = &self.organs[moving].is_base;
+                list.retain(|c| !is_base[c.particle as usize]);
                 list
             })
             .collect();
-        for (&(moving, _, _), list) in sides.iter().zip(found) {
-            contacts[moving].extend(list);
+        for (&(key, ..), list) in keys.iter().zip(found) {
+            sides[key] = list;
         }
-        self.drop_base_contacts(&mut contacts);
+        Found { parts, sides }
+    }
+
+    /// Each organ's contacts of `found`: against the parts, then each side
+    /// in order. With [`Violated::MoveHalf`] a violated contact against an
+    /// organ that gives way moves half way (a kinematic organ, two-state,
+    /// never gives way, so the organ against it moves all the way, as
+    /// against a part).
+    fn contacts(&self, found: &Found, violated: Violated) -> Vec<Vec<Contact>> {
+        let mut contacts = found.parts.clone();
+        for (index, &(inner, outer)) in self.overlaps.iter().enumerate() {
+            for (key, moving, other) in [(2 * index, inner, outer), (2 * index + 1, outer, inner)] {
+                let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
+                let positions = &self.organs[moving].positions;
+                contacts[moving].extend(found.sides[key].iter().map(|&c| {
+                    if half {
+                        move_half(c, positions[c.particle as usize])
+                    } else {
+                        c
+                    }
+                }));
+            }
+        }
         contacts
     }
 
@@ -869,10 +896,13 @@ impl Simulation {
     /// moved, and, unless the passes ran out, every organ's contacts where
     /// it now is (as `Violated::MoveAll` finds them: its last searches are
     /// those). `geometry` is what is known of the organs where they are, and
-    /// is kept up to date.
+    /// is kept up to date; `found` is the search made where they are, which
+    /// a side (or an organ against the parts) pushes with until one of its
+    /// organs is pushed.
     fn push_back(
         &mut self,
         geometry: &mut [Option<Geometry>],
+        found: Found,
     ) -> (usize, Option<Vec<Vec<Contact>>>) {
         let mut moved: Vec<Vec<bool>> = self
             .organs
@@ -886,9 +916,14 @@ impl Simulation {
         let mut pushes = vec![0u32; self.organs.len()];
         let mut parts_clear: Vec<Option<u32>> = vec![None; self.organs.len()];
         let mut side_clear: Vec<Option<(u32, u32)>> = vec![None; 2 * self.overlaps.len()];
-        // The last search against the parts, per organ, and per side.
-        let mut parts_found = vec![Vec::new(); self.organs.len()];
-        let mut side_found = vec![Vec::new(); 2 * self.overlaps.len()];
+        // The last search against the parts, per organ, and per side; at
+        // first those of `found`, made before anything was pushed.
+        let Found {
+            parts: mut parts_found,
+            sides: mut side_found,
+        } = found;
+        let mut parts_given = vec![true; self.organs.len()];
+        let mut side_given = vec![true; 2 * self.overlaps.len()];
         let mut settled = false;
         // A pushed particle turns its neighbours' normals a little, which
         // can leave a particle of the other organ just short of its side:
@@ -901,12 +936,22 @@ impl Simulation {
                 .zip(&pushes)
                 .map(|(clear, &n)| *clear != Some(n))
                 .collect();
-            self.obstacle_contacts(&mut outside, &wanted);
+            // Nothing has been pushed before the first pass's parts.
+            let search: Vec<bool> = (0..wanted.len())
+                .map(|i| wanted[i] && !parts_given[i])
+                .collect();
+            self.obstacle_contacts(&mut outside, &search);
             self.drop_base_contacts(&mut outside);
-            for (i, (organ, list)) in self.organs.iter_mut().zip(outside).enumerate() {
+            for (i, (organ, searched)) in self.organs.iter_mut().zip(outside).enumerate() {
                 if !wanted[i] {
                     continue;
                 }
+                let list = if parts_given[i] {
+                    parts_given[i] = false;
+                    std::mem::take(&mut parts_found[i])
+                } else {
+                    searched
+                };
                 let pushed = push_back(&mut organ.positions, &list, &mut moved[i]);
                 if pushed > 0 {
                     pushes[i] += 1;
@@ -927,9 +972,15 @@ impl Simulation {
                     {
                         continue;
                     }
-                    let known =
-                        geometry[other].get_or_insert_with(|| Geometry::of(&self.organs[other]));
-                    let contacts = self.contacts_between(moving, other, side, known);
+                    // The given search holds until one of the organs is pushed.
+                    let given = std::mem::take(&mut side_given[key]);
+                    let contacts = if given && pushes[moving] == 0 && pushes[other] == 0 {
+                        std::mem::take(&mut side_found[key])
+                    } else {
+                        let known = geometry[other]
+                            .get_or_insert_with(|| Geometry::of(&self.organs[other]));
+                        self.contacts_between(moving, other, side, known)
+                    };
                     let pushed = push_back(
                         &mut self.organs[moving].positions,
                         &contacts,
@@ -1002,6 +1053,15 @@ impl Simulation {
         }
         worst
     }
+}
+
+/// A contact search where the organs are (see `Simulation::search`): each
+/// organ's contacts against the parts and each overlap side's (`2 * overlap`
+/// for the inner organ's particles, `2 * overlap + 1` for the outer's), each
+/// to be put all the way, base particles left out.
+struct Found {
+    parts: Vec<Vec<Contact>>,
+    sides: Vec<Vec<Contact>>,
 }
 
 /// One organ's unit normals and nearest-particle lookup where it is:
