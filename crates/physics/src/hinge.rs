@@ -12,6 +12,7 @@ use glam::DVec3;
 
 /// Signed dihedral angle of the hinge at positions `[xi, xj, xk, xl]`,
 /// in radians, in `(-pi, pi]`.
+#[inline(always)]
 pub fn dihedral_angle(x: [DVec3; 4]) -> f64 {
     let [xi, xj, xk, xl] = x;
     let e = xj - xi;
@@ -39,6 +40,7 @@ pub fn hinge_is_degenerate(x: [DVec3; 4]) -> bool {
 /// outward bend: its gradient is `-normal / height`; the edge vertices take the balancing share given by
 /// where `k` and `l` project onto the edge, so the gradient is invariant to
 /// translation and rotation.
+#[inline(always)]
 pub fn dihedral_gradient(x: [DVec3; 4]) -> [DVec3; 4] {
     let [xi, xj, xk, xl] = x;
     let e = xj - xi;
