@@ -923,7 +923,15 @@ impl Simulation {
             sides: mut side_found,
         } = found;
         let mut parts_given = vec![true; self.organs.len()];
-        let mut side_given = vec![true; 2 * self.overlaps.len()];
+        // Where each side's moving organ was when its last list was found,
+        // and how often the other organ had been pushed then.
+        let mut side_at: Vec<(Vec<DVec3>, u32)> = (0..side_found.len())
+            .map(|key| {
+                let (inner, outer) = self.overlaps[key / 2];
+                let moving = if key % 2 == 0 { inner } else { outer };
+                (self.organs[moving].positions.clone(), 0)
+            })
+            .collect();
         let mut settled = false;
         // A pushed particle turns its neighbours' normals a little, which
         // can leave a particle of the other organ just short of its side:
@@ -972,15 +980,26 @@ impl Simulation {
                     {
                         continue;
                     }
-                    // The given search holds until one of the organs is pushed.
-                    let given = std::mem::take(&mut side_given[key]);
-                    let contacts = if given && pushes[moving] == 0 && pushes[other] == 0 {
-                        std::mem::take(&mut side_found[key])
+                    // While the other organ stays where it was, only the
+                    // moving organ's particles that moved since its last
+                    // list can find other contacts.
+                    let (before, other_pushes) = &side_at[key];
+                    let list = std::mem::take(&mut side_found[key]);
+                    let contacts = if *other_pushes == pushes[other] {
+                        let changed = self.changed_since(moving, before);
+                        if changed.is_empty() {
+                            list
+                        } else {
+                            let known = geometry[other]
+                                .get_or_insert_with(|| Geometry::of(&self.organs[other]));
+                            self.update_contacts(moving, other, side, known, list, &changed)
+                        }
                     } else {
                         let known = geometry[other]
                             .get_or_insert_with(|| Geometry::of(&self.organs[other]));
                         self.contacts_between(moving, other, side, known)
                     };
+                    side_at[key] = (self.organs[moving].positions.clone(), pushes[other]);
                     let pushed = push_back(
                         &mut self.organs[moving].positions,
                         &contacts,
@@ -1041,6 +1060,61 @@ impl Simulation {
         );
         contacts.retain(|c| !m.is_base[c.particle as usize]);
         contacts
+    }
+
+    /// Which particles of organ `moving` are no longer where `before`
+    /// has them (bit for bit).
+    fn changed_since(&self, moving: usize, before: &[DVec3]) -> Vec<usize> {
+        let bits = |p: DVec3| p.to_array().map(f64::to_bits);
+        let now = &self.organs[moving].positions;
+        (0..now.len())
+            .filter(|&p| bits(now[p]) != bits(before[p]))
+            .collect()
+    }
+
+    /// `list`, the contacts of organ `moving` against organ `other` found
+    /// where `other` is now, brought to where `moving`'s particles are now:
+    /// the particles `changed` (ascending) are searched again, the others'
+    /// contacts kept. The same as [`Simulation::contacts_between`] (each
+    /// particle's contact depends only on where it and the other organ are),
+    /// in the same order (by particle, at most one each).
+    fn update_contacts(
+        &self,
+        moving: usize,
+        other: usize,
+        side: f64,
+        known: &Geometry,
+        list: Vec<Contact>,
+        changed: &[usize],
+    ) -> Vec<Contact> {
+        let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let mut fresh = Vec::new();
+        contacts_of(
+            changed.iter().map(|&p| (p, m.positions[p])),
+            &o.surface(&known.normals),
+            &known.tracker,
+            side,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut fresh,
+        );
+        fresh.retain(|c| !m.is_base[c.particle as usize]);
+        let mut is_changed = vec![false; m.positions.len()];
+        for &p in changed {
+            is_changed[p] = true;
+        }
+        let mut merged = Vec::with_capacity(list.len() + fresh.len());
+        let mut fresh = fresh.into_iter().peekable();
+        for c in list {
+            while let Some(f) = fresh.next_if(|f| f.particle < c.particle) {
+                merged.push(f);
+            }
+            if !is_changed[c.particle as usize] {
+                merged.push(c);
+            }
+        }
+        merged.extend(fresh);
+        merged
     }
 
     fn worst_organ(&mut self, contacts: &[Vec<Contact>]) -> (String, f64) {
