@@ -12,11 +12,12 @@
 //! rerun from the first keyframe it changes (as the stroke benchmarks do).
 //!
 //! To measure how far a change that alters keyframes moves the shapes:
-//! `DIGEST_DUMP=FILE` writes the positions of keyframes 50 and 100 of the
-//! full run (`DIGEST_TOLERANCE=1e-7` runs with a tighter solver tolerance,
+//! `DIGEST_DUMP=FILE` writes the positions of every tenth keyframe of the
+//! full run (`DIGEST_EVERY=N`: every N-th) (`DIGEST_TOLERANCE=1e-7` runs with a tighter solver tolerance,
 //! for scale); `digest compare FILE FILE` prints the largest particle
-//! displacement between two dumps, relative to each organ's size (the
-//! diagonal of its bounding box).
+//! displacement between two dumps per keyframe, relative to each organ's
+//! size (the diagonal of its bounding box), and the largest over all.
+//! `DIGEST_FLOWER=NAME` runs another default flower than the lily.
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::time::Instant;
 
@@ -35,13 +36,15 @@ fn main() {
         .get(2)
         .map_or(0.6, |a| a.parse().expect("an edge scale"));
     let stroke = args.get(3).is_some_and(|a| a == "stroke");
-    let mut project = flower_at_resolution("lily", scale)
-        .expect("the lily has a builder")
-        .expect("the lily builds");
+    let name = std::env::var("DIGEST_FLOWER").unwrap_or_else(|_| "lily".to_owned());
+    let mut project = flower_at_resolution(&name, scale)
+        .expect("a default flower's name")
+        .expect("the flower builds");
     if let Ok(tolerance) = std::env::var("DIGEST_TOLERANCE") {
         project.settings.solver.relative_tolerance = tolerance.parse().expect("a tolerance");
     }
     let dump = std::env::var("DIGEST_DUMP").ok();
+    let every: u32 = std::env::var("DIGEST_EVERY").map_or(10, |n| n.parse().expect("a count"));
     let mut dumped = Vec::new();
     let selection = if whole {
         Selection::All
@@ -72,8 +75,8 @@ fn main() {
         if !stroke {
             digest(&k);
         }
-        if k.index == 50 || k.index == 100 {
-            dumped.push(k.positions_in_world.clone());
+        if k.index % every == 0 {
+            dumped.push((k.index, k.positions_in_world.clone()));
         }
     }
     if stroke {
@@ -101,8 +104,8 @@ fn main() {
     if let Some(path) = dump {
         let text: String = dumped
             .iter()
-            .map(|keyframe| {
-                keyframe
+            .map(|(index, keyframe)| {
+                let organs = keyframe
                     .iter()
                     .map(|organ| {
                         organ
@@ -112,7 +115,8 @@ fn main() {
                             .join(",")
                     })
                     .collect::<Vec<_>>()
-                    .join(";")
+                    .join(";");
+                format!("{index}:{organs}")
             })
             .collect::<Vec<_>>()
             .join("\n");
@@ -123,12 +127,13 @@ fn main() {
 /// The largest particle displacement between two dumps, per keyframe,
 /// relative to the organ's bounding-box diagonal.
 fn compare(a: &str, b: &str) {
-    let read = |path: &str| -> Vec<Vec<Vec<[f64; 3]>>> {
+    let read = |path: &str| -> Vec<(u32, Vec<Vec<[f64; 3]>>)> {
         std::fs::read_to_string(path)
             .expect("a dump")
             .lines()
-            .map(|keyframe| {
-                keyframe
+            .map(|line| {
+                let (index, keyframe) = line.split_once(':').expect("index:positions");
+                let organs = keyframe
                     .split(';')
                     .map(|organ| {
                         organ
@@ -140,12 +145,15 @@ fn compare(a: &str, b: &str) {
                             })
                             .collect()
                     })
-                    .collect()
+                    .collect();
+                (index.parse().expect("a keyframe index"), organs)
             })
             .collect()
     };
     let (a, b) = (read(a), read(b));
-    for (keyframe, (ka, kb)) in [50, 100].iter().zip(a.iter().zip(&b)) {
+    let mut largest: f64 = 0.0;
+    for ((keyframe, ka), (other, kb)) in a.iter().zip(&b) {
+        assert_eq!(keyframe, other, "the dumps hold the same keyframes");
         let worst = ka
             .iter()
             .zip(kb)
@@ -170,5 +178,7 @@ fn compare(a: &str, b: &str) {
             })
             .fold(0.0, f64::max);
         println!("keyframe {keyframe}: largest displacement {worst:.3e} of the organ's size");
+        largest = largest.max(worst);
     }
+    println!("over all: {largest:.3e}");
 }
