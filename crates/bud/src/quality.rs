@@ -94,9 +94,16 @@ pub fn quality(mesh: &Mesh) -> MeshQuality {
 /// Triangles are bucketed in a uniform grid of about twice the mean edge
 /// length, so the cost grows linearly with the mesh size.
 pub fn find_self_intersection(mesh: &Mesh) -> Option<[usize; 2]> {
+    self_intersections(mesh).first().copied()
+}
+
+/// Every pair of triangles that share no vertex and cross each other, each
+/// as `[lower, higher]` index, in increasing order (see
+/// [`find_self_intersection`]).
+pub fn self_intersections(mesh: &Mesh) -> Vec<[usize; 2]> {
     let mean_edge = quality(mesh).mean_edge;
     if mesh.triangles.is_empty() || mean_edge.is_nan() || mean_edge <= 0.0 {
-        return None;
+        return Vec::new();
     }
     let cell = 2.0 * mean_edge;
     let cell_of = |p: DVec3| (p / cell).floor().as_ivec3();
@@ -113,11 +120,8 @@ pub fn find_self_intersection(mesh: &Mesh) -> Option<[usize; 2]> {
             }
         }
     }
-    let mut cells: Vec<&Vec<usize>> = grid.values().collect();
-    // Deterministic order: the reported pair does not depend on hashing.
-    cells.sort_by_key(|c| c[0]);
-    let mut best: Option<[usize; 2]> = None;
-    for list in cells {
+    let mut pairs = Vec::new();
+    for list in grid.values() {
         for (n, &s) in list.iter().enumerate() {
             for &t in &list[n + 1..] {
                 let (ts, tt) = (mesh.triangles[s], mesh.triangles[t]);
@@ -126,15 +130,15 @@ pub fn find_self_intersection(mesh: &Mesh) -> Option<[usize; 2]> {
                 }
                 let (ps, pt) = (mesh.triangle_positions(s), mesh.triangle_positions(t));
                 if triangles_cross(&ps, &pt) {
-                    let pair = [s.min(t), s.max(t)];
-                    if best.is_none_or(|b| pair < b) {
-                        best = Some(pair);
-                    }
+                    pairs.push([s.min(t), s.max(t)]);
                 }
             }
         }
     }
-    best
+    // Deterministic: a pair in several cells is listed once, in order.
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
 }
 
 /// Whether two triangles cross: an edge of either passes through the other.
@@ -200,5 +204,12 @@ mod tests {
         both.triangles
             .extend(other.triangles.iter().map(|t| t.map(|i| i + offset)));
         assert!(find_self_intersection(&both).is_some());
+        // Every crossing pair once, in order, each one triangle of each sheet.
+        let first_sheet = m.triangles.len();
+        let pairs = self_intersections(&both);
+        assert!(pairs.len() >= 2, "{pairs:?}");
+        assert_eq!(pairs.first().copied(), find_self_intersection(&both));
+        assert!(pairs.windows(2).all(|w| w[0] < w[1]));
+        assert!(pairs.iter().all(|&[a, b]| a < first_sheet && b >= first_sheet));
     }
 }
