@@ -35,8 +35,9 @@ use crate::pattern::BlockPattern;
 pub struct SolverSettings {
     /// Converged when the largest force on any particle, `max_i |dE/dx_i|`,
     /// is below this fraction of [`Elastic::force_scale`] (the force of a
-    /// typical edge at 100 % strain). `1e-6` means residual forces worth a
-    /// strain of one in a million.
+    /// typical edge at 100 % strain). The default `1e-5` means residual
+    /// forces worth a strain of one in a hundred thousand (README,
+    /// "Accuracy").
     pub relative_tolerance: f64,
     /// Newton iterations allowed per keyframe before the run fails.
     pub max_iterations: u32,
@@ -45,7 +46,7 @@ pub struct SolverSettings {
 impl Default for SolverSettings {
     fn default() -> Self {
         SolverSettings {
-            relative_tolerance: 1e-6,
+            relative_tolerance: 1e-5,
             max_iterations: 50,
         }
     }

@@ -354,6 +354,8 @@ fn grow_uniformly(
         if let Some(membrane) = &mut elastic.membrane {
             membrane.update(&elastic.rest_lengths, &modulus);
         }
+        // As the simulation does: a fresh factor for each keyframe.
+        solver.begin_keyframe();
         let mut done = false;
         for _ in 0..settings.max_iterations {
             let report = solver.step(&elastic, &[], &mut x, &settings).expect("step");
@@ -516,7 +518,7 @@ fn strip_with_faster_inner_growth_bends_by_the_bilayer_curvature_and_not_across(
         }
         assert_bends_outwards(&x, &mesh, &midline_of);
         assert!(
-            iterations <= 3 * steps,
+            iterations as f64 <= NEWTON_BUDGET * steps as f64,
             "{name}: Newton took {iterations} iterations for {steps} keyframes"
         );
     }
@@ -620,10 +622,18 @@ fn the_paper_rule_realises_three_quarters_of_a_lengthwise_bend() {
     }
     assert_bends_outwards(&x, &mesh, &midline_of);
     assert!(
-        iterations <= 3 * steps,
+        iterations as f64 <= NEWTON_BUDGET * steps as f64,
         "Newton took {iterations} iterations for {steps} keyframes"
     );
 }
+
+/// Newton iterations per keyframe the bending strips may take. Each of
+/// their keyframes bends the strip by a few degrees from flat, three steps
+/// (measured at the tolerance 1e-6: 90 for 30 keyframes); at the default
+/// 1e-5 the conjugate gradients' target, a twentieth of the tolerance, is
+/// looser and a few keyframes take a fourth (91 and 94). A solver that
+/// converged only linearly would take several times more.
+const NEWTON_BUDGET: f64 = 3.5;
 
 /// A strip of equilateral triangles (side `side`) in the XY plane, rows
 /// along +Y, winding so the normal is +Z, UVs spanning the unit square.

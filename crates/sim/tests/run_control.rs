@@ -221,9 +221,12 @@ fn keyframe_statistics_report_convergence() {
             s.relative_gradient
         );
         // Every step grows (the maps are non-zero from step 1), so the
-        // solver has to move.
+        // solver has to move from the bud, where there is no past to
+        // extrapolate from; later a keyframe may start within the tolerance
+        // (the shape extrapolated through the last two or three).
+        let least = if i == 1 { 1 } else { 0 };
         assert!(
-            s.iterations >= 1 && s.iterations <= project.settings.solver.max_iterations,
+            s.iterations >= least && s.iterations <= project.settings.solver.max_iterations,
             "keyframe {i}: {} iterations",
             s.iterations
         );

@@ -9,7 +9,7 @@
 //!
 //! [simulation]                 # optional; each field defaults as shown
 //! keyframes = 100
-//! relative_tolerance = 0.000001
+//! relative_tolerance = 0.00001
 //! max_iterations = 50
 //! collision_offset = 0.01
 //! model = "consistent"         # or "paper" (see anthesis_physics::model);
