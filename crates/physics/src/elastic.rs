@@ -164,6 +164,13 @@ impl Elastic {
         (sum / n).max(f64::MIN_POSITIVE)
     }
 
+    /// A length of the organ's own size, whatever its mesh: the root of the
+    /// sum of the squared rest lengths (about the square root of three times
+    /// its area).
+    pub fn size(&self) -> f64 {
+        self.rest_lengths.iter().map(|l| l * l).sum::<f64>().sqrt()
+    }
+
     /// The total energy `E` (springs or membrane, hinges, anchors and the
     /// `contacts`' penalties) at particle positions `x`.
     pub fn energy(&self, x: &[DVec3], contacts: &[Contact]) -> f64 {
