@@ -210,6 +210,10 @@ mod tests {
         assert!(pairs.len() >= 2, "{pairs:?}");
         assert_eq!(pairs.first().copied(), find_self_intersection(&both));
         assert!(pairs.windows(2).all(|w| w[0] < w[1]));
-        assert!(pairs.iter().all(|&[a, b]| a < first_sheet && b >= first_sheet));
+        assert!(
+            pairs
+                .iter()
+                .all(|&[a, b]| a < first_sheet && b >= first_sheet)
+        );
     }
 }

@@ -1076,7 +1076,11 @@ mod tests {
         let edge = elastic.rest_lengths.iter().sum::<f64>() / elastic.rest_lengths.len() as f64;
         elastic.anchor_stiffness = 1e-3 * force / edge;
         let targets: Vec<DVec3> = bud.iter().map(|p| *p + DVec3::X * 0.5 * edge).collect();
-        elastic.anchors = targets.iter().enumerate().map(|(i, t)| (i as u32, *t)).collect();
+        elastic.anchors = targets
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (i as u32, *t))
+            .collect();
         let settings = SolverSettings::default();
         let mut solver = NewtonSolver::new(bud.len(), &elastic).expect("analysis");
         solver.begin_keyframe();
