@@ -75,7 +75,7 @@ fn main() {
         if !stroke {
             digest(&k);
         }
-        if k.index % every == 0 {
+        if k.index.is_multiple_of(every) {
             dumped.push((k.index, k.positions_in_world.clone()));
         }
     }

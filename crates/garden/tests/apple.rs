@@ -184,17 +184,18 @@ fn a_sliver_is_shallow_and_a_pass_through_is_deep() {
     // plane y = 0.3: pushed down through it by `reach`, it crosses it by
     // `reach`, and is crossed by it 0.3 from the flat one's nearer side.
     let crossing = |reach: f64| {
-        let mut mesh = Mesh::default();
-        mesh.positions = vec![
-            DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(1.0, 0.0, 0.0),
-            DVec3::new(0.0, 1.0, 0.0),
-            DVec3::new(0.1, 0.3, -reach),
-            DVec3::new(0.5, 0.3, -reach),
-            DVec3::new(0.3, 0.3, 1.0),
-        ];
-        mesh.uvs = vec![glam::DVec2::ZERO; 6];
-        mesh.triangles = vec![[0, 1, 2], [3, 4, 5]];
+        let mesh = Mesh {
+            positions: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(0.1, 0.3, -reach),
+                DVec3::new(0.5, 0.3, -reach),
+                DVec3::new(0.3, 0.3, 1.0),
+            ],
+            uvs: vec![glam::DVec2::ZERO; 6],
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+        };
         assert_eq!(self_intersections(&mesh), vec![[0, 1]]);
         crossing_depth(&mesh, [0, 1])
     };
