@@ -540,10 +540,7 @@ impl NewtonSolver {
             return true;
         }
         let limit = REMAINING_STEP * elastic.size();
-        let residual = &mut self.cg.residual;
-        for (v, &old) in residual.iter_mut().zip(&self.ordered.order) {
-            *v = -self.gradient[old / 3][old % 3];
-        }
+        self.ordered.negated(&self.gradient, &mut self.cg.residual);
         apply_inverse(
             &self.symbolic,
             &self.factor,
@@ -552,9 +549,8 @@ impl NewtonSolver {
             &self.cg.residual,
             &mut self.cg.preconditioned,
         );
-        for (&v, &old) in self.cg.preconditioned.iter().zip(&self.ordered.order) {
-            self.direction[old] = v;
-        }
+        self.ordered
+            .scatter(&self.cg.preconditioned, &mut self.direction);
         self.direction
             .chunks_exact(3)
             .all(|d| d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= limit * limit)
@@ -649,9 +645,7 @@ impl NewtonSolver {
             search: p,
             product: q,
         } = &mut self.cg;
-        for (v, &old) in r.iter_mut().zip(&self.ordered.order) {
-            *v = -self.gradient[old / 3][old % 3];
-        }
+        self.ordered.negated(&self.gradient, r);
         let mut precondition = |r: &[f64], z: &mut [f64]| {
             apply_inverse(
                 &self.symbolic,
@@ -694,9 +688,7 @@ impl NewtonSolver {
                 p[i] = z[i] + beta * p[i];
             }
         }
-        for (&v, &old) in x.iter().zip(&self.ordered.order) {
-            self.direction[old] = v;
-        }
+        self.ordered.scatter(x, &mut self.direction);
         if self.direction.iter().all(|v| v.is_finite()) {
             Ok(())
         } else {
@@ -733,10 +725,12 @@ fn apply_inverse(
 /// Whether `a` and `b` hold the same positions, bit for bit (a value
 /// computed at `a` may then be reused at `b`).
 pub fn same_bits(a: &[DVec3], b: &[DVec3]) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(p, q)| p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits))
+    a.len() == b.len() && a.iter().zip(b).all(|(p, q)| same_position_bits(*p, *q))
+}
+
+/// Whether `p` and `q` are the same position, bit for bit.
+pub fn same_position_bits(p: DVec3, q: DVec3) -> bool {
+    p.to_array().map(f64::to_bits) == q.to_array().map(f64::to_bits)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -837,6 +831,21 @@ impl Ordered {
                 column_sum += value * x[row];
             }
             y[col] += column_sum;
+        }
+    }
+
+    /// `-gradient` (per particle) as a vector in this order.
+    fn negated(&self, gradient: &[DVec3], ordered: &mut [f64]) {
+        for (v, &old) in ordered.iter_mut().zip(&self.order) {
+            *v = -gradient[old / 3][old % 3];
+        }
+    }
+
+    /// A vector in this order back in the particles' order (three
+    /// components per particle).
+    fn scatter(&self, ordered: &[f64], out: &mut [f64]) {
+        for (&v, &old) in ordered.iter().zip(&self.order) {
+            out[old] = v;
         }
     }
 
