@@ -25,12 +25,13 @@ use std::time::Instant;
 
 use anthesis_flower::Project;
 use anthesis_mesh::MeshError;
+use anthesis_physics::solver::same_position_bits;
 use anthesis_physics::{Contact, SolverError};
 use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::collide::{
-    Surface, Tracker, Violated, contacts_against, contacts_of, max_violation, move_half, push_back,
+    Tracker, Violated, contacts_against, contacts_of, max_violation, move_half, push_back,
     start_on_contacts,
 };
 use crate::obstacle::ObstacleSim;
@@ -775,13 +776,6 @@ impl Simulation {
                 known.get_or_insert_with(|| Geometry::of(organ));
             });
         let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
-        let surfaces: Vec<Surface> = self
-            .organs
-            .iter()
-            .zip(&geometry)
-            .map(|(o, g)| o.surface(&g.normals))
-            .collect();
-        let offset = self.settings.collision_offset;
         // Inner particles stay on the outer organ's inner side, outer
         // particles on the inner organ's outer side (side `2 * overlap` and
         // `2 * overlap + 1`). A kinematic organ (two-state) gets no contacts.
@@ -801,19 +795,7 @@ impl Simulation {
         let found: Vec<Vec<Contact>> = keys
             .par_iter()
             .map(|&(_, moving, other, side)| {
-                let mut list = Vec::new();
-                contacts_against(
-                    &surfaces[moving],
-                    &surfaces[other],
-                    &geometry[other].tracker,
-                    side,
-                    offset,
-                    Violated::MoveAll,
-                    &mut list,
-                );
-                let is_base = &self.organs[moving].is_base;
-                list.retain(|c| !is_base[c.particle as usize]);
-                list
+                self.contacts_between(moving, other, side, geometry[other])
             })
             .collect();
         for (&(key, ..), list) in keys.iter().zip(found) {
@@ -1065,10 +1047,9 @@ impl Simulation {
     /// Which particles of organ `moving` are no longer where `before`
     /// has them (bit for bit).
     fn changed_since(&self, moving: usize, before: &[DVec3]) -> Vec<usize> {
-        let bits = |p: DVec3| p.to_array().map(f64::to_bits);
         let now = &self.organs[moving].positions;
         (0..now.len())
-            .filter(|&p| bits(now[p]) != bits(before[p]))
+            .filter(|&p| !same_position_bits(now[p], before[p]))
             .collect()
     }
 
