@@ -164,7 +164,7 @@ fn first_frame_shows_the_flower_opening_and_the_timeline() {
 
     feed(&mut harness, None);
     harness.run();
-    harness.get_by_label("20 keyframes in 1 s");
+    harness.get_by_label("20 keyframes in 1.0 s");
     assert_eq!(harness.state().playback().time_in_keyframes, 20.0);
     harness.snapshot("app_open_flower");
 }
@@ -2644,7 +2644,7 @@ fn a_five_petal_flower_is_built_from_the_empty_start_in_the_flower_panel_and_sim
         tip_distance(0),
         tip_distance(100)
     );
-    harness.get_by_label("100 keyframes in 1 s");
+    harness.get_by_label("100 keyframes in 1.0 s");
     harness.snapshot("flower_panel_five_petals");
 }
 

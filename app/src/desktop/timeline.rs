@@ -114,12 +114,22 @@ impl Playback {
     }
 }
 
-/// Human-readable seconds: `42 s`, `3 min 5 s`.
+/// Human-readable seconds: `0.3 s`, `42 s`, `3 min 5 s`.
 pub fn format_seconds(seconds: f64) -> String {
-    if seconds < 60.0 {
+    if !seconds.is_finite() {
+        "an unknown time".to_string()
+    } else if seconds < 0.05 {
+        "under 0.1 s".to_string()
+    } else if seconds < 9.95 {
+        // A run of the default flowers takes about a second, an edit's
+        // rerun less: whole seconds said "0 s" for both.
+        format!("{seconds:.1} s")
+    } else if seconds < 59.5 {
         format!("{seconds:.0} s")
     } else {
-        format!("{} min {:.0} s", (seconds / 60.0).floor(), seconds % 60.0)
+        // Rounded before splitting, so 119.7 s is 2 min 0 s, not 1 min 60 s.
+        let whole = seconds.round() as u64;
+        format!("{} min {} s", whole / 60, whole % 60)
     }
 }
 
@@ -454,6 +464,20 @@ fn stats_plot(ui: &mut egui::Ui, session: &SimSession, time: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn seconds_read_as_a_person_would_say_them() {
+        assert_eq!(format_seconds(0.0), "under 0.1 s");
+        assert_eq!(format_seconds(0.3), "0.3 s");
+        assert_eq!(format_seconds(1.0), "1.0 s");
+        assert_eq!(format_seconds(9.94), "9.9 s");
+        assert_eq!(format_seconds(9.96), "10 s");
+        assert_eq!(format_seconds(59.4), "59 s");
+        assert_eq!(format_seconds(59.6), "1 min 0 s");
+        assert_eq!(format_seconds(119.7), "2 min 0 s");
+        assert_eq!(format_seconds(3725.2), "62 min 5 s");
+        assert_eq!(format_seconds(f64::NAN), "an unknown time");
+    }
 
     #[test]
     fn playing_waits_at_the_newest_keyframe_and_loops_only_a_finished_run() {
