@@ -512,6 +512,52 @@ fn a_failed_run_is_shown_and_the_app_keeps_going() {
 }
 
 #[test]
+fn the_export_dialog_runs_the_flower_again_at_a_finer_edge_for_the_file_only() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("fine.glb");
+    let mut harness = opened_small_flower();
+    let before = harness.state().project().clone();
+    harness.state_mut().open_export();
+    harness.run();
+    harness.state_mut().export_dialog_mut().path = "fine.glb".to_string();
+    harness.get_by_label("run again at mean edge").click();
+    harness.run();
+    harness.get_by_label_contains("particles in the largest organ (112 now)");
+    harness.get_by_label_contains("The export runs all 20 keyframes again at mean edge 0.716;");
+    harness.snapshot("export_dialog_run_again");
+    harness.state_mut().export_dialog_mut().path = out.display().to_string();
+    harness.run();
+    harness.get_by_label("Export").click();
+    let started = Instant::now();
+    while harness.query_by_label_contains("Wrote ").is_none() {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "export hangs; state {:?}",
+            harness.state().export_dialog().state()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        harness.step();
+    }
+    // The file holds the finer meshes; the project and the window's run
+    // are as they were.
+    let bytes = std::fs::read(&out).expect("exported file");
+    let json_length = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
+    let json: serde_json::Value =
+        serde_json::from_slice(&bytes[20..20 + json_length]).expect("JSON chunk");
+    let most_vertices = json["accessors"]
+        .as_array()
+        .expect("accessors")
+        .iter()
+        .filter_map(|a| a["count"].as_u64())
+        .max()
+        .expect("counts");
+    let built = before.flower.template_of(0).mesh.vertex_count() as u64;
+    assert!(most_vertices > 2 * built, "{most_vertices} vs {built}");
+    assert_eq!(harness.state().project(), &before);
+    assert_eq!(harness.state().session().keyframes().len(), 21);
+}
+
+#[test]
 fn the_export_dialog_writes_a_glb_and_reports_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("flower.glb");

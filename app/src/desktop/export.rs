@@ -3,13 +3,16 @@
 //! `anthesis-export` and reports progress, then the result or the error.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, sync_channel};
 use std::sync::{Arc, Mutex};
 
 use anthesis_export::{Encoding, GlbOptions, Timing, Track, UsdOptions};
-use anthesis_flower::Project;
+use anthesis_flower::resolution::{predicted_size, resolve};
+use anthesis_flower::{Project, Resolution};
 use anthesis_render::{OffscreenRenderer, OrganMesh};
-use anthesis_sim::Keyframe;
+use anthesis_sim::memory::{self, KeyframeCost};
+use anthesis_sim::{Keyframe, Selection, SimError, Simulation};
 use anyhow::Context;
 use eframe::egui;
 
@@ -53,9 +56,25 @@ pub struct ExportDialog {
     pub animation: AnimationOptions,
     /// A .gif shows every `animation_step`-th keyframe (and the last).
     pub animation_step: u32,
+    /// Export a run of its own at `resimulate_edge` (every template
+    /// remeshed at that mean edge, the painted maps kept) instead of the
+    /// keyframes the window computed: paint coarse, export fine. The
+    /// window's run and the project stay as they are.
+    pub resimulate: bool,
+    /// The mean edge of that run, in the project's lengths (0: not chosen
+    /// yet; the dialog suggests half the edge the window simulates at).
+    pub resimulate_edge: f64,
     state: ExportState,
     job: Option<(PathBuf, Receiver<Message>)>,
+    /// Set to stop the running export's simulation.
+    cancel: Arc<AtomicBool>,
+    /// The Simulation row's note ([`run_note`]) and what it was made for.
+    run_note: Option<(RunNoteKey, Result<String, String>)>,
 }
+
+/// What the Simulation row's note depends on: the edge's bits, the
+/// simulated organs, the keyframes and each template's particles.
+type RunNoteKey = (u64, Vec<usize>, u32, Vec<usize>);
 
 impl Default for ExportDialog {
     fn default() -> Self {
@@ -72,8 +91,12 @@ impl Default for ExportDialog {
             render_level: 0,
             animation: AnimationOptions::default(),
             animation_step: 1,
+            resimulate: false,
+            resimulate_edge: 0.0,
             state: ExportState::Idle,
             job: None,
+            cancel: Arc::new(AtomicBool::new(false)),
+            run_note: None,
         }
     }
 }
@@ -172,6 +195,130 @@ pub fn tracks(
     )
 }
 
+/// Writes `tracks` to `target` in the format its name picks: a USD layer
+/// for .usda, .usd (text) or .usdc (binary), a rendered animation for .gif,
+/// else the animated glTF; returns the file's size.
+fn write_tracks(
+    target: &Path,
+    tracks: &[Track],
+    options: &GlbOptions,
+    animation: &AnimationOptions,
+    animation_step: u32,
+    progress: &mut dyn FnMut(f32),
+) -> Result<u64, String> {
+    let written = if anthesis_export::is_usd_path(target) {
+        let usd = UsdOptions {
+            timing: options.timing,
+            normals: options.normals,
+        };
+        anthesis_export::write_usd(target, tracks, &usd, progress).map_err(|e| e.to_string())
+    } else if is_gif_path(target) {
+        write_gif(target, tracks, animation, animation_step, progress).map_err(|e| format!("{e:#}"))
+    } else {
+        anthesis_export::write_glb(target, tracks, options, progress).map_err(|e| e.to_string())
+    };
+    written.and_then(|()| {
+        std::fs::metadata(target)
+            .map(|m| m.len())
+            .map_err(|e| format!("{}: {e}", target.display()))
+    })
+}
+
+/// Runs `selection` of `project` at its resolution (checked against the
+/// memory first, then every template remeshed) to its last keyframe and
+/// returns its tracks, as render meshes of `render_level`. The error
+/// finishes the sentence "the run at mean edge E …".
+fn simulate_at(
+    project: &Project,
+    selection: &Selection,
+    render_level: u32,
+    progress: &mut dyn FnMut(f32),
+    cancelled: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<Track>, String> {
+    memory::check_run(project, selection, KeyframeCost::Kept)
+        .map_err(|e| format!("does not fit: {e}"))?;
+    let resolved = resolve(project).map_err(|e| format!("cannot start: {e}"))?;
+    let mut sim =
+        Simulation::new(&resolved, selection).map_err(|e| format!("cannot start: {e}"))?;
+    let total = resolved.settings.keyframes.max(1);
+    let mut keyframes = vec![Arc::new(sim.bud())];
+    while !sim.finished() {
+        match sim.step(cancelled, &mut |_| {}) {
+            Ok(keyframe) => {
+                progress(keyframe.index as f32 / total as f32);
+                keyframes.push(Arc::new(keyframe));
+            }
+            Err(SimError::Cancelled) => return Err("was cancelled".to_string()),
+            Err(error) => return Err(format!("stopped: {error}")),
+        }
+    }
+    let organs = selection.organs(resolved.flower.organs.len());
+    tracks(&resolved, &organs, &keyframes, render_level).map_err(|e| format!("{e}"))
+}
+
+/// The particles a run of `organs` of `project` at `edge` makes in its
+/// largest organ, next to the run's now; or why that run would not fit.
+fn run_note(
+    project: &Project,
+    selection: &Selection,
+    organs: &[usize],
+    edge: f64,
+) -> Result<String, String> {
+    let mut trial = project.clone();
+    trial.settings.resolution = Resolution::MeanEdge(edge);
+    memory::check_run(&trial, selection, KeyframeCost::Kept).map_err(|e| e.to_string())?;
+    let templates = || {
+        organs
+            .iter()
+            .filter(|&&i| i < project.flower.organs.len())
+            .map(|&i| project.flower.template_of(i))
+    };
+    let largest = templates()
+        .map(|t| predicted_size(&t.mesh, edge).0)
+        .max()
+        .unwrap_or(0);
+    let now = templates()
+        .map(|t| match project.settings.resolution.mean_edge() {
+            Some(shown) => predicted_size(&t.mesh, shown).0,
+            None => t.mesh.vertex_count(),
+        })
+        .max()
+        .unwrap_or(0);
+    Ok(format!(
+        "≈ {} particles in the largest organ ({} now)",
+        super::params::grouped(largest as u64),
+        super::params::grouped(now as u64)
+    ))
+}
+
+/// A mean edge as the dialog writes it: at most four decimals.
+fn edge_text(edge: f64) -> String {
+    if edge >= 1e-3 {
+        let text = format!("{edge:.4}");
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{edge:.2e}")
+    }
+}
+
+/// The mean edge the window simulates `project` at: its resolution's, or
+/// the first template's mesh as built.
+fn shown_edge(project: &Project) -> f64 {
+    project
+        .settings
+        .resolution
+        .mean_edge()
+        .or_else(|| {
+            project
+                .flower
+                .templates
+                .first()
+                .map(|t| anthesis_bud::quality(&t.mesh).mean_edge)
+        })
+        .filter(|e| e.is_finite() && *e > 0.0)
+        .unwrap_or(1.0)
+}
+
 impl ExportDialog {
     /// The .gif rows of the options grid: size, keyframe step, camera and
     /// turn, speed.
@@ -211,6 +358,66 @@ impl ExportDialog {
         ui.end_row();
     }
 
+    /// The "Simulation" row: export the window's keyframes, or a run of
+    /// its own at another mean edge, with the particles that makes in the
+    /// largest simulated organ (or why the run would not fit).
+    fn resimulate_ui(&mut self, ui: &mut egui::Ui, project: &Project, selection: &Selection) {
+        let label = ui
+            .label("Simulation")
+            .on_hover_text(
+                "Paint coarse, export fine: the export can run the flower again with every \
+                 template remeshed at another mean edge (the painted maps kept), without \
+                 changing the project or the window's run",
+            )
+            .id;
+        ui.horizontal(|ui| {
+            ui.checkbox(&mut self.resimulate, "run again at mean edge");
+            let shown = shown_edge(project);
+            let speed = 0.01 * self.resimulate_edge;
+            ui.add_enabled(
+                self.resimulate,
+                egui::DragValue::new(&mut self.resimulate_edge)
+                    .speed(speed)
+                    .range(1e-3 * shown..=1e3 * shown)
+                    .max_decimals(4),
+            )
+            .labelled_by(label);
+        });
+        ui.end_row();
+        if !self.resimulate {
+            return;
+        }
+        ui.label("");
+        // What the run makes and whether it fits, worked out again only
+        // when something it depends on changes (it clones the project and
+        // reads the free memory).
+        let organs = selection.organs(project.flower.organs.len());
+        let key = (
+            self.resimulate_edge.to_bits(),
+            organs.clone(),
+            project.settings.keyframes,
+            project
+                .flower
+                .templates
+                .iter()
+                .map(|t| t.mesh.vertex_count())
+                .collect::<Vec<_>>(),
+        );
+        if self.run_note.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.run_note = Some((
+                key,
+                run_note(project, selection, &organs, self.resimulate_edge),
+            ));
+        }
+        if let Some((_, note)) = &self.run_note {
+            match note {
+                Ok(text) => ui.label(text),
+                Err(text) => ui.colored_label(egui::Color32::from_rgb(210, 50, 40), text),
+            };
+        }
+        ui.end_row();
+    }
+
     pub fn state(&self) -> &ExportState {
         &self.state
     }
@@ -236,6 +443,58 @@ impl ExportDialog {
     /// Starts writing `tracks` to the dialog's path on a thread; `wake` is
     /// called on progress and at the end.
     pub fn start(&mut self, tracks: Vec<Track>, wake: impl Fn() + Send + Sync + 'static) {
+        if tracks.iter().all(|t| t.keyframes.is_empty()) {
+            self.state = ExportState::Failed {
+                message: "there are no keyframes to export yet".to_string(),
+            };
+            return;
+        }
+        self.spawn(0.0, move |_, _| Ok(tracks), wake);
+    }
+
+    /// Starts a run of `selection` of `project` (the document's project,
+    /// meshes as built) at the dialog's mean edge on a thread, then writes
+    /// it to the dialog's path; `wake` is called on progress and at the
+    /// end. A run too large for the memory, an edge a template cannot be
+    /// remeshed at and a run that stops are reported as the export's
+    /// failure; [`ExportDialog::cancel`] stops the run.
+    pub fn start_resimulated(
+        &mut self,
+        project: &Project,
+        selection: Selection,
+        wake: impl Fn() + Send + Sync + 'static,
+    ) {
+        let edge = self.resimulate_edge;
+        let mut project = project.clone();
+        project.settings.resolution = Resolution::MeanEdge(edge);
+        let render_level = self.render_level;
+        // The run is most of the work: 90 % of the progress bar.
+        self.spawn(
+            0.9,
+            move |progress, cancelled| {
+                simulate_at(&project, &selection, render_level, progress, cancelled)
+                    .map_err(|e| format!("the run at mean edge {} {e}", edge_text(edge)))
+            },
+            wake,
+        );
+    }
+
+    /// Stops the running export's simulation (the file is not written).
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+
+    /// Runs `make` (which builds the tracks, reporting its progress from 0
+    /// to 1 and told whether the export was cancelled) and then writes its
+    /// tracks, on a thread; `share` of the progress bar is `make`'s.
+    fn spawn(
+        &mut self,
+        share: f32,
+        make: impl FnOnce(&mut dyn FnMut(f32), &(dyn Fn() -> bool + Sync)) -> Result<Vec<Track>, String>
+        + Send
+        + 'static,
+        wake: impl Fn() + Send + Sync + 'static,
+    ) {
         let path = PathBuf::from(self.path.trim());
         if path.as_os_str().is_empty() {
             self.state = ExportState::Failed {
@@ -243,15 +502,11 @@ impl ExportDialog {
             };
             return;
         }
-        if tracks.iter().all(|t| t.keyframes.is_empty()) {
-            self.state = ExportState::Failed {
-                message: "there are no keyframes to export yet".to_string(),
-            };
-            return;
-        }
         let options = self.options();
         let animation = self.animation;
         let animation_step = self.animation_step;
+        self.cancel = Arc::new(AtomicBool::new(false));
+        let cancel = Arc::clone(&self.cancel);
         // Progress is dropped while the window has not taken the last few
         // (newer progress follows); the end waits for room.
         let (send, receive) = sync_channel(4);
@@ -273,27 +528,16 @@ impl ExportDialog {
                         (*progress_wake)();
                     }
                 };
-                // The file name picks the format: a USD layer for .usda,
-                // .usd (text) or .usdc (binary), a rendered animation for
-                // .gif, else the animated glTF.
-                let written = if anthesis_export::is_usd_path(&target) {
-                    let usd = UsdOptions {
-                        timing: options.timing,
-                        normals: options.normals,
-                    };
-                    anthesis_export::write_usd(&target, &tracks, &usd, &mut progress)
-                        .map_err(|e| e.to_string())
-                } else if is_gif_path(&target) {
-                    write_gif(&target, &tracks, &animation, animation_step, &mut progress)
-                        .map_err(|e| format!("{e:#}"))
-                } else {
-                    anthesis_export::write_glb(&target, &tracks, &options, &mut progress)
-                        .map_err(|e| e.to_string())
-                };
-                let result = written.and_then(|()| {
-                    std::fs::metadata(&target)
-                        .map(|m| m.len())
-                        .map_err(|e| format!("{}: {e}", target.display()))
+                let cancelled = || cancel.load(Ordering::Relaxed);
+                let result = make(&mut |p| progress(share * p), &cancelled).and_then(|tracks| {
+                    write_tracks(
+                        &target,
+                        &tracks,
+                        &options,
+                        &animation,
+                        animation_step,
+                        &mut |p| progress(share + (1.0 - share) * p),
+                    )
                 });
                 let _ = send.send(Message::Done(result));
                 (*wake)();
@@ -345,13 +589,21 @@ impl ExportDialog {
     }
 
     /// The dialog window. `keyframes_ready` and `keyframes_total` describe
-    /// what would be exported.
+    /// what would be exported; `project` (the document's, meshes as built)
+    /// and `selection` what a run of its own would simulate.
     pub fn ui(
         &mut self,
         ctx: &egui::Context,
         keyframes_ready: usize,
         keyframes_total: u32,
+        project: &Project,
+        selection: &Selection,
     ) -> ExportRequests {
+        if self.resimulate_edge <= 0.0 {
+            // Half the edge, about four times the particles, rounded as the
+            // Resolution control rounds.
+            self.resimulate_edge = super::params::round_to_3_digits(shown_edge(project) / 2.0);
+        }
         let mut requests = ExportRequests::default();
         let mut open = self.open;
         egui::Window::new("Export the animation")
@@ -401,6 +653,7 @@ impl ExportDialog {
                         )
                         .labelled_by(label);
                         ui.end_row();
+                        self.resimulate_ui(ui, project, selection);
                         if gif {
                             self.gif_options_ui(ui);
                             return;
@@ -478,14 +731,23 @@ impl ExportDialog {
                         ui.end_row();
                     });
                 let after_bud = keyframes_ready.saturating_sub(1);
-                ui.label(format!(
-                    "{after_bud} of {keyframes_total} keyframes computed{}",
-                    if (after_bud as u32) < keyframes_total {
-                        " — the export holds the computed ones"
-                    } else {
-                        ""
-                    }
-                ));
+                if self.resimulate {
+                    ui.label(format!(
+                        "The export runs all {} keyframes again at mean edge {}; \
+                         the window keeps its run",
+                        project.settings.keyframes,
+                        edge_text(self.resimulate_edge)
+                    ));
+                } else {
+                    ui.label(format!(
+                        "{after_bud} of {keyframes_total} keyframes computed{}",
+                        if (after_bud as u32) < keyframes_total {
+                            " — the export holds the computed ones"
+                        } else {
+                            ""
+                        }
+                    ));
+                }
                 ui.horizontal(|ui| {
                     let running = self.is_running();
                     if ui
@@ -502,6 +764,9 @@ impl ExportDialog {
                                     .show_percentage()
                                     .desired_width(200.0),
                             );
+                            if ui.button("Cancel").clicked() {
+                                self.cancel();
+                            }
                         }
                         ExportState::Done { path, bytes } => {
                             ui.label(format!(
@@ -766,5 +1031,103 @@ mod tests {
             "{:?}",
             dialog.state()
         );
+    }
+
+    #[test]
+    fn a_run_of_its_own_at_a_finer_edge_is_the_engines_run_at_that_resolution() {
+        let project = anthesis_sim::fixtures::whorl(2, 4, 6, 3);
+        let edge = shown_edge(&project) / 2.0;
+        let mut fine = project.clone();
+        fine.settings.resolution = Resolution::MeanEdge(edge);
+        let mut progress = Vec::new();
+        let made = simulate_at(
+            &fine,
+            &Selection::All,
+            0,
+            &mut |p| progress.push(p),
+            &|| false,
+        )
+        .expect("runs");
+        // The same as the engine's run of the project remeshed there, bit
+        // for bit, with more than twice the particles of the built mesh
+        // (about four times, less at this tiny mesh's rim).
+        let resolved = resolve(&fine).expect("remeshes");
+        let mut frames = Vec::new();
+        anthesis_sim::run(&resolved, &Selection::All, &mut |_, k| {
+            frames.push(Arc::new(k.clone()))
+        })
+        .expect("simulates");
+        assert_eq!(
+            made,
+            tracks(&resolved, &[0, 1], &frames, 0).expect("tracks")
+        );
+        let built = project.flower.template_of(0).mesh.vertex_count();
+        assert!(
+            made[0].uvs.len() > 2 * built,
+            "{} vs {built}",
+            made[0].uvs.len()
+        );
+        assert_eq!(made[0].keyframes.len(), 4, "the bud and three keyframes");
+        assert_eq!(progress.last(), Some(&1.0));
+
+        // Through the dialog: written, the project untouched.
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut dialog = ExportDialog {
+            path: dir.path().join("fine.glb").display().to_string(),
+            resimulate: true,
+            resimulate_edge: edge,
+            ..ExportDialog::default()
+        };
+        dialog.start_resimulated(&project, Selection::All, || {});
+        let end = wait_for_the_end(&mut dialog);
+        let ExportState::Done { bytes, .. } = end else {
+            panic!("export failed: {end:?}");
+        };
+        assert_eq!(
+            std::fs::metadata(dir.path().join("fine.glb"))
+                .expect("file")
+                .len(),
+            bytes
+        );
+        assert_eq!(project.settings.resolution, Resolution::AsBuilt);
+    }
+
+    #[test]
+    fn a_run_of_its_own_says_why_it_cannot_be_made_and_stops_when_cancelled() {
+        let project = anthesis_sim::fixtures::whorl(2, 4, 6, 3);
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("fine.glb");
+        // Far too fine for any memory: refused before anything is meshed.
+        let mut dialog = ExportDialog {
+            path: path.display().to_string(),
+            resimulate: true,
+            resimulate_edge: shown_edge(&project) * 1e-5,
+            ..ExportDialog::default()
+        };
+        dialog.start_resimulated(&project, Selection::All, || {});
+        let end = wait_for_the_end(&mut dialog);
+        assert!(
+            matches!(&end, ExportState::Failed { message }
+                if message.starts_with("the run at mean edge") && message.contains("does not fit")),
+            "{end:?}"
+        );
+        // Cancelled: the run stops and no file is written.
+        let mut fine = project.clone();
+        fine.settings.resolution = Resolution::MeanEdge(shown_edge(&project) / 2.0);
+        let stopped = simulate_at(&fine, &Selection::All, 0, &mut |_| {}, &|| true);
+        assert_eq!(stopped, Err("was cancelled".to_string()));
+        dialog.resimulate_edge = shown_edge(&project) / 2.0;
+        dialog.start_resimulated(&project, Selection::All, || {});
+        dialog.cancel();
+        let end = wait_for_the_end(&mut dialog);
+        match end {
+            // The run may have ended before the cancel reached it.
+            ExportState::Done { .. } => assert!(path.exists()),
+            ExportState::Failed { message } => {
+                assert!(message.ends_with("was cancelled"), "{message}");
+                assert!(!path.exists());
+            }
+            other => panic!("{other:?}"),
+        }
     }
 }

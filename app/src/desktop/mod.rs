@@ -355,6 +355,10 @@ impl AnthesisApp {
         &self.export
     }
 
+    pub fn export_dialog_mut(&mut self) -> &mut ExportDialog {
+        &mut self.export
+    }
+
     pub fn fit_dialog(&self) -> &fit::FitDialog {
         &self.fit
     }

@@ -124,9 +124,14 @@ impl AnthesisApp {
 
     /// The export dialog, when open.
     pub(super) fn export_window(&mut self, ctx: &egui::Context) {
-        let requests = self
-            .export
-            .ui(ctx, self.session.keyframes().len(), self.session.total());
+        let selection = self.selection();
+        let requests = self.export.ui(
+            ctx,
+            self.session.keyframes().len(),
+            self.session.total(),
+            self.doc.project(),
+            &selection,
+        );
         if requests.browse {
             self.queued.push(Command::BrowseExportPath);
         }

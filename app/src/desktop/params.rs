@@ -470,7 +470,7 @@ fn resolution_ui(
 
 /// `value` rounded to three significant digits (a starting edge a person
 /// can read).
-fn round_to_3_digits(value: f64) -> f64 {
+pub fn round_to_3_digits(value: f64) -> f64 {
     if !(value > 0.0 && value.is_finite()) {
         return 1.0;
     }

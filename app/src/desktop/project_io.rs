@@ -463,6 +463,14 @@ impl AnthesisApp {
     }
 
     pub(super) fn start_export(&mut self) {
+        let wake = self.ctx.clone();
+        if self.export.resimulate {
+            let selection = self.selection();
+            let project = self.doc.project().clone();
+            self.export
+                .start_resimulated(&project, selection, move || wake.request_repaint());
+            return;
+        }
         // The keyframes are of the meshes at the project's resolution.
         let project = self.resolved_project();
         let tracks = export::tracks(
@@ -471,7 +479,6 @@ impl AnthesisApp {
             self.session.keyframes(),
             self.export.render_level,
         );
-        let wake = self.ctx.clone();
         match tracks {
             Ok(tracks) => self.export.start(tracks, move || wake.request_repaint()),
             Err(error) => self.export.fail(error.to_string()),
