@@ -68,6 +68,8 @@ pub struct ExportDialog {
     job: Option<(PathBuf, Receiver<Message>)>,
     /// Set to stop the running export's simulation.
     cancel: Arc<AtomicBool>,
+    /// The keyframes of the running export's own run, if it makes one.
+    running_run: Option<u32>,
     /// The Simulation row's note ([`run_note`]) and what it was made for.
     run_note: Option<(RunNoteKey, Result<String, String>)>,
 }
@@ -96,6 +98,7 @@ impl Default for ExportDialog {
             state: ExportState::Idle,
             job: None,
             cancel: Arc::new(AtomicBool::new(false)),
+            running_run: None,
             run_note: None,
         }
     }
@@ -194,6 +197,10 @@ pub fn tracks(
         render_level,
     )
 }
+
+/// The share of the progress bar an export's own run takes (the rest is
+/// writing the file).
+const RUN_SHARE: f32 = 0.9;
 
 /// Writes `tracks` to `target` in the format its name picks: a USD layer
 /// for .usda, .usd (text) or .usdc (binary), a rendered animation for .gif,
@@ -468,15 +475,19 @@ impl ExportDialog {
         let mut project = project.clone();
         project.settings.resolution = Resolution::MeanEdge(edge);
         let render_level = self.render_level;
-        // The run is most of the work: 90 % of the progress bar.
+        let keyframes = project.settings.keyframes;
+        // The run is most of the work: RUN_SHARE of the progress bar.
         self.spawn(
-            0.9,
+            RUN_SHARE,
             move |progress, cancelled| {
                 simulate_at(&project, &selection, render_level, progress, cancelled)
                     .map_err(|e| format!("the run at mean edge {} {e}", edge_text(edge)))
             },
             wake,
         );
+        if self.is_running() {
+            self.running_run = Some(keyframes);
+        }
     }
 
     /// Stops the running export's simulation (the file is not written).
@@ -580,6 +591,7 @@ impl ExportDialog {
         }
         if ended.is_some() {
             self.job = None;
+            self.running_run = None;
         }
         ended
     }
@@ -759,11 +771,15 @@ impl ExportDialog {
                     match &self.state {
                         ExportState::Idle => {}
                         ExportState::Running { progress } => {
-                            ui.add(
-                                egui::ProgressBar::new(*progress)
-                                    .show_percentage()
-                                    .desired_width(200.0),
-                            );
+                            let bar = egui::ProgressBar::new(*progress).desired_width(200.0);
+                            ui.add(match self.running_run {
+                                Some(total) if *progress < RUN_SHARE => {
+                                    let done = (progress / RUN_SHARE * total as f32).floor();
+                                    bar.text(format!("running: keyframe {done} of {total}"))
+                                }
+                                Some(_) => bar.text("writing the file"),
+                                None => bar.show_percentage(),
+                            });
                             if ui.button("Cancel").clicked() {
                                 self.cancel();
                             }
@@ -1079,7 +1095,9 @@ mod tests {
             ..ExportDialog::default()
         };
         dialog.start_resimulated(&project, Selection::All, || {});
+        assert_eq!(dialog.running_run, Some(3), "the bar counts the run's keyframes");
         let end = wait_for_the_end(&mut dialog);
+        assert_eq!(dialog.running_run, None);
         let ExportState::Done { bytes, .. } = end else {
             panic!("export failed: {end:?}");
         };
