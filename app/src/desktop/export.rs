@@ -1095,7 +1095,11 @@ mod tests {
             ..ExportDialog::default()
         };
         dialog.start_resimulated(&project, Selection::All, || {});
-        assert_eq!(dialog.running_run, Some(3), "the bar counts the run's keyframes");
+        assert_eq!(
+            dialog.running_run,
+            Some(3),
+            "the bar counts the run's keyframes"
+        );
         let end = wait_for_the_end(&mut dialog);
         assert_eq!(dialog.running_run, None);
         let ExportState::Done { bytes, .. } = end else {

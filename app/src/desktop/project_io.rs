@@ -466,9 +466,10 @@ impl AnthesisApp {
         let wake = self.ctx.clone();
         if self.export.resimulate {
             let selection = self.selection();
-            let project = self.doc.project().clone();
             self.export
-                .start_resimulated(&project, selection, move || wake.request_repaint());
+                .start_resimulated(self.doc.project(), selection, move || {
+                    wake.request_repaint()
+                });
             return;
         }
         // The keyframes are of the meshes at the project's resolution.
