@@ -43,7 +43,9 @@ mod vein;
 pub use examples::{eustoma_petal_surface, lily_petal_surface};
 pub use from_mesh::{MeshSurface, remesh_mesh};
 pub use net::mirrored;
-pub use quality::{MeshQuality, find_self_intersection, quality, self_intersections};
+pub use quality::{
+    MeshQuality, crossing_depth, find_self_intersection, quality, self_intersections,
+};
 pub use scan::{
     ScanCorners, ScanError, ScanFit, ScanFitOptions, ScanOutline, fit_scan, middle_length,
     midrib_length, reversed_across,

@@ -141,6 +141,26 @@ pub fn self_intersections(mesh: &Mesh) -> Vec<[usize; 2]> {
     pairs
 }
 
+/// How far two crossing triangles `[s, t]` of `mesh` reach through each
+/// other: for each, how far the fewer of its corners lie beyond the
+/// other's plane; the smaller of the two. Two surfaces that touch and cut
+/// each other by a sliver give a small value, one passing through the
+/// other a large one (its triangles crossing the other's through their
+/// middles). Zero for triangles that do not cross (or a degenerate one).
+pub fn crossing_depth(mesh: &Mesh, [s, t]: [usize; 2]) -> f64 {
+    let through = |a: usize, b: usize| {
+        let [p, q, r] = mesh.triangle_positions(b);
+        let Some(normal) = (q - p).cross(r - p).try_normalize() else {
+            return 0.0;
+        };
+        let side = mesh.triangle_positions(a).map(|c| (c - p).dot(normal));
+        let above = side.iter().fold(0.0, |m: f64, d| m.max(*d));
+        let below = side.iter().fold(0.0, |m: f64, d| m.max(-*d));
+        above.min(below)
+    };
+    through(s, t).min(through(t, s))
+}
+
 /// Whether two triangles cross: an edge of either passes through the other.
 fn triangles_cross(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
     (0..3).any(|k| segment_hits_triangle(a[k], a[(k + 1) % 3], b))
@@ -187,6 +207,46 @@ mod tests {
         // 17 unit edges and 6 diagonals of sqrt(2).
         let mean = (17.0 + 6.0 * 2f64.sqrt()) / 23.0;
         assert!((q.mean_edge - mean).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_sliver_is_shallow_and_a_pass_through_is_deep() {
+        // A unit triangle in the XY plane and one standing across it in the
+        // plane y = 0.3: pushed down through it by `reach`, it crosses it by
+        // `reach`, and is crossed by it 0.3 from the flat one's nearer side.
+        let crossing = |reach: f64| {
+            let mesh = Mesh {
+                positions: vec![
+                    DVec3::new(0.0, 0.0, 0.0),
+                    DVec3::new(1.0, 0.0, 0.0),
+                    DVec3::new(0.0, 1.0, 0.0),
+                    DVec3::new(0.1, 0.3, -reach),
+                    DVec3::new(0.5, 0.3, -reach),
+                    DVec3::new(0.3, 0.3, 1.0),
+                ],
+                uvs: vec![glam::DVec2::ZERO; 6],
+                triangles: vec![[0, 1, 2], [3, 4, 5]],
+            };
+            assert_eq!(self_intersections(&mesh), vec![[0, 1]]);
+            crossing_depth(&mesh, [0, 1])
+        };
+        assert!((crossing(0.02) - 0.02).abs() < 1e-12);
+        assert!((crossing(0.4) - 0.3).abs() < 1e-12);
+        // Lifted clear of the flat one, it does not cross: depth 0.
+        let apart = Mesh {
+            positions: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(0.1, 0.3, 0.1),
+                DVec3::new(0.5, 0.3, 0.1),
+                DVec3::new(0.3, 0.3, 1.0),
+            ],
+            uvs: vec![glam::DVec2::ZERO; 6],
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+        };
+        assert!(self_intersections(&apart).is_empty());
+        assert_eq!(crossing_depth(&apart, [0, 1]), 0.0);
     }
 
     #[test]

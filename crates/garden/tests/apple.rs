@@ -6,7 +6,7 @@
 //! `SLIVER`), and no particle lies inside the stem or a stamen tube (the
 //! winding number of each tube's closed surface).
 
-use anthesis_bud::{quality, self_intersections};
+use anthesis_bud::{crossing_depth, quality, self_intersections};
 use anthesis_flower::Project;
 use anthesis_flower::parts::obstacles;
 use anthesis_flower::structure::lsystem::LSystem;
@@ -42,7 +42,6 @@ fn organ_of(project: &Project, mut triangle: usize) -> usize {
     usize::MAX
 }
 
-/// The distance of `p` from the flower axis.
 /// How deep two touching organs' flat triangles may cut each other, in mean
 /// edges. A contact holds a particle off the neighbour's smooth surface
 /// (its triangles curved by Phong tessellation), which lies up to a few per
@@ -53,23 +52,7 @@ fn organ_of(project: &Project, mut triangle: usize) -> usize {
 /// An organ passing through another crosses by a good part of an edge.
 const SLIVER: f64 = 0.1;
 
-/// How far two crossing triangles reach through each other: for each, how
-/// far the fewer of its corners lie beyond the other's plane; the smaller
-/// of the two. Two surfaces that touch and cut each other by a sliver give
-/// a small value, one passing through the other a large one (its
-/// triangles crossing the other's through their middles).
-fn crossing_depth(mesh: &Mesh, [s, t]: [usize; 2]) -> f64 {
-    let through = |a: usize, b: usize| {
-        let [p, q, r] = mesh.triangle_positions(b);
-        let normal = (q - p).cross(r - p).normalize();
-        let side = mesh.triangle_positions(a).map(|c| (c - p).dot(normal));
-        let above = side.iter().fold(0.0, |m: f64, d| m.max(*d));
-        let below = side.iter().fold(0.0, |m: f64, d| m.max(-*d));
-        above.min(below)
-    };
-    through(s, t).min(through(t, s))
-}
-
+/// The distance of `p` from the flower axis.
 fn from_axis(p: DVec3) -> f64 {
     p.x.hypot(p.z)
 }
@@ -176,29 +159,4 @@ fn the_apple_opens_without_any_organ_passing_through_another_or_a_tube() {
         open > 1.5 * bud,
         "the petals reach {bud:.1} in the bud, {open:.1} open"
     );
-}
-
-#[test]
-fn a_sliver_is_shallow_and_a_pass_through_is_deep() {
-    // A unit triangle in the XY plane and one standing across it in the
-    // plane y = 0.3: pushed down through it by `reach`, it crosses it by
-    // `reach`, and is crossed by it 0.3 from the flat one's nearer side.
-    let crossing = |reach: f64| {
-        let mesh = Mesh {
-            positions: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(1.0, 0.0, 0.0),
-                DVec3::new(0.0, 1.0, 0.0),
-                DVec3::new(0.1, 0.3, -reach),
-                DVec3::new(0.5, 0.3, -reach),
-                DVec3::new(0.3, 0.3, 1.0),
-            ],
-            uvs: vec![glam::DVec2::ZERO; 6],
-            triangles: vec![[0, 1, 2], [3, 4, 5]],
-        };
-        assert_eq!(self_intersections(&mesh), vec![[0, 1]]);
-        crossing_depth(&mesh, [0, 1])
-    };
-    assert!((crossing(0.02) - 0.02).abs() < 1e-12);
-    assert!((crossing(0.4) - 0.3).abs() < 1e-12);
 }
