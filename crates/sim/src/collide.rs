@@ -6,7 +6,11 @@
 //! tracked particle: that plane strays from a curved organ by about
 //! κ·h²/2 at an edge h away, enough in a tightly wrapped bud to decide
 //! which keyframe two petals meet in, so the flower's shape depended on its
-//! mesh.
+//! mesh. What is shown, though, are the flat triangles, which lie a few per
+//! cent of an edge off that surface where an organ curves: a contact holds
+//! the particle off whichever lies farther out, and farther still where the
+//! neighbour's surface bulges under the particle's own edges, so that the
+//! flat triangles of touching organs do not cut each other either.
 //!
 //! During minimisation a violated side becomes a stiff one-sided penalty
 //! (`anthesis_physics::Contact`), so Newton's method sees the contact and
@@ -201,7 +205,9 @@ pub enum Violated {
 /// outer side. Only particles within reach of `other` (two of its mean edges
 /// from its nearest particle) and over it get a contact: the point nearest
 /// them on the triangles around that particle, lifted onto the Phong
-/// surface, with the normal blended from the corners'. A particle whose
+/// surface, with the normal blended from the corners', moved out along it
+/// to the flat triangle or by the surface's bulge under the particle's
+/// edges where either lies farther out. A particle whose
 /// nearest point is on `other`'s rim is over it only if it lies within the
 /// collision `offset` of the rim sideways; farther it is beside the organ,
 /// where nothing holds it (a fixed fraction of the mean edge instead made
@@ -217,6 +223,7 @@ pub fn contacts_against(
 ) {
     contacts_of(
         moving.positions.iter().copied().enumerate(),
+        moving,
         other,
         tracker,
         side,
@@ -226,11 +233,15 @@ pub fn contacts_against(
     );
 }
 
-/// [`contacts_against`] for the particles `particles` (index, position)
-/// only: those farther than the tracker's reach from `other` get no
-/// contact anyway, so leaving them out changes nothing.
+/// [`contacts_against`] for the particles `particles` (index, position) of
+/// `moving` only: those farther than the tracker's reach from `other` get
+/// no contact anyway, so leaving them out changes nothing. A particle's
+/// contact depends on where it, the particles it shares an edge with
+/// (`moving`'s triangles around it) and `other` are.
+#[allow(clippy::too_many_arguments)]
 pub fn contacts_of(
     particles: impl Iterator<Item = (usize, DVec3)>,
+    moving: &Surface,
     other: &Surface,
     tracker: &Tracker,
     side: f64,
@@ -253,9 +264,19 @@ pub fn contacts_of(
                 continue;
             }
         }
+        // Held off the smooth surface, and off the flat triangle where it
+        // lies farther out (on the concave side of a curved neighbour):
+        // otherwise the particle could sit past the triangle drawn there.
+        // On the convex side the smooth surface bulges out between the
+        // points under the particle and its neighbours, so their straight
+        // edge, held at its ends, dips towards it in the middle (and
+        // through the flat triangles there, where they fold outwards):
+        // held off farther by that bulge.
+        let flat = (nearest.flat - nearest.point).dot(normal);
+        let bulge = bulge_under_edges(moving, i, &nearest, normal);
         let contact = Contact {
             particle: i as u32,
-            point: nearest.point,
+            point: nearest.point + normal * flat.max(bulge).max(0.0),
             normal,
             offset,
         };
@@ -264,6 +285,59 @@ pub fn contacts_of(
             Violated::MoveHalf => move_half(contact, x),
         });
     }
+}
+
+/// The barycentric weights of the projection of `p` onto the plane of the
+/// triangle `corners` (outside the triangle too); `None` for a degenerate
+/// triangle.
+fn plane_weights(corners: [DVec3; 3], p: DVec3) -> Option<[f64; 3]> {
+    let (u, v, d) = (
+        corners[1] - corners[0],
+        corners[2] - corners[0],
+        p - corners[0],
+    );
+    let (uu, uv, vv) = (u.dot(u), u.dot(v), v.dot(v));
+    let (du, dv) = (d.dot(u), d.dot(v));
+    let denominator = uu * vv - uv * uv;
+    if denominator <= 1e-12 * uu * vv {
+        return None;
+    }
+    let b = (vv * du - uv * dv) / denominator;
+    let c = (uu * dv - uv * du) / denominator;
+    Some([1.0 - b - c, b, c])
+}
+
+/// How far the other organ's smooth surface bulges along `direction`
+/// under the middles of `moving`'s edges from particle `i`, beyond the
+/// straight line between the points under their ends, at most (0 if it
+/// sags everywhere). The surface there is the Phong patch of the triangle
+/// nearest the particle continued past its edges (quadratic in the
+/// barycentric weights): its offset from the flat plane is measured under
+/// each end and the middle, so the flat part, linear, drops out.
+fn bulge_under_edges(moving: &Surface, i: usize, nearest: &Nearest, direction: DVec3) -> f64 {
+    let (corners, normals) = (nearest.corners, nearest.normals);
+    let off_plane = |p: DVec3| {
+        let weights = plane_weights(corners, p)?;
+        let flat: DVec3 = (0..3).map(|k| corners[k] * weights[k]).sum();
+        Some((phong_point(corners, normals, weights) - flat).dot(direction))
+    };
+    let x = moving.positions[i];
+    let Some(at_x) = off_plane(x) else {
+        return 0.0;
+    };
+    let mut most: f64 = 0.0;
+    for &t in moving.rings.around(i as u32) {
+        for k in moving.triangles[t as usize] {
+            if k as usize == i {
+                continue;
+            }
+            let y = moving.positions[k as usize];
+            if let (Some(middle), Some(at_y)) = (off_plane(0.5 * (x + y)), off_plane(y)) {
+                most = most.max(middle - 0.5 * (at_x + at_y));
+            }
+        }
+    }
+    most
 }
 
 /// `contact` for a particle at `x` that the other organ's particle meets
@@ -281,6 +355,11 @@ pub fn move_half(mut contact: Contact, x: DVec3) -> Contact {
 struct Nearest {
     /// On the Phong surface.
     point: DVec3,
+    /// On the flat triangle.
+    flat: DVec3,
+    /// The triangle's corners and their unit normals.
+    corners: [DVec3; 3],
+    normals: [DVec3; 3],
     /// Unit normal towards the organ's inner side.
     normal: DVec3,
     on_rim: bool,
@@ -325,6 +404,9 @@ fn nearest_on_surface(x: DVec3, surface: &Surface, q: u32) -> Option<Nearest> {
         .try_normalize()?;
     Some(Nearest {
         point: phong_point(corners, normals, weights),
+        flat: (0..3).map(|k| corners[k] * weights[k]).sum(),
+        corners,
+        normals,
         normal,
         on_rim: on_rim(tri, weights, surface.rim),
     })
@@ -476,75 +558,172 @@ mod tests {
         }
     }
 
-    /// The contact a particle inside a cylinder of radius `radius` (the
-    /// outer organ, `cells` triangle columns over 90°) gets: how far it
-    /// lies on its side of the surface, along the contact's normal.
-    fn distance_inside_cylinder(x: DVec3, radius: f64, cells: usize) -> f64 {
-        let mesh = anthesis_mesh::generate::parametric_grid(cells + 1, cells + 1, |uv| {
-            let angle = std::f64::consts::FRAC_PI_2 * uv.x;
-            DVec3::new(radius * angle.cos(), 3.0 * uv.y, radius * angle.sin())
-        });
-        let mut normals = anthesis_mesh::vertex_normals(&mesh.positions, &mesh.triangles);
-        // The inner side faces the cylinder's axis.
-        if normals[0].dot(mesh.positions[0]) > 0.0 {
-            normals.iter_mut().for_each(|n| *n = -*n);
+    /// A quarter cylinder of radius `radius` around the y axis (`cells`
+    /// triangle columns over 90°, vertices every 90°/`cells`), its
+    /// normals facing the axis (its inner side).
+    struct Cylinder {
+        mesh: anthesis_mesh::Mesh,
+        normals: Vec<DVec3>,
+        rings: TriangleRings,
+        rim: Vec<bool>,
+        mean_edge: f64,
+    }
+
+    impl Cylinder {
+        fn new(radius: f64, cells: usize) -> Cylinder {
+            let mesh = anthesis_mesh::generate::parametric_grid(cells + 1, cells + 1, |uv| {
+                let angle = std::f64::consts::FRAC_PI_2 * uv.x;
+                DVec3::new(radius * angle.cos(), 3.0 * uv.y, radius * angle.sin())
+            });
+            let mut normals = anthesis_mesh::vertex_normals(&mesh.positions, &mesh.triangles);
+            if normals[0].dot(mesh.positions[0]) > 0.0 {
+                normals.iter_mut().for_each(|n| *n = -*n);
+            }
+            Cylinder {
+                rings: TriangleRings::new(&mesh.triangles, mesh.vertex_count()),
+                rim: vec![false; mesh.vertex_count()],
+                mean_edge: radius * std::f64::consts::FRAC_PI_2 / cells as f64,
+                normals,
+                mesh,
+            }
         }
-        let rings = TriangleRings::new(&mesh.triangles, mesh.vertex_count());
-        let mean_edge = radius * std::f64::consts::FRAC_PI_2 / cells as f64;
-        let other = Surface {
-            positions: &mesh.positions,
-            normals: &normals,
-            triangles: &mesh.triangles,
-            rings: &rings,
-            rim: &vec![false; mesh.vertex_count()],
-            mean_edge,
-        };
-        let moving = Surface {
-            positions: &[x],
-            normals: &[],
-            triangles: &[],
-            rings: &TriangleRings::default(),
-            rim: &[],
-            mean_edge,
-        };
-        let tracker = Tracker::new(other.positions, 2.0 * mean_edge);
-        let mut out = Vec::new();
-        contacts_against(
-            &moving,
-            &other,
-            &tracker,
-            1.0,
-            0.0,
-            Violated::MoveAll,
-            &mut out,
-        );
-        assert_eq!(
-            out.len(),
-            1,
-            "one contact for the particle over the surface"
-        );
-        (x - out[0].point).dot(out[0].normal)
+
+        fn surface(&self) -> Surface<'_> {
+            Surface {
+                positions: &self.mesh.positions,
+                normals: &self.normals,
+                triangles: &self.mesh.triangles,
+                rings: &self.rings,
+                rim: &self.rim,
+                mean_edge: self.mean_edge,
+            }
+        }
+
+        /// The contacts of the particles `positions` (the corners of
+        /// `triangles`), inside the cylinder (`side` +1) or outside (-1).
+        fn contacts(
+            &self,
+            positions: &[DVec3],
+            triangles: &[[u32; 3]],
+            side: f64,
+            offset: f64,
+        ) -> Vec<Contact> {
+            let rings = TriangleRings::new(triangles, positions.len());
+            let moving = Surface {
+                positions,
+                normals: &[],
+                triangles,
+                rings: &rings,
+                rim: &[],
+                mean_edge: self.mean_edge,
+            };
+            let other = self.surface();
+            let tracker = Tracker::new(other.positions, 2.0 * self.mean_edge);
+            let mut out = Vec::new();
+            contacts_against(
+                &moving,
+                &other,
+                &tracker,
+                side,
+                offset,
+                Violated::MoveAll,
+                &mut out,
+            );
+            assert_eq!(out.len(), positions.len(), "one contact per particle");
+            out
+        }
+    }
+
+    /// The point at `angle` (radians from the x axis) and height `y`, `r`
+    /// from the cylinder's axis.
+    fn at(r: f64, angle: f64, y: f64) -> DVec3 {
+        DVec3::new(r * angle.cos(), y, r * angle.sin())
     }
 
     #[test]
     fn a_contact_measures_from_the_curved_surface_whatever_the_mesh() {
         let radius = 5.0;
-        // A particle 0.1 inside the cylinder, over the middle of a coarse
-        // cell (where the flat triangles sag most) and off the fine grid.
+        // A particle 0.1 outside the cylinder (on its convex side, where the
+        // flat triangles lie inside the curved surface), over the middle of
+        // a coarse cell (where they sag most) and off the fine grid.
         let angle = 0.37f64;
-        let x = DVec3::new(4.9 * angle.cos(), 1.43, 4.9 * angle.sin());
+        let x = at(5.1, angle, 1.43);
         let coarse_cells = 6;
-        // How far the coarse triangles sag inside the cylinder (and a
-        // particle's tangent plane strays from it) at half a cell.
         let half_cell = std::f64::consts::FRAC_PI_2 / coarse_cells as f64 / 2.0;
         let sag = radius * (1.0 - half_cell.cos());
         for cells in [coarse_cells, 2 * coarse_cells, 5 * coarse_cells] {
-            let distance = distance_inside_cylinder(x, radius, cells);
+            let contact = Cylinder::new(radius, cells).contacts(&[x], &[], -1.0, 0.0)[0];
+            let distance = (x - contact.point).dot(contact.normal);
             assert!(
                 (distance - 0.1).abs() < 0.05 * sag,
                 "{cells} cells: {distance} (sag {sag})"
             );
         }
+    }
+
+    #[test]
+    fn on_the_concave_side_a_particle_is_held_off_the_flat_triangles_too() {
+        // Inside the cylinder the flat triangles lie nearer the axis than
+        // the curved surface, by `sag` over the middle of a cell. A particle
+        // between the two is on its side of the curved surface but past
+        // the triangle drawn there: it is pushed onto the triangle.
+        let (radius, cells) = (5.0, 6);
+        let cylinder = Cylinder::new(radius, cells);
+        let half_cell = std::f64::consts::FRAC_PI_2 / cells as f64 / 2.0;
+        let sag = radius * (1.0 - half_cell.cos());
+        // Over the middle of the second cell.
+        let angle = 3.0 * half_cell;
+        let mut positions = vec![at(radius - 0.5 * sag, angle, 1.43)];
+        let contacts = cylinder.contacts(&positions, &[], 1.0, 0.0);
+        let mut moved = vec![false];
+        assert_eq!(push_back(&mut positions, &contacts, &mut moved), 1);
+        let chord = radius * half_cell.cos();
+        let from_axis = positions[0].x.hypot(positions[0].z);
+        assert!(
+            from_axis <= chord + 1e-12,
+            "{from_axis} from the axis, the triangle {chord}"
+        );
+        assert!(
+            from_axis > chord - 1e-3 * sag,
+            "pushed just onto it: {from_axis}"
+        );
+    }
+
+    #[test]
+    fn on_the_convex_side_an_edge_between_two_held_particles_stays_off_both_surfaces() {
+        // Outside the cylinder a straight edge of another organ across a
+        // fold of the flat triangles (a vertex under its middle, on the
+        // curved surface) dips towards the cylinder in the middle by about
+        // r·(1 - cos(half its angle)), more than the offset: held off the
+        // curved surface at its ends only, its middle would pass through
+        // the triangles.
+        let (radius, cells, offset) = (5.0, 6, 0.01);
+        let cylinder = Cylinder::new(radius, cells);
+        let vertex = 3.0 * std::f64::consts::FRAC_PI_2 / cells as f64;
+        let half = 8f64.to_radians();
+        let dip = radius * (1.0 - half.cos());
+        assert!(dip > 2.0 * offset);
+        // The edge's ends on the curved surface, its third corner along
+        // the axis from the middle.
+        let mut positions = vec![
+            at(radius, vertex - half, 1.5),
+            at(radius, vertex + half, 1.5),
+            at(radius, vertex, 2.2),
+        ];
+        let triangles = [[0, 1, 2]];
+        let contacts = cylinder.contacts(&positions, &triangles, -1.0, offset);
+        let mut moved = vec![false; 3];
+        push_back(&mut positions, &contacts, &mut moved);
+        let middle = 0.5 * (positions[0] + positions[1]);
+        let from_axis = middle.x.hypot(middle.z);
+        // The flat triangles and the curved surface both pass through the
+        // vertex under it, `radius` from the axis.
+        assert!(
+            from_axis >= radius + 0.5 * offset,
+            "the edge's middle {from_axis} from the axis, the surfaces {radius}"
+        );
+        // Not much farther than the offset (by less than a tenth of the dip).
+        assert!(from_axis < radius + offset + 0.1 * dip, "{from_axis}");
     }
 
     #[test]

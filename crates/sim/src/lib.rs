@@ -866,6 +866,7 @@ impl Simulation {
                         .filter(|&(_, p)| obstacle.reaches(p));
                     contacts_of(
                         near,
+                        &organ.surface(&[]),
                         &obstacle.surface(),
                         obstacle.tracker(),
                         1.0,
@@ -1061,10 +1062,11 @@ impl Simulation {
 
     /// `list`, the contacts of organ `moving` against organ `other` found
     /// where `other` is now, brought to where `moving`'s particles are now:
-    /// the particles `changed` (ascending) are searched again, the others'
-    /// contacts kept. The same as [`Simulation::contacts_between`] (each
-    /// particle's contact depends only on where it and the other organ are),
-    /// in the same order (by particle, at most one each).
+    /// the particles `changed` (ascending) and those sharing an edge with
+    /// one are searched again, the others' contacts kept. The same as
+    /// [`Simulation::contacts_between`] (each particle's contact depends
+    /// only on where it, the particles it shares an edge with and the other
+    /// organ are), in the same order (by particle, at most one each).
     fn update_contacts(
         &self,
         moving: usize,
@@ -1075,9 +1077,21 @@ impl Simulation {
         changed: &[usize],
     ) -> Vec<Contact> {
         let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let own = m.surface(&[]);
+        let mut is_changed = vec![false; m.positions.len()];
+        for &p in changed {
+            for &t in own.rings.around(p as u32) {
+                for k in own.triangles[t as usize] {
+                    is_changed[k as usize] = true;
+                }
+            }
+        }
         let mut fresh = Vec::new();
         contacts_of(
-            changed.iter().map(|&p| (p, m.positions[p])),
+            (0..m.positions.len())
+                .filter(|&p| is_changed[p])
+                .map(|p| (p, m.positions[p])),
+            &own,
             &o.surface(&known.normals),
             &known.tracker,
             side,
@@ -1086,10 +1100,6 @@ impl Simulation {
             &mut fresh,
         );
         fresh.retain(|c| !m.is_base[c.particle as usize]);
-        let mut is_changed = vec![false; m.positions.len()];
-        for &p in changed {
-            is_changed[p] = true;
-        }
         let mut merged = Vec::with_capacity(list.len() + fresh.len());
         let mut fresh = fresh.into_iter().peekable();
         for c in list {
