@@ -18,8 +18,9 @@
 //! displacement between two dumps per keyframe, relative to each organ's
 //! size (the diagonal of its bounding box), and the largest over all; and
 //! in mean edges, apart for the particles within a mean edge of another
-//! organ (where organs touch) and the others (`DIGEST_FLOWER` as in the
-//! runs).
+//! organ (where organs touch) and the others (the dumps name their flower
+//! and edge scale in their first line; older dumps take `DIGEST_FLOWER` at
+//! the default scale).
 //! `DIGEST_FLOWER=NAME` runs another default flower than the lily.
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::time::Instant;
@@ -124,7 +125,9 @@ fn main() {
             })
             .collect::<Vec<_>>()
             .join("\n");
-        std::fs::write(path, text).expect("a writable dump");
+        // The flower and its edge scale first, so `compare` meshes the
+        // same flower to measure edges.
+        std::fs::write(path, format!("flower {name} {scale}\n{text}")).expect("a writable dump");
     }
 }
 
@@ -135,6 +138,7 @@ fn compare(a: &str, b: &str) {
         std::fs::read_to_string(path)
             .expect("a dump")
             .lines()
+            .filter(|line| !line.starts_with("flower "))
             .map(|line| {
                 let (index, keyframe) = line.split_once(':').expect("index:positions");
                 let organs = keyframe
@@ -154,13 +158,25 @@ fn compare(a: &str, b: &str) {
             })
             .collect()
     };
+    // The flower the dumps were made of (their first line), else the lily
+    // at the default scale.
+    let header = std::fs::read_to_string(a)
+        .ok()
+        .and_then(|text| text.lines().next().map(str::to_owned))
+        .and_then(|line| {
+            let mut words = line.strip_prefix("flower ")?.split(' ');
+            Some((words.next()?.to_owned(), words.next()?.parse::<f64>().ok()?))
+        });
+    let (name, scale) = header.unwrap_or_else(|| {
+        let name = std::env::var("DIGEST_FLOWER").unwrap_or_else(|_| "lily".to_owned());
+        (name, 0.6)
+    });
+    let project = flower_at_resolution(&name, scale)
+        .expect("a default flower's name")
+        .expect("the flower builds");
     let (a, b) = (read(a), read(b));
     let mut largest: f64 = 0.0;
     let (mut largest_near, mut largest_away) = (0.0f64, 0.0f64);
-    let name = std::env::var("DIGEST_FLOWER").unwrap_or_else(|_| "lily".to_owned());
-    let project = flower_at_resolution(&name, 0.6)
-        .expect("a default flower's name")
-        .expect("the flower builds");
     for ((keyframe, ka), (other, kb)) in a.iter().zip(&b) {
         assert_eq!(keyframe, other, "the dumps hold the same keyframes");
         let worst = ka
@@ -203,15 +219,22 @@ fn compare(a: &str, b: &str) {
 
 /// The largest particle displacement between two keyframes (organs of
 /// particle positions), in mean edges of the particle's organ (the edges
-/// of the first keyframe's organs, the flower's meshes from
-/// `DIGEST_FLOWER`): of the particles that lie within a mean edge of
+/// of the first keyframe's organs, `project` the flower the dumps were
+/// made of): of the particles that lie within a mean edge of
 /// another organ's particle in the first (where organs touch), and of the
 /// others.
 fn near_and_away(project: &Project, a: &[Vec<[f64; 3]>], b: &[Vec<[f64; 3]>]) -> [f64; 2] {
     let point = |p: &[f64; 3]| glam::DVec3::from_array(*p);
     let mut largest = [0.0f64; 2];
     for (i, (oa, ob)) in a.iter().zip(b).enumerate() {
-        let triangles = &project.flower.template_of(i).mesh.triangles;
+        let mesh = &project.flower.template_of(i).mesh;
+        assert_eq!(
+            mesh.vertex_count(),
+            oa.len(),
+            "the dumps are not of {} (organ {i}): name the flower with DIGEST_FLOWER",
+            project.name
+        );
+        let triangles = &mesh.triangles;
         let (sum, count) = triangles
             .iter()
             .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
