@@ -287,24 +287,43 @@ pub fn contacts_of(
     }
 }
 
-/// The barycentric weights of the projection of `p` onto the plane of the
-/// triangle `corners` (outside the triangle too); `None` for a degenerate
-/// triangle.
-fn plane_weights(corners: [DVec3; 3], p: DVec3) -> Option<[f64; 3]> {
-    let (u, v, d) = (
-        corners[1] - corners[0],
-        corners[2] - corners[0],
-        p - corners[0],
-    );
-    let (uu, uv, vv) = (u.dot(u), u.dot(v), v.dot(v));
-    let (du, dv) = (d.dot(u), d.dot(v));
-    let denominator = uu * vv - uv * uv;
-    if denominator <= 1e-12 * uu * vv {
-        return None;
+/// The plane of a triangle, for the barycentric weights of points
+/// projected onto it (outside the triangle too).
+struct PlaneFrame {
+    origin: DVec3,
+    u: DVec3,
+    v: DVec3,
+    uu: f64,
+    uv: f64,
+    vv: f64,
+    denominator: f64,
+}
+
+impl PlaneFrame {
+    /// `None` for a degenerate triangle.
+    fn new(corners: [DVec3; 3]) -> Option<PlaneFrame> {
+        let (u, v) = (corners[1] - corners[0], corners[2] - corners[0]);
+        let (uu, uv, vv) = (u.dot(u), u.dot(v), v.dot(v));
+        let denominator = uu * vv - uv * uv;
+        (denominator > 1e-12 * uu * vv).then_some(PlaneFrame {
+            origin: corners[0],
+            u,
+            v,
+            uu,
+            uv,
+            vv,
+            denominator,
+        })
     }
-    let b = (vv * du - uv * dv) / denominator;
-    let c = (uu * dv - uv * du) / denominator;
-    Some([1.0 - b - c, b, c])
+
+    /// The barycentric weights of the projection of `p`.
+    fn weights(&self, p: DVec3) -> [f64; 3] {
+        let d = p - self.origin;
+        let (du, dv) = (d.dot(self.u), d.dot(self.v));
+        let b = (self.vv * du - self.uv * dv) / self.denominator;
+        let c = (self.uu * dv - self.uv * du) / self.denominator;
+        [1.0 - b - c, b, c]
+    }
 }
 
 /// How far the other organ's smooth surface bulges along `direction`
@@ -316,25 +335,33 @@ fn plane_weights(corners: [DVec3; 3], p: DVec3) -> Option<[f64; 3]> {
 /// each end and the middle, so the flat part, linear, drops out.
 fn bulge_under_edges(moving: &Surface, i: usize, nearest: &Nearest, direction: DVec3) -> f64 {
     let (corners, normals) = (nearest.corners, nearest.normals);
-    let off_plane = |p: DVec3| {
-        let weights = plane_weights(corners, p)?;
-        let flat: DVec3 = (0..3).map(|k| corners[k] * weights[k]).sum();
-        Some((phong_point(corners, normals, weights) - flat).dot(direction))
-    };
-    let x = moving.positions[i];
-    let Some(at_x) = off_plane(x) else {
+    let Some(plane) = PlaneFrame::new(corners) else {
         return 0.0;
     };
+    let off_plane = |p: DVec3| {
+        let weights = plane.weights(p);
+        let flat: DVec3 = (0..3).map(|k| corners[k] * weights[k]).sum();
+        (phong_point(corners, normals, weights) - flat).dot(direction)
+    };
+    let x = moving.positions[i];
+    let at_x = off_plane(x);
     let mut most: f64 = 0.0;
+    // Each neighbour is a corner of two of the ring's triangles (one at a
+    // rim): its edge is measured once (a repeat could only give the same
+    // value again).
+    let mut seen = [u32::MAX; 16];
+    let mut count = 0;
     for &t in moving.rings.around(i as u32) {
         for k in moving.triangles[t as usize] {
-            if k as usize == i {
+            if k as usize == i || seen[..count].contains(&k) {
                 continue;
             }
-            let y = moving.positions[k as usize];
-            if let (Some(middle), Some(at_y)) = (off_plane(0.5 * (x + y)), off_plane(y)) {
-                most = most.max(middle - 0.5 * (at_x + at_y));
+            if count < seen.len() {
+                seen[count] = k;
+                count += 1;
             }
+            let y = moving.positions[k as usize];
+            most = most.max(off_plane(0.5 * (x + y)) - 0.5 * (at_x + off_plane(y)));
         }
     }
     most
