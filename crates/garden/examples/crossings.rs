@@ -15,11 +15,11 @@
 //! edges pass through triangles and every corner lies on its side.
 //! `DIGEST_TOLERANCE=1e-6` runs with another solver tolerance.
 use anthesis_bud::{crossing_depth, quality, self_intersections};
-use anthesis_flower::Project;
+use anthesis_garden::flower_mesh;
 use anthesis_garden::flowers::{EDGE_SCALE, FLOWER_NAMES, flower_at_resolution};
 use anthesis_mesh::Mesh;
 use anthesis_mesh::nearest::{closest_point_on_triangle, triangles_around};
-use anthesis_sim::{Keyframe, Selection};
+use anthesis_sim::Selection;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -39,12 +39,11 @@ fn main() {
         if let Ok(tolerance) = std::env::var("DIGEST_TOLERANCE") {
             project.settings.solver.relative_tolerance = tolerance.parse().expect("a tolerance");
         }
-        let organ_of = organ_of_triangle(&project);
         let (mut keyframes, mut count, mut deepest) = (Vec::new(), 0, 0.0f64);
         let (mut vertex_face, mut edge_edge) = (0, 0);
         println!("{name}");
         anthesis_sim::run(&project, &Selection::All, &mut |_, keyframe| {
-            let mesh = combined(&project, keyframe);
+            let (mesh, organ_of) = flower_mesh(&project, &keyframe.positions_in_world);
             let edge = quality(&mesh).mean_edge;
             let around = triangles_around(&mesh.triangles, mesh.positions.len());
             let mut found = Vec::new();
@@ -103,27 +102,6 @@ fn main() {
     for line in summary {
         println!("  {line}");
     }
-}
-
-/// Every organ of a keyframe as one mesh.
-fn combined(project: &Project, keyframe: &Keyframe) -> Mesh {
-    let mut mesh = Mesh::default();
-    for (i, positions) in keyframe.positions_in_world.iter().enumerate() {
-        let template = &project.flower.template_of(i).mesh;
-        let first = mesh.positions.len() as u32;
-        mesh.positions.extend(positions);
-        mesh.uvs.extend(&template.uvs);
-        mesh.triangles
-            .extend(template.triangles.iter().map(|t| t.map(|v| v + first)));
-    }
-    mesh
-}
-
-/// The organ of each triangle of [`combined`].
-fn organ_of_triangle(project: &Project) -> Vec<usize> {
-    (0..project.flower.organs.len())
-        .flat_map(|i| std::iter::repeat_n(i, project.flower.template_of(i).mesh.triangles.len()))
-        .collect()
 }
 
 /// Whether a corner of triangle `s` lies past the flat surface of `t`'s

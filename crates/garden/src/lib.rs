@@ -46,6 +46,28 @@ use anthesis_flower::project::{ProjectError, parse_project};
 
 pub use flowers::{Cultivar, FLOWER_NAMES, GardenError};
 
+/// The organs of `project`'s flower at `positions` (one list per organ, in
+/// the flower's order, as a keyframe holds them) as one mesh, with the
+/// organ of each of its triangles: to look for organs passing through
+/// each other (`anthesis_bud::self_intersections`).
+pub fn flower_mesh(
+    project: &Project,
+    positions: &[Vec<glam::DVec3>],
+) -> (anthesis_mesh::Mesh, Vec<usize>) {
+    let mut mesh = anthesis_mesh::Mesh::default();
+    let mut organ_of_triangle = Vec::new();
+    for (i, organ) in positions.iter().enumerate() {
+        let template = &project.flower.template_of(i).mesh;
+        let first = mesh.positions.len() as u32;
+        mesh.positions.extend(organ);
+        mesh.uvs.extend(&template.uvs);
+        mesh.triangles
+            .extend(template.triangles.iter().map(|t| t.map(|v| v + first)));
+        organ_of_triangle.extend(std::iter::repeat_n(i, template.triangles.len()));
+    }
+    (mesh, organ_of_triangle)
+}
+
 /// One embedded file: its path inside its flower's folder and its bytes.
 type EmbeddedFile = (&'static str, &'static [u8]);
 
@@ -111,4 +133,56 @@ pub fn builtin_lily() -> Result<Project, ProjectError> {
                 .to_string(),
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_flower_mesh_holds_every_organ_with_its_triangles_renumbered() {
+        let project = match flowers::flower("five-petal") {
+            Some(Ok(project)) => project,
+            other => panic!("the five-petal flower builds: {:?}", other.map(|r| r.err())),
+        };
+        let organs = project.flower.organs.len();
+        // Each organ moved up by its index, so the mesh's positions say whose they are.
+        let positions: Vec<Vec<glam::DVec3>> = (0..organs)
+            .map(|i| {
+                let mesh = &project.flower.template_of(i).mesh;
+                mesh.positions
+                    .iter()
+                    .map(|p| *p + glam::DVec3::Y * i as f64)
+                    .collect()
+            })
+            .collect();
+        let (mesh, organ_of) = flower_mesh(&project, &positions);
+        let sizes: Vec<(usize, usize)> = (0..organs)
+            .map(|i| {
+                let m = &project.flower.template_of(i).mesh;
+                (m.vertex_count(), m.triangle_count())
+            })
+            .collect();
+        assert_eq!(
+            mesh.positions.len(),
+            sizes.iter().map(|s| s.0).sum::<usize>()
+        );
+        assert_eq!(mesh.uvs.len(), mesh.positions.len());
+        assert_eq!(organ_of.len(), mesh.triangles.len());
+        let (mut first_vertex, mut first_triangle) = (0, 0);
+        for (i, &(vertices, triangles)) in sizes.iter().enumerate() {
+            let template = &project.flower.template_of(i).mesh;
+            for (k, t) in template.triangles.iter().enumerate() {
+                let whole = mesh.triangles[first_triangle + k];
+                assert_eq!(whole, t.map(|v| v + first_vertex as u32));
+                assert_eq!(organ_of[first_triangle + k], i);
+                assert_eq!(
+                    mesh.positions[whole[0] as usize],
+                    positions[i][t[0] as usize]
+                );
+            }
+            first_vertex += vertices;
+            first_triangle += triangles;
+        }
+    }
 }

@@ -7,40 +7,13 @@
 //! winding number of each tube's closed surface).
 
 use anthesis_bud::{crossing_depth, quality, self_intersections};
-use anthesis_flower::Project;
 use anthesis_flower::parts::obstacles;
 use anthesis_flower::structure::lsystem::LSystem;
 use anthesis_garden::apple::{APPLE_LSYSTEM, APPLE_STEM, APPLE_UNITS, apple};
-use anthesis_mesh::Mesh;
+use anthesis_garden::flower_mesh;
 use anthesis_mesh::nearest::winding_number;
-use anthesis_sim::{Keyframe, Selection};
+use anthesis_sim::Selection;
 use glam::DVec3;
-
-/// Every organ of a keyframe as one mesh.
-fn combined(project: &Project, keyframe: &Keyframe) -> Mesh {
-    let mut mesh = Mesh::default();
-    for (i, positions) in keyframe.positions_in_world.iter().enumerate() {
-        let template = &project.flower.template_of(i).mesh;
-        let first = mesh.positions.len() as u32;
-        mesh.positions.extend(positions);
-        mesh.uvs.extend(&template.uvs);
-        mesh.triangles
-            .extend(template.triangles.iter().map(|t| t.map(|v| v + first)));
-    }
-    mesh
-}
-
-/// Which organ a triangle of [`combined`] belongs to.
-fn organ_of(project: &Project, mut triangle: usize) -> usize {
-    for i in 0..project.flower.organs.len() {
-        let n = project.flower.template_of(i).mesh.triangles.len();
-        if triangle < n {
-            return i;
-        }
-        triangle -= n;
-    }
-    usize::MAX
-}
 
 /// The distance of `p` from the flower axis.
 fn from_axis(p: DVec3) -> f64 {
@@ -106,11 +79,11 @@ fn the_apple_opens_without_any_organ_passing_through_another_or_a_tube() {
     let mut keyframes = 0;
     anthesis_sim::run(&project, &Selection::All, &mut |_, keyframe| {
         keyframes += 1;
-        let mesh = combined(&project, keyframe);
+        let (mesh, organ_of) = flower_mesh(&project, &keyframe.positions_in_world);
         let edge = quality(&mesh).mean_edge;
         for pair in self_intersections(&mesh) {
             let depth = crossing_depth(&mesh, pair) / edge;
-            let [a, b] = pair.map(|t| organ_of(&project, t));
+            let [a, b] = pair.map(|t| organ_of[t]);
             crossings.push((keyframe.index, a, b, depth));
         }
         for tube in &tubes {

@@ -8,9 +8,8 @@ use anthesis_bud::{find_self_intersection, quality};
 use anthesis_flower::Project;
 use anthesis_flower::project::load_project;
 use anthesis_garden::{
-    FLOWER_NAMES, builtin, builtin_lily, builtin_names, flowers, project_file_name,
+    FLOWER_NAMES, builtin, builtin_lily, builtin_names, flower_mesh, flowers, project_file_name,
 };
-use anthesis_mesh::Mesh;
 use glam::DVec3;
 
 fn committed(name: &str) -> PathBuf {
@@ -174,27 +173,12 @@ fn the_three_cultivars_share_one_bud_and_differ_in_their_maps() {
     );
 }
 
-/// All organs of a bud as one mesh, to look for triangles of different
-/// organs crossing.
-fn combined(project: &Project) -> Mesh {
-    let mut mesh = Mesh::default();
-    for (i, positions) in bud_positions(project).into_iter().enumerate() {
-        let template = &project.flower.template_of(i).mesh;
-        let first = mesh.positions.len() as u32;
-        mesh.positions.extend(positions);
-        mesh.uvs.extend(&template.uvs);
-        mesh.triangles
-            .extend(template.triangles.iter().map(|t| t.map(|v| v + first)));
-    }
-    mesh
-}
-
 #[test]
 fn bud_organs_do_not_cut_through_each_other() {
     for name in FLOWER_NAMES {
         let project = built(name);
         assert_eq!(
-            find_self_intersection(&combined(&project)),
+            find_self_intersection(&flower_mesh(&project, &bud_positions(&project)).0),
             None,
             "{name}: organs intersect in the bud"
         );
