@@ -450,6 +450,9 @@ impl ExportDialog {
     /// Starts writing `tracks` to the dialog's path on a thread; `wake` is
     /// called on progress and at the end.
     pub fn start(&mut self, tracks: Vec<Track>, wake: impl Fn() + Send + Sync + 'static) {
+        if self.target().is_none() {
+            return;
+        }
         if tracks.iter().all(|t| t.keyframes.is_empty()) {
             self.state = ExportState::Failed {
                 message: "there are no keyframes to export yet".to_string(),
@@ -490,6 +493,18 @@ impl ExportDialog {
         }
     }
 
+    /// The file to export to, or `None` (the export failed: no file named).
+    fn target(&mut self) -> Option<PathBuf> {
+        let path = PathBuf::from(self.path.trim());
+        if path.as_os_str().is_empty() {
+            self.state = ExportState::Failed {
+                message: "choose a file to export to".to_string(),
+            };
+            return None;
+        }
+        Some(path)
+    }
+
     /// Stops the running export's simulation (the file is not written).
     pub fn cancel(&self) {
         self.cancel.store(true, Ordering::Relaxed);
@@ -506,13 +521,9 @@ impl ExportDialog {
         + 'static,
         wake: impl Fn() + Send + Sync + 'static,
     ) {
-        let path = PathBuf::from(self.path.trim());
-        if path.as_os_str().is_empty() {
-            self.state = ExportState::Failed {
-                message: "choose a file to export to".to_string(),
-            };
+        let Some(path) = self.target() else {
             return;
-        }
+        };
         let options = self.options();
         let animation = self.animation;
         let animation_step = self.animation_step;
