@@ -5,6 +5,7 @@
 //! app as worker events), not computed by the live solver, so snapshots do
 //! not move when the physics changes.
 
+use std::path::Path;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -511,6 +512,31 @@ fn a_failed_run_is_shown_and_the_app_keeps_going() {
     assert!(harness.state().session().run() > run);
 }
 
+/// Steps `harness` until the export dialog says it wrote `out` (failing
+/// after `limit`).
+fn wait_for_export(harness: &mut Harness<'_, AnthesisApp>, out: &Path, limit: Duration) {
+    let started = Instant::now();
+    while !out.exists() || harness.query_by_label_contains("Wrote ").is_none() {
+        assert!(
+            started.elapsed() < limit,
+            "export hangs; state {:?}, path {:?}, log: {:?}",
+            harness.state().export_dialog().state(),
+            harness.state().export_dialog().path,
+            harness.state().log().entries()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        harness.step();
+    }
+}
+
+/// The JSON chunk of the .glb at `path`.
+fn glb_json(path: &Path) -> String {
+    let bytes = std::fs::read(path).expect("exported file");
+    assert_eq!(&bytes[..4], b"glTF");
+    let json_length = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
+    String::from_utf8(bytes[20..20 + json_length].to_vec()).expect("JSON chunk")
+}
+
 #[test]
 fn the_export_dialog_runs_the_flower_again_at_a_finer_edge_for_the_file_only() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -528,22 +554,11 @@ fn the_export_dialog_runs_the_flower_again_at_a_finer_edge_for_the_file_only() {
     harness.state_mut().export_dialog_mut().path = out.display().to_string();
     harness.run();
     harness.get_by_label("Export").click();
-    let started = Instant::now();
-    while harness.query_by_label_contains("Wrote ").is_none() {
-        assert!(
-            started.elapsed() < Duration::from_secs(120),
-            "export hangs; state {:?}",
-            harness.state().export_dialog().state()
-        );
-        std::thread::sleep(Duration::from_millis(20));
-        harness.step();
-    }
+    wait_for_export(&mut harness, &out, Duration::from_secs(120));
     // The file holds the finer meshes; the project and the window's run
     // are as they were.
-    let bytes = std::fs::read(&out).expect("exported file");
-    let json_length = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
     let json: serde_json::Value =
-        serde_json::from_slice(&bytes[20..20 + json_length]).expect("JSON chunk");
+        serde_json::from_str(&glb_json(&out)).expect("the JSON chunk parses");
     let most_vertices = json["accessors"]
         .as_array()
         .expect("accessors")
@@ -582,22 +597,8 @@ fn the_export_dialog_writes_a_glb_and_reports_it() {
     harness.get_by_label("meshopt").click();
     harness.run();
     harness.get_by_label("Export").click();
-    let started = Instant::now();
-    while !out.exists() || harness.query_by_label_contains("Wrote ").is_none() {
-        assert!(
-            started.elapsed() < Duration::from_secs(60),
-            "export hangs; state {:?}, path {:?}, log: {:?}",
-            harness.state().export_dialog().state(),
-            harness.state().export_dialog().path,
-            harness.state().log().entries()
-        );
-        std::thread::sleep(Duration::from_millis(20));
-        harness.step();
-    }
-    let bytes = std::fs::read(&out).expect("exported file");
-    assert_eq!(&bytes[..4], b"glTF");
-    let json_length = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as usize;
-    let json = std::str::from_utf8(&bytes[20..20 + json_length]).expect("JSON chunk");
+    wait_for_export(&mut harness, &out, Duration::from_secs(60));
+    let json = glb_json(&out);
     assert!(
         json.contains("EXT_meshopt_compression") && json.contains("KHR_mesh_quantization"),
         "the option was used"
