@@ -390,6 +390,14 @@ impl Simulation {
                 after.flower.template_of(index),
             );
         }
+        // A part's schedule may differ from a later step on (`resume`):
+        // the parts take the edited ones, as a run of `after` from the bud
+        // has them (their shapes and places are the same, or the run
+        // started over above).
+        let pieces = anthesis_flower::parts::obstacles(&after.flower);
+        for (obstacle, piece) in self.obstacles.iter_mut().zip(pieces) {
+            obstacle.take(piece);
+        }
         self.settings.keyframes = after.settings.keyframes;
         Ok(self.next_step)
     }

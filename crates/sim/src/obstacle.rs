@@ -75,6 +75,18 @@ impl ObstacleSim {
         self.hi = hi + DVec3::splat(reach);
     }
 
+    /// Takes `piece`, this part edited: the same shape and place (an edit
+    /// that changes them starts the run over, see `resume`), perhaps
+    /// another schedule from a later step on, name or colour. With another
+    /// schedule it is put again at the next step, where a run from the bud
+    /// has it.
+    pub(crate) fn take(&mut self, piece: PartPiece) {
+        if piece.schedule != self.source.schedule {
+            self.step = None;
+        }
+        self.source = piece;
+    }
+
     /// How far from its nearest vertex a particle is looked at.
     fn reach(&self) -> f64 {
         2.0 * self.mean_edge

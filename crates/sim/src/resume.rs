@@ -5,11 +5,15 @@
 //! A keyframe's result depends only on the organs' state at its start and
 //! on what the step reads from the project: the time keys its blend weights
 //! name (with their maps and weights) and the joint angle at that step.
+//! The parts that are obstacles are read the same way: their shapes and
+//! places from the bud on, their schedules at each step.
 //! Everything else a run reads (meshes, where organs sit, material
-//! constants, the model, the solver and collision settings, the parts that
-//! are obstacles) acts from the bud on; changing it starts the run over. Colours are not read at all.
+//! constants, the model, the solver and collision settings) acts from the
+//! bud on; changing it starts the run over. Colours, and the parts' names,
+//! are not read at all.
 
-use anthesis_flower::{Project, Template, joint_angle_after};
+use anthesis_flower::parts::PartPiece;
+use anthesis_flower::{JointRamp, Placement, Project, Template, joint_angle_after};
 
 /// What an edit from one project to another does to a run of `organs` (the
 /// project's organ indices the run simulates).
@@ -18,8 +22,8 @@ pub enum Edit {
     /// No keyframe changes (a colour, an organ not simulated).
     Nothing,
     /// Keyframes before this step stay as they are; this one and later ones
-    /// must be computed again (only maps, key steps, the blend, the joint
-    /// schedule or the keyframe count changed).
+    /// must be computed again (only maps, key steps, the blend, a joint or
+    /// part schedule or the keyframe count changed).
     From(u32),
     /// Something read from the bud on changed: the run starts over.
     Everything,
@@ -27,7 +31,11 @@ pub enum Edit {
 
 /// What changing `before` into `after` does to a run of `organs`.
 pub fn edit_between(before: &Project, after: &Project, organs: &[usize]) -> Edit {
-    if !same_from_the_bud(before, after, organs) {
+    let (old_parts, new_parts) = (
+        anthesis_flower::parts::obstacles(&before.flower),
+        anthesis_flower::parts::obstacles(&after.flower),
+    );
+    if !same_from_the_bud(before, after, organs, (&old_parts, &new_parts)) {
         return Edit::Everything;
     }
     let keyframes = before.settings.keyframes.min(after.settings.keyframes);
@@ -36,8 +44,23 @@ pub fn edit_between(before: &Project, after: &Project, organs: &[usize]) -> Edit
     for &organ in organs {
         let old = before.flower.template_of(organ);
         let new = after.flower.template_of(organ);
-        if let Some(step) = first_step_reading_a_change(old, new, first.unwrap_or(keyframes + 1)) {
+        // The same in both (`same_from_the_bud`).
+        let placement = &before.flower.organs[organ].placement;
+        let limit = first.unwrap_or(keyframes + 1);
+        if let Some(step) = first_step_reading_a_change(old, new, placement, limit) {
             first = Some(first.map_or(step, |f| f.min(step)));
+        }
+    }
+    // The same shapes and places (`same_from_the_bud`): a part moves
+    // otherwise from the first step its schedule turns it otherwise.
+    for (old, new) in old_parts.iter().zip(&new_parts) {
+        let limit = first.unwrap_or(keyframes + 1);
+        let moved = |step: u32| {
+            joint_angle_read(&old.placement, &old.schedule, step)
+                != joint_angle_read(&new.placement, &new.schedule, step)
+        };
+        if let Some(step) = (1..limit).find(|&step| moved(step)) {
+            first = Some(step);
         }
     }
     match first {
@@ -47,10 +70,35 @@ pub fn edit_between(before: &Project, after: &Project, organs: &[usize]) -> Edit
     }
 }
 
+/// The joint angle a step reads for something placed at `placement` with
+/// `schedule`, as bits: `Placement::world_from_template` and
+/// `parts::pose` turn by the placement's angle plus the schedule's, and
+/// nothing else reads the schedule. Compared this way, not by the
+/// schedule's angle alone: an empty schedule's angle is -0.0 (an empty
+/// sum), a ramp that has not started yet gives +0.0, and added to the
+/// placement's angle both give the same bits (unless that angle is -0.0),
+/// so adding a later ramp where there was none keeps the earlier keyframes
+/// (the apple's templates and parts have no schedule).
+fn joint_angle_read(placement: &Placement, schedule: &[JointRamp], step: u32) -> u64 {
+    (placement.joint_angle_deg.to_radians() + joint_angle_after(schedule, step)).to_bits()
+}
+
+/// What a run reads of a part from the bud on: its shape and place (its
+/// schedule is read per step, its name and colours never).
+fn part_shape(piece: &PartPiece) -> (&anthesis_mesh::Mesh, &Placement) {
+    (&piece.mesh, &piece.placement)
+}
+
 /// Whether everything a run reads from the bud on is the same: the
 /// simulated organs, their templates' meshes and constants, the overlaps
-/// between them, and the settings other than the keyframe count.
-fn same_from_the_bud(before: &Project, after: &Project, organs: &[usize]) -> bool {
+/// between them, the parts' shapes and places (`parts`: the obstacles of
+/// each), and the settings other than the keyframe count.
+fn same_from_the_bud(
+    before: &Project,
+    after: &Project,
+    organs: &[usize],
+    (old_parts, new_parts): (&[PartPiece], &[PartPiece]),
+) -> bool {
     let settings = |project: &Project| anthesis_flower::SimulationSettings {
         keyframes: 0,
         ..project.settings
@@ -58,8 +106,10 @@ fn same_from_the_bud(before: &Project, after: &Project, organs: &[usize]) -> boo
     if settings(before) != settings(after)
         || before.flower.organs.len() != after.flower.organs.len()
         || before.flower.overlaps != after.flower.overlaps
-        || anthesis_flower::parts::obstacles(&before.flower)
-            != anthesis_flower::parts::obstacles(&after.flower)
+        || !old_parts
+            .iter()
+            .map(part_shape)
+            .eq(new_parts.iter().map(part_shape))
     {
         return false;
     }
@@ -77,10 +127,16 @@ fn same_from_the_bud(before: &Project, after: &Project, organs: &[usize]) -> boo
 }
 
 /// The first step before `limit` that reads something of `new` that differs
-/// from `old`: its blend names keys with other maps or gives them other
-/// weights, or the joint angle differs. A key named with weight 0 counts as
-/// read (the product is a signed zero, which can still differ).
-fn first_step_reading_a_change(old: &Template, new: &Template, limit: u32) -> Option<u32> {
+/// from `old` for an organ at `placement`: its blend names keys with other
+/// maps or gives them other weights, or the joint angle differs. A key
+/// named with weight 0 counts as read (the product is a signed zero, which
+/// can still differ).
+fn first_step_reading_a_change(
+    old: &Template,
+    new: &Template,
+    placement: &Placement,
+    limit: u32,
+) -> Option<u32> {
     let (old_keys, new_keys) = (old.maps.keys(), new.maps.keys());
     // same[i][j]: old key i and new key j hold the same maps.
     let same: Vec<Vec<bool>> = old_keys
@@ -106,8 +162,8 @@ fn first_step_reading_a_change(old: &Template, new: &Template, limit: u32) -> Op
                 w_old.to_bits() != w_new.to_bits() || !same[k_old][k_new]
             });
         keys_differ
-            || joint_angle_after(&old.joint_schedule, step).to_bits()
-                != joint_angle_after(&new.joint_schedule, step).to_bits()
+            || joint_angle_read(placement, &old.joint_schedule, step)
+                != joint_angle_read(placement, &new.joint_schedule, step)
     })
 }
 
@@ -116,6 +172,7 @@ mod tests {
     use super::*;
     use crate::fixtures::{stroke_near_tip as paint, whorl};
     use anthesis_flower::JointRamp;
+    use anthesis_flower::parts::{Part, PartShape, Tube};
 
     /// A four-organ whorl whose templates have time keys at steps 40 and
     /// 50, blended linearly (as the lily's), over 60 keyframes.
@@ -183,6 +240,84 @@ mod tests {
             angle_deg: 5.0,
         });
         assert_eq!(edit_between(&before, &after, &ALL), Edit::From(31));
+    }
+
+    #[test]
+    fn a_first_ramp_on_a_template_without_one_keeps_the_steps_before_it() {
+        // The apple's templates have no schedule: its angle is an empty
+        // sum, -0.0, and a ramp not yet started gives +0.0. Both added to
+        // the placement's angle are the angle the step reads.
+        let mut before = lily_like();
+        before.flower.templates[1].joint_schedule.clear();
+        let mut after = before.clone();
+        after.flower.templates[1].joint_schedule.push(JointRamp {
+            from_step: 30,
+            to_step: 45,
+            angle_deg: 5.0,
+        });
+        assert_eq!(edit_between(&before, &after, &ALL), Edit::From(31));
+    }
+
+    /// A stamen beside each organ of `lily_like`, turning outwards over
+    /// the first 20 steps.
+    fn with_stamens() -> Project {
+        let mut project = lily_like();
+        project.flower.parts.push(Part {
+            name: "stamen".to_string(),
+            shape: PartShape::Stamen {
+                filament: Tube {
+                    length: 8.0,
+                    radius: 0.3,
+                    curvature_deg: 0.0,
+                },
+                anther_length: 1.5,
+                anther_radius: 0.4,
+                anther_tilt_deg: 60.0,
+            },
+            count: 3,
+            ring_radius: 1.0,
+            height: 0.0,
+            offset_deg: 0.0,
+            angle_deg: 5.0,
+            schedule: vec![JointRamp {
+                from_step: 0,
+                to_step: 20,
+                angle_deg: 10.0,
+            }],
+            color: [0.8, 0.8, 0.6, 1.0],
+            head_color: [0.6, 0.2, 0.0, 1.0],
+        });
+        project
+    }
+
+    #[test]
+    fn a_parts_later_ramp_keeps_the_steps_before_it_and_its_colour_and_name_nothing() {
+        let before = with_stamens();
+        let mut later = before.clone();
+        later.flower.parts[0].schedule.push(JointRamp {
+            from_step: 35,
+            to_step: 50,
+            angle_deg: -4.0,
+        });
+        assert_eq!(edit_between(&before, &later, &ALL), Edit::From(36));
+        // One organ alone still meets the parts.
+        assert_eq!(edit_between(&before, &later, &[1]), Edit::From(36));
+        // Fewer keyframes too: the earlier.
+        later.settings.keyframes = 30;
+        assert_eq!(edit_between(&before, &later, &ALL), Edit::From(31));
+        // Its first ramp made shorter: the angles part at step 1.
+        let mut faster = before.clone();
+        faster.flower.parts[0].schedule[0].to_step = 10;
+        assert_eq!(edit_between(&before, &faster, &ALL), Edit::Everything);
+        let mut recoloured = before.clone();
+        recoloured.flower.parts[0].color = [0.1, 0.2, 0.3, 1.0];
+        recoloured.flower.parts[0].head_color = [0.9, 0.2, 0.3, 1.0];
+        recoloured.flower.parts[0].name = "filament".to_string();
+        assert_eq!(edit_between(&before, &recoloured, &ALL), Edit::Nothing);
+        // Its shape or place acts from the bud on.
+        let mut longer = before.clone();
+        longer.flower.parts[0].ring_radius = 1.2;
+        assert_eq!(edit_between(&before, &longer, &ALL), Edit::Everything);
     }
 
     #[test]

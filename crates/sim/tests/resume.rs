@@ -5,10 +5,13 @@
 
 mod common;
 
-use anthesis_flower::{JointRamp, Project};
+use anthesis_flower::parts::{Part, PartShape, Tube};
+use anthesis_flower::{JointRamp, Project, TwoStateAnimation};
 use anthesis_sim::fixtures::{stroke_near_tip as paint, whorl};
 use anthesis_sim::{Keyframe, Selection, SimError, Simulation};
+use anthesis_twostate::{GrowthFunction, VelocityCurve};
 use common::fingerprint;
+use glam::DQuat;
 
 /// Steps `sim` to its last keyframe, collecting the keyframes it computes.
 fn finish(sim: &mut Simulation) -> Vec<Keyframe> {
@@ -135,4 +138,115 @@ fn without_checkpoints_an_edit_starts_over_and_an_edit_that_changes_nothing_keep
     assert_eq!(sim.edit(&before, &recoloured).expect("valid"), 13);
     assert!(sim.finished());
     assert_eq!(sim.color(0), [0.2, 0.3, 0.9, 1.0]);
+}
+
+#[test]
+fn a_first_ramp_where_there_was_none_goes_on_from_its_first_step_bit_for_bit() {
+    // Templates without a schedule (as the apple's): the angle the steps
+    // before the ramp read is the same, though the schedule's own angle
+    // changes from -0.0 (an empty sum) to +0.0.
+    let mut before = whorl(4, 6, 10, 16);
+    for template in &mut before.flower.templates {
+        template.joint_schedule.clear();
+    }
+    let mut after = before.clone();
+    after.flower.templates[1].joint_schedule.push(JointRamp {
+        from_step: 10,
+        to_step: 16,
+        angle_deg: 6.0,
+    });
+    let (sim, kept) = full_run(&before);
+    let (_, turned) = full_run(&after);
+    assert_ne!(fingerprint(&kept[11..]), fingerprint(&turned[11..]));
+    assert_resumes_exactly(sim, &kept, &before, &after, 11);
+}
+
+/// A pistil on the flower axis, without a schedule.
+fn pistil() -> Part {
+    Part {
+        name: "pistil".to_string(),
+        shape: PartShape::Pistil {
+            style: Tube {
+                length: 12.0,
+                radius: 0.8,
+                curvature_deg: 0.0,
+            },
+            stigma_radius: 1.0,
+            stigma_lobes: 3,
+            ovary_length: 0.0,
+            ovary_radius: 0.0,
+        },
+        count: 1,
+        ring_radius: 0.0,
+        height: 0.0,
+        offset_deg: 0.0,
+        angle_deg: 0.0,
+        schedule: Vec::new(),
+        color: [0.5, 0.7, 0.3, 1.0],
+        head_color: [0.5, 0.7, 0.3, 1.0],
+    }
+}
+
+#[test]
+fn a_part_turned_from_a_later_step_goes_on_from_there_bit_for_bit() {
+    // One petal swinging in across the axis, where the pistil stands: the
+    // pistil's contacts hold it from the middle of the run on. The edit
+    // tilts the pistil from step 8, so the run must take the new schedule
+    // (a part's colour changes nothing at all).
+    let mut before = whorl(1, 6, 10, 14);
+    before.flower.templates[0].joint_schedule = vec![JointRamp {
+        from_step: 0,
+        to_step: 14,
+        angle_deg: -40.0,
+    }];
+    before.flower.parts.push(pistil());
+    let mut after = before.clone();
+    after.flower.parts[0].schedule.push(JointRamp {
+        from_step: 8,
+        to_step: 14,
+        angle_deg: 12.0,
+    });
+    let (sim, kept) = full_run(&before);
+    assert!(kept[9..].iter().any(|k| k.stats.contact_particles > 0));
+    let (_, tilted) = full_run(&after);
+    assert_ne!(fingerprint(&kept[9..]), fingerprint(&tilted[9..]));
+    assert_resumes_exactly(sim, &kept, &before, &after, 9);
+
+    let mut recoloured = before.clone();
+    recoloured.flower.parts[0].color = [0.9, 0.1, 0.1, 1.0];
+    let (mut sim, _) = full_run(&before);
+    assert_eq!(sim.edit(&before, &recoloured).expect("valid"), 15);
+}
+
+#[test]
+fn a_two_state_organ_goes_on_from_a_later_ramp_bit_for_bit() {
+    // The outer organ is kinematic (its two-state in-betweens, placed);
+    // the inner one grows into it. Its later ramp moves it from step 9.
+    let mut before = common::inner_driven_into_outer_by(12, true, 30.0);
+    let outer = &mut before.flower.templates[1];
+    let open = outer
+        .mesh
+        .positions
+        .iter()
+        .zip(&outer.mesh.uvs)
+        .map(|(p, uv)| DQuat::from_rotation_x(0.3 * uv.y * uv.y) * *p)
+        .collect();
+    outer.two_state = Some(TwoStateAnimation {
+        open,
+        growth: GrowthFunction {
+            g: 6.0,
+            duration: 12.0,
+        },
+        velocity: VelocityCurve::Points(vec![[0.0, 0.0], [1.0, 1.0]]),
+    });
+    let mut after = before.clone();
+    after.flower.templates[1].joint_schedule.push(JointRamp {
+        from_step: 8,
+        to_step: 12,
+        angle_deg: -6.0,
+    });
+    let (sim, kept) = full_run(&before);
+    let (_, moved) = full_run(&after);
+    assert_ne!(fingerprint(&kept[9..]), fingerprint(&moved[9..]));
+    assert_resumes_exactly(sim, &kept, &before, &after, 9);
 }
