@@ -300,13 +300,22 @@ fn cases(base: &Project, selection: &Selection) -> Vec<Case> {
         });
     }
     if let Some(moving) = flower.parts.iter().position(|p| !p.schedule.is_empty()) {
-        edit(format!("part {moving}'s later ramp from {from}"), &|p| {
-            p.flower.parts[moving].schedule.push(JointRamp {
-                from_step: from,
-                to_step: from + keyframes / 5,
-                angle_deg: -5.0,
-            });
-        });
+        // Back towards the axis (the stamens of the built-ins then touch
+        // nothing at this resolution), and out into the petals (the coarse
+        // lily's run then stops at keyframe 79: the worker must stop there
+        // too, and its undo go on from the last keyframe kept).
+        for angle_deg in [-5.0, 5.0] {
+            edit(
+                format!("part {moving}'s later ramp by {angle_deg} from {from}"),
+                &|p| {
+                    p.flower.parts[moving].schedule.push(JointRamp {
+                        from_step: from,
+                        to_step: from + keyframes / 5,
+                        angle_deg,
+                    });
+                },
+            );
+        }
     }
     if matches!(selection, Selection::Only(_)) && flower.organs.len() > 1 {
         let last = flower.organs.len() - 1;
