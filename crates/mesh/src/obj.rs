@@ -3,7 +3,9 @@
 //! Import reads `v`, `vt` and `f` statements (`vn` is read past: normals
 //! are recomputed from the triangles). Face corners may be `v/vt` or
 //! `v/vt/vn`, indices may be negative (relative to the end of the list so
-//! far), and polygons with more than three corners are fan-triangulated.
+//! far), and polygons with more than three corners are fan-triangulated
+//! from their first corner, or cut by ear clipping where that fan would
+//! leave a triangle without area or folded over (see `triangulate`).
 //! `o`, `g`, `s`, `usemtl` and `mtllib` statements and `#` comments are
 //! ignored; `l` (loose edges, which Blender writes) and `p` (points) are
 //! ignored with an [`ObjWarning`]; any other statement is a syntax error.
@@ -480,8 +482,9 @@ fn parse(text: &str, uvs: bool) -> Result<Parsed, MeshError> {
                     return Err(too_many("triangles", MAX_TRIANGLES));
                 }
                 face_count += 1;
-                for k in 1..corners.len() - 1 {
-                    triangles.push([corners[0], corners[k], corners[k + 1]]);
+                let points = polygon_points(&corners, &positions, &texcoords);
+                for [a, b, c] in triangulate(corners.len(), &points) {
+                    triangles.push([corners[a], corners[b], corners[c]]);
                     face_of_triangle.push((face_count, line));
                 }
             }
@@ -581,6 +584,113 @@ fn parse(text: &str, uvs: bool) -> Result<Parsed, MeshError> {
         .map(|corners| corners.map(|c| new_index[c.position]))
         .collect();
     Ok(parsed)
+}
+
+/// Polygons with more corners than this are always fanned: ear clipping
+/// takes time cubic in the corners in the worst case.
+const MAX_EAR_CLIPPED_CORNERS: usize = 256;
+
+/// A face's corners as points in a plane, to triangulate it in: their UVs
+/// when every corner has one and the UV polygon has an area (a petal's
+/// layout is flat, and its triangles must not fold there), otherwise the
+/// positions projected onto the plane across the polygon's (Newell)
+/// normal. Empty when neither gives an area.
+fn polygon_points(corners: &[Corner], positions: &[DVec3], texcoords: &[DVec2]) -> Vec<DVec2> {
+    if corners.len() <= 3 {
+        return Vec::new();
+    }
+    let uvs: Option<Vec<DVec2>> = corners
+        .iter()
+        .map(|c| c.texcoord.map(|t| texcoords[t]))
+        .collect();
+    if let Some(uvs) = uvs
+        && doubled_signed_area(&uvs) != 0.0
+    {
+        return uvs;
+    }
+    let points: Vec<DVec3> = corners.iter().map(|c| positions[c.position]).collect();
+    let mut normal = DVec3::ZERO;
+    for (k, p) in points.iter().enumerate() {
+        let q = points[(k + 1) % points.len()];
+        normal += p.cross(q);
+    }
+    let Some(normal) = normal.try_normalize() else {
+        return Vec::new();
+    };
+    let across = normal.any_orthonormal_vector();
+    let up = normal.cross(across);
+    points
+        .iter()
+        .map(|p| DVec2::new(p.dot(across), p.dot(up)))
+        .collect()
+}
+
+/// Twice the signed area of a polygon (positive counter-clockwise).
+fn doubled_signed_area(points: &[DVec2]) -> f64 {
+    (0..points.len())
+        .map(|k| points[k].perp_dot(points[(k + 1) % points.len()]))
+        .sum()
+}
+
+/// The triangles of a polygon of `count` corners at `points` (see
+/// [`polygon_points`]), as indices into its corners, each wound as the
+/// polygon: a fan from the first corner, as most readers make, unless a
+/// fan triangle would have no area or turn the other way. Then the polygon
+/// is cut by ear clipping, skipping ears without area: a corner on a
+/// straight side (two quads merged into one face leave one) or a concave
+/// corner otherwise leaves a degenerate or folded triangle. Without
+/// points, or when no ear is left, the rest is fanned.
+fn triangulate(count: usize, points: &[DVec2]) -> Vec<[usize; 3]> {
+    let fan = |corners: &[usize]| -> Vec<[usize; 3]> {
+        (1..corners.len().saturating_sub(1))
+            .map(|k| [corners[0], corners[k], corners[k + 1]])
+            .collect()
+    };
+    let all: Vec<usize> = (0..count).collect();
+    let n = points.len();
+    if n != count || n <= 3 || n > MAX_EAR_CLIPPED_CORNERS {
+        return fan(&all);
+    }
+    let sense = doubled_signed_area(points).signum();
+    let perimeter: f64 = (0..n)
+        .map(|k| points[k].distance(points[(k + 1) % n]))
+        .sum();
+    let side = perimeter / n as f64;
+    let smallest = 2.0 * crate::validate::DEGENERATE_AREA_RATIO * side * side;
+    // Twice the area of a triangle, positive when wound as the polygon.
+    let area = |a: usize, b: usize, c: usize| {
+        sense * (points[b] - points[a]).perp_dot(points[c] - points[a])
+    };
+    if (1..n - 1).all(|k| area(0, k, k + 1) > smallest) {
+        return fan(&all);
+    }
+    let mut left = all;
+    let mut triangles = Vec::with_capacity(n - 2);
+    while left.len() > 3 {
+        let m = left.len();
+        let ear = (0..m).find(|&k| {
+            let (a, b, c) = (left[(k + m - 1) % m], left[k], left[(k + 1) % m]);
+            area(a, b, c) > smallest
+                && left.iter().all(|&p| {
+                    p == a
+                        || p == b
+                        || p == c
+                        || points[p] == points[a]
+                        || points[p] == points[b]
+                        || points[p] == points[c]
+                        || area(a, b, p) < 0.0
+                        || area(b, c, p) < 0.0
+                        || area(c, a, p) < 0.0
+                })
+        });
+        let Some(k) = ear else {
+            break;
+        };
+        triangles.push([left[(k + m - 1) % m], left[k], left[(k + 1) % m]]);
+        left.remove(k);
+    }
+    triangles.extend(fan(&left));
+    triangles
 }
 
 /// Parses the first `N` numbers after a keyword; further numbers (such as
@@ -827,6 +937,56 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
     fn polygon_is_fan_triangulated_and_ignored_statements_are_skipped() {
         let mesh = parse_obj(QUAD).expect("valid quad");
         assert_eq!(mesh, unit_square());
+    }
+
+    /// The triangles' areas in 3D and in UV, each wound as the mesh's
+    /// first triangle (positive when the same way round in UV).
+    fn areas(mesh: &Mesh) -> Vec<(f64, f64)> {
+        (0..mesh.triangle_count())
+            .map(|t| {
+                let [a, b, c] = mesh.triangle_uvs(t);
+                (mesh.triangle_area(t), 0.5 * (b - a).perp_dot(c - a))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_polygon_with_a_corner_on_a_straight_side_is_cut_into_proper_triangles() {
+        // Two unit squares merged into one face (as Blender's dissolve or
+        // a CAD export leaves them): the corner (1, 0) lies on the straight
+        // bottom side, so a fan from the first corner would make the
+        // triangle (0,0)-(1,0)-(2,0) of no area.
+        let text = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 0 1 0\n\
+                    vt 0 0\nvt 0.5 0\nvt 1 0\nvt 1 1\nvt 0.5 1\nvt 0 1\n\
+                    f 1/1 2/2 3/3 4/4 5/5 6/6\n";
+        let mesh = parse_obj(text).expect("a proper hexagon");
+        assert_eq!(mesh.triangle_count(), 4);
+        let areas = areas(&mesh);
+        assert!(
+            areas.iter().all(|&(world, uv)| world > 0.1 && uv > 0.05),
+            "{areas:?}"
+        );
+        let total: f64 = areas.iter().map(|(world, _)| world).sum();
+        assert!((total - 2.0).abs() < 1e-12, "{total}");
+        // The same face without UVs, read as a shape: cut in its plane.
+        let shape = parse_obj_shape(text).expect("a proper shape").mesh;
+        let total: f64 = (0..4).map(|t| shape.triangle_area(t)).sum();
+        assert!((total - 2.0).abs() < 1e-12, "{total}");
+    }
+
+    #[test]
+    fn a_concave_polygon_is_cut_without_folding() {
+        // An L whose first corner sees the reflex corner (1, 1) from
+        // outside: the fan's second triangle would turn the other way.
+        let text = "v 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\n\
+                    vt 1 0\nvt 1 0.5\nvt 0.5 0.5\nvt 0.5 1\nvt 0 1\nvt 0 0\n\
+                    f 1/1 2/2 3/3 4/4 5/5 6/6\n";
+        let mesh = parse_obj(text).expect("a proper L");
+        let areas = areas(&mesh);
+        assert_eq!(areas.len(), 4);
+        assert!(areas.iter().all(|&(_, uv)| uv > 0.0), "{areas:?}");
+        let total: f64 = areas.iter().map(|(world, _)| world).sum();
+        assert!((total - 3.0).abs() < 1e-12, "{total}");
     }
 
     #[test]
