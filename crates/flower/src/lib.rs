@@ -179,6 +179,11 @@ impl TwoStateAnimation {
     }
 }
 
+/// The fewest base particles that attach an organ: a project whose
+/// template has fewer is refused on loading, and so is a resolution whose
+/// remeshed template would have fewer ([`resolution::remesh_template`]).
+pub const MIN_BASE_PARTICLES: usize = 3;
+
 /// The base particles: those whose UV lies in this region.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BaseRegion {

@@ -22,7 +22,7 @@ use anthesis_bud::{BudError, RemeshOptions, remesh_mesh};
 use anthesis_mesh::Mesh;
 use thiserror::Error;
 
-use crate::{Project, Template};
+use crate::{MIN_BASE_PARTICLES, Project, Template};
 
 /// How finely the templates are simulated.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -81,10 +81,10 @@ pub enum ResolutionProblem {
         /// The base region's upper `u` limit.
         u_max: f64,
     },
-    /// The new mesh has fewer base particles than needed to hold the organ
-    /// (two, or the old mesh's count if that was smaller).
+    /// The new mesh has fewer base particles than attach an organ
+    /// ([`MIN_BASE_PARTICLES`], what loading a project asks for).
     #[error(
-        "the new mesh has {particles} base particles where the old had {old}; at least two are needed to hold the organ"
+        "the new mesh has {particles} base particles where the old had {old}; at least {MIN_BASE_PARTICLES} are needed to attach the organ; use a finer edge or widen base_region"
     )]
     TooFewBaseParticles {
         /// Base particles in the new mesh.
@@ -103,8 +103,10 @@ fn options(mean_edge: f64) -> RemeshOptions {
 }
 
 /// `template`'s mesh remeshed at `mean_edge` (see the module
-/// documentation); its base region must still hold at least two particles
-/// (or as many as the old mesh had, if fewer).
+/// documentation); its base region must still hold at least
+/// [`MIN_BASE_PARTICLES`], as loading a project asks of every template (a
+/// remesh that left fewer was taken and the run then stopped without
+/// naming the edge).
 pub fn remesh_template(template: &Template, mean_edge: f64) -> Result<Mesh, ResolutionError> {
     let error = |problem: ResolutionProblem| ResolutionError {
         template: template.name.clone(),
@@ -123,7 +125,7 @@ pub fn remesh_template(template: &Template, mean_edge: f64) -> Result<Mesh, Reso
             u_max: region.u_max,
         }));
     }
-    if base < old.min(2) {
+    if base < MIN_BASE_PARTICLES {
         return Err(error(ResolutionProblem::TooFewBaseParticles {
             particles: base,
             old,
@@ -269,6 +271,37 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("more than the limit of 200000"), "{text}");
+    }
+
+    #[test]
+    fn a_remesh_leaving_too_few_base_particles_to_attach_is_refused_naming_the_edge() {
+        // The base of this petal is 1.25 wide: at mean edge 2 the base row
+        // of the new mesh holds two particles, fewer than loading a project
+        // asks of a template.
+        let template = template(test_petal(10.0, 5.0, 9, 17));
+        let region = template.base_region;
+        assert!(region.particles(&template.mesh).len() >= MIN_BASE_PARTICLES);
+        let coarse = remesh_mesh(&template.mesh, &options(2.0)).expect("remeshes");
+        let base = region.particles(&coarse.mesh).len();
+        assert!(base > 0 && base < MIN_BASE_PARTICLES, "{base}");
+        let error = remesh_template(&template, 2.0).expect_err("too few base particles");
+        assert!(
+            matches!(
+                error.problem,
+                ResolutionProblem::TooFewBaseParticles { particles, .. } if particles == base
+            ),
+            "{error:?}"
+        );
+        let text = error.to_string();
+        assert!(
+            text.starts_with("template \"petal\" cannot be remeshed at mean edge 2:"),
+            "{text}"
+        );
+        assert!(text.contains("at least 3 are needed"), "{text}");
+        // What the remesh gives is a project that loads: a resolution that
+        // works passes the same check.
+        let fine = remesh_template(&template, 0.8).expect("fine remesh");
+        assert!(region.particles(&fine).len() >= MIN_BASE_PARTICLES);
     }
 
     #[test]

@@ -7,7 +7,7 @@ use anthesis_files::short_number;
 use anthesis_maps::{Blend, MapKind};
 
 use super::error::ProjectError;
-use crate::{MAX_KEYFRAMES, Project, Template};
+use crate::{MAX_KEYFRAMES, MIN_BASE_PARTICLES, Project, Template};
 
 /// All raster maps of a template must share one size. 1x1 maps are
 /// constants and fit any size. The size most maps have is the right one
@@ -311,10 +311,10 @@ fn template_problem(template: &Template) -> Option<String> {
         ));
     }
     let base = region.particles(&template.mesh).len();
-    if base < 3 {
+    if base < MIN_BASE_PARTICLES {
         return Some(format!(
             "the base region (v <= {}, u from {} to {}) holds {base} particle(s) of the mesh; at \
-             least 3 are needed to attach the organ",
+             least {MIN_BASE_PARTICLES} are needed to attach the organ",
             short_number(region.v_max),
             short_number(region.u_min),
             short_number(region.u_max)
