@@ -1233,6 +1233,34 @@ fn obj_warnings_reach_the_caller_naming_the_file() {
 }
 
 #[test]
+fn a_mesh_wound_with_its_inner_side_outwards_loads_with_a_warning() {
+    // Another tool's export wound the other way round: the organs would
+    // bend inwards instead of opening, and nothing else says why.
+    let (_folder, path) = saved_lily();
+    let obj = path.parent().expect("folder").join("meshes/petal.obj");
+    let text = fs::read_to_string(&obj).expect("read");
+    let reversed: Vec<String> = text
+        .lines()
+        .map(|line| match line.strip_prefix("f ") {
+            Some(corners) => {
+                let corners: Vec<&str> = corners.split_whitespace().rev().collect();
+                format!("f {}", corners.join(" "))
+            }
+            None => line.to_string(),
+        })
+        .collect();
+    fs::write(&obj, reversed.join("\n")).expect("write");
+    let loaded = anthesis_flower::project::load_project_with_warnings(&path).expect("loads");
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    let warning = &loaded.warnings[0];
+    assert!(
+        warning.contains("meshes/petal.obj: template \"Petal\": the triangles wind so that the inner side faces +Z"),
+        "{warning}"
+    );
+    assert!(warning.contains("reverse the faces' winding"), "{warning}");
+}
+
+#[test]
 fn the_model_is_read_from_the_file_and_version_1_files_keep_the_papers() {
     use anthesis_physics::BendBase;
     let (_folder, path) = saved_lily();

@@ -639,9 +639,22 @@ impl Loader<'_> {
         })
     }
 
+    /// A template's mesh. One whose triangles wind so that its inner side
+    /// faces +Z on average loads, with a warning: the winding decides the
+    /// inner side, so its organs would bend the other way than the template
+    /// frame's (−Z inner) and a mesh from another tool gives no other sign.
     fn mesh(&self, relative: &str, template: &str) -> Result<Mesh, ProjectError> {
-        self.mesh_entry(relative, &format!("template \"{template}\": mesh"))
-            .map(|(mesh, _)| mesh)
+        let (mesh, path) = self.mesh_entry(relative, &format!("template \"{template}\": mesh"))?;
+        if anthesis_bud::inner_side_faces_minus_z(&mesh) == Some(false) {
+            self.warnings.borrow_mut().push(format!(
+                "{}: template \"{template}\": the triangles wind so that the inner side faces +Z, \
+                 away from the flower's axis (the template frame's inner side is -Z), so its \
+                 organs bend the other way; if the petal should open outwards, reverse the \
+                 faces' winding (or \"Flip inner side\" in the Flower panel's Shape section)",
+                path.display()
+            ));
+        }
+        Ok(mesh)
     }
 
     /// A mesh named at `entry`, and the path shown for it.
