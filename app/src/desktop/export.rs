@@ -64,6 +64,9 @@ pub struct ExportDialog {
     /// The mean edge of that run, in the project's lengths (0: not chosen
     /// yet; the dialog suggests half the edge the window simulates at).
     pub resimulate_edge: f64,
+    /// The edge last suggested: while `resimulate_edge` is still that
+    /// suggestion, it follows the window's resolution.
+    suggested_edge: f64,
     state: ExportState,
     job: Option<(PathBuf, Receiver<Message>)>,
     /// Set to stop the running export's simulation.
@@ -95,6 +98,7 @@ impl Default for ExportDialog {
             animation_step: 1,
             resimulate: false,
             resimulate_edge: 0.0,
+            suggested_edge: 0.0,
             state: ExportState::Idle,
             job: None,
             cancel: Arc::new(AtomicBool::new(false)),
@@ -327,6 +331,19 @@ fn shown_edge(project: &Project) -> f64 {
 }
 
 impl ExportDialog {
+    /// Suggests half the edge the window simulates at (about four times
+    /// the particles, rounded as the Resolution control rounds) for a run
+    /// of its own, until the user chooses an edge: the dialog is drawn from
+    /// the first frame, and a suggestion made then, for the meshes as
+    /// built, was kept after the Resolution changed.
+    fn suggest_edge(&mut self, project: &Project) {
+        let suggestion = super::params::round_to_3_digits(shown_edge(project) / 2.0);
+        if self.resimulate_edge <= 0.0 || self.resimulate_edge == self.suggested_edge {
+            self.resimulate_edge = suggestion;
+        }
+        self.suggested_edge = suggestion;
+    }
+
     /// The .gif rows of the options grid: size, keyframe step, camera and
     /// turn, speed.
     fn gif_options_ui(&mut self, ui: &mut egui::Ui) {
@@ -622,11 +639,7 @@ impl ExportDialog {
         project: &Project,
         selection: &Selection,
     ) -> ExportRequests {
-        if self.resimulate_edge <= 0.0 {
-            // Half the edge, about four times the particles, rounded as the
-            // Resolution control rounds.
-            self.resimulate_edge = super::params::round_to_3_digits(shown_edge(project) / 2.0);
-        }
+        self.suggest_edge(project);
         let mut requests = ExportRequests::default();
         let mut open = self.open;
         egui::Window::new("Export the animation")
@@ -1123,6 +1136,27 @@ mod tests {
             bytes
         );
         assert_eq!(project.settings.resolution, Resolution::AsBuilt);
+    }
+
+    #[test]
+    fn the_suggested_edge_follows_the_resolution_until_one_is_chosen() {
+        let mut project = anthesis_sim::fixtures::whorl(2, 4, 6, 3);
+        let mut dialog = ExportDialog::default();
+        dialog.suggest_edge(&project);
+        let built = shown_edge(&project);
+        assert_eq!(
+            dialog.resimulate_edge,
+            super::super::params::round_to_3_digits(built / 2.0)
+        );
+        // The window's Resolution set coarser: half of that now.
+        project.settings.resolution = Resolution::MeanEdge(0.8);
+        dialog.suggest_edge(&project);
+        assert_eq!(dialog.resimulate_edge, 0.4);
+        // An edge the user chose stays.
+        dialog.resimulate_edge = 0.25;
+        project.settings.resolution = Resolution::MeanEdge(2.0);
+        dialog.suggest_edge(&project);
+        assert_eq!(dialog.resimulate_edge, 0.25);
     }
 
     #[test]
