@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anthesis_export::{Encoding, GlbOptions, Timing};
-use anthesis_flower::project::load_project;
+use anthesis_flower::project::load_project_with_warnings;
 use anthesis_flower::{Project, Resolution};
 use anthesis_sim::Selection;
 use anthesis_sim::memory::KeyframeCost;
@@ -290,8 +290,14 @@ fn load(path: &Path) -> Result<Project> {
             ),
         };
     }
-    // The project error names the file itself.
-    let project = load_project(path).context("cannot open project")?;
+    // The project error names the file itself; what was read past (an
+    // OBJ's loose edges, a mesh wound inside out) is said and the command
+    // goes on.
+    let loaded = load_project_with_warnings(path).context("cannot open project")?;
+    for warning in &loaded.warnings {
+        eprintln!("warning: {warning}");
+    }
+    let project = loaded.project;
     check_units(&project)?;
     Ok(project)
 }

@@ -30,6 +30,33 @@ fn info_prints_one_line_per_organ_with_counts() {
 }
 
 #[test]
+fn what_loading_reads_past_is_said_and_the_command_goes_on() {
+    // A mesh from another tool with Blender's loose edges (`l`): read
+    // past with a warning naming the file and line, which the command line
+    // dropped.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 3);
+    let obj = dir.path().join("meshes/petal.obj");
+    let mut mesh = std::fs::read_to_string(&obj).expect("mesh");
+    mesh.push_str("l 1 2\n");
+    std::fs::write(&obj, mesh).expect("write");
+    let out = anthesis(&["info", path.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(text(&out.stdout).lines().count(), 2);
+    let stderr = text(&out.stderr);
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("warning: "))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(
+        warnings[0].contains("meshes/petal.obj: OBJ line")
+            && warnings[0].contains("1 line (`l`) statement ignored"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn edge_remeshes_what_info_counts_and_what_simulate_runs() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = saved_whorl(dir.path(), 2, 2);

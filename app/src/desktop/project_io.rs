@@ -4,7 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
-use anthesis_flower::project::{keep_backup, load_project, save_project};
+use anthesis_flower::project::{
+    LoadedProject, keep_backup, load_project_with_warnings, save_project,
+};
 use eframe::egui;
 
 use super::AnthesisApp;
@@ -24,8 +26,8 @@ impl AnthesisApp {
         // document's path (saved to, remembered).
         let resolved = anthesis_flower::project::project_file(path);
         let path = resolved.as_deref().unwrap_or(path);
-        match load_project(path) {
-            Ok(project) => {
+        match load_project_with_warnings(path) {
+            Ok(LoadedProject { project, warnings }) => {
                 self.settings.remember(path);
                 // The work open before was saved or thrown away (the
                 // "save changes?" prompt came first).
@@ -33,6 +35,9 @@ impl AnthesisApp {
                 self.replace_document(Document::new(project, Some(path.to_path_buf())));
                 self.log.info(format!("opened {}", path.display()));
                 self.log.succeeded(Topic::Project);
+                for warning in warnings {
+                    self.log.warn(warning);
+                }
                 // The command line refuses such a project; the window opens
                 // it (the user may fix the mesh or thickness here) and says
                 // why a run will likely fail.
