@@ -194,9 +194,13 @@ fn kind_of(meta: &Metadata) -> &'static str {
 /// ([`FileError::Absolute`]), one whose `..` climb above `folder`
 /// ([`FileError::ClimbsOut`]), one that resolves outside `folder` through
 /// a symbolic link ([`FileError::LinksOut`]); a path that does not exist is
-/// [`FileError::NotFound`]. `meshes/../maps/a.png` is fine.
+/// [`FileError::NotFound`]. `meshes/../maps/a.png` is fine. A `\` is a
+/// separator as on Windows (`maps\a.png`, as a project written by hand
+/// there names its files; elsewhere it was looked for as one file name and
+/// not found), and the rules above apply to the path with `/`.
 pub fn resolve_inside(folder: &Path, relative: &str) -> Result<PathBuf, FileError> {
-    let path = Path::new(relative);
+    let relative = relative.replace('\\', "/");
+    let path = Path::new(&relative);
     check_relative(path)?;
     let folder = if folder.as_os_str().is_empty() {
         Path::new(".")

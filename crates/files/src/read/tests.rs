@@ -155,6 +155,26 @@ fn paths_inside_the_folder_resolve() {
 }
 
 #[test]
+fn a_backslash_separates_folders_as_on_windows_and_the_same_rules_apply() {
+    let outer = tempfile::tempdir().expect("temp dir");
+    let dir = outer.path().join("project");
+    fs::create_dir_all(dir.join("maps")).expect("mkdir");
+    fs::write(dir.join("maps/a.png"), b"x").expect("write");
+    fs::write(outer.path().join("secret.txt"), b"secret").expect("write");
+    let real = fs::canonicalize(dir.join("maps/a.png")).expect("canonical");
+    assert_eq!(resolve_inside(&dir, "maps\\a.png").expect("found"), real);
+    assert_eq!(resolve_inside(&dir, ".\\maps/a.png").expect("found"), real);
+    assert!(matches!(
+        resolve_inside(&dir, "..\\secret.txt"),
+        Err(FileError::ClimbsOut)
+    ));
+    assert!(matches!(
+        resolve_inside(&dir, "\\etc\\hostname"),
+        Err(FileError::Absolute)
+    ));
+}
+
+#[test]
 fn paths_leaving_the_folder_are_refused_with_the_reason() {
     let outer = tempfile::tempdir().expect("temp dir");
     let dir = outer.path().join("project");
