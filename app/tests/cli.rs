@@ -607,6 +607,104 @@ fn validated(glb: &Path) -> serde_json::Value {
     report
 }
 
+/// `app/tests/fixtures/stranger`: a flower written by hand from the format
+/// documentation with files as other tools write them (see its README).
+fn stranger_flower() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/stranger")
+}
+
+/// The triangles an OBJ's faces make (a polygon of n corners makes n - 2)
+/// and its distinct `v` statements used by faces.
+fn obj_counts(path: &Path) -> (usize, usize) {
+    let text = std::fs::read_to_string(path).expect("obj");
+    let mut used = std::collections::BTreeSet::new();
+    let mut triangles = 0;
+    for line in text.lines() {
+        if let Some(corners) = line.strip_prefix("f ") {
+            let corners: Vec<&str> = corners.split_whitespace().collect();
+            triangles += corners.len() - 2;
+            for corner in corners {
+                used.insert(corner.split('/').next().expect("v").to_string());
+            }
+        }
+    }
+    (used.len(), triangles)
+}
+
+#[test]
+fn a_flower_made_elsewhere_loads_with_every_particle_and_triangle_of_its_files() {
+    let folder = stranger_flower();
+    // What makes it a stranger's: CRLF, n-gons, split vt, vn.
+    let toml = std::fs::read(folder.join("stranger.anthesis.toml")).expect("project");
+    assert!(toml.windows(2).any(|w| w == b"\r\n"));
+    let broad = std::fs::read_to_string(folder.join("geo/broad.obj")).expect("obj");
+    assert!(broad.contains("\r\nvn ") && broad.contains("\r\ng "));
+    assert!(
+        broad
+            .lines()
+            .any(|l| l.starts_with("f ") && l.split_whitespace().count() == 7),
+        "a hexagon"
+    );
+    let out = anthesis(&["info", folder.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (narrow_v, narrow_t) = obj_counts(&folder.join("geo/narrow.obj"));
+    let (broad_v, broad_t) = obj_counts(&folder.join("geo/broad.obj"));
+    let lines: Vec<String> = text(&out.stdout).lines().map(str::to_owned).collect();
+    assert_eq!(lines.len(), 9, "{lines:?}");
+    for line in &lines {
+        let words: Vec<&str> = line.split(' ').collect();
+        let (particles, triangles) = match words[0].split('-').next() {
+            Some("inner") => (narrow_v, narrow_t),
+            Some("outer") => (broad_v, broad_t),
+            other => panic!("{other:?} in {line}"),
+        };
+        assert_eq!(
+            words[words.len() - 3..words.len() - 1],
+            [particles.to_string(), triangles.to_string()],
+            "{line}"
+        );
+    }
+}
+
+#[test]
+fn a_flower_made_elsewhere_exports_smooth_and_finer_runs_that_validate() {
+    let folder = stranger_flower();
+    let f = folder.to_str().expect("utf-8");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut vertices = Vec::new();
+    for (name, args) in [
+        ("as built", vec![]),
+        ("smooth", vec!["--subdivide", "1"]),
+        ("fine", vec!["--edge", "1.5"]),
+    ] {
+        let glb = dir.path().join(format!("{name}.glb"));
+        let mut all = vec!["simulate", f, "--out", glb.to_str().expect("utf-8")];
+        all.extend(args);
+        let out = anthesis(&all);
+        assert!(out.status.success(), "{name}: {}", text(&out.stderr));
+        let info = &validated(&glb)["info"];
+        // Nine organs and the receptacle; the two templates' colour maps
+        // as textures.
+        assert_eq!(info["drawCallCount"], 10, "{name}: {info:#}");
+        let images = info["resources"]
+            .as_array()
+            .expect("resources")
+            .iter()
+            .filter(|r| {
+                r["pointer"]
+                    .as_str()
+                    .is_some_and(|p| p.starts_with("/images/"))
+            })
+            .count();
+        assert_eq!(images, 2, "{name}: {info:#}");
+        vertices.push(info["totalVertexCount"].as_u64().expect("vertices"));
+    }
+    assert!(
+        vertices[1] > 2 * vertices[0] && vertices[2] > vertices[0],
+        "{vertices:?}"
+    );
+}
+
 #[test]
 fn simulate_subdivide_exports_smooth_render_meshes() {
     let dir = tempfile::tempdir().expect("tempdir");
