@@ -1686,6 +1686,37 @@ fn opening_a_project_with_a_mesh_in_another_unit_warns_and_keeps_it_open() {
     );
 }
 
+#[test]
+fn opening_a_project_shows_what_loading_read_past() {
+    // A mesh from another tool wound inside out: it loads, and the log
+    // says so (the loader's warnings were dropped).
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut project = small_flower();
+    project.flower.templates[0].mesh =
+        anthesis_bud::with_inner_side_flipped(&project.flower.templates[0].mesh);
+    let path = dir.path().join("flipped.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let mut harness = harness(small_flower());
+    harness.run();
+    harness.state_mut().open_path(&path);
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.document().path.as_deref(), Some(path.as_path()));
+    let warnings: Vec<&str> = app
+        .log()
+        .entries()
+        .iter()
+        .filter(|e| e.message.contains("the inner side faces +Z"))
+        .map(|e| e.message.as_str())
+        .collect();
+    assert_eq!(warnings.len(), 1, "{:?}", app.log().entries());
+    assert!(
+        warnings[0].contains("reverse the faces' winding"),
+        "{}",
+        warnings[0]
+    );
+}
+
 /// Queues `events` for the next frame, all in that one frame.
 fn in_one_frame(harness: &mut Harness<'_, AnthesisApp>, events: Vec<egui::Event>) {
     harness.input_mut().events.extend(events);
