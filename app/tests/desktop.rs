@@ -1659,6 +1659,47 @@ fn the_parameters_panel_with_a_resolution() {
 }
 
 #[test]
+fn a_typed_resolution_is_one_edit_when_entered_not_one_per_key() {
+    // Typing 0.5 passed through 0, which the field clamped to its
+    // smallest edge and applied as a resolution: the remesh was refused
+    // for its memory, and the value typed never arrived.
+    use anthesis_flower::Resolution;
+    let mut project = small_flower();
+    let edge = anthesis_bud::quality(&project.flower.templates[0].mesh).mean_edge;
+    project.settings.resolution = Resolution::MeanEdge((edge * 100.0).round() / 100.0);
+    let resolved = anthesis_flower::resolution::resolve(&project).expect("remeshes");
+    let (mut harness, chosen) = parameters_panel(project, resolved, 560.0);
+    harness.run();
+    let row = harness.get_by_label("mean edge").rect().center().y;
+    fn field<'h>(harness: &'h Harness<'static>, row: f32) -> egui_kittest::Node<'h> {
+        harness
+            .get_all_by_role(egui::accesskit::Role::SpinButton)
+            .find(|n| (n.rect().center().y - row).abs() < 8.0)
+            .expect("the edge field beside the checkbox")
+    }
+    field(&harness, row).click();
+    harness.run();
+    let resolutions = |chosen: &std::cell::RefCell<Vec<_>>| -> Vec<String> {
+        chosen
+            .borrow()
+            .iter()
+            .map(|c| format!("{c:?}"))
+            .filter(|c| c.contains("Resolution("))
+            .collect()
+    };
+    for text in ["0", ".", "5"] {
+        field(&harness, row).type_text(text);
+        harness.run();
+        assert_eq!(resolutions(&chosen), Vec::<String>::new(), "after {text:?}");
+    }
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+    let edits = resolutions(&chosen);
+    assert_eq!(edits.len(), 1, "{edits:?}");
+    assert!(edits[0].contains("Resolution(MeanEdge(0.5))"), "{edits:?}");
+}
+
+#[test]
 fn opening_a_project_with_a_mesh_in_another_unit_warns_and_keeps_it_open() {
     let dir = tempfile::tempdir().expect("temp dir");
     let mut project = small_flower();

@@ -406,7 +406,11 @@ fn resolution_ui(
                             DragValue::new(&mut value)
                                 .speed(0.01 * edge)
                                 .range(1e-3 * built_edge..=1e3 * built_edge)
-                                .max_decimals(4),
+                                .max_decimals(4)
+                                // A typed edge counts when entered: on the
+                                // way to 0.5, "0" would be the smallest
+                                // edge, remeshed (or refused) at once.
+                                .update_while_editing(false),
                         )
                         .on_hover_text(RESOLUTION_TOOLTIP);
                     if response.dragged() {
