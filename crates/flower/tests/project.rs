@@ -1260,6 +1260,73 @@ fn a_mesh_wound_with_its_inner_side_outwards_loads_with_a_warning() {
     assert!(warning.contains("reverse the faces' winding"), "{warning}");
 }
 
+/// The saved lily with every `vt` of its petal mesh changed by `change`.
+fn lily_with_petal_uvs(change: impl Fn(f64, f64) -> (f64, f64)) -> (tempfile::TempDir, PathBuf) {
+    let (folder, path) = saved_lily();
+    let obj = path.parent().expect("folder").join("meshes/petal.obj");
+    let text = fs::read_to_string(&obj).expect("read");
+    let changed: Vec<String> = text
+        .lines()
+        .map(|line| match line.strip_prefix("vt ") {
+            Some(uv) => {
+                let uv: Vec<f64> = uv
+                    .split_whitespace()
+                    .map(|n| n.parse().expect("a number"))
+                    .collect();
+                let (u, v) = change(uv[0], uv[1]);
+                format!("vt {u} {v}")
+            }
+            None => line.to_string(),
+        })
+        .collect();
+    fs::write(&obj, changed.join("\n")).expect("write");
+    (folder, path)
+}
+
+#[test]
+fn a_uv_layout_outside_the_unit_square_is_named_where_it_misses_the_base() {
+    // A UDIM tile other than 1001: u from 1 to 2. The base region, over
+    // the unit square, then holds only the particles at u = 1, and the
+    // message said nothing of why.
+    let (_folder, path) = lily_with_petal_uvs(|u, v| (u + 1.0, v));
+    let message = load_message(&path);
+    assert!(message.contains("the base region"), "{message}");
+    assert!(
+        message.contains("(the mesh's UVs span u 1 to 2, v 0 to 1; the maps and the base region are read over the unit square"),
+        "{message}"
+    );
+    // Scaled past 1 but still holding the base: it loads, with the note.
+    let (_folder, path) = lily_with_petal_uvs(|u, v| (u, 1.5 * v));
+    let loaded = anthesis_flower::project::load_project_with_warnings(&path).expect("loads");
+    assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+    assert!(
+        loaded.warnings[0].contains("the mesh's UVs span u 0 to 1, v 0 to 1.5"),
+        "{:?}",
+        loaded.warnings
+    );
+}
+
+#[test]
+fn a_uv_layout_with_v_across_the_organ_loads_with_a_warning() {
+    // u along the petal and v across: the base region (v <= 0.06) is a
+    // margin, which then held the petal along its side, silently.
+    let (_folder, path) = lily_with_petal_uvs(|u, v| (v, u));
+    let loaded = anthesis_flower::project::load_project_with_warnings(&path).expect("loads");
+    let notes: Vec<&String> = loaded
+        .warnings
+        .iter()
+        .filter(|w| {
+            w.contains("the UV layout's v seems not to run from the base (0) to the tip (1)")
+        })
+        .collect();
+    assert_eq!(notes.len(), 1, "{:?}", loaded.warnings);
+    assert!(
+        notes[0].starts_with("template \"Petal\": the base region's particles (v <= 0.06) reach"),
+        "{}",
+        notes[0]
+    );
+}
+
 #[test]
 fn the_model_is_read_from_the_file_and_version_1_files_keep_the_papers() {
     use anthesis_physics::BendBase;

@@ -227,6 +227,58 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
     Ok(())
 }
 
+/// A note when `mesh`'s UVs leave the unit square (a UDIM tile other than
+/// 1001, an unwrap scaled past 1): maps and the base region are read over
+/// the unit square, so such a layout is held or painted elsewhere than
+/// meant.
+pub(super) fn uv_outside_unit_square(mesh: &anthesis_mesh::Mesh) -> Option<String> {
+    const SLACK: f64 = 1e-6;
+    let (lo, hi) = mesh.uvs.iter().fold(
+        (
+            glam::DVec2::splat(f64::INFINITY),
+            glam::DVec2::splat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), uv| (lo.min(*uv), hi.max(*uv)),
+    );
+    if lo.min_element() >= -SLACK && hi.max_element() <= 1.0 + SLACK {
+        return None;
+    }
+    Some(format!(
+        "the mesh's UVs span u {} to {}, v {} to {}; the maps and the base region are read over \
+         the unit square, u across and v from the base (0) to the tip (1)",
+        short_number(lo.x),
+        short_number(hi.x),
+        short_number(lo.y),
+        short_number(hi.y)
+    ))
+}
+
+/// A note when `template`'s base particles reach more than half way up the
+/// organ (+Y in the template frame, from the base at the origin): the UV
+/// layout's `v` then runs across or from tip to base, and the organ is
+/// held along a margin or at its tip.
+pub(super) fn base_not_at_base(template: &Template) -> Option<String> {
+    let mesh = &template.mesh;
+    let length = mesh.positions.iter().map(|p| p.y).fold(0.0, f64::max);
+    let reach = template
+        .base_region
+        .particles(mesh)
+        .iter()
+        .map(|&i| mesh.positions[i as usize].y)
+        .fold(0.0, f64::max);
+    if !(length > 0.0 && reach > 0.5 * length) {
+        return None;
+    }
+    Some(format!(
+        "the base region's particles (v <= {}) reach {} up the organ, which is {} long (+Y from \
+         the base): the UV layout's v seems not to run from the base (0) to the tip (1), so the \
+         organ would be held along its side or tip; u runs across and v along",
+        short_number(template.base_region.v_max),
+        short_number(reach),
+        short_number(length)
+    ))
+}
+
 impl Template {
     /// What is wrong with this template's numbers, if anything: the one
     /// set of rules that loading, saving, `anthesis info` and the
@@ -314,10 +366,13 @@ fn template_problem(template: &Template) -> Option<String> {
     if base < MIN_BASE_PARTICLES {
         return Some(format!(
             "the base region (v <= {}, u from {} to {}) holds {base} particle(s) of the mesh; at \
-             least {MIN_BASE_PARTICLES} are needed to attach the organ",
+             least {MIN_BASE_PARTICLES} are needed to attach the organ{}",
             short_number(region.v_max),
             short_number(region.u_min),
-            short_number(region.u_max)
+            short_number(region.u_max),
+            uv_outside_unit_square(&template.mesh)
+                .map(|note| format!(" ({note})"))
+                .unwrap_or_default()
         ));
     }
     if let Some(animation) = &template.two_state

@@ -479,7 +479,7 @@ impl Loader<'_> {
                 })?)
             }
         };
-        Ok(Template {
+        let template = Template {
             vein,
             two_state,
             name: file.name,
@@ -498,7 +498,19 @@ impl Loader<'_> {
             color: file.color,
             colouring,
             source,
-        })
+        };
+        // A UV layout from another tool that loads but is read otherwise
+        // than its author meant.
+        let notes = [
+            super::check::uv_outside_unit_square(&template.mesh),
+            super::check::base_not_at_base(&template),
+        ];
+        for note in notes.into_iter().flatten() {
+            self.warnings
+                .borrow_mut()
+                .push(format!("template \"{}\": {note}", template.name));
+        }
+        Ok(template)
     }
 
     /// A sketched petal's `[templates.source]`: every stroke at least two
