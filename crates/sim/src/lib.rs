@@ -118,7 +118,10 @@ pub enum SimError {
     #[error("organ index {0} does not exist")]
     NoSuchOrgan(usize),
     /// The energy minimisation of one organ failed (see [`SolverError`]).
-    #[error("keyframe {keyframe}, organ `{organ}`: the solver diverged: {error}")]
+    #[error(
+        "keyframe {keyframe}, organ `{organ}`: the solver diverged: {error}{}",
+        held_against_note(held_against)
+    )]
     Diverged {
         /// The keyframe being computed.
         keyframe: u32,
@@ -126,12 +129,16 @@ pub enum SimError {
         organ: String,
         /// How the solver failed.
         error: SolverError,
+        /// What the organ was held off in that keyframe (see
+        /// [`held_against_note`]).
+        held_against: Vec<String>,
     },
     /// An organ's energy became non-finite or rose more than a
     /// million-fold from the previous keyframe: growth too strong for the
     /// mesh or its stiffness.
     #[error(
-        "keyframe {keyframe}, organ `{organ}`: the energy blew up to {energy:.3e} (from {previous:.3e})"
+        "keyframe {keyframe}, organ `{organ}`: the energy blew up to {energy:.3e} (from {previous:.3e}){}",
+        held_against_note(held_against)
     )]
     EnergyBlowUp {
         /// The keyframe being computed.
@@ -142,12 +149,16 @@ pub enum SimError {
         energy: f64,
         /// Its elastic energy at the previous keyframe.
         previous: f64,
+        /// What the organ was held off in that keyframe (see
+        /// [`held_against_note`]).
+        held_against: Vec<String>,
     },
     /// The organs did not settle within the solver's iteration limit
     /// (`max_iterations` per contact round); a higher limit or a looser
     /// tolerance may help.
     #[error(
-        "keyframe {keyframe}, organ `{organ}`: not converged after {iterations} iterations (relative gradient {relative_gradient:.3e})"
+        "keyframe {keyframe}, organ `{organ}`: not converged after {iterations} iterations (relative gradient {relative_gradient:.3e}){}",
+        held_against_note(held_against)
     )]
     NotConverged {
         /// The keyframe being computed.
@@ -160,6 +171,9 @@ pub enum SimError {
         /// That organ's relative gradient when the limit was reached (see
         /// [`KeyframeStats::relative_gradient`]).
         relative_gradient: f64,
+        /// What the organ was held off in that keyframe (see
+        /// [`held_against_note`]).
+        held_against: Vec<String>,
     },
     /// A bug: the simulation panicked. Caught so the worker and the
     /// command line survive it and keep what was computed before.
@@ -176,6 +190,24 @@ pub enum SimError {
     /// failure, and the keyframes before are kept.
     #[error("cancelled")]
     Cancelled,
+}
+
+/// What a run that stopped at an organ adds about what held it: a
+/// painter whose petal curls around a sepal, or is pressed onto a stamen,
+/// should learn which neighbours to look at. The contacts keep each organ
+/// on its side of the others (the overlap order) and outside the parts; an
+/// organ grown around another, or caught between neighbours and a part,
+/// cannot be, and the solver then stops there.
+pub fn held_against_note(held_against: &[String]) -> String {
+    const CAUGHT: &str = ": organs grown around or caught between each other can stop a run";
+    match held_against {
+        [] => String::new(),
+        [one] => format!("; it was against {one} there{CAUGHT}"),
+        [init @ .., last] => format!(
+            "; it was against {} and {last} there{CAUGHT}",
+            init.join(", ")
+        ),
+    }
 }
 
 fn describe_panic(run: Option<u64>, keyframe: Option<u32>, message: &str) -> String {
@@ -542,7 +574,7 @@ impl Simulation {
         // Contacts are found right after growth and held while the organs
         // relax: rebuilt every iteration from organs that all move at once,
         // they made neighbours bounce off each other instead of settling.
-        let found = self.search(&mut unknown_geometry(self.organs.len()));
+        let mut found = self.search(&mut unknown_geometry(self.organs.len()));
         let mut contacts = self.contacts(&found, Violated::MoveHalf);
         // Growth and the joint schedule may have carried particles onto the
         // wrong side. Newton's method started there sees deep, stiff
@@ -629,6 +661,7 @@ impl Simulation {
                     keyframe: step,
                     organ: self.organs[organ].name.clone(),
                     error: error.clone(),
+                    held_against: self.held_against(&found, organ),
                 });
             }
             if not_converged {
@@ -636,9 +669,10 @@ impl Simulation {
                 let (organ, relative_gradient) = self.worst_organ(&contacts);
                 return Err(SimError::NotConverged {
                     keyframe: step,
-                    organ,
+                    organ: self.organs[organ].name.clone(),
                     iterations,
                     relative_gradient,
+                    held_against: self.held_against(&found, organ),
                 });
             }
             iterations += reported.saturating_sub(1) as u32;
@@ -658,8 +692,8 @@ impl Simulation {
             // there, particles jumped and left spikes; instead, while some
             // particle lies deep on the wrong side, the organs settle again
             // against contacts found where they are now.
-            let found = self.search(&mut geometry);
-            let fresh = self.contacts(&found, Violated::MoveHalf);
+            let next = self.search(&mut geometry);
+            let fresh = self.contacts(&next, Violated::MoveHalf);
             let deepest = self
                 .organs
                 .iter()
@@ -676,11 +710,12 @@ impl Simulation {
             }
             if deepest <= RESETTLE_DEPTH || round == MAX_CONTACT_ROUNDS {
                 // The paper's push-back: nobody ends on the wrong side.
-                let (pushed, after) = self.push_back(&mut geometry, found);
+                let (pushed, after) = self.push_back(&mut geometry, next);
                 contacts_now = after;
                 break pushed;
             }
             contacts = fresh;
+            found = next;
             round += 1;
         };
 
@@ -696,6 +731,7 @@ impl Simulation {
                     organ: organ.name.clone(),
                     energy: e,
                     previous: self.previous_energy[i],
+                    held_against: self.held_against(&found, i),
                 });
             }
             self.previous_energy[i] = e;
@@ -1122,15 +1158,41 @@ impl Simulation {
         merged
     }
 
-    fn worst_organ(&mut self, contacts: &[Vec<Contact>]) -> (String, f64) {
-        let mut worst = (String::new(), -1.0);
-        for (organ, c) in self.organs.iter_mut().zip(contacts) {
+    fn worst_organ(&mut self, contacts: &[Vec<Contact>]) -> (usize, f64) {
+        let mut worst = (0, -1.0);
+        for (i, (organ, c)) in self.organs.iter_mut().zip(contacts).enumerate() {
             let g = organ.relative_gradient(c);
             if g > worst.1 {
-                worst = (organ.name.clone(), g);
+                worst = (i, g);
             }
         }
         worst
+    }
+
+    /// The organs, in the flower's order, and "the parts" that held
+    /// `organ` off them in the search `found` (the names a stopped run
+    /// gives, see [`held_against_note`]).
+    fn held_against(&self, found: &Found, organ: usize) -> Vec<String> {
+        let mut others: Vec<usize> = self
+            .overlaps
+            .iter()
+            .enumerate()
+            .flat_map(|(index, &(inner, outer))| {
+                [(2 * index, inner, outer), (2 * index + 1, outer, inner)]
+            })
+            .filter(|&(key, moving, _)| moving == organ && !found.sides[key].is_empty())
+            .map(|(_, _, other)| other)
+            .collect();
+        others.sort_unstable();
+        others.dedup();
+        let mut names: Vec<String> = others
+            .into_iter()
+            .map(|o| format!("`{}`", self.organs[o].name))
+            .collect();
+        if !found.parts[organ].is_empty() {
+            names.push("the parts".to_string());
+        }
+        names
     }
 }
 
@@ -1184,6 +1246,20 @@ pub fn run(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_note_on_what_held_an_organ_lists_its_neighbours_in_words() {
+        let names = |n: &[&str]| n.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        assert_eq!(held_against_note(&[]), "");
+        assert!(
+            held_against_note(&names(&["`sepal-1`"]))
+                .starts_with("; it was against `sepal-1` there: ")
+        );
+        assert!(
+            held_against_note(&names(&["`petal-1`", "`petal-3`", "the parts"]))
+                .starts_with("; it was against `petal-1`, `petal-3` and the parts there: ")
+        );
+    }
+
     use super::*;
     use crate::fault::Fault;
     use crate::fixtures::whorl;

@@ -146,6 +146,42 @@ fn absurd_growth_ends_in_a_typed_error() {
 }
 
 #[test]
+fn a_run_that_stops_at_an_organ_names_the_organs_it_was_against() {
+    // Two petals, one driven through the other while both grow a third a
+    // step: they jam within a few keyframes, and the message points the
+    // painter at the neighbour that held the organ where it stopped.
+    for drive_deg in [60.0, 200.0] {
+        let mut project = common::inner_driven_into_outer_by(20, true, drive_deg);
+        project.flower.templates[0].dg = 0.3;
+        let (keyframes, error) = run_all(&project, &Selection::All);
+        let error = error.unwrap_or_else(|| panic!("drive {drive_deg}: the run finished"));
+        let (organ, other) = match &error {
+            SimError::Diverged { organ, .. }
+            | SimError::NotConverged { organ, .. }
+            | SimError::EnergyBlowUp { organ, .. } => (
+                organ.clone(),
+                if organ == "inner" { "outer" } else { "inner" },
+            ),
+            e => panic!("drive {drive_deg}: expected a stop at an organ, got {e:?}"),
+        };
+        let message = error.to_string();
+        assert!(
+            message.contains(&format!("organ `{organ}`: "))
+                && message.contains(&format!(
+                    "; it was against `{other}` there: organs grown around"
+                )),
+            "drive {drive_deg}: {message}"
+        );
+        assert!(keyframes.len() >= 2, "drive {drive_deg}: stopped at once");
+    }
+    // On its own nothing held it, and the message says nothing of it.
+    let mut alone = whorl(1, 8, 14, 20);
+    alone.flower.templates[0].dg = 40.0;
+    let message = assert_diverges(&alone, "dg 40 alone").to_string();
+    assert!(!message.contains("against"), "{message}");
+}
+
+#[test]
 fn maps_that_collapse_the_organ_end_in_a_typed_error() {
     // Shrinking along the growth direction only, 20 % a step: triangles
     // flatten until the solver cannot go on.
