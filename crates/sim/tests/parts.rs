@@ -2,11 +2,14 @@
 //! outside it, checked geometrically (winding number of the pistil's
 //! closed surface), not by trusting the solver.
 
+mod common;
+
 use anthesis_flower::JointRamp;
 use anthesis_flower::Project;
-use anthesis_flower::parts::{Part, PartShape, Tube, obstacles};
+use anthesis_flower::parts::{Part, obstacles};
 use anthesis_mesh::nearest::winding_number;
 use anthesis_sim::{Selection, fixtures, run};
+use common::pistil;
 use glam::DVec3;
 
 /// One petal of a one-organ whorl that tilts 40° inwards over the run, so
@@ -19,31 +22,6 @@ fn petal_swinging_in() -> Project {
         angle_deg: -40.0,
     }];
     project
-}
-
-fn pistil() -> Part {
-    Part {
-        name: "pistil".to_string(),
-        shape: PartShape::Pistil {
-            style: Tube {
-                length: 12.0,
-                radius: 0.8,
-                curvature_deg: 0.0,
-            },
-            stigma_radius: 1.0,
-            stigma_lobes: 3,
-            ovary_length: 0.0,
-            ovary_radius: 0.0,
-        },
-        count: 1,
-        ring_radius: 0.0,
-        height: 0.0,
-        offset_deg: 0.0,
-        angle_deg: 0.0,
-        schedule: Vec::new(),
-        color: [0.5, 0.7, 0.3, 1.0],
-        head_color: [0.5, 0.7, 0.3, 1.0],
-    }
 }
 
 /// The most particles inside the pistil (any of its closed components) at

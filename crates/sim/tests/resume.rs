@@ -5,12 +5,11 @@
 
 mod common;
 
-use anthesis_flower::parts::{Part, PartShape, Tube};
 use anthesis_flower::{JointRamp, Project, TwoStateAnimation};
 use anthesis_sim::fixtures::{stroke_near_tip as paint, whorl};
 use anthesis_sim::{Keyframe, Selection, SimError, Simulation};
 use anthesis_twostate::{GrowthFunction, VelocityCurve};
-use common::fingerprint;
+use common::{fingerprint, pistil};
 use glam::DQuat;
 
 /// Steps `sim` to its last keyframe, collecting the keyframes it computes.
@@ -159,32 +158,6 @@ fn a_first_ramp_where_there_was_none_goes_on_from_its_first_step_bit_for_bit() {
     let (_, turned) = full_run(&after);
     assert_ne!(fingerprint(&kept[11..]), fingerprint(&turned[11..]));
     assert_resumes_exactly(sim, &kept, &before, &after, 11);
-}
-
-/// A pistil on the flower axis, without a schedule.
-fn pistil() -> Part {
-    Part {
-        name: "pistil".to_string(),
-        shape: PartShape::Pistil {
-            style: Tube {
-                length: 12.0,
-                radius: 0.8,
-                curvature_deg: 0.0,
-            },
-            stigma_radius: 1.0,
-            stigma_lobes: 3,
-            ovary_length: 0.0,
-            ovary_radius: 0.0,
-        },
-        count: 1,
-        ring_radius: 0.0,
-        height: 0.0,
-        offset_deg: 0.0,
-        angle_deg: 0.0,
-        schedule: Vec::new(),
-        color: [0.5, 0.7, 0.3, 1.0],
-        head_color: [0.5, 0.7, 0.3, 1.0],
-    }
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! Helpers shared by the simulation's integration tests.
 #![allow(dead_code)]
 
+use anthesis_flower::parts::{Part, PartShape, Tube};
 use anthesis_flower::{Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings};
 use anthesis_sim::fixtures::petal_template;
 use anthesis_sim::{Keyframe, Selection, SimError, run};
@@ -244,4 +245,30 @@ pub fn fingerprint(keyframes: &[Keyframe]) -> Vec<u64> {
         ]);
     }
     bits
+}
+
+/// A pistil on the flower axis, without a schedule.
+pub fn pistil() -> Part {
+    Part {
+        name: "pistil".to_string(),
+        shape: PartShape::Pistil {
+            style: Tube {
+                length: 12.0,
+                radius: 0.8,
+                curvature_deg: 0.0,
+            },
+            stigma_radius: 1.0,
+            stigma_lobes: 3,
+            ovary_length: 0.0,
+            ovary_radius: 0.0,
+        },
+        count: 1,
+        ring_radius: 0.0,
+        height: 0.0,
+        offset_deg: 0.0,
+        angle_deg: 0.0,
+        schedule: Vec::new(),
+        color: [0.5, 0.7, 0.3, 1.0],
+        head_color: [0.5, 0.7, 0.3, 1.0],
+    }
 }
