@@ -9,7 +9,8 @@
 //! `o`, `g`, `s`, `usemtl` and `mtllib` statements and `#` comments are
 //! ignored; `l` (loose edges, which Blender writes) and `p` (points) are
 //! ignored with an [`ObjWarning`]; any other statement is a syntax error.
-//! A UTF-8 byte-order mark at the start is skipped.
+//! A UTF-8 byte-order mark at the start is skipped; lines end in LF, CRLF or
+//! (classic Mac OS) a lone CR.
 //!
 //! An organ needs exactly one UV per vertex, so every OBJ position takes the
 //! UV of the face corners that use it; a position used with two different
@@ -432,7 +433,14 @@ fn parse(text: &str, uvs: bool) -> Result<Parsed, MeshError> {
     let mut first_face_without_uv: Option<usize> = None;
     let mut warnings: Vec<ObjWarning> = Vec::new();
 
-    for (line_index, raw_line) in text.lines().enumerate() {
+    // Classic Mac OS ended lines with a lone CR; such a file has no LF,
+    // and read by LF it was one comment line, "empty".
+    let lines: Box<dyn Iterator<Item = &str>> = if text.contains('\n') {
+        Box::new(text.lines())
+    } else {
+        Box::new(text.split('\r'))
+    };
+    for (line_index, raw_line) in lines.enumerate() {
         let line = line_index + 1;
         let content = raw_line.split('#').next().unwrap_or("");
         let mut words = content.split_whitespace();
@@ -987,6 +995,17 @@ f 1/1/1 2/2/1 3/3/1 4/4/1
         assert!(areas.iter().all(|&(_, uv)| uv > 0.0), "{areas:?}");
         let total: f64 = areas.iter().map(|(world, _)| world).sum();
         assert!((total - 3.0).abs() < 1e-12, "{total}");
+    }
+
+    #[test]
+    fn lines_ended_by_a_lone_cr_are_lines() {
+        let text = "# classic Mac OS\rv 0 0 0\rv 1 0 0\rv 1 1 0\rv 0 1 0\r\
+                    vt 0 0\rvt 1 0\rvt 1 1\rvt 0 1\rf 1/1 2/2 3/3 4/4\r";
+        assert_eq!(parse_obj(text).expect("a square"), unit_square());
+        // Its errors count those lines.
+        let bad = text.replace("v 1 1 0", "v one 1 0");
+        let error = parse_obj(&bad).expect_err("not a number").to_string();
+        assert!(error.contains("line 4"), "{error}");
     }
 
     #[test]
