@@ -79,7 +79,7 @@ pub struct ExportDialog {
 
 /// What the Simulation row's note depends on: the edge's bits, the
 /// simulated organs, the keyframes and each template's particles.
-type RunNoteKey = (u64, Vec<usize>, u32, Vec<usize>);
+type RunNoteKey = (u64, Vec<usize>, u32, Vec<usize>, usize);
 
 impl Default for ExportDialog {
     fn default() -> Self {
@@ -268,12 +268,14 @@ fn simulate_at(
 }
 
 /// The particles a run of `organs` of `project` at `edge` makes in its
-/// largest organ, next to the run's now; or why that run would not fit.
+/// largest organ, next to `now`, the largest organ's in the window's run;
+/// or why that run would not fit.
 fn run_note(
     project: &Project,
     selection: &Selection,
     organs: &[usize],
     edge: f64,
+    now: usize,
 ) -> Result<String, String> {
     let mut trial = project.clone();
     trial.settings.resolution = Resolution::MeanEdge(edge);
@@ -286,13 +288,6 @@ fn run_note(
     };
     let largest = templates()
         .map(|t| predicted_size(&t.mesh, edge).0)
-        .max()
-        .unwrap_or(0);
-    let now = templates()
-        .map(|t| match project.settings.resolution.mean_edge() {
-            Some(shown) => predicted_size(&t.mesh, shown).0,
-            None => t.mesh.vertex_count(),
-        })
         .max()
         .unwrap_or(0);
     Ok(format!(
@@ -385,7 +380,13 @@ impl ExportDialog {
     /// The "Simulation" row: export the window's keyframes, or a run of
     /// its own at another mean edge, with the particles that makes in the
     /// largest simulated organ (or why the run would not fit).
-    fn resimulate_ui(&mut self, ui: &mut egui::Ui, project: &Project, selection: &Selection) {
+    fn resimulate_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        project: &Project,
+        selection: &Selection,
+        now: usize,
+    ) {
         let label = ui
             .label("Simulation")
             .on_hover_text(
@@ -426,11 +427,12 @@ impl ExportDialog {
                 .iter()
                 .map(|t| t.mesh.vertex_count())
                 .collect::<Vec<_>>(),
+            now,
         );
         if self.run_note.as_ref().is_none_or(|(k, _)| *k != key) {
             self.run_note = Some((
                 key,
-                run_note(project, selection, &organs, self.resimulate_edge),
+                run_note(project, selection, &organs, self.resimulate_edge, now),
             ));
         }
         if let Some((_, note)) = &self.run_note {
@@ -630,7 +632,9 @@ impl ExportDialog {
 
     /// The dialog window. `keyframes_ready` and `keyframes_total` describe
     /// what would be exported; `project` (the document's, meshes as built)
-    /// and `selection` what a run of its own would simulate.
+    /// and `selection` what a run of its own would simulate;
+    /// `simulated_now` the particles of the largest selected organ as the
+    /// window simulates it.
     pub fn ui(
         &mut self,
         ctx: &egui::Context,
@@ -638,6 +642,7 @@ impl ExportDialog {
         keyframes_total: u32,
         project: &Project,
         selection: &Selection,
+        simulated_now: usize,
     ) -> ExportRequests {
         self.suggest_edge(project);
         let mut requests = ExportRequests::default();
@@ -689,7 +694,7 @@ impl ExportDialog {
                         )
                         .labelled_by(label);
                         ui.end_row();
-                        self.resimulate_ui(ui, project, selection);
+                        self.resimulate_ui(ui, project, selection, simulated_now);
                         if gif {
                             self.gif_options_ui(ui);
                             return;

@@ -125,12 +125,23 @@ impl AnthesisApp {
     /// The export dialog, when open.
     pub(super) fn export_window(&mut self, ctx: &egui::Context) {
         let selection = self.selection();
+        // What the window simulates (remeshed at the project's resolution),
+        // for the dialog's "(N now)": the meshes as remeshed, not a
+        // prediction of them.
+        let simulated = self.resolved_project();
+        let simulated_now = selection
+            .organs(simulated.flower.organs.len())
+            .into_iter()
+            .map(|i| simulated.flower.template_of(i).mesh.vertex_count())
+            .max()
+            .unwrap_or(0);
         let requests = self.export.ui(
             ctx,
             self.session.keyframes().len(),
             self.session.total(),
             self.doc.project(),
             &selection,
+            simulated_now,
         );
         if requests.browse {
             self.queued.push(Command::BrowseExportPath);
