@@ -88,6 +88,7 @@ fn main() -> Result<()> {
                 project: Some((project, None)),
                 live: false,
                 restore: false,
+                warnings: Vec::new(),
             };
             let app = AnthesisApp::new(cc, startup).map_err(|e| e.to_string())?;
             Ok(Box::new(Orbiting {

@@ -226,7 +226,13 @@ fn one_line(message: &str) -> String {
 pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         // No subcommand: the desktop window, on PROJECT if one is given.
-        None => crate::desktop::run(cli.project.as_deref().map(open).transpose()?),
+        None => match cli.project.as_deref() {
+            None => crate::desktop::run(None, Vec::new()),
+            Some(path) => {
+                let (project, file, warnings) = open(path)?;
+                crate::desktop::run(Some((project, file)), warnings)
+            }
+        },
         Some(Command::Info { project, edge }) => simulate::info(&project, edge),
         Some(Command::Simulate {
             project,
@@ -281,37 +287,45 @@ pub fn run(cli: Cli) -> Result<()> {
 /// Loads a project file, or a flower built into the binary when the path
 /// is `builtin:NAME` (`builtin:lily`, `builtin:eustoma-maite-lady`, …).
 fn load(path: &Path) -> Result<Project> {
+    load_with_warnings(path).map(|(project, _)| project)
+}
+
+/// [`load`], with what loading read past (an OBJ's loose edges, a mesh
+/// wound inside out): said on the terminal, and returned for the window's
+/// log; the command goes on.
+fn load_with_warnings(path: &Path) -> Result<(Project, Vec<String>)> {
     if let Some(name) = path.to_str().and_then(|p| p.strip_prefix("builtin:")) {
         return match anthesis_garden::builtin(name) {
-            Some(project) => project.context("the built-in flower does not load"),
+            Some(project) => Ok((
+                project.context("the built-in flower does not load")?,
+                Vec::new(),
+            )),
             None => bail!(
                 "no built-in flower `{name}` (there are: {})",
                 anthesis_garden::builtin_names().join(", ")
             ),
         };
     }
-    // The project error names the file itself; what was read past (an
-    // OBJ's loose edges, a mesh wound inside out) is said and the command
-    // goes on.
+    // The project error names the file itself.
     let loaded = load_project_with_warnings(path).context("cannot open project")?;
     for warning in &loaded.warnings {
         eprintln!("warning: {warning}");
     }
-    let project = loaded.project;
-    check_units(&project)?;
-    Ok(project)
+    check_units(&loaded.project)?;
+    Ok((loaded.project, loaded.warnings))
 }
 
-/// The project the window opens at `path` and the file it saves to (none
-/// for a built-in flower, which Save asks a place for).
-fn open(path: &Path) -> Result<(Project, Option<PathBuf>)> {
-    let project = load(path)?;
+/// The project the window opens at `path`, the file it saves to (none for
+/// a built-in flower, which Save asks a place for) and what loading read
+/// past.
+fn open(path: &Path) -> Result<(Project, Option<PathBuf>, Vec<String>)> {
+    let (project, warnings) = load_with_warnings(path)?;
     let file = if path.to_str().is_some_and(|p| p.starts_with("builtin:")) {
         None
     } else {
         Some(anthesis_flower::project::project_file(path).context("cannot open project")?)
     };
-    Ok((project, file))
+    Ok((project, file, warnings))
 }
 
 /// Refuses folder `dir` if it already holds a project file, so nothing is
@@ -416,6 +430,32 @@ fn selection(project: &Project, organ: Option<&str>) -> Result<Selection> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_project_opened_in_the_window_brings_what_loading_read_past() {
+        // `anthesis PROJECT` opens the window: the loader's warnings go to
+        // its log (they were said on the terminal only).
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut project = anthesis_garden::five_petal::five_petal().expect("the five-petal start");
+        project.flower.templates[0].mesh =
+            anthesis_bud::with_inner_side_flipped(&project.flower.templates[0].mesh);
+        let path = dir.path().join("flipped.anthesis.toml");
+        anthesis_flower::project::save_project(&project, &path).expect("save");
+        let (opened, file, warnings) = open(&path).expect("opens with a warning");
+        assert_eq!(file.as_deref(), Some(path.as_path()));
+        assert_eq!(
+            opened.flower.templates.len(),
+            project.flower.templates.len()
+        );
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(
+            warnings[0].contains("the inner side faces +Z"),
+            "{warnings:?}"
+        );
+        // A built-in flower reads nothing past.
+        let (_, file, warnings) = open(Path::new("builtin:lily")).expect("the lily");
+        assert_eq!((file, warnings.len()), (None, 0));
+    }
 
     #[test]
     fn each_cause_is_said_once() {

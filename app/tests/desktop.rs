@@ -90,6 +90,7 @@ fn harness_stepping(project: Project, step_seconds: f32) -> Harness<'static, Ant
                     project: Some((project, None)),
                     live: false,
                     restore: false,
+                    warnings: Vec::new(),
                 },
             )
             .expect("the app starts")
@@ -1145,6 +1146,7 @@ fn the_last_project_and_view_are_remembered_between_launches() {
                     project: None,
                     live: false,
                     restore: true,
+                    warnings: Vec::new(),
                 },
             )
             .expect("the app starts")
@@ -1767,6 +1769,36 @@ fn opening_a_project_with_a_mesh_in_another_unit_warns_and_keeps_it_open() {
 }
 
 #[test]
+fn a_project_given_at_launch_shows_what_loading_read_past_in_the_log() {
+    let warning = "template `petal`: the mesh's inner side faces +Z".to_string();
+    let harness = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .wgpu()
+        .build_eframe({
+            let warning = warning.clone();
+            move |cc| {
+                AnthesisApp::new(
+                    cc,
+                    Startup {
+                        project: Some((small_flower(), None)),
+                        live: false,
+                        restore: false,
+                        warnings: vec![warning],
+                    },
+                )
+                .expect("the app starts")
+            }
+        });
+    let entries = harness.state().log().entries();
+    assert!(
+        entries
+            .iter()
+            .any(|e| e.message == warning && e.level == anthesis_app::desktop::log::Level::Warning),
+        "{entries:?}"
+    );
+}
+
+#[test]
 fn opening_a_project_shows_what_loading_read_past() {
     // A mesh from another tool wound inside out: it loads, and the log
     // says so (the loader's warnings were dropped).
@@ -2070,6 +2102,7 @@ fn harness_with_file_browser(path: &std::path::Path) -> Harness<'static, Anthesi
                     project: Some((project, Some(path))),
                     live: false,
                     restore: false,
+                    warnings: Vec::new(),
                 },
             )
             .expect("the app starts");

@@ -31,6 +31,7 @@ fn launch(
                     project,
                     live: false,
                     restore: false,
+                    warnings: Vec::new(),
                 },
             )
             .expect("the app starts");

@@ -28,6 +28,7 @@ fn launch(project: Project) -> Harness<'static, AnthesisApp> {
                     project: Some((project, None)),
                     live: true,
                     restore: false,
+                    warnings: Vec::new(),
                 },
             )
             .expect("the app starts")

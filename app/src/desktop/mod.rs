@@ -43,7 +43,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anthesis_flower::Project;
-use anthesis_flower::project::load_project;
+use anthesis_flower::project::load_project_with_warnings;
 use anthesis_sim::Selection;
 use anyhow::{Result, anyhow};
 use eframe::egui;
@@ -92,8 +92,9 @@ fn autosave_interval(settings: &Settings) -> std::time::Duration {
 const SETTINGS_KEY: &str = "anthesis-settings";
 
 /// Opens the window, on `project` (and the file it came from) if given,
-/// else as [`Startup::default`]; returns when it is closed.
-pub fn run(project: Option<(Project, Option<PathBuf>)>) -> Result<()> {
+/// else as [`Startup::default`], with `warnings`, what loading the project
+/// read past, in the log; returns when it is closed.
+pub fn run(project: Option<(Project, Option<PathBuf>)>, warnings: Vec<String>) -> Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("Anthesis")
@@ -108,6 +109,7 @@ pub fn run(project: Option<(Project, Option<PathBuf>)>) -> Result<()> {
         Box::new(|cc| {
             let startup = Startup {
                 project,
+                warnings,
                 ..Startup::default()
             };
             let mut app = AnthesisApp::new(cc, startup).map_err(|e| e.to_string())?;
@@ -135,6 +137,9 @@ pub struct Startup {
     pub live: bool,
     /// Read settings saved by an earlier launch.
     pub restore: bool,
+    /// What loading `project` read past (a mesh wound inside out, loose
+    /// edges), shown in the log as File → Open shows it.
+    pub warnings: Vec<String>,
 }
 
 impl Default for Startup {
@@ -143,6 +148,7 @@ impl Default for Startup {
             project: None,
             live: true,
             restore: true,
+            warnings: Vec::new(),
         }
     }
 }
@@ -256,11 +262,19 @@ impl AnthesisApp {
         } else {
             SimSession::recorded()
         };
+        for warning in startup.warnings {
+            log.warn(warning);
+        }
         let (project, path) = match startup.project {
             Some(given) => given,
             None => match &settings.last_project {
-                Some(path) => match load_project(path) {
-                    Ok(project) => (project, Some(path.clone())),
+                Some(path) => match load_project_with_warnings(path) {
+                    Ok(loaded) => {
+                        for warning in loaded.warnings {
+                            log.warn(warning);
+                        }
+                        (loaded.project, Some(path.clone()))
+                    }
                     Err(e) => {
                         log.warn(format!("could not reopen the last project: {e}"));
                         (default_project()?, None)
