@@ -13,7 +13,7 @@ use anthesis_app::desktop::{AnthesisApp, Command, ProjectEdit, Startup};
 use anthesis_flower::Project;
 use anthesis_maps::MapKind;
 use anthesis_maps::brush::{Brush, PaintTarget, StrokeDab};
-use anthesis_sim::{Keyframe, Selection, run};
+use anthesis_sim::{Selection, run};
 use eframe::egui;
 use egui_kittest::Harness;
 
@@ -55,23 +55,6 @@ fn finish_run_after(harness: &mut Harness<'_, AnthesisApp>, after: u64) -> u32 {
     }
 }
 
-/// A keyframe as bits: positions and statistics (not its time).
-fn bits(k: &Keyframe) -> Vec<u64> {
-    let s = &k.stats;
-    let mut out = vec![
-        u64::from(k.index),
-        s.energy.to_bits(),
-        u64::from(s.iterations),
-        s.relative_gradient.to_bits(),
-        u64::from(s.pushed_particles),
-        u64::from(s.contact_particles),
-    ];
-    for organ in &k.positions_in_world {
-        out.extend(organ.iter().flat_map(|p| p.to_array().map(f64::to_bits)));
-    }
-    out
-}
-
 /// The timeline's keyframes, as bits.
 fn shown(harness: &Harness<'_, AnthesisApp>) -> Vec<Vec<u64>> {
     harness
@@ -79,7 +62,7 @@ fn shown(harness: &Harness<'_, AnthesisApp>) -> Vec<Vec<u64>> {
         .session()
         .keyframes()
         .iter()
-        .map(|k| bits(k))
+        .map(|k| k.bits())
         .collect()
 }
 
@@ -89,7 +72,7 @@ fn from_the_bud(harness: &mut Harness<'_, AnthesisApp>) -> Vec<Vec<u64>> {
     let project = harness.state_mut().resolved_project();
     let mut keyframes = Vec::new();
     run(&project, &Selection::All, &mut |_, k| {
-        keyframes.push(bits(k))
+        keyframes.push(k.bits())
     })
     .expect("the run converges");
     keyframes

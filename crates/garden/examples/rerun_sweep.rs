@@ -37,30 +37,11 @@ use anthesis_maps::{Blend, MapKind};
 use anthesis_sim::fixtures::stroke_near_tip;
 use anthesis_sim::resume::{Edit, edit_between};
 use anthesis_sim::worker::{Event, Worker};
-use anthesis_sim::{Keyframe, Selection, Simulation, run};
+use anthesis_sim::{Selection, Simulation, run};
 use glam::DVec2;
 
 /// One edit: its name and the edited project.
 type Case = (String, Project);
-
-/// The bits a keyframe holds (positions and statistics, not its time).
-fn bits(k: &Keyframe) -> Vec<u64> {
-    let s = &k.stats;
-    let mut out = vec![
-        u64::from(k.index),
-        u64::from(s.index),
-        s.energy.to_bits(),
-        u64::from(s.iterations),
-        s.relative_gradient.to_bits(),
-        u64::from(s.pushed_particles),
-        u64::from(s.contact_particles),
-    ];
-    for organ in &k.positions_in_world {
-        out.push(organ.len() as u64);
-        out.extend(organ.iter().flat_map(|p| p.to_array().map(f64::to_bits)));
-    }
-    out
-}
 
 /// Every keyframe of a run of `project` from the bud (no checkpoints), and
 /// the error it stopped on, if it did (a coarse flower edited hard may
@@ -68,7 +49,7 @@ fn bits(k: &Keyframe) -> Vec<u64> {
 /// way).
 fn from_the_bud(project: &Project, selection: &Selection) -> (Vec<Vec<u64>>, Option<String>) {
     let mut keyframes = Vec::new();
-    let error = run(project, selection, &mut |_, k| keyframes.push(bits(k)))
+    let error = run(project, selection, &mut |_, k| keyframes.push(k.bits()))
         .err()
         .map(|e| e.to_string());
     (keyframes, error)
@@ -90,7 +71,7 @@ fn collect(worker: &Worker, run: u64) -> Result<Sent, String> {
         }
         match event {
             Event::Started { first_computed, .. } => first = Some(first_computed),
-            Event::Keyframe { keyframe, .. } => keyframes.push(bits(&keyframe)),
+            Event::Keyframe { keyframe, .. } => keyframes.push(keyframe.bits()),
             Event::Progress { .. } => {}
             Event::Finished { .. } => {
                 return Ok((first.ok_or("no Started event")?, keyframes, None));

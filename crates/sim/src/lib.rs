@@ -93,6 +93,30 @@ pub struct Keyframe {
     pub stats: KeyframeStats,
 }
 
+impl Keyframe {
+    /// Every bit of the keyframe but its wall time: its number, each
+    /// organ's particle count and positions, and its statistics. Two runs
+    /// made the same keyframe when these are equal (the rerun and
+    /// determinism checks compare them).
+    pub fn bits(&self) -> Vec<u64> {
+        let s = &self.stats;
+        let mut out = vec![
+            u64::from(self.index),
+            u64::from(s.index),
+            s.energy.to_bits(),
+            u64::from(s.iterations),
+            s.relative_gradient.to_bits(),
+            u64::from(s.pushed_particles),
+            u64::from(s.contact_particles),
+        ];
+        for organ in &self.positions_in_world {
+            out.push(organ.len() as u64);
+            out.extend(organ.iter().flat_map(|p| p.to_array().map(f64::to_bits)));
+        }
+        out
+    }
+}
+
 /// Why a run stopped early. Each names the keyframe and organ involved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {

@@ -227,24 +227,7 @@ pub fn shape_change(
 
 /// Every number of every keyframe as bits (wall time excluded).
 pub fn fingerprint(keyframes: &[Keyframe]) -> Vec<u64> {
-    let mut bits = Vec::new();
-    for k in keyframes {
-        bits.push(u64::from(k.index));
-        for organ in &k.positions_in_world {
-            bits.push(organ.len() as u64);
-            for p in organ {
-                bits.extend([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]);
-            }
-        }
-        bits.extend([
-            u64::from(k.stats.index),
-            k.stats.energy.to_bits(),
-            u64::from(k.stats.iterations),
-            k.stats.relative_gradient.to_bits(),
-            u64::from(k.stats.pushed_particles),
-        ]);
-    }
-    bits
+    keyframes.iter().flat_map(Keyframe::bits).collect()
 }
 
 /// A pistil on the flower axis, without a schedule.
