@@ -850,19 +850,9 @@ impl Simulation {
                 known.get_or_insert_with(|| Geometry::of(organ));
             });
         let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
-        // Inner particles stay on the outer organ's inner side, outer
-        // particles on the inner organ's outer side (side `2 * overlap` and
-        // `2 * overlap + 1`). A kinematic organ (two-state) gets no contacts.
+        // A kinematic organ (two-state) gets no contacts.
         let keys: Vec<(usize, usize, usize, f64)> = self
-            .overlaps
-            .iter()
-            .enumerate()
-            .flat_map(|(index, &(inner, outer))| {
-                [
-                    (2 * index, inner, outer, 1.0),
-                    (2 * index + 1, outer, inner, -1.0),
-                ]
-            })
+            .sides()
             .filter(|&(_, moving, _, _)| !self.organs[moving].is_kinematic())
             .collect();
         // Each side's contacts on its own thread.
@@ -885,18 +875,16 @@ impl Simulation {
     /// against a part).
     fn contacts(&self, found: &Found, violated: Violated) -> Vec<Vec<Contact>> {
         let mut contacts = found.parts.clone();
-        for (index, &(inner, outer)) in self.overlaps.iter().enumerate() {
-            for (key, moving, other) in [(2 * index, inner, outer), (2 * index + 1, outer, inner)] {
-                let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
-                let positions = &self.organs[moving].positions;
-                contacts[moving].extend(found.sides[key].iter().map(|&c| {
-                    if half {
-                        move_half(c, positions[c.particle as usize])
-                    } else {
-                        c
-                    }
-                }));
-            }
+        for (key, moving, other, _) in self.sides() {
+            let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
+            let positions = &self.organs[moving].positions;
+            contacts[moving].extend(found.sides[key].iter().map(|&c| {
+                if half {
+                    move_half(c, positions[c.particle as usize])
+                } else {
+                    c
+                }
+            }));
         }
         contacts
     }
@@ -982,12 +970,10 @@ impl Simulation {
         let mut parts_given = vec![true; self.organs.len()];
         // Where each side's moving organ was when its last list was found,
         // and how often the other organ had been pushed then.
-        let mut side_at: Vec<(Vec<DVec3>, u32)> = (0..side_found.len())
-            .map(|key| {
-                let (inner, outer) = self.overlaps[key / 2];
-                let moving = if key % 2 == 0 { inner } else { outer };
-                (self.organs[moving].positions.clone(), 0)
-            })
+        let sides: Vec<(usize, usize, usize, f64)> = self.sides().collect();
+        let mut side_at: Vec<(Vec<DVec3>, u32)> = sides
+            .iter()
+            .map(|&(_, moving, _, _)| (self.organs[moving].positions.clone(), 0))
             .collect();
         let mut settled = false;
         // A pushed particle turns its neighbours' normals a little, which
@@ -1027,50 +1013,45 @@ impl Simulation {
                 parts_found[i] = list;
                 pushed_in_pass += pushed;
             }
-            for index in 0..self.overlaps.len() {
-                let (inner, outer) = self.overlaps[index];
-                let sides = [(inner, outer, 1.0), (outer, inner, -1.0)];
-                for (key, (moving, other, side)) in sides.into_iter().enumerate() {
-                    let key = 2 * index + key;
-                    if self.organs[moving].is_kinematic()
-                        || side_clear[key] == Some((pushes[moving], pushes[other]))
-                    {
-                        continue;
-                    }
-                    // While the other organ stays where it was, only the
-                    // moving organ's particles that moved since its last
-                    // list can find other contacts.
-                    let (before, other_pushes) = &side_at[key];
-                    let list = std::mem::take(&mut side_found[key]);
-                    let contacts = if *other_pushes == pushes[other] {
-                        let changed = self.changed_since(moving, before);
-                        if changed.is_empty() {
-                            list
-                        } else {
-                            let known = geometry[other]
-                                .get_or_insert_with(|| Geometry::of(&self.organs[other]));
-                            self.update_contacts(moving, other, side, known, list, &changed)
-                        }
+            for &(key, moving, other, side) in &sides {
+                if self.organs[moving].is_kinematic()
+                    || side_clear[key] == Some((pushes[moving], pushes[other]))
+                {
+                    continue;
+                }
+                // While the other organ stays where it was, only the
+                // moving organ's particles that moved since its last
+                // list can find other contacts.
+                let (before, other_pushes) = &side_at[key];
+                let list = std::mem::take(&mut side_found[key]);
+                let contacts = if *other_pushes == pushes[other] {
+                    let changed = self.changed_since(moving, before);
+                    if changed.is_empty() {
+                        list
                     } else {
                         let known = geometry[other]
                             .get_or_insert_with(|| Geometry::of(&self.organs[other]));
-                        self.contacts_between(moving, other, side, known)
-                    };
-                    side_at[key] = (self.organs[moving].positions.clone(), pushes[other]);
-                    let pushed = push_back(
-                        &mut self.organs[moving].positions,
-                        &contacts,
-                        &mut moved[moving],
-                    );
-                    if pushed > 0 {
-                        pushes[moving] += 1;
-                        geometry[moving] = None;
-                    } else {
-                        side_clear[key] = Some((pushes[moving], pushes[other]));
+                        self.update_contacts(moving, other, side, known, list, &changed)
                     }
-                    side_found[key] = contacts;
-                    pushed_in_pass += pushed;
+                } else {
+                    let known =
+                        geometry[other].get_or_insert_with(|| Geometry::of(&self.organs[other]));
+                    self.contacts_between(moving, other, side, known)
+                };
+                side_at[key] = (self.organs[moving].positions.clone(), pushes[other]);
+                let pushed = push_back(
+                    &mut self.organs[moving].positions,
+                    &contacts,
+                    &mut moved[moving],
+                );
+                if pushed > 0 {
+                    pushes[moving] += 1;
+                    geometry[moving] = None;
+                } else {
+                    side_clear[key] = Some((pushes[moving], pushes[other]));
                 }
+                side_found[key] = contacts;
+                pushed_in_pass += pushed;
             }
             if pushed_in_pass == 0 {
                 settled = true;
@@ -1082,9 +1063,8 @@ impl Simulation {
         // was made where the organs are now, and found nothing to push.
         let found = settled.then(|| {
             let mut contacts = parts_found;
-            for (index, &(inner, outer)) in self.overlaps.iter().enumerate() {
-                contacts[inner].extend_from_slice(&side_found[2 * index]);
-                contacts[outer].extend_from_slice(&side_found[2 * index + 1]);
+            for (key, moving, _, _) in self.sides() {
+                contacts[moving].extend_from_slice(&side_found[key]);
             }
             contacts
         });
@@ -1193,19 +1173,31 @@ impl Simulation {
         worst
     }
 
+    /// Every overlap side in order: its key in [`Found::sides`], the organ
+    /// whose particles it holds, the other organ, and which side of the
+    /// other they stay on (+1 its inner side). Inner particles stay on the
+    /// outer organ's inner side (key `2 * overlap`), outer particles on the
+    /// inner organ's outer side (`2 * overlap + 1`).
+    fn sides(&self) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
+        self.overlaps
+            .iter()
+            .enumerate()
+            .flat_map(|(index, &(inner, outer))| {
+                [
+                    (2 * index, inner, outer, 1.0),
+                    (2 * index + 1, outer, inner, -1.0),
+                ]
+            })
+    }
+
     /// The organs, in the flower's order, and "the parts" that held
     /// `organ` off them in the search `found` (the names a stopped run
     /// gives, see [`held_against_note`]).
     fn held_against(&self, found: &Found, organ: usize) -> Vec<String> {
         let mut others: Vec<usize> = self
-            .overlaps
-            .iter()
-            .enumerate()
-            .flat_map(|(index, &(inner, outer))| {
-                [(2 * index, inner, outer), (2 * index + 1, outer, inner)]
-            })
-            .filter(|&(key, moving, _)| moving == organ && !found.sides[key].is_empty())
-            .map(|(_, _, other)| other)
+            .sides()
+            .filter(|&(key, moving, _, _)| moving == organ && !found.sides[key].is_empty())
+            .map(|(_, _, other, _)| other)
             .collect();
         others.sort_unstable();
         others.dedup();
