@@ -1740,21 +1740,32 @@ fn a_typed_resolution_is_one_edit_when_entered_not_one_per_key() {
     assert!(edits[0].contains("Resolution(MeanEdge(0.5))"), "{edits:?}");
 }
 
-#[test]
-fn opening_a_project_with_a_mesh_in_another_unit_warns_and_keeps_it_open() {
+/// The window on the small flower, then File → Open of `project` saved as
+/// `name` in a temporary folder (kept alive by the returned guard); checks
+/// it became the document.
+fn open_saved(project: &Project, name: &str) -> (Harness<'static, AnthesisApp>, tempfile::TempDir) {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut project = small_flower();
-    for p in &mut project.flower.templates[0].mesh.positions {
-        *p *= 100.0;
-    }
-    let path = dir.path().join("mm.anthesis.toml");
-    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let path = dir.path().join(name);
+    anthesis_flower::project::save_project(project, &path).expect("save");
     let mut harness = harness(small_flower());
     harness.run();
     harness.state_mut().open_path(&path);
     harness.run();
+    assert_eq!(
+        harness.state().document().path.as_deref(),
+        Some(path.as_path())
+    );
+    (harness, dir)
+}
+
+#[test]
+fn opening_a_project_with_a_mesh_in_another_unit_warns_and_keeps_it_open() {
+    let mut project = small_flower();
+    for p in &mut project.flower.templates[0].mesh.positions {
+        *p *= 100.0;
+    }
+    let (harness, _dir) = open_saved(&project, "mm.anthesis.toml");
     let app = harness.state();
-    assert_eq!(app.document().path.as_deref(), Some(path.as_path()));
     let warning = app
         .log()
         .entries()
@@ -1802,18 +1813,11 @@ fn a_project_given_at_launch_shows_what_loading_read_past_in_the_log() {
 fn opening_a_project_shows_what_loading_read_past() {
     // A mesh from another tool wound inside out: it loads, and the log
     // says so (the loader's warnings were dropped).
-    let dir = tempfile::tempdir().expect("temp dir");
     let mut project = small_flower();
     project.flower.templates[0].mesh =
         anthesis_bud::with_inner_side_flipped(&project.flower.templates[0].mesh);
-    let path = dir.path().join("flipped.anthesis.toml");
-    anthesis_flower::project::save_project(&project, &path).expect("save");
-    let mut harness = harness(small_flower());
-    harness.run();
-    harness.state_mut().open_path(&path);
-    harness.run();
+    let (harness, _dir) = open_saved(&project, "flipped.anthesis.toml");
     let app = harness.state();
-    assert_eq!(app.document().path.as_deref(), Some(path.as_path()));
     let warnings: Vec<&str> = app
         .log()
         .entries()
