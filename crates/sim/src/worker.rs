@@ -10,6 +10,15 @@
 //! A panic inside a job (a bug) ends that job with a `Failed` event naming
 //! the run; the thread lives on and serves the next run. Jobs read an
 //! immutable snapshot, so the owner's document is untouched by it.
+//!
+//! A run may bring a *proxy*: the same flower with coarser meshes
+//! ([`Worker::start_with_proxy`]). The job then first computes the proxy
+//! from the first keyframe the edit changes to the end (`Proxy` events),
+//! and then the converged keyframes (`Keyframe` events), which replace the
+//! proxy's one by one where they arrive. The worker keeps the last few
+//! runs' simulations, one per selection and kind ([`Lane`]), so an edit of
+//! either, or a switch back to a selection run before, goes on from the
+//! first keyframe it changes.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -44,6 +53,8 @@ pub enum Event {
         /// last run's, which the edit could not change, and are sent again
         /// at once (1 when the run starts from the bud).
         first_computed: u32,
+        /// Whether a proxy pass comes before the converged keyframes.
+        proxy: bool,
     },
     /// One keyframe, reused or newly computed, in increasing order.
     Keyframe {
@@ -51,6 +62,27 @@ pub enum Event {
         run: RunId,
         /// The keyframe (shared: the worker keeps it to resume a later run).
         keyframe: Arc<Keyframe>,
+    },
+    /// One keyframe of the run's proxy (see [`Worker::start_with_proxy`]),
+    /// computed before the converged keyframes of the same index; its
+    /// positions belong to the proxy project's meshes. Proxy keyframes
+    /// come in increasing order from `Started::first_computed` on.
+    Proxy {
+        /// The run.
+        run: RunId,
+        /// The proxy keyframe.
+        keyframe: Arc<Keyframe>,
+    },
+    /// The proxy pass is over: every proxy keyframe was sent, or the proxy
+    /// stopped (`error`: a coarse mesh may fail where the converged one does
+    /// not). The converged keyframes follow either way.
+    ProxyEnded {
+        /// The run.
+        run: RunId,
+        /// Wall time of the proxy pass, in seconds.
+        seconds: f64,
+        /// Why the proxy stopped early, if it did.
+        error: Option<SimError>,
     },
     /// One Newton iteration of the keyframe being computed.
     Progress {
@@ -88,6 +120,8 @@ impl Event {
         match self {
             Event::Started { run, .. }
             | Event::Keyframe { run, .. }
+            | Event::Proxy { run, .. }
+            | Event::ProxyEnded { run, .. }
             | Event::Progress { run, .. }
             | Event::Finished { run, .. }
             | Event::Failed { run, .. }
@@ -110,6 +144,8 @@ impl Event {
 struct RunRequest {
     run: RunId,
     project: Arc<Project>,
+    /// The same flower with coarser meshes, computed first.
+    proxy: Option<Arc<Project>>,
     selection: Selection,
     #[cfg(any(test, feature = "fault-hook"))]
     fault: Option<Fault>,
@@ -162,6 +198,29 @@ impl Mailbox {
 
 type Wake = Box<dyn Fn() + Send + Sync>;
 
+/// Shortest time between two wakes for `Progress` events alone.
+pub const PROGRESS_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Whether an event wakes the owner: every event but progress does;
+/// progress when [`PROGRESS_WAKE_EVERY`] has passed since the last wake.
+#[derive(Debug, Default)]
+struct WakeGate {
+    last_wake: Option<Instant>,
+}
+
+impl WakeGate {
+    fn wakes(&mut self, progress: bool, now: Instant) -> bool {
+        let due = self
+            .last_wake
+            .is_none_or(|at| now.saturating_duration_since(at) >= PROGRESS_WAKE_EVERY);
+        let wakes = !progress || due;
+        if wakes {
+            self.last_wake = Some(now);
+        }
+        wakes
+    }
+}
+
 /// Handle to the worker thread.
 pub struct Worker {
     mailbox: Arc<Mailbox>,
@@ -201,9 +260,24 @@ impl Worker {
     /// Starts simulating `project`, cancelling whatever runs now. Returns the
     /// new run's id. Never blocks on the simulation.
     pub fn start(&self, project: Arc<Project>, selection: Selection) -> RunId {
+        self.start_with_proxy(project, None, selection)
+    }
+
+    /// [`Worker::start`] with a proxy: `proxy` is the same project with
+    /// coarser meshes (the same organs, maps and settings), simulated
+    /// first from the first keyframe the edit changes, so that something
+    /// is on screen fast; `project`'s own keyframes follow. `None` runs
+    /// `project` alone.
+    pub fn start_with_proxy(
+        &self,
+        project: Arc<Project>,
+        proxy: Option<Arc<Project>>,
+        selection: Selection,
+    ) -> RunId {
         self.post_run(|run| RunRequest {
             run,
             project,
+            proxy,
             selection,
             #[cfg(any(test, feature = "fault-hook"))]
             fault: None,
@@ -221,6 +295,7 @@ impl Worker {
         self.post_run(|run| RunRequest {
             run,
             project,
+            proxy: None,
             selection,
             fault: Some(fault),
         })
@@ -265,84 +340,220 @@ impl Drop for Worker {
 }
 
 fn serve(mailbox: &Mailbox, events: Sender<Event>, current: Arc<AtomicU64>, wake: Wake) {
+    // Progress (one event per Newton iteration) wakes the owner at most
+    // every `PROGRESS_WAKE_EVERY`: a window redraws on each wake, and on a
+    // software renderer that takes a core from the solver. Every other
+    // event wakes it at once.
+    let mut gate = WakeGate::default();
     let send = Mutex::new(move |event: Event| {
+        let progress = matches!(event, Event::Progress { .. });
         let _ = events.send(event);
-        wake();
+        if gate.wakes(progress, Instant::now()) {
+            wake();
+        }
     });
     // A panic while sending (in `wake`) poisons the lock; the sender is
     // still whole, so later events still go out.
     let emit = |event: Event| {
-        let send = send.lock().unwrap_or_else(PoisonError::into_inner);
+        let mut send = send.lock().unwrap_or_else(PoisonError::into_inner);
         send(event);
     };
-    // The last run's simulation, kept so that an edit goes on from the
-    // first keyframe it changes. Taken out while a job runs: a job that
-    // panics outside the simulation's own guard leaves nothing behind.
-    let mut last: Option<LastRun> = None;
+    // The last runs' simulations, so that an edit goes on from the first
+    // keyframe it changes. A job takes out the ones it uses: a job that
+    // panics outside the simulation's own guard leaves them behind.
+    let mut kept = Kept::default();
     while let Some(request) = mailbox.next() {
         let run = request.run;
         if current.load(Ordering::SeqCst) != run {
             // Cancelled before it started.
             continue;
         }
-        let previous = last.take();
-        // Unwind safety: the job owns its simulation and reads an
-        // immutable project; nothing it leaves half done outlives it.
+        // Unwind safety: the job owns the simulations it took and reads
+        // immutable projects; nothing it leaves half done outlives it.
         let job = catch_unwind(AssertUnwindSafe(|| {
-            run_job(&request, previous, &current, &emit)
+            run_job(&request, &mut kept, &current, &emit)
         }));
-        match job {
-            Ok(kept) => last = kept,
-            Err(payload) => emit(Event::Failed {
+        if let Err(payload) = job {
+            emit(Event::Failed {
                 run,
                 error: SimError::Panicked {
                     run: Some(run),
                     keyframe: None,
                     message: panic_message(payload.as_ref()),
                 },
-            }),
+            });
         }
     }
 }
 
-/// What the worker keeps of its last run: the project and selection it
-/// ran, its simulation (with checkpoints) and the keyframes it computed.
+/// Which kept simulation a run goes on from: the organs it simulates, and
+/// whether it is a proxy (coarse meshes) or the converged run.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Lane {
+    /// The organs simulated.
+    pub selection: Selection,
+    /// Whether the lane simulates a proxy.
+    pub proxy: bool,
+}
+
+/// What the worker keeps of a finished or cancelled run: the project and
+/// lane it ran, its simulation (with checkpoints) and the keyframes it
+/// computed.
 struct LastRun {
     project: Arc<Project>,
-    selection: Selection,
+    lane: Lane,
     sim: Simulation,
     keyframes: Vec<Arc<Keyframe>>,
 }
 
-/// The simulation for `request`: the last run's, edited, when it ran the
-/// same organs (keeping the keyframes the edit cannot change), else a new
-/// one. Returns it with the keyframes kept.
+/// The most simulations kept: the converged run and the proxy of the
+/// selection being edited, and the converged run of one other (the whole
+/// flower while a single organ is previewed), so that leaving the preview
+/// computes nothing that did not change.
+const KEPT_RUNS: usize = 3;
+
+/// The kept simulations, the most recently used first.
+#[derive(Default)]
+struct Kept {
+    runs: Vec<LastRun>,
+}
+
+impl Kept {
+    /// Takes out the simulation of `lane`, if one is kept.
+    fn take(&mut self, lane: &Lane) -> Option<LastRun> {
+        let at = self.runs.iter().position(|r| r.lane == *lane)?;
+        Some(self.runs.remove(at))
+    }
+
+    /// Keeps `last` as the most recently used, forgetting the least
+    /// recently used beyond [`KEPT_RUNS`].
+    fn put(&mut self, last: LastRun) {
+        self.runs.retain(|r| r.lane != last.lane);
+        self.runs.insert(0, last);
+        self.runs.truncate(KEPT_RUNS);
+    }
+}
+
+/// The simulation of `project` in `lane`: the kept one, edited, when there
+/// is one (keeping the keyframes the edit cannot change), else a new one.
+/// Returns it with the keyframes kept.
 fn simulation_for(
-    request: &RunRequest,
+    project: &Arc<Project>,
+    lane: &Lane,
     last: Option<LastRun>,
 ) -> Result<(Simulation, Vec<Arc<Keyframe>>), SimError> {
-    #[cfg(any(test, feature = "fault-hook"))]
-    let last = last.filter(|_| request.fault.is_none());
-    if let Some(mut last) = last.filter(|l| l.selection == request.selection) {
-        let first = last.sim.edit(&last.project, &request.project)?;
+    if let Some(mut last) = last {
+        let first = last.sim.edit(&last.project, project)?;
         // Starting over may start from another bud (a new mesh).
         last.keyframes
             .truncate(if first == 1 { 0 } else { first as usize });
         return Ok((last.sim, last.keyframes));
     }
-    let mut sim = Simulation::new(&request.project, &request.selection)?;
+    let mut sim = Simulation::new(project, &lane.selection)?;
     sim.keep_checkpoints();
     Ok((sim, Vec::new()))
 }
 
-/// Runs one job. Returns what a later edit can go on from (nothing when the
-/// simulation could not be made).
-fn run_job(
-    request: &RunRequest,
-    last: Option<LastRun>,
-    current: &AtomicU64,
+/// How a run of steps ended.
+enum Steps {
+    /// Every keyframe is computed.
+    Finished,
+    /// A newer run or a cancel replaced this one.
+    Cancelled,
+    /// A step failed.
+    Failed(SimError),
+}
+
+/// Steps `sim` to its last keyframe, handing each new keyframe to `keyframe`.
+fn step_to_end(
+    sim: &mut Simulation,
+    keyframes: &mut Vec<Arc<Keyframe>>,
+    run: RunId,
+    stale: &(dyn Fn() -> bool + Sync),
     emit: &dyn Fn(Event),
-) -> Option<LastRun> {
+    keyframe: &dyn Fn(Arc<Keyframe>) -> Event,
+) -> Steps {
+    while !sim.finished() {
+        let result = sim.step(stale, &mut |progress| {
+            emit(Event::Progress { run, progress })
+        });
+        match result {
+            Ok(made) => {
+                let made = Arc::new(made);
+                keyframes.push(Arc::clone(&made));
+                emit(keyframe(made));
+            }
+            Err(SimError::Cancelled) => return Steps::Cancelled,
+            Err(SimError::Panicked {
+                keyframe, message, ..
+            }) => {
+                return Steps::Failed(SimError::Panicked {
+                    run: Some(run),
+                    keyframe,
+                    message,
+                });
+            }
+            Err(error) => return Steps::Failed(error),
+        }
+    }
+    Steps::Finished
+}
+
+/// The proxy pass of run `run`: `proxy` simulated in its lane, every
+/// keyframe from `first` on sent as a `Proxy` event, then `ProxyEnded`.
+/// Returns false when the run was cancelled meanwhile.
+fn run_proxy(
+    run: RunId,
+    proxy: &Arc<Project>,
+    lane: Lane,
+    first: u32,
+    kept: &mut Kept,
+    stale: &(dyn Fn() -> bool + Sync),
+    emit: &dyn Fn(Event),
+) -> bool {
+    let started = Instant::now();
+    let ended = |error| Event::ProxyEnded {
+        run,
+        seconds: started.elapsed().as_secs_f64(),
+        error,
+    };
+    let (mut sim, mut keyframes) = match simulation_for(proxy, &lane, kept.take(&lane)) {
+        Ok(made) => made,
+        Err(error) => {
+            emit(ended(Some(error)));
+            return !stale();
+        }
+    };
+    if keyframes.is_empty() {
+        keyframes.push(Arc::new(sim.bud()));
+    }
+    // Kept proxy keyframes the converged run has not kept: at once.
+    for keyframe in keyframes.iter().skip(first as usize) {
+        emit(Event::Proxy {
+            run,
+            keyframe: Arc::clone(keyframe),
+        });
+    }
+    let steps = step_to_end(&mut sim, &mut keyframes, run, stale, emit, &|keyframe| {
+        Event::Proxy { run, keyframe }
+    });
+    kept.put(LastRun {
+        project: Arc::clone(proxy),
+        lane,
+        sim,
+        keyframes,
+    });
+    match steps {
+        Steps::Finished => emit(ended(None)),
+        Steps::Cancelled => return false,
+        Steps::Failed(error) => emit(ended(Some(error))),
+    }
+    true
+}
+
+/// Runs one job: the proxy first when the request has one, then the
+/// converged run. The simulations used go back into `kept`.
+fn run_job(request: &RunRequest, kept: &mut Kept, current: &AtomicU64, emit: &dyn Fn(Event)) {
     let run = request.run;
     let started = Instant::now();
     let stale = || current.load(Ordering::SeqCst) != run;
@@ -350,22 +561,32 @@ fn run_job(
     if request.fault == Some(Fault::PanicBeforeStart) {
         panic!("forced fault before run {run} started (test hook)");
     }
-    let (mut sim, mut keyframes) = match simulation_for(request, last) {
+    let lane = Lane {
+        selection: request.selection.clone(),
+        proxy: false,
+    };
+    let last = kept.take(&lane);
+    #[cfg(any(test, feature = "fault-hook"))]
+    let last = last.filter(|_| request.fault.is_none());
+    let (mut sim, mut keyframes) = match simulation_for(&request.project, &lane, last) {
         Ok(made) => made,
         Err(error) => {
             emit(Event::Failed { run, error });
-            return None;
+            return;
         }
     };
     #[cfg(any(test, feature = "fault-hook"))]
     if request.fault.is_some() {
         sim.inject(request.fault);
     }
+    let first_computed = keyframes.len().max(1) as u32;
+    let proxy = request.proxy.as_ref().filter(|_| !sim.finished());
     emit(Event::Started {
         run,
         organs: sim.organs().iter().map(|s| s.to_string()).collect(),
         keyframes: sim.keyframe_count(),
-        first_computed: keyframes.len().max(1) as u32,
+        first_computed,
+        proxy: proxy.is_some(),
     });
     if keyframes.is_empty() {
         keyframes.push(Arc::new(sim.bud()));
@@ -377,52 +598,40 @@ fn run_job(
             keyframe: Arc::clone(keyframe),
         });
     }
-    while !sim.finished() {
-        let result = sim.step(&stale, &mut |progress| {
-            emit(Event::Progress { run, progress })
-        });
-        match result {
-            Ok(keyframe) => {
-                let keyframe = Arc::new(keyframe);
-                keyframes.push(Arc::clone(&keyframe));
-                emit(Event::Keyframe { run, keyframe });
-            }
-            Err(SimError::Cancelled) => {
-                emit(Event::Cancelled { run });
-                break;
-            }
-            Err(SimError::Panicked {
-                keyframe, message, ..
-            }) => {
-                emit(Event::Failed {
-                    run,
-                    error: SimError::Panicked {
-                        run: Some(run),
-                        keyframe,
-                        message,
-                    },
-                });
-                break;
-            }
-            Err(error) => {
-                emit(Event::Failed { run, error });
-                break;
-            }
+    if let Some(proxy) = proxy {
+        let proxy_lane = Lane {
+            selection: request.selection.clone(),
+            proxy: true,
+        };
+        if !run_proxy(run, proxy, proxy_lane, first_computed, kept, &stale, emit) {
+            emit(Event::Cancelled { run });
+            kept.put(LastRun {
+                project: Arc::clone(&request.project),
+                lane,
+                sim,
+                keyframes,
+            });
+            return;
         }
     }
-    if sim.finished() {
-        emit(Event::Finished {
+    let steps = step_to_end(&mut sim, &mut keyframes, run, &stale, emit, &|keyframe| {
+        Event::Keyframe { run, keyframe }
+    });
+    match steps {
+        Steps::Finished => emit(Event::Finished {
             run,
             keyframes: sim.keyframe_count(),
             seconds: started.elapsed().as_secs_f64(),
-        });
+        }),
+        Steps::Cancelled => emit(Event::Cancelled { run }),
+        Steps::Failed(error) => emit(Event::Failed { run, error }),
     }
-    Some(LastRun {
+    kept.put(LastRun {
         project: Arc::clone(&request.project),
-        selection: request.selection.clone(),
+        lane,
         sim,
         keyframes,
-    })
+    });
 }
 
 #[cfg(test)]
@@ -473,13 +682,38 @@ mod tests {
             events.last(),
             Some(Event::Finished { keyframes: 5, .. })
         ));
-        // The wake follows each send, so the last one may still be on its
-        // way when the last event arrives.
+        // Every event but progress wakes the owner; progress alone at most
+        // every PROGRESS_WAKE_EVERY. The wake follows each send, so the
+        // last one may still be on its way when the last event arrives.
+        let progress = events
+            .iter()
+            .filter(|e| matches!(e, Event::Progress { .. }))
+            .count();
+        assert!(progress > 0, "the run reports its iterations");
+        let others = events.len() - progress;
         let deadline = Instant::now() + Duration::from_secs(10);
-        while wakes.load(Ordering::SeqCst) < events.len() && Instant::now() < deadline {
+        while wakes.load(Ordering::SeqCst) < others + 1 && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(1));
         }
-        assert_eq!(wakes.load(Ordering::SeqCst), events.len());
+        let woken = wakes.load(Ordering::SeqCst);
+        assert!(
+            woken >= others && woken <= events.len(),
+            "{woken} wakes for {others} events and {progress} iterations"
+        );
+    }
+
+    #[test]
+    fn progress_wakes_the_owner_at_most_every_tenth_of_a_second() {
+        let mut gate = WakeGate::default();
+        let t0 = Instant::now();
+        let at = |ms| t0 + Duration::from_millis(ms);
+        assert!(gate.wakes(true, at(0)), "the first progress wakes");
+        assert!(!gate.wakes(true, at(30)));
+        assert!(!gate.wakes(true, at(99)));
+        assert!(gate.wakes(false, at(99)), "a keyframe always wakes");
+        assert!(!gate.wakes(true, at(150)), "counted from the last wake");
+        assert!(gate.wakes(true, at(199)));
+        assert!(gate.wakes(false, at(200)) && gate.wakes(false, at(201)));
     }
 
     /// The keyframes of `events`, in the order they came.
@@ -742,5 +976,154 @@ mod tests {
             started.elapsed() < Duration::from_secs(10),
             "drop must not wait for 100 000 keyframes"
         );
+    }
+
+    /// The proxy keyframes of `events`, in the order they came.
+    fn proxies_of(events: &[Event]) -> Vec<Arc<Keyframe>> {
+        events
+            .iter()
+            .filter_map(|e| match e {
+                Event::Proxy { keyframe, .. } => Some(Arc::clone(keyframe)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Each organ's particle count in `keyframe`.
+    fn counts(keyframe: &Keyframe) -> Vec<usize> {
+        keyframe.positions_in_world.iter().map(Vec::len).collect()
+    }
+
+    #[test]
+    fn a_proxy_comes_first_and_the_converged_keyframes_are_those_of_a_run_without_it() {
+        let fine = Arc::new(whorl(2, 6, 10, 6));
+        let coarse = Arc::new(whorl(2, 4, 6, 6));
+        let plain = Worker::spawn(|| {}).expect("thread");
+        let run = plain.start(Arc::clone(&fine), Selection::All);
+        let expected = keyframes_of(&collect_until_end(&plain, run));
+
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let run =
+            worker.start_with_proxy(Arc::clone(&fine), Some(Arc::clone(&coarse)), Selection::All);
+        let events = collect_until_end(&worker, run);
+        assert!(matches!(
+            events.first(),
+            Some(Event::Started {
+                proxy: true,
+                first_computed: 1,
+                ..
+            })
+        ));
+        // The bud (converged), the proxy's keyframes 1-6, the end of the
+        // proxy, then the converged keyframes 1-6.
+        let order: Vec<String> = events
+            .iter()
+            .filter_map(|e| match e {
+                Event::Keyframe { keyframe, .. } => Some(format!("k{}", keyframe.index)),
+                Event::Proxy { keyframe, .. } => Some(format!("p{}", keyframe.index)),
+                Event::ProxyEnded { error: None, .. } => Some("end".to_string()),
+                Event::ProxyEnded { error: Some(e), .. } => Some(format!("failed: {e}")),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(
+            order.join(" "),
+            "k0 p1 p2 p3 p4 p5 p6 end k1 k2 k3 k4 k5 k6"
+        );
+        let coarse_counts: Vec<usize> = (0..2)
+            .map(|o| coarse.flower.template_of(o).mesh.vertex_count())
+            .collect();
+        for proxy in proxies_of(&events) {
+            assert_eq!(counts(&proxy), coarse_counts, "proxy on the coarse meshes");
+        }
+        let got = keyframes_of(&events);
+        assert_eq!(got.len(), expected.len());
+        for (a, b) in got.iter().zip(&expected) {
+            assert_eq!(a.bits(), b.bits(), "keyframe {}", a.index);
+        }
+    }
+
+    #[test]
+    fn an_edit_with_a_proxy_keeps_the_unchanged_keyframes_and_redoes_the_proxy_from_the_first_change()
+     {
+        let before = whorl(2, 6, 10, 44);
+        let mut after = before.clone();
+        crate::fixtures::stroke_near_tip(&mut after, 0, 1);
+        let coarse = |fine: &Project| {
+            let mut coarse = whorl(2, 4, 6, 44);
+            coarse.flower.templates[0].maps = fine.flower.templates[0].maps.clone();
+            Arc::new(coarse)
+        };
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let mut last = Vec::new();
+        for project in [before, after] {
+            let proxy = coarse(&project);
+            let run = worker.start_with_proxy(Arc::new(project), Some(proxy), Selection::All);
+            last = collect_until_end(&worker, run);
+        }
+        let Some(Event::Started { first_computed, .. }) = last.first() else {
+            panic!("the run starts");
+        };
+        assert_eq!(*first_computed, 40, "the stroke is on the step-40 key");
+        let proxies: Vec<u32> = proxies_of(&last).iter().map(|k| k.index).collect();
+        assert_eq!(proxies, (40..=44).collect::<Vec<_>>());
+        let converged: Vec<u32> = keyframes_of(&last).iter().map(|k| k.index).collect();
+        assert_eq!(converged, (0..=44).collect::<Vec<_>>());
+        // The kept keyframes come before the proxy, the new ones after it.
+        let first_proxy = last
+            .iter()
+            .position(|e| matches!(e, Event::Proxy { .. }))
+            .expect("a proxy");
+        let kept = last[..first_proxy]
+            .iter()
+            .filter(|e| matches!(e, Event::Keyframe { .. }))
+            .count();
+        assert_eq!(kept, 40);
+    }
+
+    #[test]
+    fn going_back_to_a_selection_run_before_computes_nothing_that_did_not_change() {
+        let project = Arc::new(whorl(2, 6, 10, 5));
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let run = worker.start(Arc::clone(&project), Selection::All);
+        let whole = keyframes_of(&collect_until_end(&worker, run));
+        let run = worker.start(Arc::clone(&project), Selection::Only(1));
+        let alone = collect_until_end(&worker, run);
+        assert!(matches!(alone.last(), Some(Event::Finished { .. })));
+        let run = worker.start(Arc::clone(&project), Selection::All);
+        let back = collect_until_end(&worker, run);
+        assert!(matches!(
+            back.first(),
+            Some(Event::Started {
+                first_computed: 6,
+                ..
+            })
+        ));
+        assert!(
+            !back.iter().any(|e| matches!(e, Event::Progress { .. })),
+            "nothing computed"
+        );
+        let again = keyframes_of(&back);
+        assert_eq!(again.len(), whole.len());
+        assert!(again.iter().zip(&whole).all(|(a, b)| Arc::ptr_eq(a, b)));
+    }
+
+    #[test]
+    fn a_proxy_that_fails_says_so_and_the_converged_run_goes_on() {
+        let fine = Arc::new(whorl(1, 6, 10, 3));
+        // A proxy the simulation refuses: no organs to simulate for
+        // organ 0 of a one-organ selection.
+        let mut broken = whorl(1, 4, 6, 3);
+        broken.flower.organs.clear();
+        let worker = Worker::spawn(|| {}).expect("thread");
+        let run = worker.start_with_proxy(fine, Some(Arc::new(broken)), Selection::Only(0));
+        let events = collect_until_end(&worker, run);
+        assert!(
+            events
+                .iter()
+                .any(|e| matches!(e, Event::ProxyEnded { error: Some(_), .. }))
+        );
+        assert!(matches!(events.last(), Some(Event::Finished { .. })));
+        assert_eq!(keyframes_of(&events).len(), 4);
     }
 }
