@@ -115,6 +115,7 @@ fn feed(harness: &mut Harness<'_, AnthesisApp>, up_to: Option<u32>) {
             organs: Vec::new(),
             keyframes: total,
             first_computed: 1,
+            proxy: false,
         },
         &mut failures,
     );
@@ -275,26 +276,13 @@ fn an_edit_keeps_the_viewed_frame_stale_until_the_new_run_reaches_it() {
     );
     harness.snapshot("app_stale_after_an_edit");
 
-    // It reaches keyframe 12: the new result is shown, and the time the
-    // user waited is logged once.
+    // It reaches keyframe 12: the new result is shown.
     feed(&mut harness, Some(13));
     harness.run();
     let app = harness.state();
     assert!(!app.session().is_stale_at(12.0));
     assert_ne!(shown(&harness), old, "the new opening is shown");
     assert_eq!(app.playback().time_in_keyframes, 12.0);
-    let logged: Vec<_> = app
-        .log()
-        .entries()
-        .iter()
-        .filter(|e| e.message.starts_with("edit on screen after "))
-        .map(|e| e.message.clone())
-        .collect();
-    assert_eq!(logged.len(), 1, "{logged:?}");
-    assert!(
-        logged[0].ends_with("(keyframe 12 of the whole flower)"),
-        "{logged:?}"
-    );
 }
 
 #[test]
@@ -687,17 +675,7 @@ fn a_stroke_on_the_uv_canvas_paints_the_map_restarts_and_undoes_in_one_step() {
     assert!((left - right).abs() < 1e-6, "mirrored: {left} vs {right}");
     feed(&mut harness, None);
     harness.run();
-    // The time from mouse-up to the viewed keyframe on screen is logged
-    // once; the log is cleared for the snapshot (the time varies).
-    let latency = |harness: &Harness<'_, AnthesisApp>| {
-        let log = harness.state().log().entries();
-        log.iter()
-            .filter(|e| e.message.starts_with("edit on screen after "))
-            .count()
-    };
-    assert_eq!(latency(&harness), 1);
-    harness.run();
-    assert_eq!(latency(&harness), 1, "logged once per edit");
+    // The log is cleared for the snapshot.
     harness.get_by_label("Clear").click();
     harness.hover_at(egui::pos2(600.0, 300.0));
     harness.run();
@@ -1399,6 +1377,7 @@ fn the_window_and_anthesis_render_show_an_organ_in_the_same_colour() {
             organs: Vec::new(),
             keyframes: 4,
             first_computed: 1,
+            proxy: false,
         },
         &mut failures,
     );
@@ -2679,6 +2658,7 @@ fn feed_simulated(harness: &mut Harness<'_, AnthesisApp>) {
             organs: Vec::new(),
             keyframes: project.settings.keyframes,
             first_computed: 1,
+            proxy: false,
         },
         &mut failures,
     );
@@ -3948,4 +3928,84 @@ fn wait_for_scan_fit(
         std::thread::sleep(Duration::from_millis(10));
     }
     panic!("the scan's fit did not come");
+}
+
+#[test]
+fn an_edits_proxy_shows_first_badged_and_blue_and_the_converged_run_replaces_it() {
+    let mut harness = harness(small_flower());
+    harness.run();
+    feed(&mut harness, None);
+    harness.state_mut().playback_mut().scrub_to(12.0, Some(20));
+    harness.run();
+    // A run with a proxy: the same flower on coarser meshes, as the window
+    // makes for a fine flower.
+    let project = Arc::new(harness.state().project().clone());
+    let mut proxy = anthesis_sim::fixtures::whorl(6, 5, 9, 20);
+    proxy.name = project.name.clone();
+    let proxy = Arc::new(proxy);
+    let coarse = proxy.flower.template_of(0).mesh.vertex_count();
+    assert!(coarse < project.flower.template_of(0).mesh.vertex_count());
+    let converged = recorded_keyframes(&project, &Selection::All);
+    let proxied = recorded_keyframes(&proxy, &Selection::All);
+    let app = harness.state_mut();
+    let session = app.session_mut();
+    let run = session.start_with_proxy(
+        Arc::clone(&project),
+        Some(Arc::clone(&proxy)),
+        Selection::All,
+    );
+    let mut failures = Vec::new();
+    session.accept(
+        Event::Started {
+            run,
+            organs: Vec::new(),
+            keyframes: 20,
+            first_computed: 1,
+            proxy: true,
+        },
+        &mut failures,
+    );
+    let converged_event = |k: &Keyframe| Event::Keyframe {
+        run,
+        keyframe: Arc::new(k.clone()),
+    };
+    session.accept(converged_event(&converged[0]), &mut failures);
+    for keyframe in proxied.iter().skip(1) {
+        let keyframe = Arc::new(keyframe.clone());
+        session.accept(Event::Proxy { run, keyframe }, &mut failures);
+    }
+    harness.run();
+    let app = harness.state();
+    assert_eq!(app.playback().time_in_keyframes, 12.0, "the playhead stays");
+    let shown = app.session().shown_at(12.0).expect("shown");
+    assert!(Arc::ptr_eq(&shown.meshes, &proxy), "the proxy is shown");
+    assert_eq!(shown.positions[0].len(), coarse);
+    assert!(
+        harness
+            .get_by_label_contains("proxy: coarse preview until the full-resolution run reaches 12")
+            .rect()
+            .width()
+            > 0.0
+    );
+    harness.snapshot("app_proxy_after_an_edit");
+
+    // The converged keyframes arrive up to 12: they replace the proxy's.
+    let app = harness.state_mut();
+    let session = app.session_mut();
+    for keyframe in converged.iter().skip(1).take(12) {
+        session.accept(converged_event(keyframe), &mut failures);
+    }
+    harness.run();
+    let shown = harness.state().session().shown_at(12.0).expect("shown");
+    assert!(!Arc::ptr_eq(&shown.meshes, &proxy));
+    assert_eq!(
+        shown.positions[0].len(),
+        project.flower.template_of(0).mesh.vertex_count()
+    );
+    assert!(
+        harness
+            .query_by_label_contains("proxy: coarse preview")
+            .is_none()
+    );
+    assert!(failures.is_empty(), "{failures:?}");
 }

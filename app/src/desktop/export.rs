@@ -61,6 +61,10 @@ pub struct ExportDialog {
     /// keyframes the window computed: paint coarse, export fine. The
     /// window's run and the project stay as they are.
     pub resimulate: bool,
+    /// With a single organ previewed: export the whole flower (its
+    /// keyframes kept from before the preview when they are up to date,
+    /// else a run of its own) rather than the previewed organ alone.
+    pub whole_flower: bool,
     /// The mean edge of that run, in the project's lengths (0: not chosen
     /// yet; the dialog suggests half the edge the window simulates at).
     pub resimulate_edge: f64,
@@ -97,6 +101,7 @@ impl Default for ExportDialog {
             animation: AnimationOptions::default(),
             animation_step: 1,
             resimulate: false,
+            whole_flower: true,
             resimulate_edge: 0.0,
             suggested_edge: 0.0,
             state: ExportState::Idle,
@@ -238,7 +243,7 @@ fn write_tracks(
 /// Runs `selection` of `project` at its resolution (checked against the
 /// memory first, then every template remeshed) to its last keyframe and
 /// returns its tracks, as render meshes of `render_level`. The error
-/// finishes the sentence "the run at mean edge E …".
+/// finishes a sentence naming the run ("the run at mean edge E …").
 fn simulate_at(
     project: &Project,
     selection: &Selection,
@@ -377,6 +382,26 @@ impl ExportDialog {
         ui.end_row();
     }
 
+    /// The "Organs" row, shown while one organ is previewed: the whole
+    /// flower (the default) or the previewed organ alone.
+    fn scope_ui(&mut self, ui: &mut egui::Ui, project: &Project, organ: usize) {
+        ui.label("Organs").on_hover_text(
+            "The window previews one organ; the export can hold the whole flower (run \
+             with collisions, from the keyframes kept from before the preview or a run of its \
+             own) or the previewed organ alone",
+        );
+        let name = project
+            .flower
+            .organs
+            .get(organ)
+            .map_or("the previewed organ", |o| o.name.as_str());
+        ui.horizontal(|ui| {
+            ui.radio_value(&mut self.whole_flower, true, "whole flower");
+            ui.radio_value(&mut self.whole_flower, false, format!("{name} alone"));
+        });
+        ui.end_row();
+    }
+
     /// The "Simulation" row: export the window's keyframes, or a run of
     /// its own at another mean edge, with the particles that makes in the
     /// largest simulated organ (or why the run would not fit).
@@ -496,6 +521,33 @@ impl ExportDialog {
         let edge = self.resimulate_edge;
         let mut project = project.clone();
         project.settings.resolution = Resolution::MeanEdge(edge);
+        let what = format!("the run at mean edge {}", edge_text(edge));
+        self.start_run(project, selection, what, wake);
+    }
+
+    /// Starts a run of the whole of `project` (the document's project) at
+    /// its own resolution on a thread, then writes it (as
+    /// [`ExportDialog::start_resimulated`]): the export of the whole
+    /// flower while the window previews one organ, when the window has no
+    /// up-to-date keyframes of it.
+    pub fn start_whole_flower(
+        &mut self,
+        project: &Project,
+        wake: impl Fn() + Send + Sync + 'static,
+    ) {
+        let what = "the run of the whole flower".to_string();
+        self.start_run(project.clone(), Selection::All, what, wake);
+    }
+
+    /// Runs `selection` of `project` at its resolution, then writes it;
+    /// `what` names the run in errors ("… does not fit: …").
+    fn start_run(
+        &mut self,
+        project: Project,
+        selection: Selection,
+        what: String,
+        wake: impl Fn() + Send + Sync + 'static,
+    ) {
         let render_level = self.render_level;
         let keyframes = project.settings.keyframes;
         // The run is most of the work: RUN_SHARE of the progress bar.
@@ -503,7 +555,7 @@ impl ExportDialog {
             RUN_SHARE,
             move |progress, cancelled| {
                 simulate_at(&project, &selection, render_level, progress, cancelled)
-                    .map_err(|e| format!("the run at mean edge {} {e}", edge_text(edge)))
+                    .map_err(|e| format!("{what} {e}"))
             },
             wake,
         );
@@ -694,6 +746,9 @@ impl ExportDialog {
                         )
                         .labelled_by(label);
                         ui.end_row();
+                        if let Selection::Only(organ) = selection {
+                            self.scope_ui(ui, project, *organ);
+                        }
                         self.resimulate_ui(ui, project, selection, simulated_now);
                         if gif {
                             self.gif_options_ui(ui);
@@ -772,7 +827,14 @@ impl ExportDialog {
                         ui.end_row();
                     });
                 let after_bud = keyframes_ready.saturating_sub(1);
-                if self.resimulate {
+                let whole_of_preview = matches!(selection, Selection::Only(_)) && self.whole_flower;
+                if whole_of_preview && !self.resimulate {
+                    ui.label(
+                        "The export holds the whole flower: its keyframes from before the \
+                         preview if nothing changed since, else a run of its own (with progress); \
+                         the window keeps its preview",
+                    );
+                } else if self.resimulate {
                     ui.label(format!(
                         "The export runs all {} keyframes again at mean edge {}; \
                          the window keeps its run",

@@ -196,10 +196,8 @@ pub struct AnthesisApp {
     may_close: bool,
     /// The project changed since the last run started.
     needs_run: bool,
-    /// Restart pacing while painting, and the edit latency measured.
+    /// Restart pacing while painting.
     rerun: rerun::Rerun,
-    /// The document revision the last run started from.
-    simulated_revision: Option<u64>,
     /// The viewport's GPU state is installed.
     has_gpu: bool,
     /// The viewport's scene, rebuilt only when what it shows changes.
@@ -309,7 +307,6 @@ impl AnthesisApp {
             may_close: false,
             needs_run: true,
             rerun: rerun::Rerun::default(),
-            simulated_revision: None,
             has_gpu,
             scene: viewport::SceneCache::default(),
             outline: viewport::Outline::default(),
@@ -427,13 +424,11 @@ impl AnthesisApp {
     }
 
     /// Starts simulating the project as it is now (cancelling the running
-    /// job). The playhead stays where it is: what was shown stays shown,
-    /// marked stale, until the new run reaches it; only when nothing is
-    /// shown yet does the view follow the new keyframes. `dragging`: the
-    /// pointer is down, so the edit is not finished yet; the time until a
-    /// finished edit's result is on screen is measured and logged. `clock`:
-    /// the frame clock (egui's input time) the restarts are paced on.
-    fn start_run(&mut self, dragging: bool, clock: f64) {
+    /// job), its proxy first where it has one. The playhead stays where it
+    /// is: what was shown stays shown, marked stale, until the new run's
+    /// proxy or converged keyframes reach it. `clock`: the frame clock
+    /// (egui's input time) the restarts are paced on.
+    fn start_run(&mut self, clock: f64) {
         let selection = self.selection();
         let project = self.resolved_project();
         // A run too large for the memory would be killed by the kernel,
@@ -450,23 +445,10 @@ impl AnthesisApp {
             self.needs_run = false;
             return;
         }
-        // Measured: an edit of the document over a result on screen (not a
-        // switch to the preview, or the first run).
-        let edited = self.session.shown_end().is_some()
-            && self.simulated_revision != Some(self.doc.revision());
-        let run = self.session.start(project, selection);
+        let proxy = self.resolved.proxy().cloned();
+        self.session.start_with_proxy(project, proxy, selection);
         self.needs_run = false;
-        self.simulated_revision = Some(self.doc.revision());
-        self.rerun.started(
-            run,
-            !dragging && edited,
-            dragging,
-            std::time::Instant::now(),
-            clock,
-        );
-        if self.session.is_live() && self.session.shown_end().is_none() {
-            self.playback.follow = true;
-        }
+        self.rerun.started(clock);
     }
 
     /// Starts the run the project's changes want, paced while the pointer
@@ -479,7 +461,7 @@ impl AnthesisApp {
         let clock = ctx.input(|i| i.time);
         let wait = self.rerun.wait(dragging, clock);
         if wait.is_zero() {
-            self.start_run(dragging, clock);
+            self.start_run(clock);
         } else {
             ctx.request_repaint_after(wait);
         }
@@ -506,6 +488,9 @@ impl AnthesisApp {
         let drained = self.session.drain(DRAIN_BUDGET);
         if drained.finished {
             self.log.succeeded(Topic::Simulation);
+        }
+        for note in drained.notes {
+            self.log.info(note);
         }
         for failure in drained.failures {
             self.log.error_about(
@@ -567,8 +552,6 @@ impl eframe::App for AnthesisApp {
         if ctx.input(|i| i.pointer.any_released()) {
             self.doc.seal();
             self.paint.end_stroke();
-            self.rerun
-                .released(self.needs_run, std::time::Instant::now());
         }
 
         let dt = f64::from(ctx.input(|i| i.stable_dt)).min(0.1);

@@ -159,7 +159,7 @@ impl AnthesisApp {
         let key = viewport::SceneKey {
             document_revision: self.doc.revision(),
             run: self.session.run(),
-            keyframes_received: self.session.keyframes().len(),
+            keyframes_received: self.session.current_frames(),
             shown_end: self.session.shown_end(),
             time_in_keyframes: self.playback.time_in_keyframes,
             selected_organ: self.selected_organ,
@@ -179,30 +179,20 @@ impl AnthesisApp {
             ));
             (scene, meshes)
         });
-        if let Some(waited) = self.rerun.shown(
-            &self.session,
-            key.time_in_keyframes,
-            std::time::Instant::now(),
-        ) {
-            let what = if self.single_organ_preview {
-                format!("the preview of organ {}", self.selected_organ + 1)
-            } else {
-                "the whole flower".to_string()
-            };
-            self.log.info(format!(
-                "edit on screen after {} ms (keyframe {:.0} of {what})",
-                waited.as_millis(),
-                key.time_in_keyframes.ceil()
-            ));
-        }
         self.frame_automatically(&scene);
         if !self.has_gpu {
             ui.label("The 3D viewport needs the wgpu renderer.");
             return;
         }
-        let outline = self
-            .outline
-            .edges_of(&resolved.flower.template_of(self.selected_organ).mesh);
+        // The outline of the selected organ as shown (a proxy frame is on
+        // the proxy's mesh).
+        let outline = match scene.iter().find(|o| o.organ == self.selected_organ) {
+            Some(organ) => self.outline.edges_of_triangles(&organ.triangles),
+            None => self
+                .outline
+                .edges_of(&resolved.flower.template_of(self.selected_organ).mesh),
+        };
+        let viewport_rect = ui.available_rect_before_wrap();
         let response = viewport::viewport_ui(
             ui,
             &mut self.camera,
@@ -216,6 +206,10 @@ impl AnthesisApp {
             self.paint.on_3d,
             self.paint.brush.radius_in_uv,
         );
+        if let Some((badge, color)) = timeline::viewport_badge(&self.session, key.time_in_keyframes)
+        {
+            viewport::badge(ui, viewport_rect, badge, color);
+        }
         let template = self.selected_template();
         // Alt, or the eyedropper, picks the value under the pointer on the
         // organ as on the canvas, instead of painting.

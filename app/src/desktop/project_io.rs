@@ -17,6 +17,7 @@ use super::files::{DialogPurpose, Polled};
 use super::log::Topic;
 use super::prompts::{Pending, UnitOffer};
 use anthesis_maps::brush::PaintTarget;
+use anthesis_sim::Selection;
 
 impl AnthesisApp {
     /// Opens the project at `path`; on failure the current work stays and
@@ -467,26 +468,44 @@ impl AnthesisApp {
         }
     }
 
+    /// Starts the export the dialog asks for. It never writes the proxy:
+    /// the window's converged keyframes, or a run of the export's own. With
+    /// one organ previewed it writes the whole flower unless the dialog
+    /// asks for the organ alone: from the whole flower's keyframes kept
+    /// from before the preview when they are complete and of this very
+    /// project, else from a run of its own.
     pub(super) fn start_export(&mut self) {
         let wake = self.ctx.clone();
+        let wake = move || wake.request_repaint();
+        let previewing = self.single_organ_preview;
+        let whole = previewing && self.export.whole_flower;
+        let selection = if whole {
+            Selection::All
+        } else {
+            self.selection()
+        };
         if self.export.resimulate {
-            let selection = self.selection();
             self.export
-                .start_resimulated(self.doc.project(), selection, move || {
-                    wake.request_repaint()
-                });
+                .start_resimulated(self.doc.project(), selection, wake);
             return;
         }
         // The keyframes are of the meshes at the project's resolution.
         let project = self.resolved_project();
-        let tracks = export::tracks(
-            &project,
-            self.session.organs(),
-            self.session.keyframes(),
-            self.export.render_level,
-        );
+        let organs: Vec<usize> = selection.organs(project.flower.organs.len());
+        let keyframes = if whole {
+            match self.session.complete_run_of(&organs, &project) {
+                Some(keyframes) => keyframes,
+                None => {
+                    self.export.start_whole_flower(self.doc.project(), wake);
+                    return;
+                }
+            }
+        } else {
+            self.session.keyframes().to_vec()
+        };
+        let tracks = export::tracks(&project, &organs, &keyframes, self.export.render_level);
         match tracks {
-            Ok(tracks) => self.export.start(tracks, move || wake.request_repaint()),
+            Ok(tracks) => self.export.start(tracks, wake),
             Err(error) => self.export.fail(error.to_string()),
         }
     }

@@ -2,10 +2,18 @@
 //! at the project's resolution (`anthesis_flower::resolution`), remeshed
 //! only when its mesh or the resolution changes. The document keeps the
 //! meshes as built; painting (in UV), saving and undo work on those.
+//!
+//! Next to it, the *proxy*: the same project with every template remeshed
+//! coarser (`anthesis_flower::resolution::proxy_mesh`, about
+//! `PROXY_PARTICLES` particles an organ; the same UV layout, so the same
+//! maps), simulated first after every edit so the edit shows at once. A
+//! template already that coarse keeps its mesh in the proxy; when none is
+//! coarser there is no proxy. Proxy meshes are remeshed only when the
+//! converged mesh they come from changes.
 
 use std::sync::Arc;
 
-use anthesis_flower::resolution::remesh_template;
+use anthesis_flower::resolution::{proxy_mesh, remesh_template};
 use anthesis_flower::{Project, Resolution};
 use anthesis_mesh::Mesh;
 use anthesis_sim::Selection;
@@ -28,6 +36,17 @@ pub struct Resolved {
     /// the same, so a stroke or a parameter edit remeshes nothing).
     remeshed: Vec<Option<Remeshed>>,
     project: Option<Arc<Project>>,
+    /// Per template, its proxy mesh (`None`: the converged mesh serves).
+    proxies: Vec<Option<ProxyMesh>>,
+    proxy: Option<Arc<Project>>,
+}
+
+/// One template's proxy: the converged mesh it was made from and the
+/// coarser mesh (`None` when that mesh is coarse enough or no coarser one
+/// could be made).
+struct ProxyMesh {
+    converged: Mesh,
+    mesh: Option<Mesh>,
 }
 
 impl Resolved {
@@ -88,6 +107,7 @@ impl Resolved {
                 }
             }
         }
+        self.proxy = self.make_proxy(&resolved);
         let changed_meshes = self.project.as_ref().is_none_or(|old| {
             old.flower.templates.len() != resolved.flower.templates.len()
                 || old
@@ -106,6 +126,37 @@ impl Resolved {
     /// The project at its resolution (as last updated).
     pub fn project(&self) -> Option<&Arc<Project>> {
         self.project.as_ref()
+    }
+
+    /// The proxy of the project at its resolution (as last updated), if
+    /// any template has a coarser one.
+    pub fn proxy(&self) -> Option<&Arc<Project>> {
+        self.proxy.as_ref()
+    }
+
+    /// The proxy of `resolved` (a project at its resolution), its meshes
+    /// made again only where a converged mesh changed.
+    fn make_proxy(&mut self, resolved: &Project) -> Option<Arc<Project>> {
+        self.proxies
+            .resize_with(resolved.flower.templates.len(), || None);
+        let mut proxy = resolved.clone();
+        let mut coarser = false;
+        for (template, slot) in proxy.flower.templates.iter_mut().zip(&mut self.proxies) {
+            if !slot.as_ref().is_some_and(|p| p.converged == template.mesh) {
+                *slot = Some(ProxyMesh {
+                    converged: template.mesh.clone(),
+                    mesh: proxy_mesh(template),
+                });
+            }
+            if let Some(ProxyMesh {
+                mesh: Some(mesh), ..
+            }) = slot
+            {
+                template.mesh = mesh.clone();
+                coarser = true;
+            }
+        }
+        coarser.then(|| Arc::new(proxy))
     }
 }
 
@@ -170,5 +221,49 @@ mod tests {
         project.settings.resolution = Resolution::MeanEdge(1e-5);
         let message = resolved.prepare(&project).expect_err("too fine");
         assert!(message.starts_with("this run needs about"), "{message}");
+    }
+
+    #[test]
+    fn the_proxy_is_coarser_keeps_the_maps_and_is_made_again_only_when_a_mesh_changes() {
+        let mut project = anthesis_sim::fixtures::whorl(2, 30, 50, 3);
+        let mut resolved = Resolved::default();
+        resolved.update(&project, 1);
+        let converged = Arc::clone(resolved.project().expect("made"));
+        let proxy = Arc::clone(resolved.proxy().expect("a fine flower has a proxy"));
+        for (fine, coarse) in converged
+            .flower
+            .templates
+            .iter()
+            .zip(&proxy.flower.templates)
+        {
+            let (fine_count, coarse_count) = (fine.mesh.vertex_count(), coarse.mesh.vertex_count());
+            assert!(
+                coarse_count * 3 < fine_count,
+                "{}: {coarse_count} of {fine_count}",
+                fine.name
+            );
+            assert_eq!(fine.maps, coarse.maps, "the same maps");
+            assert_eq!(fine.base_region, coarse.base_region);
+        }
+        assert_eq!(proxy.flower.organs, converged.flower.organs);
+        assert_eq!(proxy.settings, converged.settings);
+
+        // A stroke: the same proxy meshes, the new maps.
+        anthesis_sim::fixtures::stroke_near_tip(&mut project, 0, 1);
+        resolved.update(&project, 2);
+        let stroked = Arc::clone(resolved.proxy().expect("a proxy"));
+        assert_eq!(
+            stroked.flower.templates[0].mesh,
+            proxy.flower.templates[0].mesh
+        );
+        assert_eq!(
+            stroked.flower.templates[0].maps,
+            project.flower.templates[0].maps
+        );
+
+        // A coarse flower has no proxy.
+        let coarse = anthesis_sim::fixtures::whorl(2, 6, 10, 3);
+        resolved.update(&coarse, 3);
+        assert!(resolved.proxy().is_none());
     }
 }

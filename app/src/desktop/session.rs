@@ -1,6 +1,13 @@
 //! The simulation as the window sees it: the engine's worker (or, in tests,
 //! keyframes fed in by hand), the keyframes of the current run and its
 //! status. Events of superseded runs are dropped by their run id.
+//!
+//! Every keyframe index shows the best frame there is: the current run's
+//! converged keyframe, else its proxy's (the same flower on coarser meshes,
+//! computed first so an edit shows at once), else an earlier run's (stale,
+//! so an edit keeps the frame the user looks at). Each frame keeps the
+//! project whose meshes its positions belong to, so a proxy is drawn on the
+//! proxy's meshes.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -9,6 +16,7 @@ use anthesis_export::KeyframeBlend;
 use anthesis_flower::Project;
 use anthesis_sim::worker::{Event, RunId, Worker};
 use anthesis_sim::{Keyframe, KeyframeStats, Selection};
+use glam::DVec3;
 
 /// Where keyframes come from.
 enum Source {
@@ -37,6 +45,57 @@ pub enum RunStatus {
     },
 }
 
+/// Which computation a shown frame comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameKind {
+    /// The converged run, at the project's resolution.
+    Converged,
+    /// The proxy: the same flower on coarser meshes.
+    Proxy,
+}
+
+/// What is shown at one keyframe index, as the timeline colours it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrameState {
+    /// The current run's converged keyframe.
+    Converged,
+    /// The current run's proxy keyframe (the converged one is coming).
+    Proxy,
+    /// An earlier run's keyframe, shown until the current run reaches it.
+    Stale,
+}
+
+/// One shown keyframe: its positions and the project whose template meshes
+/// they belong to.
+#[derive(Clone)]
+struct Frame {
+    keyframe: Arc<Keyframe>,
+    meshes: Arc<Project>,
+    kind: FrameKind,
+    run: RunId,
+}
+
+/// The organs at a time on the timeline, as shown.
+#[derive(Clone)]
+pub struct ShownAt {
+    /// One position list per simulated organ (in [`SimSession::organs`]
+    /// order), interpolated between the keyframes around the time.
+    pub positions: Vec<Vec<DVec3>>,
+    /// The project whose template meshes the positions belong to (the
+    /// proxy's for a proxy frame).
+    pub meshes: Arc<Project>,
+    pub kind: FrameKind,
+    /// An earlier run's frame.
+    pub stale: bool,
+}
+
+/// The frames shown for one selection of organs, set aside while another
+/// selection is simulated (the whole flower while one organ is previewed).
+struct Stash {
+    organs: Vec<usize>,
+    frames: Vec<Option<Frame>>,
+}
+
 /// Keyframes and status of the newest run.
 pub struct SimSession {
     source: Source,
@@ -44,21 +103,25 @@ pub struct SimSession {
     /// What the current run simulates: indices into the project's organs, in
     /// keyframe order.
     organs: Vec<usize>,
+    /// The current run's project (its converged meshes) and proxy.
+    project: Option<Arc<Project>>,
+    proxy: Option<Arc<Project>>,
     /// Keyframes the run will produce after the bud.
     total: u32,
-    /// Keyframes received so far, contiguous from the bud (index 0).
+    /// The current run's converged keyframes, contiguous from the bud.
     keyframes: Vec<Arc<Keyframe>>,
-    /// Keyframes of earlier runs of the same organs and meshes, shown
-    /// (marked stale) where the current run has not arrived yet, so an edit
-    /// keeps the frame the user looks at until its new version is computed.
-    /// Emptied when the current run finishes or the document is replaced.
-    previous: Vec<Arc<Keyframe>>,
+    /// What each keyframe index shows (see the module documentation).
+    frames: Vec<Option<Frame>>,
+    /// The frames of the selection simulated before this one.
+    stash: Option<Stash>,
     status: RunStatus,
     started_at: Option<Instant>,
     /// Newton iteration inside the keyframe being computed.
     iteration: Option<(u32, u32)>,
     /// The first keyframe the current run computes (see `Event::Started`).
     first_computed: u32,
+    /// Whether the current run's proxy is still being computed.
+    proxy_running: bool,
 }
 
 /// Longest time one frame spends taking events from the worker.
@@ -82,13 +145,17 @@ impl SimSession {
             source,
             run: 0,
             organs: Vec::new(),
+            project: None,
+            proxy: None,
             total: 0,
             keyframes: Vec::new(),
-            previous: Vec::new(),
+            frames: Vec::new(),
+            stash: None,
             status: RunStatus::Idle,
             started_at: None,
             iteration: None,
             first_computed: 1,
+            proxy_running: false,
         }
     }
 
@@ -100,35 +167,73 @@ impl SimSession {
     /// Starts a new run of `project`, superseding (and cancelling) the
     /// current one. What was shown so far stays shown, as stale keyframes,
     /// until the new run's keyframes arrive (see [`SimSession::shown_end`]);
-    /// unless it cannot fit the new run (other organs, remeshed templates).
+    /// unless it cannot stand for the new run (other meshes). A run of
+    /// other organs (a preview switched on or off) sets the shown frames
+    /// aside and brings back those of its own organs, if they were set
+    /// aside before.
     pub fn start(&mut self, project: Arc<Project>, selection: Selection) -> RunId {
+        self.start_with_proxy(project, None, selection)
+    }
+
+    /// [`SimSession::start`] with a proxy of `project` (coarser meshes),
+    /// computed and shown first.
+    pub fn start_with_proxy(
+        &mut self,
+        project: Arc<Project>,
+        proxy: Option<Arc<Project>>,
+        selection: Selection,
+    ) -> RunId {
         let organs = selection.organs(project.flower.organs.len());
-        let mut shown = std::mem::take(&mut self.keyframes);
-        let fresh = shown.len();
-        shown.extend(self.previous.drain(..).skip(fresh));
-        shown.truncate(project.settings.keyframes as usize + 1);
-        let fits = |keyframe: &Arc<Keyframe>| {
-            keyframe.positions_in_world.len() == organs.len()
-                && organs
-                    .iter()
-                    .zip(&keyframe.positions_in_world)
-                    .all(|(&o, p)| p.len() == project.flower.template_of(o).mesh.vertex_count())
-        };
-        if organs == self.organs && shown.first().is_some_and(fits) {
-            self.previous = shown;
+        if organs != self.organs {
+            let frames = std::mem::take(&mut self.frames);
+            let previous = self.stash.replace(Stash {
+                organs: self.organs.clone(),
+                frames,
+            });
+            if let Some(stash) = previous.filter(|s| s.organs == organs) {
+                self.frames = stash.frames;
+            }
         }
+        // The bud (always a converged frame) tells which meshes the shown
+        // frames stand for: other meshes (a resolution or a template
+        // changed) cannot stand for the new run.
+        let fits = |frame: &Frame| {
+            frame.kind == FrameKind::Converged
+                && frame.keyframe.positions_in_world.len() == organs.len()
+                && organs.iter().all(|&o| {
+                    o < frame.meshes.flower.organs.len()
+                        && o < project.flower.organs.len()
+                        && frame.meshes.flower.template_of(o).mesh
+                            == project.flower.template_of(o).mesh
+                })
+        };
+        if !self
+            .frames
+            .first()
+            .is_some_and(|f| f.as_ref().is_some_and(fits))
+        {
+            self.frames.clear();
+        }
+        self.frames
+            .truncate(project.settings.keyframes as usize + 1);
+        self.keyframes.clear();
         self.organs = organs;
         self.total = project.settings.keyframes;
         self.run = match &mut self.source {
-            Source::Worker(worker) => worker.start(project, selection),
+            Source::Worker(worker) => {
+                worker.start_with_proxy(Arc::clone(&project), proxy.clone(), selection)
+            }
             Source::Recorded { next_run } => {
                 *next_run += 1;
                 *next_run
             }
         };
+        self.project = Some(project);
+        self.proxy = proxy;
         self.status = RunStatus::Queued;
         self.started_at = Some(Instant::now());
         self.iteration = None;
+        self.proxy_running = false;
         self.run
     }
 
@@ -136,7 +241,8 @@ impl SimSession {
     /// project's frames must not stand in for the new one's).
     pub fn forget_shown(&mut self) {
         self.keyframes.clear();
-        self.previous.clear();
+        self.frames.clear();
+        self.stash = None;
     }
 
     /// Cancels the current run, if any; the keyframes so far stay.
@@ -168,7 +274,7 @@ impl SimSession {
         }
         for event in events {
             let finished = matches!(event, Event::Finished { .. });
-            let accepted = self.accept(event, &mut drained.failures);
+            let accepted = self.accept_into(event, &mut drained);
             drained.changed |= accepted;
             drained.finished |= accepted && finished;
         }
@@ -178,6 +284,35 @@ impl SimSession {
     /// Applies one event; events of other runs are ignored (returns false).
     /// Failure messages are appended to `failures`.
     pub fn accept(&mut self, event: Event, failures: &mut Vec<String>) -> bool {
+        let mut drained = Drained::default();
+        let accepted = self.accept_into(event, &mut drained);
+        failures.append(&mut drained.failures);
+        accepted
+    }
+
+    /// Sets what index `index` shows, growing the list as needed.
+    fn show(&mut self, index: u32, frame: Frame) {
+        let index = index as usize;
+        if self.frames.len() <= index {
+            self.frames.resize(index + 1, None);
+        }
+        self.frames[index] = Some(frame);
+    }
+
+    fn frame(&self, keyframe: Arc<Keyframe>, kind: FrameKind) -> Option<Frame> {
+        let meshes = match kind {
+            FrameKind::Converged => self.project.as_ref()?,
+            FrameKind::Proxy => self.proxy.as_ref()?,
+        };
+        Some(Frame {
+            keyframe,
+            meshes: Arc::clone(meshes),
+            kind,
+            run: self.run,
+        })
+    }
+
+    fn accept_into(&mut self, event: Event, drained: &mut Drained) -> bool {
         if event.run() != self.run {
             return false;
         }
@@ -185,25 +320,49 @@ impl SimSession {
             Event::Started {
                 keyframes,
                 first_computed,
+                proxy,
                 ..
             } => {
                 self.total = keyframes;
                 self.first_computed = first_computed;
                 self.status = RunStatus::Running;
+                self.proxy_running = proxy;
             }
             Event::Keyframe { keyframe, .. } => {
                 if keyframe.index as usize == self.keyframes.len() {
-                    self.keyframes.push(keyframe);
+                    let index = keyframe.index;
+                    self.keyframes.push(Arc::clone(&keyframe));
+                    if let Some(frame) = self.frame(keyframe, FrameKind::Converged) {
+                        self.show(index, frame);
+                    }
                 }
                 self.iteration = None;
+            }
+            Event::Proxy { keyframe, .. } => {
+                let index = keyframe.index;
+                if index as usize >= self.keyframes.len()
+                    && let Some(frame) = self.frame(keyframe, FrameKind::Proxy)
+                {
+                    self.show(index, frame);
+                }
+                self.iteration = None;
+            }
+            Event::ProxyEnded { error, .. } => {
+                self.proxy_running = false;
+                self.iteration = None;
+                if let Some(error) = error {
+                    drained.notes.push(format!(
+                        "the quick preview (proxy) stopped: {error}; the full-resolution run goes on"
+                    ));
+                }
             }
             Event::Progress { progress, .. } => {
                 self.iteration = Some((progress.keyframe, progress.iteration));
             }
             Event::Finished { seconds, .. } => {
-                // Every keyframe of the run is fresh now; earlier runs'
+                // Every keyframe of the run is converged now; earlier runs'
                 // keyframes past its end (the count was lowered) go too.
-                self.previous.clear();
+                self.frames.truncate(self.keyframes.len());
                 self.status = RunStatus::Finished {
                     seconds,
                     first_computed: self.first_computed,
@@ -212,12 +371,16 @@ impl SimSession {
             }
             Event::Failed { error, .. } => {
                 let message = error.to_string();
-                failures.push(message.clone());
+                drained.failures.push(message.clone());
                 self.status = RunStatus::Failed { message };
                 self.iteration = None;
+                self.proxy_running = false;
+                // What the run did not confirm is not shown as its result.
+                self.frames.truncate(self.keyframes.len());
             }
             Event::Cancelled { .. } => {
                 self.iteration = None;
+                self.proxy_running = false;
             }
         }
         true
@@ -236,6 +399,11 @@ impl SimSession {
         matches!(self.status, RunStatus::Queued | RunStatus::Running)
     }
 
+    /// Whether the current run's proxy is still being computed.
+    pub fn proxy_running(&self) -> bool {
+        self.proxy_running
+    }
+
     /// Project organ indices of the keyframes' position lists.
     pub fn organs(&self) -> &[usize] {
         &self.organs
@@ -246,14 +414,23 @@ impl SimSession {
         self.total
     }
 
-    /// Keyframes received, the bud first.
+    /// The current run's converged keyframes received, the bud first.
     pub fn keyframes(&self) -> &[Arc<Keyframe>] {
         &self.keyframes
     }
 
-    /// Index of the newest keyframe received, if any.
+    /// Index of the newest converged keyframe received, if any.
     pub fn last_index(&self) -> Option<u32> {
         self.keyframes.last().map(|k| k.index)
+    }
+
+    /// How many keyframes of the current run (converged or proxy) can be
+    /// shown: a measure of progress that changes whenever a frame arrives.
+    pub fn current_frames(&self) -> usize {
+        self.frames
+            .iter()
+            .filter(|f| f.as_ref().is_some_and(|f| f.run == self.run))
+            .count()
     }
 
     /// Statistics of the computed keyframes after the bud.
@@ -273,61 +450,144 @@ impl SimSession {
 
     /// Estimated seconds left, from the mean time per keyframe so far.
     pub fn seconds_left(&self) -> Option<f64> {
-        if !self.is_running() {
+        if !self.is_running() || self.proxy_running {
             return None;
         }
         let done = self.last_index()?;
         if done == 0 {
             return None;
         }
-        let elapsed: f64 = self.stats().map(|s| s.seconds).sum();
-        Some(elapsed / f64::from(done) * f64::from(self.total.saturating_sub(done)))
+        let computed: Vec<f64> = self
+            .stats()
+            .skip(self.first_computed.saturating_sub(1) as usize)
+            .map(|s| s.seconds)
+            .collect();
+        let per_keyframe = if computed.is_empty() {
+            self.stats().map(|s| s.seconds).sum::<f64>() / f64::from(done)
+        } else {
+            computed.iter().sum::<f64>() / computed.len() as f64
+        };
+        Some(per_keyframe * f64::from(self.total.saturating_sub(done)))
     }
 
     /// Index of the newest keyframe that can be shown: the current run's
-    /// or, past it, an earlier run's (stale).
+    /// (converged or proxy) or, past it, an earlier run's (stale).
     pub fn shown_end(&self) -> Option<u32> {
-        let shown = self.keyframes.len().max(self.previous.len());
+        let shown = self.frames.iter().take_while(|f| f.is_some()).count();
         shown.checked_sub(1).map(|last| last as u32)
+    }
+
+    /// What keyframe index `index` shows, if anything.
+    pub fn frame_state(&self, index: usize) -> Option<FrameState> {
+        let frame = self.frames.get(index)?.as_ref()?;
+        Some(if frame.run != self.run {
+            FrameState::Stale
+        } else if frame.kind == FrameKind::Proxy {
+            FrameState::Proxy
+        } else {
+            FrameState::Converged
+        })
+    }
+
+    /// What the view at `time_in_keyframes` shows: the state of the
+    /// keyframe at or after it (the newest shown past the end).
+    pub fn state_at(&self, time_in_keyframes: f64) -> Option<FrameState> {
+        let end = self.shown_end()? as usize;
+        self.frame_state((time_in_keyframes.max(0.0).ceil() as usize).min(end))
     }
 
     /// Whether the view at `time_in_keyframes` shows an earlier run's
     /// keyframe: the current run has not computed the keyframe at or after
     /// it yet.
     pub fn is_stale_at(&self, time_in_keyframes: f64) -> bool {
-        let needed = time_in_keyframes.max(0.0).ceil() as usize;
-        needed >= self.keyframes.len() && needed < self.previous.len()
+        self.state_at(time_in_keyframes) == Some(FrameState::Stale)
     }
 
-    /// Whether the current run has computed the keyframes the view at
-    /// `time_in_keyframes` blends (the view is up to date).
+    /// Whether the view at `time_in_keyframes` shows the current run's
+    /// converged keyframes (the view is final).
     pub fn is_current_at(&self, time_in_keyframes: f64) -> bool {
         (time_in_keyframes.max(0.0).ceil() as usize) < self.keyframes.len()
     }
 
-    /// Keyframe `index` as shown: the current run's, else an earlier run's.
-    fn shown(&self, index: usize) -> Option<&Arc<Keyframe>> {
-        self.keyframes
-            .get(index)
-            .or_else(|| self.previous.get(index))
-    }
-
-    /// Positions of every simulated organ at `time_in_keyframes`,
-    /// interpolated linearly between the two keyframes around it (each the
-    /// current run's where it has arrived, else an earlier run's); times
-    /// past the newest keyframe show the newest. `None` before the bud.
-    pub fn positions_at(&self, time_in_keyframes: f64) -> Option<Vec<Vec<glam::DVec3>>> {
+    /// The organs at `time_in_keyframes`, interpolated linearly between the
+    /// two keyframes around it where both are on the same meshes (else the
+    /// nearer one); times past the newest shown keyframe show the newest.
+    /// `None` before the bud.
+    pub fn shown_at(&self, time_in_keyframes: f64) -> Option<ShownAt> {
         let count = self.shown_end()? as usize + 1;
         let blend = KeyframeBlend::at(count, time_in_keyframes)?;
-        let (below, above) = (self.shown(blend.below)?, self.shown(blend.above)?);
-        Some(
-            below
+        let below = self.frames.get(blend.below)?.as_ref()?;
+        let above = self.frames.get(blend.above)?.as_ref()?;
+        let same_meshes = below.kind == above.kind
+            && below
+                .keyframe
                 .positions_in_world
                 .iter()
-                .zip(&above.positions_in_world)
+                .map(Vec::len)
+                .eq(above.keyframe.positions_in_world.iter().map(Vec::len));
+        let (positions, frame) = if same_meshes {
+            let positions = below
+                .keyframe
+                .positions_in_world
+                .iter()
+                .zip(&above.keyframe.positions_in_world)
                 .map(|(a, b)| blend.positions(a, b))
-                .collect(),
-        )
+                .collect();
+            (positions, above)
+        } else {
+            let nearer = if time_in_keyframes - blend.below as f64 <= 0.5 {
+                below
+            } else {
+                above
+            };
+            (nearer.keyframe.positions_in_world.clone(), nearer)
+        };
+        Some(ShownAt {
+            positions,
+            meshes: Arc::clone(&frame.meshes),
+            kind: frame.kind,
+            stale: frame.run != self.run,
+        })
+    }
+
+    /// Every converged keyframe of a finished run of `organs` of exactly
+    /// `project` (the current run's, or the frames set aside for another
+    /// selection), or `None` when there is no such complete run (for an
+    /// export of the whole flower while one organ is previewed).
+    pub fn complete_run_of(
+        &self,
+        organs: &[usize],
+        project: &Project,
+    ) -> Option<Vec<Arc<Keyframe>>> {
+        let complete = |frames: &[Option<Frame>], total: u32| {
+            let first = frames.first()?.as_ref()?;
+            let all: Option<Vec<Arc<Keyframe>>> = frames
+                .iter()
+                .map(|f| {
+                    f.as_ref()
+                        .filter(|f| {
+                            f.kind == FrameKind::Converged
+                                && f.run == first.run
+                                && *f.meshes == *project
+                        })
+                        .map(|f| Arc::clone(&f.keyframe))
+                })
+                .collect();
+            all.filter(|all| all.len() == total as usize + 1)
+        };
+        if organs == self.organs.as_slice() {
+            return matches!(self.status, RunStatus::Finished { .. })
+                .then(|| complete(&self.frames, self.total))
+                .flatten();
+        }
+        let stash = self.stash.as_ref().filter(|s| s.organs == organs)?;
+        complete(&stash.frames, project.settings.keyframes)
+    }
+
+    /// Positions of every simulated organ at `time_in_keyframes` (see
+    /// [`SimSession::shown_at`]).
+    pub fn positions_at(&self, time_in_keyframes: f64) -> Option<Vec<Vec<DVec3>>> {
+        self.shown_at(time_in_keyframes).map(|s| s.positions)
     }
 }
 
@@ -338,6 +598,9 @@ pub struct Drained {
     /// The current run finished.
     pub finished: bool,
     pub failures: Vec<String>,
+    /// Things worth a line in the log that stop nothing (a proxy that
+    /// failed).
+    pub notes: Vec<String>,
 }
 
 #[cfg(test)]
@@ -585,5 +848,180 @@ mod tests {
                 && line.ends_with("(39 kept: the edit cannot change them)"),
             "{line}"
         );
+    }
+
+    /// `project` with every template's mesh a coarser grid (a proxy as
+    /// far as the session can tell: other meshes, same organs).
+    fn proxy_of(project: &Project) -> Arc<Project> {
+        let mut proxy = project.clone();
+        for template in &mut proxy.flower.templates {
+            template.mesh = anthesis_mesh::generate::test_petal(10.0, 4.0, 3, 4);
+        }
+        Arc::new(proxy)
+    }
+
+    fn proxy_keyframe(proxy: &Project, index: u32, x: f64) -> Arc<Keyframe> {
+        keyframe_of(proxy, index, x)
+    }
+
+    fn started(session: &mut SimSession, run: RunId, keyframes: u32, proxy: bool) {
+        assert!(session.accept(
+            Event::Started {
+                run,
+                organs: Vec::new(),
+                keyframes,
+                first_computed: 1,
+                proxy,
+            },
+            &mut Vec::new()
+        ));
+    }
+
+    #[test]
+    fn proxy_frames_show_first_on_their_own_meshes_and_converged_ones_replace_them() {
+        let project = Arc::new(anthesis_sim::fixtures::whorl(2, 4, 6, 3));
+        let proxy = proxy_of(&project);
+        let mut session = SimSession::recorded();
+        let run = session.start_with_proxy(
+            Arc::clone(&project),
+            Some(Arc::clone(&proxy)),
+            Selection::All,
+        );
+        started(&mut session, run, 3, true);
+        assert!(session.proxy_running());
+        feed(&mut session, &project, run, &[0.0]);
+        for (i, x) in [(1, 10.0), (2, 20.0), (3, 30.0)] {
+            let keyframe = proxy_keyframe(&proxy, i, x);
+            assert!(session.accept(Event::Proxy { run, keyframe }, &mut Vec::new()));
+        }
+        assert_eq!(session.shown_end(), Some(3));
+        assert_eq!(session.last_index(), Some(0), "only the bud is converged");
+        assert_eq!(session.state_at(2.0), Some(FrameState::Proxy));
+        let shown = session.shown_at(2.0).expect("shown");
+        assert_eq!(shown.kind, FrameKind::Proxy);
+        assert!(
+            Arc::ptr_eq(&shown.meshes, &proxy),
+            "drawn on the proxy's meshes"
+        );
+        assert_eq!(
+            shown.positions[0].len(),
+            proxy.flower.template_of(0).mesh.vertex_count()
+        );
+        // Between two proxy frames: blended.
+        assert_eq!(
+            session.shown_at(2.5).expect("shown").positions[0][0].x,
+            25.0
+        );
+        assert!(session.accept(
+            Event::ProxyEnded {
+                run,
+                seconds: 0.1,
+                error: None
+            },
+            &mut Vec::new()
+        ));
+        assert!(!session.proxy_running());
+
+        // The converged keyframes 1 and 2 arrive and replace the proxy's.
+        for (i, x) in [(1, 1.0), (2, 2.0)] {
+            let keyframe = keyframe_of(&project, i, x);
+            assert!(session.accept(Event::Keyframe { run, keyframe }, &mut Vec::new()));
+        }
+        assert_eq!(session.state_at(2.0), Some(FrameState::Converged));
+        assert_eq!(session.state_at(2.5), Some(FrameState::Proxy));
+        let shown = session.shown_at(2.0).expect("shown");
+        assert!(Arc::ptr_eq(&shown.meshes, &project));
+        assert_eq!(shown.positions[0][0].x, 2.0);
+        // Between a converged and a proxy frame (other meshes): the nearer.
+        assert_eq!(session.shown_at(2.4).expect("shown").positions[0][0].x, 2.0);
+        assert_eq!(
+            session.shown_at(2.6).expect("shown").positions[0][0].x,
+            30.0
+        );
+        assert!(!session.is_current_at(3.0) && session.is_current_at(2.0));
+        assert_eq!(
+            crate::desktop::timeline::stale_line(&session, 3.0).as_deref(),
+            Some("proxy: coarse preview until the full-resolution run reaches 3")
+        );
+        assert_eq!(
+            crate::desktop::timeline::viewport_badge(&session, 3.0).map(|b| b.0),
+            Some("PROXY")
+        );
+        assert_eq!(
+            crate::desktop::timeline::viewport_badge(&session, 2.0),
+            None
+        );
+    }
+
+    #[test]
+    fn a_failed_run_does_not_show_the_proxy_frames_it_never_confirmed() {
+        let project = Arc::new(anthesis_sim::fixtures::whorl(1, 4, 6, 3));
+        let proxy = proxy_of(&project);
+        let mut session = SimSession::recorded();
+        let run = session.start_with_proxy(
+            Arc::clone(&project),
+            Some(Arc::clone(&proxy)),
+            Selection::All,
+        );
+        started(&mut session, run, 3, true);
+        feed(&mut session, &project, run, &[0.0, 1.0]);
+        for i in 2..=3 {
+            let keyframe = proxy_keyframe(&proxy, i, 9.0);
+            session.accept(Event::Proxy { run, keyframe }, &mut Vec::new());
+        }
+        assert_eq!(session.shown_end(), Some(3));
+        let mut failures = Vec::new();
+        session.accept(
+            Event::Failed {
+                run,
+                error: anthesis_sim::SimError::Cancelled,
+            },
+            &mut failures,
+        );
+        assert_eq!(failures.len(), 1);
+        assert_eq!(session.shown_end(), Some(1));
+    }
+
+    #[test]
+    fn a_preview_and_back_brings_the_whole_flowers_frames_back_at_once() {
+        let project = Arc::new(anthesis_sim::fixtures::whorl(2, 4, 6, 3));
+        let mut session = SimSession::recorded();
+        let whole = session.start(Arc::clone(&project), Selection::All);
+        started(&mut session, whole, 3, false);
+        feed(&mut session, &project, whole, &[0.0, 1.0, 2.0, 3.0]);
+        assert!(session.accept(
+            Event::Finished {
+                run: whole,
+                keyframes: 3,
+                seconds: 1.0
+            },
+            &mut Vec::new()
+        ));
+        let all = [0, 1];
+        assert_eq!(
+            session.complete_run_of(&all, &project).map(|k| k.len()),
+            Some(4)
+        );
+
+        // The preview of organ 1: nothing of it yet; the whole flower's
+        // keyframes are kept aside, complete.
+        let alone = session.start(Arc::clone(&project), Selection::Only(1));
+        assert_eq!(session.shown_end(), None);
+        assert_eq!(
+            session.complete_run_of(&all, &project).map(|k| k.len()),
+            Some(4)
+        );
+        // Not for another project (an edit made in the preview).
+        let mut edited = (*project).clone();
+        edited.flower.templates[0].dg += 0.001;
+        assert!(session.complete_run_of(&all, &edited).is_none());
+        started(&mut session, alone, 3, false);
+
+        // Back to the whole flower: its frames are shown at once (stale
+        // until the run sends them again).
+        session.start(Arc::clone(&project), Selection::All);
+        assert_eq!(session.shown_end(), Some(3));
+        assert!(session.is_stale_at(2.0));
+        assert_eq!(x_at(&session, 2.0), 2.0);
     }
 }

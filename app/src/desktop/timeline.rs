@@ -7,7 +7,7 @@
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, StrokeKind, Vec2};
 
 use super::command::Command;
-use super::session::{RunStatus, SimSession};
+use super::session::{FrameState, RunStatus, SimSession};
 
 /// Keyframes per second at speed 1 (the glTF export's default frame rate).
 pub const BASE_KEYFRAMES_PER_SECOND: f64 = 24.0;
@@ -46,7 +46,16 @@ impl Playback {
     /// keyframe available and `total` the last keyframe of the run.
     /// Playing stops at the newest computed keyframe and waits there;
     /// with loop on, a finished run starts again from the bud.
+    ///
+    /// Paused and not following, the playhead stays where the user put it
+    /// even past the keyframes shown (a new run, or another selection's,
+    /// has not reached it yet: the view shows the newest until it does).
     pub fn advance(&mut self, seconds: f64, computed: Option<u32>, total: u32) {
+        if !self.playing && !self.follow {
+            let end = computed.map_or(0.0, f64::from).max(f64::from(total));
+            self.time_in_keyframes = self.time_in_keyframes.clamp(0.0, end);
+            return;
+        }
         let Some(computed) = computed else {
             self.time_in_keyframes = 0.0;
             return;
@@ -140,6 +149,13 @@ pub fn status_line(session: &SimSession) -> String {
     match session.status() {
         RunStatus::Idle => "not simulated".to_string(),
         RunStatus::Queued => "starting…".to_string(),
+        RunStatus::Running if session.proxy_running() => {
+            let mut line = "quick preview (proxy) first".to_string();
+            if let Some((keyframe, _)) = session.iteration() {
+                line += &format!(", keyframe {keyframe}/{total}");
+            }
+            line + ", then full resolution"
+        }
         RunStatus::Running => {
             let mut line = format!("simulating keyframe {}/{total}", (done + 1).min(total));
             if let Some(elapsed) = session.elapsed() {
@@ -176,20 +192,37 @@ pub struct KeyMarks {
     pub painted: Option<usize>,
 }
 
-/// What the status says about a stale view at `time`: `None` when the view
-/// shows the current run.
+/// What the status says about a view at `time` that is not the current
+/// run's converged result (a proxy or an earlier run's): `None` when it
+/// is.
 pub fn stale_line(session: &SimSession, time: f64) -> Option<String> {
-    if !session.is_stale_at(time) {
-        return None;
-    }
     let viewed = time.max(0.0).ceil();
-    Some(format!(
-        "stale: previous result until the run reaches {viewed:.0}"
-    ))
+    match session.state_at(time)? {
+        FrameState::Converged => None,
+        FrameState::Proxy => Some(format!(
+            "proxy: coarse preview until the full-resolution run reaches {viewed:.0}"
+        )),
+        FrameState::Stale => Some(format!(
+            "stale: previous result until the run reaches {viewed:.0}"
+        )),
+    }
+}
+
+/// The badge the viewport shows over a view that is not the current run's
+/// converged result, and its colour.
+pub fn viewport_badge(session: &SimSession, time: f64) -> Option<(&'static str, Color32)> {
+    match session.state_at(time)? {
+        FrameState::Converged => None,
+        FrameState::Proxy => Some(("PROXY", PROXY_COLOR)),
+        FrameState::Stale => Some(("STALE", STALE_COLOR)),
+    }
 }
 
 /// Colour of the current run's computed keyframes.
 const COMPUTED_COLOR: Color32 = Color32::from_rgb(90, 140, 90);
+/// Colour of the current run's proxy keyframes (the converged ones are
+/// coming).
+pub const PROXY_COLOR: Color32 = Color32::from_rgb(70, 130, 170);
 /// Colour of stale keyframes (an earlier run's, still shown).
 const STALE_COLOR: Color32 = Color32::from_rgb(150, 125, 70);
 /// Colour of the playhead and of the key being painted.
@@ -266,12 +299,15 @@ pub fn timeline_ui(
         ui.separator();
         ui.label(status_line(session));
         if let Some(stale) = stale_line(session, playback.time_in_keyframes) {
+            let color =
+                viewport_badge(session, playback.time_in_keyframes).map_or(STALE_COLOR, |(_, c)| c);
             ui.separator();
-            ui.label(egui::RichText::new(stale).color(STALE_COLOR))
+            ui.label(egui::RichText::new(stale).color(color))
                 .on_hover_text(
-                    "The edit started a new run. The viewed keyframe shows the result from \
-                     before the edit until the new run has computed it; then the new one \
-                     replaces it (the log says how long that took).",
+                    "The edit started a new run. The viewed keyframe shows a coarse proxy of \
+                     the edited flower (blue), computed first, or the result from before the \
+                     edit (brown), until the full-resolution run has computed it; then that \
+                     replaces it.",
                 );
         }
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
@@ -297,8 +333,9 @@ pub fn timeline_ui(
     chosen
 }
 
-/// The scrubber: one cell per keyframe, filled where computed (green) or
-/// shown from an earlier run (stale, brown); the time keys; the playhead;
+/// The scrubber: one cell per keyframe, filled where computed (green),
+/// shown from the proxy (blue) or from an earlier run (stale, brown); the
+/// time keys; the playhead;
 /// click or drag to scrub.
 fn scrubber(
     ui: &mut egui::Ui,
@@ -312,7 +349,8 @@ fn scrubber(
     let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "Timeline"));
     let response = response.on_hover_text(format!(
-        "Timeline: green cells are computed keyframes, brown ones the previous result \
+        "Timeline: green cells are computed keyframes, blue ones the coarse proxy (shown \
+         until the full-resolution run reaches them), brown ones the previous result \
          (stale, shown until the new run reaches them), empty ones pending. Triangles mark \
          the time keys of {} (filled: the key being painted). Click or drag to scrub.",
         keys.template
@@ -327,17 +365,30 @@ fn scrubber(
     let painter = ui.painter_at(rect);
     let visuals = ui.visuals();
     painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
-    let done = session.last_index().map_or(0.0, f64::from);
-    let shown_to = shown.map_or(0.0, f64::from);
-    if shown_to > done {
-        let stale_rect = Rect::from_min_max(
-            Pos2::new(x_of(done), rect.top()),
-            Pos2::new(x_of(shown_to), rect.bottom()),
+    // Runs of cells in one state, each a rectangle from the keyframe
+    // before the run to its last one.
+    let color_of = |state: FrameState| match state {
+        FrameState::Converged => COMPUTED_COLOR,
+        FrameState::Proxy => PROXY_COLOR,
+        FrameState::Stale => STALE_COLOR,
+    };
+    let end = shown.unwrap_or(0);
+    let mut k = 1;
+    while k <= end {
+        let Some(state) = session.frame_state(k as usize) else {
+            break;
+        };
+        let mut last = k;
+        while last < end && session.frame_state(last as usize + 1) == Some(state) {
+            last += 1;
+        }
+        let cells = Rect::from_min_max(
+            Pos2::new(x_of(f64::from(k - 1)), rect.top()),
+            Pos2::new(x_of(f64::from(last)), rect.bottom()),
         );
-        painter.rect_filled(stale_rect, 3.0, STALE_COLOR);
+        painter.rect_filled(cells, 0.0, color_of(state));
+        k = last + 1;
     }
-    let computed_rect = Rect::from_min_max(rect.min, Pos2::new(x_of(done), rect.bottom()));
-    painter.rect_filled(computed_rect, 3.0, COMPUTED_COLOR);
     // Keyframe ticks: every keyframe when they are far enough apart,
     // otherwise every 10th.
     let every = if rect.width() / total as f32 > 4.0 {

@@ -7,6 +7,12 @@
 //! lily, 0.1 s for one petal in preview). Each is measured at the default
 //! resolution and at Table 1's (painting) resolution.
 //!
+//! The `proxy_*` ones measure the window's proxy (every template remeshed
+//! at `anthesis_flower::resolution::proxy_mesh`), what is on screen first
+//! after an edit: a late-key stroke until the viewed keyframe 54, an
+//! early-key stroke (which reruns from the bud) until keyframe 100, and a
+//! late-key stroke in the one-petal preview until keyframe 54.
+//!
 //! `cargo bench -p anthesis-garden --bench lily`
 
 use std::hint::black_box;
@@ -64,14 +70,39 @@ fn finish(sim: &mut Simulation) {
     }
 }
 
+/// Steps `sim` until keyframe `last` is computed (or to its end).
+fn step_until(sim: &mut Simulation, last: u32) {
+    while !sim.finished() {
+        match sim.step(&|| false, &mut |_| {}) {
+            Ok(keyframe) if keyframe.index >= last => return,
+            Ok(_) => {}
+            Err(error) => panic!("a stroke's run failed: {error}"),
+        }
+    }
+}
+
 /// A stroke on the petals' late key, then every keyframe it changes.
 /// Iterations alternate between painting the stroke and taking it back
 /// (undo), each an edit of the late key.
 fn stroke(c: &mut Criterion, name: &str, project: &Project, selection: Selection) {
     let petal_template = project.flower.organs[first_petal(project)].template;
     let late_key = project.flower.templates[petal_template].maps.keys().len() - 1;
+    stroke_until(c, name, project, selection, late_key, u32::MAX);
+}
+
+/// A stroke on the petals' time key `key`, then the keyframes it changes up
+/// to keyframe `last` (the one viewed).
+fn stroke_until(
+    c: &mut Criterion,
+    name: &str,
+    project: &Project,
+    selection: Selection,
+    key: usize,
+    last: u32,
+) {
+    let petal_template = project.flower.organs[first_petal(project)].template;
     let mut painted = project.clone();
-    stroke_near_tip(&mut painted, petal_template, late_key);
+    stroke_near_tip(&mut painted, petal_template, key);
     let mut sim = match Simulation::new(project, &selection) {
         Ok(sim) => sim,
         Err(error) => panic!("{name}: {error}"),
@@ -85,8 +116,11 @@ fn stroke(c: &mut Criterion, name: &str, project: &Project, selection: Selection
                 Ok(first) => first,
                 Err(error) => panic!("{name}: {error}"),
             };
-            assert!(first > 1, "{name}: a late stroke started the run over");
-            finish(&mut sim);
+            assert!(
+                first > 1 || key == 0,
+                "{name}: a late stroke started the run over"
+            );
+            step_until(&mut sim, last);
             states.swap(0, 1);
         })
     });
@@ -121,9 +155,51 @@ fn strokes(c: &mut Criterion) {
     }
 }
 
+/// What the window shows first after an edit of the built-in lily: its
+/// proxy's keyframes up to the viewed one.
+fn proxy(c: &mut Criterion) {
+    let project = match anthesis_garden::builtin_lily() {
+        Ok(project) => project,
+        Err(error) => panic!("the built-in lily does not load: {error}"),
+    };
+    let Some(proxy) = anthesis_flower::resolution::proxy(&project) else {
+        panic!("the built-in lily has no proxy");
+    };
+    let petal = first_petal(&proxy);
+    let keys = proxy.flower.templates[proxy.flower.organs[petal].template]
+        .maps
+        .keys()
+        .len();
+    let (early, late) = (0, keys - 1);
+    stroke_until(
+        c,
+        "proxy_stroke_late_key_whole_lily_to_54",
+        &proxy,
+        Selection::All,
+        late,
+        54,
+    );
+    stroke_until(
+        c,
+        "proxy_stroke_early_key_whole_lily_to_100",
+        &proxy,
+        Selection::All,
+        early,
+        100,
+    );
+    stroke_until(
+        c,
+        "proxy_stroke_late_key_petal_preview_to_54",
+        &proxy,
+        Selection::Only(petal),
+        late,
+        54,
+    );
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10);
-    targets = lily, strokes
+    targets = lily, strokes, proxy
 }
 criterion_main!(benches);

@@ -7,6 +7,7 @@
 //! cargo run --release -p anthesis-garden --example refine -- FLOWER [--scales 1,0.6,0.3]
 //! cargo run --release -p anthesis-garden --example refine -- FLOWER --keyframes 50,100,200
 //! cargo run --release -p anthesis-garden --example refine -- FLOWER --tolerances 1e-5,1e-6,1e-8
+//! cargo run --release -p anthesis-garden --example refine -- FLOWER --proxy
 //! ```
 //!
 //! `--scales`: mesh edge as a fraction of Table 1's (the default flowers use
@@ -14,7 +15,9 @@
 //! the same opening in N steps (`anthesis_garden::retime::in_keyframes`:
 //! dg, time keys, joint and part schedules scaled so that dg·N and their
 //! place in the opening stay fixed). `--tolerances`:
-//! the solver's relative tolerance. Add `--whole` for the whole flower
+//! the solver's relative tolerance. `--proxy`: the window's proxy (every
+//! template at `anthesis_flower::resolution::proxy_mesh`) against the
+//! default resolution it stands for. Add `--whole` for the whole flower
 //! (organ 0 is measured), `--paper` for the paper's model.
 use std::time::Instant;
 
@@ -64,6 +67,13 @@ fn main() {
                 )
             })
             .collect()
+    } else if args.iter().any(|a| a == "--proxy") {
+        let converged = build(EDGE_SCALE);
+        let proxy = anthesis_flower::resolution::proxy(&converged).expect("the flower has a proxy");
+        vec![
+            ("proxy".to_string(), proxy),
+            (format!("edge scale {EDGE_SCALE:4.2}"), converged),
+        ]
     } else if let Some(tolerances) = list(&args, "--tolerances") {
         tolerances
             .iter()

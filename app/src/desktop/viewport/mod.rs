@@ -82,6 +82,21 @@ pub struct ViewportResponse {
     pub painting_off_organ: bool,
 }
 
+/// A badge in the top-left corner of the viewport `rect` saying what the
+/// view shows when it is not the converged result ("PROXY", "STALE"):
+/// white text on `color`.
+pub fn badge(ui: &egui::Ui, rect: egui::Rect, text: &str, color: egui::Color32) {
+    let font = egui::FontId::proportional(13.0);
+    let galley = ui
+        .painter()
+        .layout_no_wrap(text.to_string(), font, egui::Color32::WHITE);
+    let at = rect.left_top() + Vec2::new(10.0, 10.0);
+    let frame = egui::Rect::from_min_size(at, galley.size() + Vec2::new(12.0, 6.0));
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(frame, 4.0, color);
+    painter.galley(at + Vec2::new(6.0, 3.0), galley, egui::Color32::WHITE);
+}
+
 /// The zoom of one mouse-wheel line (egui scrolls
 /// [`egui::InputOptions::line_scroll_speed`], 40 points, per line on the
 /// desktop): 4 % closer or further, so that a few notches frame a petal

@@ -41,11 +41,17 @@ impl Outline {
     /// The boundary edges of `mesh` (none when it has no valid topology;
     /// template meshes are validated when they are loaded).
     pub fn edges_of(&mut self, mesh: &Mesh) -> &[[u32; 2]] {
-        if self.triangles != mesh.triangles {
-            self.edges = Topology::build(mesh)
+        self.edges_of_triangles(&mesh.triangles)
+    }
+
+    /// The boundary edges of the mesh of `triangles` (an organ as shown:
+    /// a proxy frame's mesh is not the template's).
+    pub fn edges_of_triangles(&mut self, triangles: &[[u32; 3]]) -> &[[u32; 2]] {
+        if self.triangles != triangles {
+            self.edges = Topology::from_triangles(triangles)
                 .map(|topology| topology.boundary_edges().collect())
                 .unwrap_or_default();
-            self.triangles.clone_from(&mesh.triangles);
+            self.triangles = triangles.to_vec();
         }
         &self.edges
     }

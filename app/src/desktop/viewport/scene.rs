@@ -26,28 +26,36 @@ pub struct SceneOrgan {
     pub simulated: bool,
 }
 
-/// The organs at keyframe time `time`: simulated organs from the run,
-/// the others (when `show_others`) in their bud placement. An organ whose
-/// keyframes no longer fit its template (the mesh was replaced) is shown as
-/// a bud.
+/// The organs at keyframe time `time`: simulated organs from the run (on
+/// the meshes of the frame shown: a proxy's are coarser), the others (when
+/// `show_others`) in their bud placement. An organ whose keyframes no
+/// longer fit its template (the mesh was replaced) is shown as a bud.
 pub fn build_scene(
     project: &Project,
     session: &SimSession,
     time: f64,
     show_others: bool,
 ) -> Vec<SceneOrgan> {
-    let positions = session.positions_at(time);
+    let shown = session.shown_at(time);
     let flower = &project.flower;
     let mut scene = Vec::new();
     for (i, organ) in flower.organs.iter().enumerate() {
-        let template = flower.template_of(i);
         let slot = session.organs().iter().position(|&o| o == i);
-        let simulated = slot
-            .and_then(|s| positions.as_ref().and_then(|p| p.get(s)))
-            .filter(|p| p.len() == template.mesh.vertex_count())
-            .cloned();
-        let (positions_in_world, simulated) = match simulated {
-            Some(p) => (p, true),
+        let simulated = slot.and_then(|s| {
+            let shown = shown.as_ref()?;
+            let mesh = &shown
+                .meshes
+                .flower
+                .organs
+                .get(i)
+                .map(|_| shown.meshes.flower.template_of(i))?
+                .mesh;
+            let positions = shown.positions.get(s)?;
+            (positions.len() == mesh.vertex_count()).then_some((positions, mesh))
+        });
+        let template = flower.template_of(i);
+        let (positions_in_world, mesh, simulated) = match simulated {
+            Some((positions, mesh)) => (positions.clone(), mesh, true),
             None if slot.is_some() || show_others => (
                 template
                     .mesh
@@ -55,6 +63,7 @@ pub fn build_scene(
                     .iter()
                     .map(|p| organ.placement.world_from_template(*p, 0.0))
                     .collect(),
+                &template.mesh,
                 false,
             ),
             None => continue,
@@ -62,8 +71,8 @@ pub fn build_scene(
         scene.push(SceneOrgan {
             organ: i,
             positions_in_world,
-            triangles: template.mesh.triangles.clone(),
-            uvs: template.mesh.uvs.clone(),
+            triangles: mesh.triangles.clone(),
+            uvs: mesh.uvs.clone(),
             simulated,
         });
     }
