@@ -4009,3 +4009,95 @@ fn an_edits_proxy_shows_first_badged_and_blue_and_the_converged_run_replaces_it(
     );
     assert!(failures.is_empty(), "{failures:?}");
 }
+
+/// The organ meshes' names in the .glb at `path`.
+fn exported_meshes(path: &Path) -> Vec<String> {
+    let json: serde_json::Value =
+        serde_json::from_str(&glb_json(path)).expect("the JSON chunk parses");
+    json["meshes"]
+        .as_array()
+        .expect("meshes")
+        .iter()
+        .filter_map(|m| m["name"].as_str().map(str::to_string))
+        .collect()
+}
+
+#[test]
+fn with_one_organ_previewed_the_export_writes_the_whole_flower_unless_asked_for_the_organ() {
+    use anthesis_app::desktop::{Command, ProjectEdit};
+    let dir = tempfile::tempdir().expect("temp dir");
+    // The whole flower ran to its end; then one organ is previewed.
+    let mut harness = opened_small_flower();
+    let organs = harness.state().project().flower.organs.len();
+    harness
+        .state_mut()
+        .apply(Command::SetSingleOrganPreview(true));
+    harness.run();
+    assert_eq!(harness.state().selection(), Selection::Only(0));
+    feed(&mut harness, None);
+    harness.run();
+    harness.state_mut().open_export();
+    harness.run();
+    harness.get_by_label("whole flower");
+    harness.get_by_label_contains("The export holds the whole flower");
+    // From the keyframes kept from before the preview (no run: the window
+    // runs none here, and the file is written at once).
+    let whole = dir.path().join("whole.glb");
+    harness.state_mut().export_dialog_mut().path = whole.display().to_string();
+    harness.run();
+    harness.get_by_label("Export").click();
+    wait_for_export(&mut harness, &whole, Duration::from_secs(60));
+    let names = exported_meshes(&whole);
+    for i in 0..organs {
+        let name = &harness.state().project().flower.organs[i].name;
+        assert!(names.contains(name), "{name} in {names:?}");
+    }
+
+    // The organ alone, when asked for.
+    harness.get_by_label("petal-1 alone").click();
+    harness.run();
+    let alone = dir.path().join("alone.glb");
+    harness.state_mut().export_dialog_mut().path = alone.display().to_string();
+    harness.run();
+    harness.get_by_label("Export").click();
+    wait_for_export(&mut harness, &alone, Duration::from_secs(60));
+    let names = exported_meshes(&alone);
+    assert!(names.contains(&"petal-1".to_string()), "{names:?}");
+    assert!(!names.contains(&"sepal-1".to_string()), "{names:?}");
+
+    // An edit made in the preview: the kept keyframes are no longer of
+    // this project, so the export runs the whole flower itself.
+    let mut edited = harness.state().project().flower.templates[1].clone();
+    edited.dg += 0.0005;
+    let keyframes = harness.state().project().settings.keyframes;
+    harness.state_mut().apply(Command::Edit {
+        label: "dg of sepal".to_string(),
+        edit: ProjectEdit::Template {
+            template: 1,
+            value: Box::new(edited),
+            keyframes,
+        },
+    });
+    harness.get_by_label("whole flower").click();
+    harness.run();
+    let rerun = dir.path().join("rerun.glb");
+    harness.state_mut().export_dialog_mut().path = rerun.display().to_string();
+    harness.run();
+    harness.get_by_label("Export").click();
+    harness.run();
+    assert!(
+        harness
+            .query_by_label_contains("running: keyframe")
+            .is_some()
+            || harness.query_by_label_contains("Wrote ").is_some(),
+        "the export runs the whole flower with progress"
+    );
+    wait_for_export(&mut harness, &rerun, Duration::from_secs(120));
+    let names = exported_meshes(&rerun);
+    assert!(names.contains(&"sepal-3".to_string()), "{names:?}");
+    // The solver's opening, not the recorded one kept from before.
+    assert_ne!(
+        std::fs::read(&rerun).expect("written"),
+        std::fs::read(&whole).expect("written")
+    );
+}
