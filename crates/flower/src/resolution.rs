@@ -95,7 +95,7 @@ pub enum ResolutionProblem {
 }
 
 /// The options the remesh uses at `mean_edge`.
-fn options(mean_edge: f64) -> RemeshOptions {
+pub(crate) fn options(mean_edge: f64) -> RemeshOptions {
     RemeshOptions {
         max_vertices: MAX_PARTICLES_PER_TEMPLATE,
         ..RemeshOptions::new(mean_edge)
@@ -136,7 +136,8 @@ pub fn remesh_template(template: &Template, mean_edge: f64) -> Result<Mesh, Reso
 
 /// The project to simulate: `project` with every template remeshed as its
 /// resolution says (unchanged, but for the setting, when it is
-/// [`Resolution::AsBuilt`]). The result's resolution is `AsBuilt`: its
+/// [`Resolution::AsBuilt`]), through the installed remesh cache
+/// ([`remesh_template_cached`](crate::remesh_cache::remesh_template_cached)). The result's resolution is `AsBuilt`: its
 /// meshes are the resolution. The first template that cannot be remeshed is
 /// an error naming it.
 pub fn resolve(project: &Project) -> Result<Project, ResolutionError> {
@@ -147,7 +148,7 @@ pub fn resolve(project: &Project) -> Result<Project, ResolutionError> {
         // mesh's vertices, which a remesh would not keep.
         for template in &mut resolved.flower.templates {
             if template.two_state.is_none() {
-                template.mesh = remesh_template(template, edge)?;
+                template.mesh = crate::remesh_cache::remesh_template_cached(template, edge)?;
             }
         }
     }
