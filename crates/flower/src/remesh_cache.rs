@@ -23,7 +23,9 @@
 
 use std::sync::OnceLock;
 
-use anthesis_files::cache::{Cache, Key, KeyHasher, Outcome};
+/// The cache and what a lookup found, for callers of this module.
+pub use anthesis_files::cache::{Cache, Outcome};
+use anthesis_files::cache::{Key, KeyHasher};
 use anthesis_mesh::Mesh;
 use anthesis_mesh::binary::{mesh_from_bytes, mesh_to_bytes};
 

@@ -221,11 +221,14 @@ pub fn proxy_edge(mesh: &Mesh) -> Option<f64> {
 /// `template`'s proxy mesh: its mesh remeshed at [`proxy_edge`]; where that
 /// fails or leaves too few base particles, at a finer edge (up to three
 /// tries, each a quarter finer). `None` when the mesh is coarse enough
-/// already or no coarser mesh works.
+/// already or no coarser mesh works. Remeshed through the installed remesh
+/// cache ([`remesh_template_cached`](crate::remesh_cache::remesh_template_cached)):
+/// the edge is a function of the mesh, so a launch or an edit that leaves
+/// a template's mesh as it was reads its proxy back.
 pub fn proxy_mesh(template: &Template) -> Option<Mesh> {
     let mut edge = proxy_edge(&template.mesh)?;
     for _ in 0..3 {
-        if let Ok(mesh) = remesh_template(template, edge)
+        if let Ok(mesh) = crate::remesh_cache::remesh_template_cached(template, edge)
             && mesh.vertex_count() < template.mesh.vertex_count()
         {
             return Some(mesh);
