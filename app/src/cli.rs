@@ -38,6 +38,13 @@ pub struct Cli {
     /// folder, or builtin:NAME; default: the last one, else the lily).
     #[arg(value_name = "PROJECT")]
     pub project: Option<PathBuf>,
+    /// Remesh every time instead of keeping remeshed templates in the user
+    /// cache (`$ANTHESIS_CACHE_DIR/remesh`, else
+    /// `$XDG_CACHE_HOME/anthesis/remesh`, else `~/.cache/anthesis/remesh`;
+    /// `ANTHESIS_CACHE_DIR=` set empty turns it off too). Given after the
+    /// command: `anthesis simulate --no-cache …`.
+    #[arg(long, global = true)]
+    pub no_cache: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -172,6 +179,9 @@ pub fn main() -> ExitCode {
             return code;
         }
     };
+    if !cli.no_cache {
+        install_remesh_cache();
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that stopped reading (`anthesis info … | head -1`) is not
@@ -181,6 +191,22 @@ pub fn main() -> ExitCode {
             eprintln!("error: {}", one_line(&error_message(&e)));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Keeps remeshed templates in the user's cache for this process (the
+/// command line's and the window's remeshes:
+/// `anthesis_flower::remesh_cache`).
+fn install_remesh_cache() {
+    use anthesis_files::cache::Cache;
+    anthesis_flower::remesh_cache::install(Cache::user(anthesis_flower::remesh_cache::FOLDER));
+}
+
+/// Says on the terminal, once, why the remesh cache could not be written
+/// (the command goes on without it).
+pub(crate) fn warn_about_the_cache() {
+    if let Some(warning) = anthesis_flower::remesh_cache::installed().take_warning() {
+        eprintln!("warning: {warning}");
     }
 }
 
@@ -395,7 +421,9 @@ fn at_resolution(
     if let Some((selection, cost)) = memory {
         anthesis_sim::memory::check_run(&project, selection, cost)?;
     }
-    Ok(anthesis_flower::resolution::resolve(&project)?)
+    let resolved = anthesis_flower::resolution::resolve(&project);
+    warn_about_the_cache();
+    Ok(resolved?)
 }
 
 /// Refuses a project with a mesh in another unit than the project (see

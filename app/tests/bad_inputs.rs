@@ -609,7 +609,7 @@ fn catalogue() -> Vec<Case> {
 /// Runs the binary, killing it after [`MAX_SECONDS`].
 fn run_bounded(args: &[String], env: &[(&str, &str)]) -> (Option<i32>, String, Duration) {
     let started = Instant::now();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+    let mut child = common::command()
         .args(args)
         .envs(env.iter().copied())
         .env("RUST_BACKTRACE", "0")

@@ -115,6 +115,108 @@ fn edge_remeshes_what_info_counts_and_what_simulate_runs() {
     );
 }
 
+/// The entries of a remesh cache folder, sorted, with their bytes.
+fn cache_entries(folder: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut entries: Vec<(PathBuf, Vec<u8>)> = std::fs::read_dir(folder)
+        .map(|listing| {
+            listing
+                .map(|e| e.expect("entry").path())
+                .map(|path| {
+                    let bytes = std::fs::read(&path).expect("readable");
+                    (path, bytes)
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    entries.sort();
+    entries
+}
+
+#[test]
+fn remeshes_are_cached_and_a_damaged_or_unwritable_cache_never_stops_a_run() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 2, 2);
+    let p = path.to_str().expect("utf-8");
+    let project = anthesis_flower::project::load_project(&path).expect("loads");
+    let edge = format!(
+        "{}",
+        anthesis_bud::quality(&project.flower.templates[0].mesh).mean_edge / 1.5
+    );
+    let root = dir.path().join("cache");
+    let run = |root: &Path, args: &[&str]| {
+        let out = common::command()
+            .env("ANTHESIS_CACHE_DIR", root)
+            .args(args)
+            .output()
+            .expect("the binary runs");
+        assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+        (text(&out.stdout), text(&out.stderr))
+    };
+    let uncached = anthesis(&["info", p, "--edge", &edge]);
+    let counts = text(&uncached.stdout);
+    // The first run remeshes both templates and keeps them.
+    assert_eq!(
+        run(&root, &["info", p, "--edge", &edge]),
+        (counts.clone(), String::new())
+    );
+    let folder = root.join("remesh");
+    let kept = cache_entries(&folder);
+    assert_eq!(kept.len(), 2, "{kept:?}");
+    // The next reads them: the same answer, the same entries.
+    assert_eq!(run(&root, &["info", p, "--edge", &edge]).0, counts);
+    assert_eq!(cache_entries(&folder), kept);
+    // A run from the cache is the run from a fresh remesh, bit for bit.
+    let glb = |name: &str| dir.path().join(name);
+    for (name, no_cache) in [("cached.glb", false), ("fresh.glb", true)] {
+        let out = glb(name);
+        let mut args = vec![
+            "simulate",
+            p,
+            "--edge",
+            &edge,
+            "--organ",
+            "petal-1",
+            "--keyframes",
+            "2",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ];
+        if no_cache {
+            args.push("--no-cache");
+        }
+        run(&root, &args);
+    }
+    assert!(
+        std::fs::read(glb("cached.glb")).expect("written")
+            == std::fs::read(glb("fresh.glb")).expect("written"),
+        "the cached run's file differs from the fresh run's"
+    );
+    // Damaged entries are misses, said nowhere, and written anew.
+    std::fs::write(&kept[0].0, &kept[0].1[..kept[0].1.len() / 3]).expect("truncated");
+    std::fs::write(&kept[1].0, b"not a cache entry at all").expect("overwritten");
+    assert_eq!(
+        run(&root, &["info", p, "--edge", &edge]),
+        (counts.clone(), String::new())
+    );
+    assert_eq!(cache_entries(&folder), kept);
+    // --no-cache and an empty ANTHESIS_CACHE_DIR write nothing.
+    let unused = dir.path().join("unused");
+    run(&unused, &["info", p, "--edge", &edge, "--no-cache"]);
+    assert!(!unused.exists());
+    // A cache that cannot be written: the answer, and one warning.
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, b"x").expect("written");
+    let (stdout, stderr) = run(&file, &["info", p, "--edge", &edge]);
+    assert_eq!(stdout, counts);
+    let warnings: Vec<&str> = stderr.lines().collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(
+        warnings[0].starts_with("warning: the cache in ")
+            && warnings[0].contains("cannot be written, working without it"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn simulate_writes_stats_json_and_a_glb() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -363,7 +465,7 @@ fn bad_input_gives_one_line_and_a_non_zero_exit() {
 #[test]
 fn without_a_subcommand_it_opens_the_window_or_says_why_not() {
     // No display here: the window cannot open, and that is one clear line.
-    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+    let out = common::command()
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
         .env_remove("WAYLAND_SOCKET")
@@ -385,7 +487,7 @@ fn without_a_subcommand_it_opens_the_window_or_says_why_not() {
 #[test]
 fn the_built_in_lily_needs_no_files() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+    let out = common::command()
         .args(["info", "builtin:lily"])
         .current_dir(dir.path())
         .output()
@@ -427,7 +529,7 @@ fn a_project_the_window_cannot_open_is_refused_before_any_window() {
         ),
         ("/no/such/folder", &["/no/such/folder"][..]),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+        let out = common::command()
             .arg(arg)
             .env_remove("DISPLAY")
             .env_remove("WAYLAND_DISPLAY")
@@ -508,7 +610,7 @@ fn a_fleshy_petal_in_another_unit_is_named_by_where_it_sits() {
 fn a_reader_that_stops_reading_ends_the_output_quietly() {
     // `anthesis info builtin:lily | head -1`: the pipe's reader is gone
     // before the first line is written.
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_anthesis"))
+    let mut child = common::command()
         .args(["info", "builtin:lily"])
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
@@ -543,7 +645,7 @@ fn a_step_that_fails_part_way_keeps_the_keyframes_before_it() {
     let glb = dir.path().join("kept.glb");
     // A panic inside keyframe 4 (the test-only hook of crates/sim/src/fault.rs;
     // a bug, the worst way a step can fail).
-    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+    let out = common::command()
         .args([
             "simulate",
             path.to_str().expect("utf-8"),

@@ -4,7 +4,6 @@
 //! rendering test fails: it is not skipped.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use image::RgbaImage;
 
@@ -295,7 +294,7 @@ fn render_without_a_graphics_adapter_says_so_in_one_line() {
     let dir = tempfile::tempdir().expect("tempdir");
     let project = saved_whorl(dir.path());
     // Direct3D 12 does not exist on this platform: no adapter.
-    let out = Command::new(env!("CARGO_BIN_EXE_anthesis"))
+    let out = common::command()
         .args(["render", utf8(&project), "--out", utf8(dir.path())])
         .env("WGPU_BACKEND", if cfg!(windows) { "metal" } else { "dx12" })
         .output()

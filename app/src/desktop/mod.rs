@@ -478,6 +478,9 @@ impl AnthesisApp {
         {
             self.log.error_about(Topic::Resolution, problem);
         }
+        if let Some(warning) = anthesis_flower::remesh_cache::installed().take_warning() {
+            self.log.warn(warning);
+        }
         match self.resolved.project() {
             Some(project) => Arc::clone(project),
             None => Arc::new(self.doc.project().clone()),

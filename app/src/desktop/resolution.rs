@@ -13,7 +13,8 @@
 
 use std::sync::Arc;
 
-use anthesis_flower::resolution::{proxy_mesh, remesh_template};
+use anthesis_flower::remesh_cache::remesh_template_cached;
+use anthesis_flower::resolution::proxy_mesh;
 use anthesis_flower::{Project, Resolution};
 use anthesis_mesh::Mesh;
 use anthesis_sim::Selection;
@@ -72,7 +73,7 @@ impl Resolved {
                 *slot = Some(Remeshed {
                     built: template.mesh.clone(),
                     mean_edge: edge,
-                    mesh: remesh_template(template, edge).map_err(|e| e.to_string()),
+                    mesh: remesh_template_cached(template, edge).map_err(|e| e.to_string()),
                 });
             }
             if let Some(Remeshed { mesh: Err(e), .. }) = slot {

@@ -5,10 +5,16 @@
 use std::process::{Command, Output};
 
 pub fn anthesis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_anthesis"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
+    command().args(args).output().expect("the binary runs")
+}
+
+/// The binary as a command, with the remesh cache off (`ANTHESIS_CACHE_DIR`
+/// set empty), so tests never write into the user's cache; a test of the
+/// cache sets the variable to a folder of its own.
+pub fn command() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_anthesis"));
+    command.env("ANTHESIS_CACHE_DIR", "");
+    command
 }
 
 pub fn text(bytes: &[u8]) -> String {

@@ -77,6 +77,16 @@ pub enum InnerSide {
     AgainstSurfaceNormal,
 }
 
+/// The version of what the remesher gives ([`remesh_mesh`] and the
+/// surface remeshers it shares code with). Caches key remeshed meshes on it
+/// (`anthesis_flower::remesh_cache`), so **bump it in the same commit as
+/// any change that can change the mesh remeshed from the same input**: a
+/// cache keyed on the old value would otherwise go on serving the old mesh.
+/// The flower crate's `a_changed_remesher_must_bump_its_version` test holds
+/// the digest of a remesh made at this version and fails when the output
+/// changes without the bump.
+pub const REMESH_VERSION: u32 = 1;
+
 /// How to remesh a surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RemeshOptions {

@@ -2,10 +2,12 @@
 //! ([`read`]): only regular files within a size limit, paths a project
 //! names confined to its folder, and at most a short escaped excerpt of a
 //! file's content in a message. Writing the files Anthesis saves so that
-//! nothing is lost ([`write`]): the one atomic writer.
+//! nothing is lost ([`write`]): the one atomic writer. Results kept between
+//! runs under the hash of what they were made from ([`cache`]).
 
 #![warn(missing_docs)]
 
+pub mod cache;
 pub mod read;
 pub mod write;
 

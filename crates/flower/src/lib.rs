@@ -9,6 +9,7 @@ pub mod edit;
 pub mod parts;
 pub mod project;
 mod receptacle;
+pub mod remesh_cache;
 pub mod resolution;
 pub mod scale;
 pub mod sketched_bud;

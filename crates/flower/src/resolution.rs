@@ -95,7 +95,7 @@ pub enum ResolutionProblem {
 }
 
 /// The options the remesh uses at `mean_edge`.
-fn options(mean_edge: f64) -> RemeshOptions {
+pub(crate) fn options(mean_edge: f64) -> RemeshOptions {
     RemeshOptions {
         max_vertices: MAX_PARTICLES_PER_TEMPLATE,
         ..RemeshOptions::new(mean_edge)
@@ -136,7 +136,8 @@ pub fn remesh_template(template: &Template, mean_edge: f64) -> Result<Mesh, Reso
 
 /// The project to simulate: `project` with every template remeshed as its
 /// resolution says (unchanged, but for the setting, when it is
-/// [`Resolution::AsBuilt`]). The result's resolution is `AsBuilt`: its
+/// [`Resolution::AsBuilt`]), through the installed remesh cache
+/// ([`remesh_template_cached`](crate::remesh_cache::remesh_template_cached)). The result's resolution is `AsBuilt`: its
 /// meshes are the resolution. The first template that cannot be remeshed is
 /// an error naming it.
 pub fn resolve(project: &Project) -> Result<Project, ResolutionError> {
@@ -147,7 +148,7 @@ pub fn resolve(project: &Project) -> Result<Project, ResolutionError> {
         // mesh's vertices, which a remesh would not keep.
         for template in &mut resolved.flower.templates {
             if template.two_state.is_none() {
-                template.mesh = remesh_template(template, edge)?;
+                template.mesh = crate::remesh_cache::remesh_template_cached(template, edge)?;
             }
         }
     }
@@ -220,11 +221,14 @@ pub fn proxy_edge(mesh: &Mesh) -> Option<f64> {
 /// `template`'s proxy mesh: its mesh remeshed at [`proxy_edge`]; where that
 /// fails or leaves too few base particles, at a finer edge (up to three
 /// tries, each a quarter finer). `None` when the mesh is coarse enough
-/// already or no coarser mesh works.
+/// already or no coarser mesh works. Remeshed through the installed remesh
+/// cache ([`remesh_template_cached`](crate::remesh_cache::remesh_template_cached)):
+/// the edge is a function of the mesh, so a launch or an edit that leaves
+/// a template's mesh as it was reads its proxy back.
 pub fn proxy_mesh(template: &Template) -> Option<Mesh> {
     let mut edge = proxy_edge(&template.mesh)?;
     for _ in 0..3 {
-        if let Ok(mesh) = remesh_template(template, edge)
+        if let Ok(mesh) = crate::remesh_cache::remesh_template_cached(template, edge)
             && mesh.vertex_count() < template.mesh.vertex_count()
         {
             return Some(mesh);

@@ -11,6 +11,7 @@
 
 #![warn(missing_docs)]
 
+pub mod binary;
 mod error;
 pub mod generate;
 pub mod nearest;
