@@ -15,7 +15,9 @@ event by then, and the time it took to start (`action_ms`, tens of
 milliseconds on a busy machine) is not counted. Or, with
 `--zero-on-change NAME`, the first moment region NAME changes (e.g. a
 window's first frame); the other regions' baselines are then read at that
-moment. For every region it reports the first change after time zero and
+moment (once region NAME holds still for a poll, at most 0.1 s later, so
+a frame read half-written does not count as a change). For every region
+it reports the first change after time zero and
 the last change before the screen settled: nothing changed in any watched
 region for `--settle` seconds (or `--timeout` passed). One JSON object is
 printed on stdout:
@@ -167,6 +169,17 @@ def main():
                 print(json.dumps({"timed_out": True, "regions": {}}))
                 return
             time.sleep(period)
+        # The first frame may have been read while the server was still
+        # writing it: take the baselines once the screen holds still for a
+        # poll (a frame takes far longer than that to draw).
+        settle_until = clock() + 0.1
+        current = read[name]()
+        while clock() < settle_until:
+            time.sleep(period)
+            again = read[name]()
+            if again == current:
+                break
+            current = again
         previous = {name: get() for name, get in read.items()}
     else:
         started = clock()

@@ -30,7 +30,9 @@
 # settles (nothing watched changes for SETTLE seconds, default 3; the
 # timeline is watched too, so a run still computing keyframes keeps it
 # from settling). Changes from runs started while the button was down
-# count if they reach the screen after the release. A strip along the
+# count if they reach the screen after the release; a stroke whose result
+# was on screen before the release (no change after it) counts as 0 ms. A
+# key step that changed nothing is left out of the median. A strip along the
 # viewport's top edge (where a "proxy" badge may be drawn) and the
 # timeline's scrubber are watched separately and reported in the details.
 # The pointer stays off the viewport while watching.
@@ -206,7 +208,9 @@ case_late_stroke() {
 
 case_early_stroke() {
   launch early; wait_window; settled
-  click "$keyframe_100"; click "$key_40"; settled
+  # Near the scrubber's end, then one keyframe on: exactly keyframe 100.
+  click "$keyframe_100"; focus; xdotool key Right; sleep 0.5
+  click "$key_40"; settled
   screenshot early-stroke
   strokes_case early-stroke
   quit
@@ -248,15 +252,20 @@ median() {
     printf "%d\n", m + 0.5
   }'
 }
-# Field FIELD of region REGION from each JSON line on stdin.
+# Field FIELD of region REGION from each JSON line on stdin; with a third
+# argument, a region that did not change counts as that many ms (a stroke
+# whose result was already on screen at the release), else it is left out.
 field() {
   python3 -c '
 import json, sys
 region, field = sys.argv[1], sys.argv[2]
+missing = sys.argv[3] if len(sys.argv) > 3 else None
 for line in sys.stdin:
     value = json.loads(line)["regions"].get(region, {}).get(field)
+    if value is None:
+        value = missing
     if value is not None:
-        print(value)' "$1" "$2"
+        print(value)' "$@"
 }
 details() {
   python3 -c '
@@ -283,11 +292,19 @@ for c in "${cases[@]}"; do
   details "$c" <"$work/$c.jsonl"
 done
 for c in "${cases[@]}"; do
-  first=$(field viewport first_ms <"$work/$c.jsonl" | median)
+  if [ "$c" = key-step ] || [ "$c" = first-launch ]; then
+    first=$(field viewport first_ms <"$work/$c.jsonl" | median)
+  else
+    first=$(field viewport first_ms 0 <"$work/$c.jsonl" | median)
+  fi
   if [ "$c" = key-step ]; then
     echo "key-step: median $first ms"
   else
-    last=$(field viewport last_ms <"$work/$c.jsonl" | median)
+    if [ "$c" = first-launch ]; then
+      last=$(field viewport last_ms <"$work/$c.jsonl" | median)
+    else
+      last=$(field viewport last_ms 0 <"$work/$c.jsonl" | median)
+    fi
     echo "$c: median $first ms (proxy), $last ms (final)"
   fi
 done
