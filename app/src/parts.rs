@@ -3,13 +3,23 @@
 //! same pieces [`anthesis_export::flower_tracks`] exports.
 
 use anthesis_flower::Flower;
-use anthesis_flower::parts::part_pieces;
+use anthesis_flower::parts::{PartPiece, part_pieces};
 use anthesis_render::OrganMesh;
 
 /// The parts of `flower` at `time_in_keyframes` (0 the bud; between two
 /// keyframes the positions blend linearly, as the timeline and the exports
 /// blend organs), each in its colour.
 pub fn part_meshes(flower: &Flower, time_in_keyframes: f64) -> Vec<OrganMesh> {
+    let pieces = part_pieces(flower);
+    pieces
+        .iter()
+        .map(|piece| piece_mesh(piece, time_in_keyframes))
+        .collect()
+}
+
+/// One piece of [`part_pieces`] at `time_in_keyframes`, as
+/// [`part_meshes`] draws it.
+pub fn piece_mesh(piece: &PartPiece, time_in_keyframes: f64) -> OrganMesh {
     let time = if time_in_keyframes.is_finite() {
         time_in_keyframes.max(0.0)
     } else {
@@ -18,19 +28,14 @@ pub fn part_meshes(flower: &Flower, time_in_keyframes: f64) -> Vec<OrganMesh> {
     let below = time.floor();
     let fraction = time - below;
     let below = below.min(f64::from(u32::MAX - 1)) as u32;
-    part_pieces(flower)
-        .iter()
-        .map(|piece| {
-            let mut positions = piece.positions_at(below);
-            if fraction > 0.0 && piece.moves() {
-                let above = piece.positions_at(below + 1);
-                for (p, a) in positions.iter_mut().zip(above) {
-                    *p = p.lerp(a, fraction);
-                }
-            }
-            OrganMesh::from_positions(&positions, &piece.mesh.triangles, piece.color)
-        })
-        .collect()
+    let mut positions = piece.positions_at(below);
+    if fraction > 0.0 && piece.moves() {
+        let above = piece.positions_at(below + 1);
+        for (p, a) in positions.iter_mut().zip(above) {
+            *p = p.lerp(a, fraction);
+        }
+    }
+    OrganMesh::from_positions(&positions, &piece.mesh.triangles, piece.color)
 }
 
 #[cfg(test)]

@@ -167,18 +167,7 @@ impl AnthesisApp {
             show_others: self.shows_others(),
         };
         let resolved = self.resolved_project();
-        let (project, session) = (resolved.as_ref(), &self.session);
-        let (scene, meshes, revision) = self.scene.get(key, || {
-            let scene =
-                viewport::build_scene(project, session, key.time_in_keyframes, key.show_others);
-            let mut meshes =
-                viewport::scene_meshes(project, &scene, Some(key.selected_organ), overlay);
-            meshes.extend(crate::parts::part_meshes(
-                &project.flower,
-                key.time_in_keyframes,
-            ));
-            (scene, meshes)
-        });
+        let (scene, meshes, revision) = self.scene.get(key, &resolved, &self.session);
         self.frame_automatically(&scene);
         if !self.has_gpu {
             ui.label("The 3D viewport needs the wgpu renderer.");

@@ -2,7 +2,10 @@
 //! organs with `anthesis-render`'s [`OrganPipeline`] into the viewport's
 //! own colour + depth target in `prepare` (egui's render pass has no depth
 //! attachment) and copies that image into egui's pass in `paint` with the
-//! render crate's [`BlitPipeline`].
+//! render crate's [`BlitPipeline`]. The organ pass is recorded only when
+//! the meshes, the camera or the size changed: a frame drawn for the rest
+//! of the window (a panel, the timeline, the log) copies the image it
+//! already has.
 
 use std::sync::Arc;
 
@@ -26,6 +29,8 @@ pub struct ViewportGpu {
     organs: OrganPipeline,
     target: Option<RenderTarget>,
     uploaded_revision: Option<u64>,
+    /// What the target's image shows: meshes revision, camera, size.
+    rendered: Option<(u64, Camera, (u32, u32))>,
     blit: BlitPipeline,
     /// The blit's source: the current target.
     image: Option<wgpu::BindGroup>,
@@ -43,6 +48,7 @@ impl ViewportGpu {
             organs: OrganPipeline::new(device, queue, BLIT_SOURCE_FORMAT),
             target: None,
             uploaded_revision: None,
+            rendered: None,
             blit: BlitPipeline::new(device, egui_target_format),
             image: None,
         }
@@ -78,6 +84,7 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
             let target = RenderTarget::new(device, BLIT_SOURCE_FORMAT, width, height);
             gpu.image = Some(gpu.blit.bind(device, &target));
             gpu.target = Some(target);
+            gpu.rendered = None;
         }
         if gpu.uploaded_revision != Some(self.revision) {
             // Meshes come from validated templates; a malformed one is
@@ -85,9 +92,13 @@ impl egui_wgpu::CallbackTrait for ViewportCallback {
             let _ = gpu.organs.set_organs(device, queue, &self.meshes);
             gpu.uploaded_revision = Some(self.revision);
         }
-        if let Some(target) = &gpu.target {
+        let wanted = (self.revision, self.camera, (width, height));
+        if let Some(target) = &gpu.target
+            && gpu.rendered != Some(wanted)
+        {
             gpu.organs.set_camera(queue, &self.camera, target.aspect());
             target.render(&gpu.organs, egui_encoder);
+            gpu.rendered = Some(wanted);
         }
         Vec::new()
     }

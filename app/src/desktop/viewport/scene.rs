@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use anthesis_flower::Project;
+use anthesis_flower::parts::{PartPiece, part_pieces};
 use anthesis_maps::MapKind;
 use anthesis_render::OrganMesh;
 use glam::{DVec2, DVec3};
@@ -91,16 +92,19 @@ const HIGHLIGHT_LINEAR: [f32; 3] = [1.0, 0.71, 0.17];
 
 /// Meshes for the renderer: each organ in its template colour (linear, as
 /// the renderer takes it) or its colour map (`crate::look`, baked once per
-/// template); the selected one tinted towards a warm
-/// highlight; organs not simulated (bud placeholders in preview) washed out
-/// towards grey; the overlay map as a ramp.
+/// template and kept in `looks`, one slot per template, while the project
+/// is the same: the renderer keeps a texture uploaded while the same image
+/// comes back); the selected one tinted towards a warm highlight; organs
+/// not simulated (bud placeholders in preview) washed out towards grey;
+/// the overlay map as a ramp.
 pub fn scene_meshes(
     project: &Project,
     scene: &[SceneOrgan],
     selected: Option<usize>,
     overlay: Option<(MapKind, usize)>,
+    looks: &mut Vec<Option<crate::look::Look>>,
 ) -> Vec<OrganMesh> {
-    let mut looks: Vec<Option<crate::look::Look>> = vec![None; project.flower.templates.len()];
+    looks.resize(project.flower.templates.len(), None);
     scene
         .iter()
         .map(|o| {
@@ -153,6 +157,48 @@ pub struct SceneKey {
     pub show_others: bool,
 }
 
+/// What a scene needs from its project that does not change with the
+/// time shown: each template's look (its baked colour image) and the
+/// parts' pieces, with the meshes of those that do not move. Kept while
+/// the project shown is the same `Arc`, so a step in time does not bake
+/// the colour maps again (nor upload them again: the renderer keeps a
+/// texture while the same image comes back) or rebuild the parts.
+struct ProjectStatics {
+    project: Arc<Project>,
+    looks: Vec<Option<crate::look::Look>>,
+    pieces: Vec<PartPiece>,
+    /// Per piece, its mesh when it does not move.
+    still: Vec<Option<OrganMesh>>,
+}
+
+impl ProjectStatics {
+    fn of(project: &Arc<Project>) -> ProjectStatics {
+        let pieces = part_pieces(&project.flower);
+        let still = pieces
+            .iter()
+            .map(|piece| (!piece.moves()).then(|| crate::parts::piece_mesh(piece, 0.0)))
+            .collect();
+        ProjectStatics {
+            project: Arc::clone(project),
+            looks: Vec::new(),
+            pieces,
+            still,
+        }
+    }
+
+    /// The parts at `time_in_keyframes`, as [`crate::parts::part_meshes`]
+    /// draws them.
+    fn part_meshes(&self, time_in_keyframes: f64) -> impl Iterator<Item = OrganMesh> + '_ {
+        self.pieces
+            .iter()
+            .zip(&self.still)
+            .map(move |(piece, still)| match still {
+                Some(mesh) => mesh.clone(),
+                None => crate::parts::piece_mesh(piece, time_in_keyframes),
+            })
+    }
+}
+
 /// The scene shown last and what it was built from.
 #[derive(Default)]
 pub struct SceneCache {
@@ -161,18 +207,48 @@ pub struct SceneCache {
     meshes: Arc<Vec<OrganMesh>>,
     /// Counts the builds; the GPU side uploads the meshes when it changes.
     revision: u64,
+    statics: Option<ProjectStatics>,
 }
 
 impl SceneCache {
-    /// The scene for `key`, its meshes and their revision; `build` runs only
-    /// when `key` differs from the previous call's.
+    /// The scene of `project` (the project as simulated and shown) and
+    /// `session` for `key`, the meshes handed to the renderer (the
+    /// organs, then the parts) and their revision; built again only when
+    /// `key` differs from the previous call's.
     pub fn get(
         &mut self,
         key: SceneKey,
-        build: impl FnOnce() -> (Vec<SceneOrgan>, Vec<OrganMesh>),
+        project: &Arc<Project>,
+        session: &SimSession,
+    ) -> (Arc<Vec<SceneOrgan>>, Arc<Vec<OrganMesh>>, u64) {
+        self.get_or_build(key, |statics| {
+            let statics = match statics.take() {
+                Some(kept) if Arc::ptr_eq(&kept.project, project) => statics.insert(kept),
+                _ => statics.insert(ProjectStatics::of(project)),
+            };
+            let scene = build_scene(project, session, key.time_in_keyframes, key.show_others);
+            let mut meshes = scene_meshes(
+                project,
+                &scene,
+                Some(key.selected_organ),
+                key.overlay,
+                &mut statics.looks,
+            );
+            meshes.extend(statics.part_meshes(key.time_in_keyframes));
+            (scene, meshes)
+        })
+    }
+
+    /// The scene for `key`, its meshes and their revision; `build` (given
+    /// what is kept of the project) runs only when `key` differs from the
+    /// previous call's.
+    fn get_or_build(
+        &mut self,
+        key: SceneKey,
+        build: impl FnOnce(&mut Option<ProjectStatics>) -> (Vec<SceneOrgan>, Vec<OrganMesh>),
     ) -> (Arc<Vec<SceneOrgan>>, Arc<Vec<OrganMesh>>, u64) {
         if self.key != Some(key) {
-            let (scene, meshes) = build();
+            let (scene, meshes) = build(&mut self.statics);
             self.scene = Arc::new(scene);
             self.meshes = Arc::new(meshes);
             self.key = Some(key);
@@ -214,7 +290,7 @@ mod tests {
         let mut builds = 0;
         let mut get = |cache: &mut SceneCache, key: SceneKey| {
             cache
-                .get(key, || {
+                .get_or_build(key, |_| {
                     builds += 1;
                     (Vec::new(), Vec::new())
                 })
