@@ -159,7 +159,7 @@ impl AnthesisApp {
         let key = viewport::SceneKey {
             document_revision: self.doc.revision(),
             run: self.session.run(),
-            keyframes_received: self.session.current_frames(),
+            frames: self.session.frames_at(self.playback.time_in_keyframes),
             shown_end: self.session.shown_end(),
             time_in_keyframes: self.playback.time_in_keyframes,
             selected_organ: self.selected_organ,

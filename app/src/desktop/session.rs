@@ -73,6 +73,8 @@ struct Frame {
     meshes: Arc<Project>,
     kind: FrameKind,
     run: RunId,
+    /// Tells this frame from every other the session has held (counted).
+    serial: u64,
 }
 
 /// The organs at a time on the timeline, as shown.
@@ -122,6 +124,8 @@ pub struct SimSession {
     first_computed: u32,
     /// Whether the current run's proxy is still being computed.
     proxy_running: bool,
+    /// The serial number of the next frame.
+    next_serial: u64,
 }
 
 /// Longest time one frame spends taking events from the worker.
@@ -156,6 +160,7 @@ impl SimSession {
             iteration: None,
             first_computed: 1,
             proxy_running: false,
+            next_serial: 0,
         }
     }
 
@@ -299,16 +304,18 @@ impl SimSession {
         self.frames[index] = Some(frame);
     }
 
-    fn frame(&self, keyframe: Arc<Keyframe>, kind: FrameKind) -> Option<Frame> {
+    fn frame(&mut self, keyframe: Arc<Keyframe>, kind: FrameKind) -> Option<Frame> {
         let meshes = match kind {
             FrameKind::Converged => self.project.as_ref()?,
             FrameKind::Proxy => self.proxy.as_ref()?,
         };
+        self.next_serial += 1;
         Some(Frame {
             keyframe,
             meshes: Arc::clone(meshes),
             kind,
             run: self.run,
+            serial: self.next_serial,
         })
     }
 
@@ -424,15 +431,6 @@ impl SimSession {
         self.keyframes.last().map(|k| k.index)
     }
 
-    /// How many keyframes of the current run (converged or proxy) can be
-    /// shown: a measure of progress that changes whenever a frame arrives.
-    pub fn current_frames(&self) -> usize {
-        self.frames
-            .iter()
-            .filter(|f| f.as_ref().is_some_and(|f| f.run == self.run))
-            .count()
-    }
-
     /// Statistics of the computed keyframes after the bud.
     pub fn stats(&self) -> impl Iterator<Item = &KeyframeStats> {
         self.keyframes.iter().skip(1).map(|k| &k.stats)
@@ -494,6 +492,17 @@ impl SimSession {
     pub fn state_at(&self, time_in_keyframes: f64) -> Option<FrameState> {
         let end = self.shown_end()? as usize;
         self.frame_state((time_in_keyframes.max(0.0).ceil() as usize).min(end))
+    }
+
+    /// Which frames the view at `time_in_keyframes` shows (the two it
+    /// blends, as [`SimSession::shown_at`] picks them), as serial numbers
+    /// that change whenever another frame takes their place: the scene
+    /// needs building again exactly when these change.
+    pub fn frames_at(&self, time_in_keyframes: f64) -> Option<(u64, u64)> {
+        let count = self.shown_end()? as usize + 1;
+        let blend = KeyframeBlend::at(count, time_in_keyframes)?;
+        let serial = |i: usize| self.frames.get(i)?.as_ref().map(|f| f.serial);
+        Some((serial(blend.below)?, serial(blend.above)?))
     }
 
     /// Whether the view at `time_in_keyframes` shows an earlier run's
@@ -922,13 +931,18 @@ mod tests {
         ));
         assert!(!session.proxy_running());
 
-        // The converged keyframes 1 and 2 arrive and replace the proxy's.
+        // The converged keyframes 1 and 2 arrive and replace the proxy's:
+        // the view at 2 shows other frames (its scene is built again), the
+        // view at 3 the same.
+        let (at_2, at_3) = (session.frames_at(2.0), session.frames_at(3.0));
         for (i, x) in [(1, 1.0), (2, 2.0)] {
             let keyframe = keyframe_of(&project, i, x);
             assert!(session.accept(Event::Keyframe { run, keyframe }, &mut Vec::new()));
         }
         assert_eq!(session.state_at(2.0), Some(FrameState::Converged));
         assert_eq!(session.state_at(2.5), Some(FrameState::Proxy));
+        assert_ne!(session.frames_at(2.0), at_2);
+        assert_eq!(session.frames_at(3.0), at_3);
         let shown = session.shown_at(2.0).expect("shown");
         assert!(Arc::ptr_eq(&shown.meshes, &project));
         assert_eq!(shown.positions[0][0].x, 2.0);

@@ -144,9 +144,11 @@ pub struct SceneKey {
     /// [`crate::desktop::document::Document::revision`]: which project,
     /// as changed so far.
     pub document_revision: u64,
-    /// The run shown and how many of its keyframes have arrived.
+    /// The run shown, and the frames the view blends
+    /// ([`SimSession::frames_at`]: a proxy replaced by the converged
+    /// keyframe is another frame).
     pub run: RunId,
-    pub keyframes_received: usize,
+    pub frames: Option<(u64, u64)>,
     /// The newest keyframe shown (an earlier run's where this one has not
     /// arrived, see [`SimSession::shown_end`]).
     pub shown_end: Option<u32>,
@@ -275,7 +277,7 @@ mod tests {
         SceneKey {
             document_revision: 7,
             run: 2,
-            keyframes_received: 10,
+            frames: Some((10, 11)),
             shown_end: Some(9),
             time_in_keyframes: 4.5,
             selected_organ: 1,
@@ -305,7 +307,7 @@ mod tests {
             },
             SceneKey { run: 3, ..key() },
             SceneKey {
-                keyframes_received: 11,
+                frames: Some((10, 12)),
                 ..key()
             },
             SceneKey {
