@@ -11,6 +11,7 @@
 
 #![warn(missing_docs)]
 
+pub mod crossing;
 mod error;
 pub mod generate;
 pub mod nearest;
