@@ -21,6 +21,7 @@
 //! glam's `DVec3` is a few dozen lines.
 
 use glam::{DVec3, IVec3};
+use rayon::prelude::*;
 
 /// One triangle mesh taking part in a search: positions and triangles
 /// (indices into the positions).
@@ -77,6 +78,14 @@ pub struct CrossingSearch {
     starts: Vec<u32>,
     /// The entries, by bucket: a triangle and the cell it covers.
     entries: Vec<(u32, IVec3)>,
+    /// Per bucket, where its next entry goes while filling.
+    next: Vec<u32>,
+    /// Per triangle: its corners, its vertices and its range of cells.
+    corners: Vec<[DVec3; 3]>,
+    vertices: Vec<[u32; 3]>,
+    ranges: Vec<(IVec3, IVec3)>,
+    /// Per pair of bodies, whether they may cross.
+    tested: Vec<bool>,
 }
 
 impl CrossingSearch {
@@ -101,10 +110,13 @@ impl CrossingSearch {
         self.boxes.clear();
         self.owner.clear();
         self.first.clear();
+        self.corners.clear();
+        self.vertices.clear();
         for (b, body) in bodies.iter().enumerate() {
             self.first.push(self.boxes.len());
             for t in body.triangles {
-                let [p, q, r] = t.map(|v| body.positions[v as usize]);
+                let corners = t.map(|v| body.positions[v as usize]);
+                let [p, q, r] = corners;
                 // `min` and `max` pass NaN over: a broken corner is
                 // marked so that the triangle is left out.
                 let broken = !(p.is_finite() && q.is_finite() && r.is_finite());
@@ -115,39 +127,43 @@ impl CrossingSearch {
                 };
                 self.boxes.push((lo, hi));
                 self.owner.push(b as u32);
+                self.corners.push(corners);
+                self.vertices.push(*t);
             }
         }
         let n = self.boxes.len();
-        let finite = |(lo, hi): (DVec3, DVec3)| lo.is_finite() && hi.is_finite();
         let mut cell = if cell.is_finite() && cell > 0.0 {
             cell
         } else {
             1.0
         };
-        // Grow the cell until the boxes cover few enough of them (a box
-        // too large for `i32` cells counts as too many).
-        let range = |(lo, hi): (DVec3, DVec3), cell: f64| {
-            let (a, b) = ((lo / cell).floor(), (hi / cell).floor());
-            let limit = f64::from(i32::MAX / 2);
-            (a.abs().max_element() < limit && b.abs().max_element() < limit)
-                .then(|| (a.as_ivec3(), b.as_ivec3()))
-        };
-        let count = |(a, b): (IVec3, IVec3)| {
-            let d = (b - a + IVec3::ONE).as_i64vec3();
-            (d.x * d.y * d.z) as usize
-        };
+        // Each triangle's range of cells; the cell grows until the boxes
+        // cover few enough of them (a box too large for `i32` cells counts
+        // as too many).
+        let limit = f64::from(i32::MAX / 2);
         let entries = loop {
+            self.ranges.clear();
             let mut total = 0usize;
             let mut fits = true;
-            for &bx in self.boxes.iter().filter(|&&bx| finite(bx)) {
-                match range(bx, cell) {
-                    Some(r) => total = total.saturating_add(count(r)),
-                    None => fits = false,
+            for &(lo, hi) in &self.boxes {
+                if !(lo.is_finite() && hi.is_finite()) {
+                    // Left out: an empty range.
+                    self.ranges.push((IVec3::ONE, IVec3::ZERO));
+                    continue;
                 }
-                if !fits || total > MAX_CELLS_PER_TRIANGLE * n.max(1) {
+                let (a, b) = ((lo / cell).floor(), (hi / cell).floor());
+                if a.abs().max_element() >= limit || b.abs().max_element() >= limit {
                     fits = false;
                     break;
                 }
+                let (a, b) = (a.as_ivec3(), b.as_ivec3());
+                let d = (b - a + IVec3::ONE).as_i64vec3();
+                total = total.saturating_add((d.x * d.y * d.z) as usize);
+                if total > MAX_CELLS_PER_TRIANGLE * n.max(1) {
+                    fits = false;
+                    break;
+                }
+                self.ranges.push((a, b));
             }
             if fits {
                 break total;
@@ -164,22 +180,16 @@ impl CrossingSearch {
             // Mix the high bits down, so that the mask sees them.
             ((h ^ (h >> 17)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32 & mask) as usize
         };
-        let cells = |bx: (DVec3, DVec3)| {
-            finite(bx)
-                .then(|| range(bx, cell))
-                .flatten()
-                .into_iter()
-                .flat_map(|(a, b)| {
-                    (a.x..=b.x).flat_map(move |x| {
-                        (a.y..=b.y).flat_map(move |y| (a.z..=b.z).map(move |z| IVec3::new(x, y, z)))
-                    })
-                })
+        let cells = |(a, b): (IVec3, IVec3)| {
+            (a.x..=b.x).flat_map(move |x| {
+                (a.y..=b.y).flat_map(move |y| (a.z..=b.z).map(move |z| IVec3::new(x, y, z)))
+            })
         };
         // Counting sort of the entries by bucket.
         self.starts.clear();
         self.starts.resize(buckets + 1, 0);
-        for &bx in &self.boxes {
-            for c in cells(bx) {
+        for &range in &self.ranges {
+            for c in cells(range) {
                 self.starts[bucket(c) + 1] += 1;
             }
         }
@@ -188,62 +198,90 @@ impl CrossingSearch {
         }
         self.entries.clear();
         self.entries.resize(entries, (0, IVec3::ZERO));
-        let mut next: Vec<u32> = self.starts[..buckets].to_vec();
-        for (t, &bx) in self.boxes.iter().enumerate() {
-            for c in cells(bx) {
-                let slot = &mut next[bucket(c)];
+        self.next.clear();
+        self.next.extend_from_slice(&self.starts[..buckets]);
+        for (t, &range) in self.ranges.iter().enumerate() {
+            for c in cells(range) {
+                let slot = &mut self.next[bucket(c)];
                 self.entries[*slot as usize] = (t as u32, c);
                 *slot += 1;
             }
         }
 
-        let mut found = Vec::new();
-        for k in 0..buckets {
-            let list = &self.entries[self.starts[k] as usize..self.starts[k + 1] as usize];
-            for (i, &(s, cs)) in list.iter().enumerate() {
-                for &(t, ct) in &list[i + 1..] {
-                    if cs != ct {
-                        continue;
-                    }
-                    let (s, t) = (s.min(t) as usize, s.max(t) as usize);
-                    let (bs, bt) = (self.owner[s] as usize, self.owner[t] as usize);
-                    if !tested(bs, bt) {
-                        continue;
-                    }
-                    let ((ls, hs), (lt, ht)) = (self.boxes[s], self.boxes[t]);
-                    if ls.cmpgt(ht).any() || lt.cmpgt(hs).any() {
-                        continue;
-                    }
-                    // The pair's one cell: where the boxes' overlap starts.
-                    if (ls.max(lt) / cell).floor().as_ivec3() != cs {
-                        continue;
-                    }
-                    let (ts, tt) = (s - self.first[bs], t - self.first[bt]);
-                    let (vs, vt) = (bodies[bs].triangles[ts], bodies[bt].triangles[tt]);
-                    if bs == bt && vs.iter().any(|v| vt.contains(v)) {
-                        continue;
-                    }
-                    let ps = vs.map(|v| bodies[bs].positions[v as usize]);
-                    let pt = vt.map(|v| bodies[bt].positions[v as usize]);
-                    if let Some((at_a, at_b)) = triangles_cross(&ps, &pt) {
-                        found.push(Crossing {
-                            a: TriangleOf {
-                                body: bs as u32,
-                                triangle: ts as u32,
-                            },
-                            b: TriangleOf {
-                                body: bt as u32,
-                                triangle: tt as u32,
-                            },
-                            at_a,
-                            at_b,
-                        });
-                    }
+        // Which bodies may cross, looked up per pair.
+        let count = bodies.len();
+        self.tested.clear();
+        self.tested.extend(
+            (0..count * count)
+                .map(|k| tested((k / count).min(k % count), (k / count).max(k % count))),
+        );
+        // The buckets in chunks on rayon's threads (sorted after, so the
+        // answer does not depend on them).
+        let this = &*self;
+        let chunk = buckets.div_ceil(64).max(1024);
+        let mut found: Vec<Crossing> = (0..buckets)
+            .step_by(chunk)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .flat_map_iter(|first| {
+                let mut out = Vec::new();
+                for k in first..(first + chunk).min(buckets) {
+                    this.pairs_in(k, bodies.len(), &mut out);
+                }
+                out
+            })
+            .collect();
+        found.sort_unstable_by_key(|c| (c.a, c.b));
+        found
+    }
+
+    /// The crossings among the entries of bucket `k` (of a search over
+    /// `count` bodies), each pair in the one cell where its boxes' overlap
+    /// starts.
+    fn pairs_in(&self, k: usize, count: usize, out: &mut Vec<Crossing>) {
+        let list = &self.entries[self.starts[k] as usize..self.starts[k + 1] as usize];
+        for (i, &(s, cs)) in list.iter().enumerate() {
+            let s = s as usize;
+            let (ls, hs) = self.boxes[s];
+            let low_s = self.ranges[s].0;
+            for &(t, ct) in &list[i + 1..] {
+                let t = t as usize;
+                let (lt, ht) = self.boxes[t];
+                // Another cell in the same bucket, boxes apart, or not the
+                // pair's one cell: where the boxes' overlap starts (the
+                // larger of their lowest cells).
+                if cs != ct
+                    || ls.cmpgt(ht).any()
+                    || lt.cmpgt(hs).any()
+                    || low_s.max(self.ranges[t].0) != cs
+                {
+                    continue;
+                }
+                let (s, t) = (s.min(t), s.max(t));
+                let (bs, bt) = (self.owner[s] as usize, self.owner[t] as usize);
+                if !self.tested[bs * count + bt] {
+                    continue;
+                }
+                let (vs, vt) = (self.vertices[s], self.vertices[t]);
+                if bs == bt && vs.iter().any(|v| vt.contains(v)) {
+                    continue;
+                }
+                if let Some((at_a, at_b)) = triangles_cross(&self.corners[s], &self.corners[t]) {
+                    out.push(Crossing {
+                        a: TriangleOf {
+                            body: bs as u32,
+                            triangle: (s - self.first[bs]) as u32,
+                        },
+                        b: TriangleOf {
+                            body: bt as u32,
+                            triangle: (t - self.first[bt]) as u32,
+                        },
+                        at_a,
+                        at_b,
+                    });
                 }
             }
         }
-        found.sort_unstable_by_key(|c| (c.a, c.b));
-        found
     }
 }
 
@@ -251,9 +289,31 @@ impl CrossingSearch {
 /// the other's interior), and if so where: the point, as barycentric
 /// weights of `a`'s corners and of `b`'s.
 pub fn triangles_cross(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<([f64; 3], [f64; 3])> {
-    if all_on_one_side(a, b) || all_on_one_side(b, a) {
+    // Möller's interval test first (most pairs the grid hands over are
+    // neighbours of one smooth sheet, which it rejects cheaply); the edges
+    // are then tested for where they cross.
+    let (na, nb) = (
+        (a[1] - a[0]).cross(a[2] - a[0]),
+        (b[1] - b[0]).cross(b[2] - b[0]),
+    );
+    let da = a.map(|p| (p - b[0]).dot(nb));
+    let db = b.map(|p| (p - a[0]).dot(na));
+    let one_side = |d: &[f64; 3]| d.iter().all(|&x| x > 0.0) || d.iter().all(|&x| x < 0.0);
+    if one_side(&da) || one_side(&db) {
         return None;
     }
+    let line = na.cross(nb);
+    if let (Some(ia), Some(ib)) = (interval(a, &da, line), interval(b, &db, line))
+        && (ia.1 < ib.0 || ib.1 < ia.0)
+    {
+        return None;
+    }
+    edges_cross(a, b)
+}
+
+/// Where an edge of `a` or `b` passes through the other's interior, the
+/// first found (see [`triangles_cross`]).
+fn edges_cross(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<([f64; 3], [f64; 3])> {
     for k in 0..3 {
         let (i, j) = (k, (k + 1) % 3);
         if let Some((t, inside)) = segment_through_triangle(a[i], a[j], b) {
@@ -275,11 +335,22 @@ pub fn triangles_cross(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<([f64; 3], [f64
     None
 }
 
-/// Whether every corner of `a` lies strictly on one side of `b`'s plane.
-fn all_on_one_side(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
-    let normal = (b[1] - b[0]).cross(b[2] - b[0]);
-    let side = a.map(|p| (p - b[0]).dot(normal));
-    side.iter().all(|&d| d > 0.0) || side.iter().all(|&d| d < 0.0)
+/// Where a triangle with corners `t`, at signed distances `d` from the
+/// other's plane (not all on one side), meets that plane, as an interval
+/// along `line` (the planes' common direction): `None` where a corner lies
+/// in the plane (the edge tests decide).
+fn interval(t: &[DVec3; 3], d: &[f64; 3], line: DVec3) -> Option<(f64, f64)> {
+    if d.contains(&0.0) {
+        return None;
+    }
+    // The corner alone on its side.
+    let alone = (0..3).find(|&i| {
+        (d[i] > 0.0) != (d[(i + 1) % 3] > 0.0) && (d[i] > 0.0) != (d[(i + 2) % 3] > 0.0)
+    })?;
+    let p = t.map(|c| c.dot(line));
+    let at = |j: usize| p[j] + (p[alone] - p[j]) * d[j] / (d[j] - d[alone]);
+    let (x, y) = (at((alone + 1) % 3), at((alone + 2) % 3));
+    Some((x.min(y), x.max(y)))
 }
 
 /// Where the segment `p -> q` passes through the interior of `tri`
@@ -413,6 +484,29 @@ mod tests {
             search.find(&[body(&through)], 0.2, &|_, _| false),
             Vec::new()
         );
+    }
+
+    #[test]
+    fn the_interval_test_rejects_no_pair_whose_edges_cross() {
+        // Random triangles in a small box: the quick rejections must agree
+        // with testing every edge, crossing or not.
+        let mut state = 7u64;
+        let mut random = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut point = || DVec3::new(random(), random(), random());
+        let mut crossing = 0;
+        for _ in 0..20_000 {
+            let a = [point(), point(), point()];
+            let b = [point(), point(), point()];
+            let quick = triangles_cross(&a, &b);
+            assert_eq!(quick, edges_cross(&a, &b), "{a:?} {b:?}");
+            crossing += usize::from(quick.is_some());
+        }
+        assert!(crossing > 1000, "{crossing}");
     }
 
     #[test]
