@@ -458,6 +458,48 @@ pub fn self_contacts(
     }
 }
 
+/// Contacts of the particles of `moving` (not `skip`ped) against `other`,
+/// an organ it has no overlap rule with (two organs of one whorl, issue
+/// 35): each on the side of `other` it was on when the last keyframe ended
+/// (`previous_moving`: its positions then; `previous_other`: the other's
+/// surface then, near the same nearest particle), else as
+/// [`contacts_against`].
+#[allow(clippy::too_many_arguments)]
+pub fn kept_side_contacts(
+    moving: &Surface,
+    other: &Surface,
+    tracker: &Tracker,
+    previous_moving: &[DVec3],
+    previous_other: &Surface,
+    skip: &[bool],
+    offset: f64,
+    violated: Violated,
+    out: &mut Vec<Contact>,
+) {
+    for (i, &x) in moving.positions.iter().enumerate() {
+        if skip[i] {
+            continue;
+        }
+        let Some(q) = tracker.nearest(x, other.positions) else {
+            continue;
+        };
+        let Some(nearest) = nearest_on_surface(x, other, q) else {
+            continue;
+        };
+        let was = nearest_on_surface(previous_moving[i], previous_other, q).map_or(0.0, |then| {
+            (previous_moving[i] - then.point).dot(then.normal)
+        });
+        let side = if was != 0.0 {
+            was.signum()
+        } else {
+            (x - nearest.point).dot(nearest.normal).signum()
+        };
+        if let Some(contact) = contact_at(moving, i, x, &nearest, side, offset, offset, violated) {
+            out.push(contact);
+        }
+    }
+}
+
 /// The plane of a triangle, for the barycentric weights of points
 /// projected onto it (outside the triangle too).
 struct PlaneFrame {

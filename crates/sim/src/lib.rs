@@ -33,8 +33,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::collide::{
-    Surface, Tracker, Violated, contacts_against, contacts_of, max_violation, move_half, push_back,
-    self_contacts, start_on_contacts,
+    Surface, Tracker, Violated, contacts_against, contacts_of, kept_side_contacts, max_violation,
+    move_half, push_back, self_contacts, start_on_contacts,
 };
 use crate::crossing::{Crossed, Crossings, OnCrossing};
 use crate::obstacle::ObstacleSim;
@@ -321,6 +321,9 @@ pub struct Simulation {
     checkpoints: Option<Vec<Checkpoint>>,
     /// Overlaps between simulated organs, as indices into `organs`.
     overlaps: Vec<(usize, usize)>,
+    /// Every (moving, other) pair of growing organ and organ with no
+    /// overlap rule between them, each keeping the side it was on.
+    free: Vec<(usize, usize)>,
     /// The parts every organ is kept out of.
     obstacles: Vec<ObstacleSim>,
     settings: anthesis_flower::SimulationSettings,
@@ -374,8 +377,9 @@ impl Simulation {
                 let outer = chosen.iter().position(|&c| c == o.outer)?;
                 Some((inner, outer))
             })
-            .collect();
+            .collect::<Vec<_>>();
         let previous_energy = vec![0.0; organs.len()];
+        let free = free_pairs(&organs, &overlaps);
         let obstacles = anthesis_flower::parts::obstacles(flower)
             .into_iter()
             .map(ObstacleSim::new)
@@ -386,6 +390,7 @@ impl Simulation {
             chosen,
             checkpoints: None,
             overlaps,
+            free,
             obstacles,
             settings: project.settings,
             next_step: 1,
@@ -829,7 +834,11 @@ impl Simulation {
             }
             // Every organ moved.
             geometry = unknown_geometry(self.organs.len());
-            if self.overlaps.is_empty() && self.obstacles.is_empty() && !self.self_contact() {
+            if self.overlaps.is_empty()
+                && self.free.is_empty()
+                && self.obstacles.is_empty()
+                && !self.self_contact()
+            {
                 break 0;
             }
             // The contacts held, less the self-contacts (appended last).
@@ -1001,11 +1010,17 @@ impl Simulation {
             });
         let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
         let selves = self.self_contacts(&geometry);
+        let free = self
+            .free
+            .par_iter()
+            .map(|&(moving, other)| self.free_contacts_of(moving, other, geometry[other]))
+            .collect();
         if self.overlaps.is_empty() {
             return Found {
                 parts,
                 sides,
                 selves,
+                free,
             };
         }
         // A kinematic organ (two-state) gets no contacts.
@@ -1027,7 +1042,40 @@ impl Simulation {
             parts,
             sides,
             selves,
+            free,
         }
+    }
+
+    /// Organ `moving`'s contacts against organ `other` (a free pair;
+    /// `known`: the other's geometry where it is), each keeping the side it
+    /// was on when the last keyframe ended, to be put all the way.
+    fn free_contacts_of(&self, moving: usize, other: usize, known: &Geometry) -> Vec<Contact> {
+        let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let mut list = Vec::new();
+        let (Some(previous_moving), Some(previous_other)) = (
+            m.previous(),
+            o.previous()
+                .or_else(|| o.is_kinematic().then_some(o.positions.as_slice())),
+        ) else {
+            return list;
+        };
+        let previous_normals = anthesis_mesh::vertex_normals(previous_other, &o.mesh.triangles);
+        let then = Surface {
+            positions: previous_other,
+            ..o.surface(&previous_normals)
+        };
+        kept_side_contacts(
+            &m.surface(&[]),
+            &o.surface(&known.normals),
+            &known.tracker,
+            previous_moving,
+            &then,
+            &m.is_base,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut list,
+        );
+        list
     }
 
     /// How many of each organ's contacts of `found` are against the parts
@@ -1037,6 +1085,9 @@ impl Simulation {
         let mut counts: Vec<usize> = found.parts.iter().map(Vec::len).collect();
         for (key, moving, _, _) in self.sides() {
             counts[moving] += found.sides[key].len();
+        }
+        for (&(moving, _), list) in self.free.iter().zip(&found.free) {
+            counts[moving] += list.len();
         }
         counts
     }
@@ -1099,6 +1150,17 @@ impl Simulation {
             let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
             let positions = &self.organs[moving].positions;
             contacts[moving].extend(found.sides[key].iter().map(|&c| {
+                if half {
+                    move_half(c, positions[c.particle as usize])
+                } else {
+                    c
+                }
+            }));
+        }
+        for (&(moving, other), list) in self.free.iter().zip(&found.free) {
+            let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
+            let positions = &self.organs[moving].positions;
+            contacts[moving].extend(list.iter().map(|&c| {
                 if half {
                     move_half(c, positions[c.particle as usize])
                 } else {
@@ -1195,7 +1257,9 @@ impl Simulation {
             parts: mut parts_found,
             sides: mut side_found,
             selves: mut self_found,
+            free: mut free_found,
         } = found;
+        let mut free_clear: Vec<Option<(u32, u32)>> = vec![None; self.free.len()];
         let mut self_clear: Vec<Option<u32>> = vec![None; self.organs.len()];
         let mut parts_given = vec![true; self.organs.len()];
         // Where each side's moving organ was when its last list was found,
@@ -1283,6 +1347,35 @@ impl Simulation {
                 side_found[key] = contacts;
                 pushed_in_pass += pushed;
             }
+            // Each free pair: the search made before the push-back while
+            // neither organ was pushed, else where they are.
+            for (key, &(moving, other)) in self.free.iter().enumerate() {
+                if free_clear[key] == Some((pushes[moving], pushes[other])) {
+                    continue;
+                }
+                let given = std::mem::take(&mut free_found[key]);
+                let list = if pushes[moving] == 0 && pushes[other] == 0 && free_clear[key].is_none()
+                {
+                    given
+                } else {
+                    let known =
+                        geometry[other].get_or_insert_with(|| Geometry::of(&self.organs[other]));
+                    self.free_contacts_of(moving, other, known)
+                };
+                let pushed = push_back(
+                    &mut self.organs[moving].positions,
+                    &list,
+                    &mut moved[moving],
+                );
+                if pushed > 0 {
+                    pushes[moving] += 1;
+                    geometry[moving] = None;
+                } else {
+                    free_clear[key] = Some((pushes[moving], pushes[other]));
+                }
+                free_found[key] = list;
+                pushed_in_pass += pushed;
+            }
             // Each organ against itself: the search made before the
             // push-back while nothing has pushed it, else where it is.
             for i in 0..self.organs.len() {
@@ -1317,6 +1410,9 @@ impl Simulation {
             let mut contacts = parts_found;
             for (key, moving, _, _) in self.sides() {
                 contacts[moving].extend_from_slice(&side_found[key]);
+            }
+            for (&(moving, _), list) in self.free.iter().zip(&free_found) {
+                contacts[moving].extend_from_slice(list);
             }
             contacts
         });
@@ -1450,6 +1546,13 @@ impl Simulation {
             .sides()
             .filter(|&(key, moving, _, _)| moving == organ && !found.sides[key].is_empty())
             .map(|(_, _, other, _)| other)
+            .chain(
+                self.free
+                    .iter()
+                    .zip(&found.free)
+                    .filter(|((moving, _), list)| *moving == organ && !list.is_empty())
+                    .map(|(&(_, other), _)| other),
+            )
             .collect();
         others.sort_unstable();
         others.dedup();
@@ -1476,6 +1579,8 @@ struct Found {
     sides: Vec<Vec<Contact>>,
     /// Each organ's contacts against itself.
     selves: Vec<Vec<Contact>>,
+    /// Each free pair's contacts (`Simulation::free`, same order).
+    free: Vec<Vec<Contact>>,
 }
 
 /// One organ's unit normals and nearest-particle lookup where it is:
@@ -1493,6 +1598,27 @@ impl Geometry {
             tracker: Tracker::new(&organ.positions, 2.0 * organ.mean_edge),
         }
     }
+}
+
+/// Every (moving, other) pair of organs with no overlap rule between them
+/// (either way), the moving one growing (a kinematic organ gets no
+/// contacts): issue 35's organs of one whorl, which keep the side of each
+/// other they were on.
+fn free_pairs(organs: &[OrganSim], overlaps: &[(usize, usize)]) -> Vec<(usize, usize)> {
+    let ruled = |a: usize, b: usize| {
+        overlaps
+            .iter()
+            .any(|&(i, o)| (i, o) == (a, b) || (i, o) == (b, a))
+    };
+    let mut pairs = Vec::new();
+    for a in 0..organs.len() {
+        for b in 0..organs.len() {
+            if a != b && !ruled(a, b) && !organs[a].is_kinematic() {
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
 }
 
 /// Nothing known yet of `organs` organs' geometry.
