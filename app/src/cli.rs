@@ -103,6 +103,11 @@ pub enum Command {
         /// (0 = the simulated mesh).
         #[arg(long, value_name = "N", default_value_t = 0)]
         subdivide: u32,
+        /// Go on past a keyframe whose triangles cross (an organ through
+        /// another, a part or itself), with a warning naming them, instead
+        /// of stopping there with an error and a non-zero exit.
+        #[arg(long)]
+        allow_crossings: bool,
     },
     /// Simulate a project and render chosen keyframes to PNG pictures, all
     /// seen by one camera.
@@ -273,6 +278,7 @@ pub fn run(cli: Cli) -> Result<()> {
             no_normals,
             encoding,
             subdivide,
+            allow_crossings,
         }) => {
             let timing = match (fps, duration) {
                 (_, Some(d)) if d > 0.0 && d.is_finite() => Timing::Duration(d),
@@ -293,6 +299,7 @@ pub fn run(cli: Cli) -> Result<()> {
                     organ: organ.as_deref(),
                     keyframes,
                     edge,
+                    allow_crossings,
                 },
                 stats.as_deref(),
                 out.as_deref(),

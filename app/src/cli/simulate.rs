@@ -7,8 +7,9 @@ use std::time::Instant;
 
 use anthesis_export::{GlbOptions, UsdOptions};
 use anthesis_flower::{MAX_KEYFRAMES, Resolution};
+use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::memory::{self, KeyframeCost};
-use anthesis_sim::{Keyframe, KeyframeStats, Simulation};
+use anthesis_sim::{Keyframe, KeyframeStats, SimError, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
@@ -50,6 +51,8 @@ pub(super) struct RunChoice<'a> {
     pub(super) organ: Option<&'a str>,
     pub(super) keyframes: Option<u32>,
     pub(super) edge: Option<Resolution>,
+    /// Go on past crossing keyframes with a warning (`--allow-crossings`).
+    pub(super) allow_crossings: bool,
 }
 
 pub(super) fn simulate(
@@ -58,6 +61,7 @@ pub(super) fn simulate(
         organ,
         keyframes,
         edge,
+        allow_crossings,
     }: RunChoice<'_>,
     stats_path: Option<&Path>,
     out: Option<&Path>,
@@ -95,6 +99,9 @@ pub(super) fn simulate(
     memory::check_run(&project, &selection, cost)?;
 
     let mut sim = Simulation::new(&project, &selection)?;
+    if allow_crossings {
+        sim.on_crossing(OnCrossing::Warn);
+    }
     let total = sim.keyframe_count();
     let mut frames: Vec<Vec<Vec<DVec3>>> = vec![sim.bud().positions_in_world];
     let mut stats = Vec::new();
@@ -196,13 +203,26 @@ pub(super) fn run_keyframes(
     let mut done = 0;
     let mut failure = None;
     while done < last && !sim.finished() {
+        let warned = sim.crossings().len();
         let keyframe = match sim.step(&|| false, &mut |_| {}) {
             Ok(keyframe) => keyframe,
+            Err(error @ SimError::Crossed(_)) => {
+                failure = Some(anyhow::Error::new(error).context(
+                    "the run stopped where organs cross (`--allow-crossings` goes on with a warning)",
+                ));
+                break;
+            }
             Err(error) => {
                 failure = Some(anyhow::Error::new(error));
                 break;
             }
         };
+        for crossing in &sim.crossings()[warned..] {
+            if show_progress {
+                eprintln!();
+            }
+            eprintln!("warning: {crossing}");
+        }
         done = keyframe.index;
         if show_progress {
             let elapsed = started.elapsed().as_secs_f64();

@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod binary;
+pub mod crossing;
 mod error;
 pub mod generate;
 pub mod nearest;

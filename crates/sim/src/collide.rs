@@ -19,7 +19,7 @@
 
 use anthesis_mesh::nearest::{TriangleRings, closest_point_on_triangle, on_rim, phong_point};
 use anthesis_physics::Contact;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 /// One organ's current geometry as collisions see it.
 pub struct Surface<'a> {
@@ -146,6 +146,72 @@ impl Tracker {
         inside.then(|| ((c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]) as usize)
     }
 
+    /// Per cell of the grid, the bounds of `values` (one per particle
+    /// the tracker was made over) of the particles in it (empty cells:
+    /// inverted bounds).
+    pub fn cell_bounds(&self, values: &[DVec2]) -> Vec<(DVec2, DVec2)> {
+        let cells = self.cell_start.len().saturating_sub(1);
+        (0..cells)
+            .map(|c| {
+                let range = self.cell_start[c] as usize..self.cell_start[c + 1] as usize;
+                self.items[range].iter().fold(
+                    (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+                    |(lo, hi), &i| (lo.min(values[i as usize]), hi.max(values[i as usize])),
+                )
+            })
+            .collect()
+    }
+
+    /// The nearest particle within the search radius of `x` that is not in
+    /// particle `of`'s neighbourhood (`locality`), ties to the lower index.
+    /// Cells whose particles all lie in it (`cells`, from
+    /// [`Tracker::cell_bounds`] of `locality.uv`) are skipped whole.
+    fn nearest_beyond(
+        &self,
+        x: DVec3,
+        positions: &[DVec3],
+        cells: &[(DVec2, DVec2)],
+        locality: &Locality,
+        of: usize,
+    ) -> Option<u32> {
+        let [cx, cy, cz] = self.cell_of(x);
+        let centre = locality.uv[of];
+        let local2 = locality.local * locality.local;
+        let mut best: Option<(f64, u32)> = None;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let Some(c) = self.flat([cx + dx, cy + dy, cz + dz]) else {
+                        continue;
+                    };
+                    // The farthest corner of the cell's UV bounds inside
+                    // the neighbourhood: every particle there is.
+                    let (lo, hi) = cells[c];
+                    let far = (centre - lo).abs().max((hi - centre).abs());
+                    if far.length_squared() < local2 {
+                        continue;
+                    }
+                    let range = self.cell_start[c] as usize..self.cell_start[c + 1] as usize;
+                    for &i in &self.items[range] {
+                        if locality.near(of, i as usize) {
+                            continue;
+                        }
+                        let d = (positions[i as usize] - x).length_squared();
+                        let better = match best {
+                            None => true,
+                            Some((bd, bi)) => d < bd || (d == bd && i < bi),
+                        };
+                        if better {
+                            best = Some((d, i));
+                        }
+                    }
+                }
+            }
+        }
+        best.filter(|(d, _)| *d <= self.radius * self.radius)
+            .map(|(_, i)| i)
+    }
+
     /// The nearest particle within the search radius of `x` (ties go to
     /// the lower index).
     pub fn nearest(&self, x: DVec3, positions: &[DVec3]) -> Option<u32> {
@@ -256,34 +322,181 @@ pub fn contacts_of(
         let Some(nearest) = nearest_on_surface(x, other, q) else {
             continue;
         };
-        let normal = nearest.normal * side;
-        if nearest.on_rim {
-            let d = x - nearest.point;
-            let beside = (d - normal * d.dot(normal)).length();
-            if beside > offset {
-                continue;
-            }
+        if let Some(contact) = contact_at(moving, i, x, &nearest, side, offset, offset, violated) {
+            out.push(contact);
         }
-        // Held off the smooth surface, and off the flat triangle where it
-        // lies farther out (on the concave side of a curved neighbour):
-        // otherwise the particle could sit past the triangle drawn there.
-        // On the convex side the smooth surface bulges out between the
-        // points under the particle and its neighbours, so their straight
-        // edge, held at its ends, dips towards it in the middle (and
-        // through the flat triangles there, where they fold outwards):
-        // held off farther by that bulge.
-        let flat = (nearest.flat - nearest.point).dot(normal);
-        let bulge = bulge_under_edges(moving, i, &nearest, normal);
-        let contact = Contact {
-            particle: i as u32,
-            point: nearest.point + normal * flat.max(bulge).max(0.0),
-            normal,
-            offset,
+    }
+}
+
+/// The contact holding particle `i` of `moving`, at `x`, on side `side` of
+/// the surface point `nearest` (see [`contacts_against`]), or `None` where
+/// the point is on the rim and the particle more than `beside_rim` beside
+/// it.
+#[allow(clippy::too_many_arguments)]
+fn contact_at(
+    moving: &Surface,
+    i: usize,
+    x: DVec3,
+    nearest: &Nearest,
+    side: f64,
+    offset: f64,
+    beside_rim: f64,
+    violated: Violated,
+) -> Option<Contact> {
+    let normal = nearest.normal * side;
+    if nearest.on_rim {
+        let d = x - nearest.point;
+        let beside = (d - normal * d.dot(normal)).length();
+        if beside > beside_rim {
+            return None;
+        }
+    }
+    // Held off the smooth surface, and off the flat triangle where it
+    // lies farther out (on the concave side of a curved neighbour):
+    // otherwise the particle could sit past the triangle drawn there.
+    // On the convex side the smooth surface bulges out between the
+    // points under the particle and its neighbours, so their straight
+    // edge, held at its ends, dips towards it in the middle (and
+    // through the flat triangles there, where they fold outwards):
+    // held off farther by that bulge.
+    let flat = (nearest.flat - nearest.point).dot(normal);
+    let bulge = bulge_under_edges(moving, i, nearest, normal);
+    let contact = Contact {
+        particle: i as u32,
+        point: nearest.point + normal * flat.max(bulge).max(0.0),
+        normal,
+        offset,
+    };
+    Some(match violated {
+        Violated::MoveAll => contact,
+        Violated::MoveHalf => move_half(contact, x),
+    })
+}
+
+/// How far beside its own margin, in mean edges, a particle is still held
+/// off a fold of its organ (against another organ: the collision offset).
+const SELF_RIM_REACH: f64 = 0.5;
+
+/// Where an organ is far from itself along its surface: its particles'
+/// UVs scaled to lengths of its bud (see `OrganSim::locality`), and the
+/// distance in those below which two particles are neighbours (their
+/// nearness is the surface's own, not a fold of it onto itself).
+pub struct Locality<'a> {
+    /// Per particle, its UV scaled by the bud's lengths along `u` and `v`.
+    pub uv: &'a [DVec2],
+    /// Particles nearer than this in `uv` are each other's neighbourhood.
+    pub local: f64,
+}
+
+impl Locality<'_> {
+    fn near(&self, a: usize, b: usize) -> bool {
+        self.uv[a].distance_squared(self.uv[b]) < self.local * self.local
+    }
+}
+
+/// Self-contact (issue 35): contacts keeping each particle of `surface`
+/// (not `skip`ped) off the organ's own surface beyond its neighbourhood
+/// (`locality`), on the side it was on at the end of the last keyframe
+/// (`previous`: the organ's surface then, which the crossing check found
+/// clean). The nearest
+/// particle beyond the neighbourhood is found through `tracker` (over the
+/// organ's particles) and `cells` ([`Tracker::cell_bounds`] of the scaled
+/// UVs), whose cells lying wholly in the neighbourhood are not looked in;
+/// the contact is then as against another organ ([`contacts_against`]).
+#[allow(clippy::too_many_arguments)]
+pub fn self_contacts(
+    surface: &Surface,
+    tracker: &Tracker,
+    cells: &[(DVec2, DVec2)],
+    locality: &Locality,
+    previous: &Surface,
+    skip: &[bool],
+    offset: f64,
+    violated: Violated,
+    out: &mut Vec<Contact>,
+) {
+    for (i, &x) in surface.positions.iter().enumerate() {
+        if skip[i] {
+            continue;
+        }
+        let Some(q) = tracker.nearest_beyond(x, surface.positions, cells, locality, i) else {
+            continue;
         };
-        out.push(match violated {
-            Violated::MoveAll => contact,
-            Violated::MoveHalf => move_half(contact, x),
+        let Some(nearest) = nearest_on_surface(x, surface, q) else {
+            continue;
+        };
+        // The nearest point may lie on a triangle that reaches back into
+        // the neighbourhood (past the rim of a fold): not a self-contact.
+        if nearest
+            .triangle
+            .iter()
+            .any(|&k| locality.near(i, k as usize))
+        {
+            continue;
+        }
+        // The side: where the particle was against the organ's surface
+        // near the same particle when the last keyframe ended (the plane
+        // of the triangle nearest now, taken then, can lie on the wrong
+        // side of a fold that particle was beside).
+        let was = nearest_on_surface(previous.positions[i], previous, q).map_or(0.0, |then| {
+            (previous.positions[i] - then.point).dot(then.normal)
         });
+        let side = if was != 0.0 {
+            was.signum()
+        } else {
+            (x - nearest.point).dot(nearest.normal).signum()
+        };
+        // Two turns of a roll lie rim on rim: a particle just beside the
+        // other turn's margin is held too, or its edges to the held
+        // particles beside it pass through that margin.
+        let beside_rim = SELF_RIM_REACH * surface.mean_edge;
+        if let Some(contact) =
+            contact_at(surface, i, x, &nearest, side, offset, beside_rim, violated)
+        {
+            out.push(contact);
+        }
+    }
+}
+
+/// Contacts of the particles of `moving` (not `skip`ped) against `other`,
+/// an organ it has no overlap rule with (two organs of one whorl, issue
+/// 35): each on the side of `other` it was on when the last keyframe ended
+/// (`previous_moving`: its positions then; `previous_other`: the other's
+/// surface then, near the same nearest particle), else as
+/// [`contacts_against`].
+#[allow(clippy::too_many_arguments)]
+pub fn kept_side_contacts(
+    moving: &Surface,
+    other: &Surface,
+    tracker: &Tracker,
+    previous_moving: &[DVec3],
+    previous_other: &Surface,
+    skip: &[bool],
+    offset: f64,
+    violated: Violated,
+    out: &mut Vec<Contact>,
+) {
+    for (i, &x) in moving.positions.iter().enumerate() {
+        if skip[i] {
+            continue;
+        }
+        let Some(q) = tracker.nearest(x, other.positions) else {
+            continue;
+        };
+        let Some(nearest) = nearest_on_surface(x, other, q) else {
+            continue;
+        };
+        let was = nearest_on_surface(previous_moving[i], previous_other, q).map_or(0.0, |then| {
+            (previous_moving[i] - then.point).dot(then.normal)
+        });
+        let side = if was != 0.0 {
+            was.signum()
+        } else {
+            (x - nearest.point).dot(nearest.normal).signum()
+        };
+        if let Some(contact) = contact_at(moving, i, x, &nearest, side, offset, offset, violated) {
+            out.push(contact);
+        }
     }
 }
 
@@ -390,6 +603,8 @@ struct Nearest {
     /// Unit normal towards the organ's inner side.
     normal: DVec3,
     on_rim: bool,
+    /// The triangle's particles.
+    triangle: [u32; 3],
 }
 
 /// The point of `surface` nearest `x` among the triangles near particle
@@ -436,6 +651,7 @@ fn nearest_on_surface(x: DVec3, surface: &Surface, q: u32) -> Option<Nearest> {
         normals,
         normal,
         on_rim: on_rim(tri, weights, surface.rim),
+        triangle: tri,
     })
 }
 

@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 pub mod collide;
+pub mod crossing;
 #[cfg(any(test, feature = "fault-hook"))]
 pub mod fault;
 pub mod fixtures;
@@ -25,15 +26,17 @@ use std::time::Instant;
 
 use anthesis_flower::Project;
 use anthesis_mesh::MeshError;
+use anthesis_mesh::crossing::{Body, CrossingSearch};
 use anthesis_physics::solver::same_position_bits;
 use anthesis_physics::{Contact, SolverError};
 use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::collide::{
-    Tracker, Violated, contacts_against, contacts_of, max_violation, move_half, push_back,
-    start_on_contacts,
+    Surface, Tracker, Violated, contacts_against, contacts_of, kept_side_contacts, max_violation,
+    move_half, push_back, self_contacts, start_on_contacts,
 };
+use crate::crossing::{Crossed, Crossings, OnCrossing};
 use crate::obstacle::ObstacleSim;
 use crate::organ::{OrganSim, OrganState, Settle, Settled};
 use crate::resume::{Edit, edit_between};
@@ -199,6 +202,11 @@ pub enum SimError {
         /// [`held_against_note`]).
         held_against: Vec<String>,
     },
+    /// Triangles of the keyframe cross: an organ passes through another,
+    /// a part or itself (see [`crossing`]). The organs are left where that
+    /// keyframe put them; the keyframes before it stay good.
+    #[error("{0}; the keyframes before it are kept")]
+    Crossed(Box<Crossings>),
     /// A bug: the simulation panicked. Caught so the worker and the
     /// command line survive it and keep what was computed before.
     #[error("{}", describe_panic(*.run, *.keyframe, .message))]
@@ -313,6 +321,9 @@ pub struct Simulation {
     checkpoints: Option<Vec<Checkpoint>>,
     /// Overlaps between simulated organs, as indices into `organs`.
     overlaps: Vec<(usize, usize)>,
+    /// Every (moving, other) pair of growing organ and organ with no
+    /// overlap rule between them, each keeping the side it was on.
+    free: Vec<(usize, usize)>,
     /// The parts every organ is kept out of.
     obstacles: Vec<ObstacleSim>,
     settings: anthesis_flower::SimulationSettings,
@@ -322,6 +333,15 @@ pub struct Simulation {
     /// The keyframe whose step panicked: the organs may be half updated,
     /// so no further step runs.
     panicked_at: Option<u32>,
+    /// What a step does when its keyframe has crossing triangles.
+    on_crossing: OnCrossing,
+    /// The crossing search's buffers, kept between keyframes.
+    crossing_search: CrossingSearch,
+    /// What [`OnCrossing::Warn`] let through, per keyframe in order.
+    crossings: Vec<Crossings>,
+    /// Particles held off their own organ by a self-contact while the
+    /// organs settled, summed over the keyframes computed.
+    self_pressed: u64,
     #[cfg(any(test, feature = "fault-hook"))]
     fault: Option<fault::Fault>,
 }
@@ -357,8 +377,9 @@ impl Simulation {
                 let outer = chosen.iter().position(|&c| c == o.outer)?;
                 Some((inner, outer))
             })
-            .collect();
+            .collect::<Vec<_>>();
         let previous_energy = vec![0.0; organs.len()];
+        let free = free_pairs(&organs, &overlaps);
         let obstacles = anthesis_flower::parts::obstacles(flower)
             .into_iter()
             .map(ObstacleSim::new)
@@ -369,11 +390,16 @@ impl Simulation {
             chosen,
             checkpoints: None,
             overlaps,
+            free,
             obstacles,
             settings: project.settings,
             next_step: 1,
             previous_energy,
             panicked_at: None,
+            on_crossing: OnCrossing::Stop,
+            crossing_search: CrossingSearch::new(),
+            crossings: Vec::new(),
+            self_pressed: 0,
             #[cfg(all(feature = "fault-hook", not(test)))]
             fault: fault::Fault::from_env(),
             #[cfg(test)]
@@ -434,7 +460,9 @@ impl Simulation {
         if !rewound {
             let keep = self.checkpoints.is_some();
             let selection = self.selection.clone();
+            let on_crossing = self.on_crossing;
             *self = Simulation::new(after, &selection)?;
+            self.on_crossing = on_crossing;
             if keep {
                 self.keep_checkpoints();
             }
@@ -473,6 +501,7 @@ impl Simulation {
         self.previous_energy.clone_from(&state.previous_energy);
         checkpoints.truncate(step as usize);
         self.next_step = step;
+        self.crossings.retain(|c| c.keyframe < step);
         true
     }
 
@@ -480,6 +509,105 @@ impl Simulation {
     #[cfg(any(test, feature = "fault-hook"))]
     pub fn inject(&mut self, fault: Option<fault::Fault>) {
         self.fault = fault;
+    }
+
+    /// What a step does when its keyframe has crossing triangles (see
+    /// [`crossing`]): stop ([`OnCrossing::Stop`], the default) or go on
+    /// and keep what it found ([`Simulation::crossings`]).
+    pub fn on_crossing(&mut self, choice: OnCrossing) {
+        self.on_crossing = choice;
+    }
+
+    /// How many particles a self-contact held off their own organ while
+    /// the organs settled, summed over the keyframes computed (a particle
+    /// counts once per keyframe and contact round).
+    pub fn self_contact_count(&self) -> u64 {
+        self.self_pressed
+    }
+
+    /// The crossings [`OnCrossing::Warn`] let through, one per keyframe
+    /// that had any, in keyframe order.
+    pub fn crossings(&self) -> &[Crossings] {
+        &self.crossings
+    }
+
+    /// Where the triangles of the organs where they are now cross each
+    /// other, themselves or the parts at step `step`'s pose, if anywhere.
+    fn find_crossings(&mut self, step: u32) -> Option<Crossings> {
+        for obstacle in &mut self.obstacles {
+            obstacle.move_to(step);
+        }
+        let organs = self.organs.len();
+        let bodies: Vec<Body<'_>> = self
+            .organs
+            .iter()
+            .map(|o| Body {
+                positions: &o.positions,
+                triangles: &o.mesh.triangles,
+            })
+            .chain(self.obstacles.iter().map(|o| {
+                let s = o.surface();
+                Body {
+                    positions: s.positions,
+                    triangles: s.triangles,
+                }
+            }))
+            .collect();
+        // Twice the organs' largest mean edge: a cell holds a triangle and
+        // its neighbours.
+        let cell = 2.0 * self.organs.iter().map(|o| o.mean_edge).fold(0.0, f64::max);
+        // Parts against parts are not tested: they overlap by design.
+        let found = self
+            .crossing_search
+            .find(&bodies, cell, &|i, j| i.min(j) < organs);
+        if found.is_empty() {
+            return None;
+        }
+        let side = |body: u32, triangle: u32, at: [f64; 3]| {
+            let body = body as usize;
+            match self.organs.get(body) {
+                Some(o) => {
+                    let corners = o.mesh.triangles[triangle as usize];
+                    let uv = (0..3)
+                        .map(|k| o.mesh.uvs[corners[k] as usize] * at[k])
+                        .sum::<glam::DVec2>();
+                    Crossed::Organ {
+                        index: body,
+                        name: o.name.clone(),
+                        uv,
+                    }
+                }
+                None => Crossed::Part {
+                    name: self.obstacles[body - organs].name().to_string(),
+                },
+            }
+        };
+        let mut between: Vec<((u32, u32), Crossed, Crossed, usize)> = Vec::new();
+        for c in &found {
+            let key = (c.a.body, c.b.body);
+            match between.iter_mut().find(|(k, ..)| *k == key) {
+                Some((_, _, _, n)) => *n += 1,
+                None => between.push((
+                    key,
+                    side(c.a.body, c.a.triangle, c.at_a),
+                    side(c.b.body, c.b.triangle, c.at_b),
+                    1,
+                )),
+            }
+        }
+        let mut crossing_organs: Vec<usize> = found
+            .iter()
+            .flat_map(|c| [c.a.body as usize, c.b.body as usize])
+            .filter(|&b| b < organs)
+            .collect();
+        crossing_organs.sort_unstable();
+        crossing_organs.dedup();
+        Some(Crossings {
+            keyframe: step,
+            pairs: found.len(),
+            between: between.into_iter().map(|(_, a, b, n)| (a, b, n)).collect(),
+            organs: crossing_organs,
+        })
     }
 
     /// Names of the simulated organs, in keyframe order.
@@ -599,7 +727,7 @@ impl Simulation {
         // relax: rebuilt every iteration from organs that all move at once,
         // they made neighbours bounce off each other instead of settling.
         let mut found = self.search(&mut unknown_geometry(self.organs.len()));
-        let mut contacts = self.contacts(&found, Violated::MoveHalf);
+        let mut contacts = self.contacts(&found, Violated::MoveHalf, true);
         // Growth and the joint schedule may have carried particles onto the
         // wrong side. Newton's method started there sees deep, stiff
         // penalties and its first steps crumpled organs (a tip folded until
@@ -706,10 +834,27 @@ impl Simulation {
             }
             // Every organ moved.
             geometry = unknown_geometry(self.organs.len());
-            if self.overlaps.is_empty() && self.obstacles.is_empty() {
+            if self.overlaps.is_empty()
+                && self.free.is_empty()
+                && self.obstacles.is_empty()
+                && !self.self_contact()
+            {
                 break 0;
             }
-            pressed = self.pressed(&contacts);
+            // The contacts held, less the self-contacts (appended last).
+            let neighbours = self.neighbour_contacts(&found);
+            let held: Vec<Vec<Contact>> = contacts
+                .iter()
+                .zip(&neighbours)
+                .map(|(c, &n)| c[..n].to_vec())
+                .collect();
+            pressed = self.pressed(&held);
+            self.self_pressed += self
+                .pressed(&found.selves)
+                .iter()
+                .flatten()
+                .filter(|&&p| p)
+                .count() as u64;
             // Each organ kept off where its neighbours were when the
             // contacts were found, but the neighbours moved too: where
             // organs press on each other they now overlap. Pushed back from
@@ -717,7 +862,7 @@ impl Simulation {
             // particle lies deep on the wrong side, the organs settle again
             // against contacts found where they are now.
             let next = self.search(&mut geometry);
-            let fresh = self.contacts(&next, Violated::MoveHalf);
+            let fresh = self.contacts(&next, Violated::MoveHalf, true);
             let deepest = self
                 .organs
                 .iter()
@@ -729,7 +874,17 @@ impl Simulation {
                 // look for (moving a violated contact half way is the only
                 // difference to `Violated::MoveAll`), and nothing moves
                 // before they are counted.
-                contacts_now = Some(fresh);
+                let neighbours = self.neighbour_contacts(&next);
+                contacts_now = Some(
+                    fresh
+                        .into_iter()
+                        .zip(neighbours)
+                        .map(|(mut c, n)| {
+                            c.truncate(n);
+                            c
+                        })
+                        .collect(),
+                );
                 break 0;
             }
             if deepest <= RESETTLE_DEPTH || round == MAX_CONTACT_ROUNDS {
@@ -760,6 +915,13 @@ impl Simulation {
             }
             self.previous_energy[i] = e;
             energy += e;
+        }
+        // No silent crossing (see `crossing`).
+        if let Some(crossings) = self.find_crossings(step) {
+            match self.on_crossing {
+                OnCrossing::Stop => return Err(SimError::Crossed(Box::new(crossings))),
+                OnCrossing::Warn => self.crossings.push(crossings),
+            }
         }
         self.next_step += 1;
         if self.checkpoints.is_some() {
@@ -812,7 +974,7 @@ impl Simulation {
     ) -> u32 {
         let offset = self.settings.collision_offset;
         contacts
-            .unwrap_or_else(|| self.contacts(&self.search(geometry), Violated::MoveAll))
+            .unwrap_or_else(|| self.contacts(&self.search(geometry), Violated::MoveAll, false))
             .iter()
             .zip(&self.organs)
             .enumerate()
@@ -840,9 +1002,6 @@ impl Simulation {
         self.obstacle_contacts(&mut parts, &vec![true; self.organs.len()]);
         self.drop_base_contacts(&mut parts);
         let mut sides = vec![Vec::new(); 2 * self.overlaps.len()];
-        if self.overlaps.is_empty() {
-            return Found { parts, sides };
-        }
         geometry
             .par_iter_mut()
             .zip(&self.organs)
@@ -850,6 +1009,20 @@ impl Simulation {
                 known.get_or_insert_with(|| Geometry::of(organ));
             });
         let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
+        let selves = self.self_contacts(&geometry);
+        let free = self
+            .free
+            .par_iter()
+            .map(|&(moving, other)| self.free_contacts_of(moving, other, geometry[other]))
+            .collect();
+        if self.overlaps.is_empty() {
+            return Found {
+                parts,
+                sides,
+                selves,
+                free,
+            };
+        }
         // A kinematic organ (two-state) gets no contacts.
         let keys: Vec<(usize, usize, usize, f64)> = self
             .sides()
@@ -865,15 +1038,113 @@ impl Simulation {
         for (&(key, ..), list) in keys.iter().zip(found) {
             sides[key] = list;
         }
-        Found { parts, sides }
+        Found {
+            parts,
+            sides,
+            selves,
+            free,
+        }
+    }
+
+    /// Organ `moving`'s contacts against organ `other` (a free pair;
+    /// `known`: the other's geometry where it is), each keeping the side it
+    /// was on when the last keyframe ended, to be put all the way.
+    fn free_contacts_of(&self, moving: usize, other: usize, known: &Geometry) -> Vec<Contact> {
+        let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let mut list = Vec::new();
+        let (Some(previous_moving), Some(previous_other)) = (
+            m.previous(),
+            o.previous()
+                .or_else(|| o.is_kinematic().then_some(o.positions.as_slice())),
+        ) else {
+            return list;
+        };
+        let previous_normals = anthesis_mesh::vertex_normals(previous_other, &o.mesh.triangles);
+        let then = Surface {
+            positions: previous_other,
+            ..o.surface(&previous_normals)
+        };
+        kept_side_contacts(
+            &m.surface(&[]),
+            &o.surface(&known.normals),
+            &known.tracker,
+            previous_moving,
+            &then,
+            &m.is_base,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut list,
+        );
+        list
+    }
+
+    /// How many of each organ's contacts of `found` are against the parts
+    /// and its neighbours: [`Simulation::contacts`] appends the
+    /// self-contacts after them.
+    fn neighbour_contacts(&self, found: &Found) -> Vec<usize> {
+        let mut counts: Vec<usize> = found.parts.iter().map(Vec::len).collect();
+        for (key, moving, _, _) in self.sides() {
+            counts[moving] += found.sides[key].len();
+        }
+        for (&(moving, _), list) in self.free.iter().zip(&found.free) {
+            counts[moving] += list.len();
+        }
+        counts
+    }
+
+    /// Whether any organ can touch itself (a growing organ: a kinematic
+    /// one gets no contacts).
+    fn self_contact(&self) -> bool {
+        self.organs.iter().any(|o| !o.is_kinematic())
+    }
+
+    /// Each organ's self-contacts where it is (`geometry`: each organ's),
+    /// each to be put all the way, base particles left out (see
+    /// `collide::self_contacts`).
+    fn self_contacts(&self, geometry: &[&Geometry]) -> Vec<Vec<Contact>> {
+        (0..self.organs.len())
+            .into_par_iter()
+            .map(|i| self.self_contacts_of(i, geometry[i]))
+            .collect()
+    }
+
+    /// Organ `i`'s self-contacts where it is (`known`: its geometry).
+    fn self_contacts_of(&self, i: usize, known: &Geometry) -> Vec<Contact> {
+        let organ = &self.organs[i];
+        let mut list = Vec::new();
+        let Some(previous) = organ.previous().filter(|_| !organ.is_kinematic()) else {
+            return list;
+        };
+        let locality = organ.locality();
+        let cells = known.tracker.cell_bounds(locality.uv);
+        let previous_normals = anthesis_mesh::vertex_normals(previous, &organ.mesh.triangles);
+        let then = Surface {
+            positions: previous,
+            ..organ.surface(&previous_normals)
+        };
+        self_contacts(
+            &organ.surface(&known.normals),
+            &known.tracker,
+            &cells,
+            &locality,
+            &then,
+            &organ.is_base,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut list,
+        );
+        list
     }
 
     /// Each organ's contacts of `found`: against the parts, then each side
-    /// in order. With [`Violated::MoveHalf`] a violated contact against an
-    /// organ that gives way moves half way (a kinematic organ, two-state,
-    /// never gives way, so the organ against it moves all the way, as
-    /// against a part).
-    fn contacts(&self, found: &Found, violated: Violated) -> Vec<Vec<Contact>> {
+    /// in order, then (with `selves`) against itself. With
+    /// [`Violated::MoveHalf`] a violated contact against an organ that
+    /// gives way moves half way (a kinematic organ, two-state, never gives
+    /// way, so the organ against it moves all the way, as against a part);
+    /// so does a self-contact (the other side of the fold is held off this
+    /// one too). The statistics count contacts without `selves` (particles
+    /// touching a neighbour).
+    fn contacts(&self, found: &Found, violated: Violated, selves: bool) -> Vec<Vec<Contact>> {
         let mut contacts = found.parts.clone();
         for (key, moving, other, _) in self.sides() {
             let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
@@ -885,6 +1156,25 @@ impl Simulation {
                     c
                 }
             }));
+        }
+        for (&(moving, other), list) in self.free.iter().zip(&found.free) {
+            let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
+            let positions = &self.organs[moving].positions;
+            contacts[moving].extend(list.iter().map(|&c| {
+                if half {
+                    move_half(c, positions[c.particle as usize])
+                } else {
+                    c
+                }
+            }));
+        }
+        if selves {
+            for ((list, own), organ) in contacts.iter_mut().zip(&found.selves).zip(&self.organs) {
+                list.extend(own.iter().map(|&c| match violated {
+                    Violated::MoveHalf => move_half(c, organ.positions[c.particle as usize]),
+                    Violated::MoveAll => c,
+                }));
+            }
         }
         contacts
     }
@@ -966,7 +1256,11 @@ impl Simulation {
         let Found {
             parts: mut parts_found,
             sides: mut side_found,
+            selves: mut self_found,
+            free: mut free_found,
         } = found;
+        let mut free_clear: Vec<Option<(u32, u32)>> = vec![None; self.free.len()];
+        let mut self_clear: Vec<Option<u32>> = vec![None; self.organs.len()];
         let mut parts_given = vec![true; self.organs.len()];
         // Where each side's moving organ was when its last list was found,
         // and how often the other organ had been pushed then.
@@ -1053,6 +1347,57 @@ impl Simulation {
                 side_found[key] = contacts;
                 pushed_in_pass += pushed;
             }
+            // Each free pair: the search made before the push-back while
+            // neither organ was pushed, else where they are.
+            for (key, &(moving, other)) in self.free.iter().enumerate() {
+                if free_clear[key] == Some((pushes[moving], pushes[other])) {
+                    continue;
+                }
+                let given = std::mem::take(&mut free_found[key]);
+                let list = if pushes[moving] == 0 && pushes[other] == 0 && free_clear[key].is_none()
+                {
+                    given
+                } else {
+                    let known =
+                        geometry[other].get_or_insert_with(|| Geometry::of(&self.organs[other]));
+                    self.free_contacts_of(moving, other, known)
+                };
+                let pushed = push_back(
+                    &mut self.organs[moving].positions,
+                    &list,
+                    &mut moved[moving],
+                );
+                if pushed > 0 {
+                    pushes[moving] += 1;
+                    geometry[moving] = None;
+                } else {
+                    free_clear[key] = Some((pushes[moving], pushes[other]));
+                }
+                free_found[key] = list;
+                pushed_in_pass += pushed;
+            }
+            // Each organ against itself: the search made before the
+            // push-back while nothing has pushed it, else where it is.
+            for i in 0..self.organs.len() {
+                if self.organs[i].is_kinematic() || self_clear[i] == Some(pushes[i]) {
+                    continue;
+                }
+                let given = std::mem::take(&mut self_found[i]);
+                let list = if pushes[i] == 0 && self_clear[i].is_none() {
+                    given
+                } else {
+                    let known = geometry[i].get_or_insert_with(|| Geometry::of(&self.organs[i]));
+                    self.self_contacts_of(i, known)
+                };
+                let pushed = push_back(&mut self.organs[i].positions, &list, &mut moved[i]);
+                if pushed > 0 {
+                    pushes[i] += 1;
+                    geometry[i] = None;
+                } else {
+                    self_clear[i] = Some(pushes[i]);
+                }
+                pushed_in_pass += pushed;
+            }
             if pushed_in_pass == 0 {
                 settled = true;
                 break;
@@ -1065,6 +1410,9 @@ impl Simulation {
             let mut contacts = parts_found;
             for (key, moving, _, _) in self.sides() {
                 contacts[moving].extend_from_slice(&side_found[key]);
+            }
+            for (&(moving, _), list) in self.free.iter().zip(&free_found) {
+                contacts[moving].extend_from_slice(list);
             }
             contacts
         });
@@ -1198,6 +1546,13 @@ impl Simulation {
             .sides()
             .filter(|&(key, moving, _, _)| moving == organ && !found.sides[key].is_empty())
             .map(|(_, _, other, _)| other)
+            .chain(
+                self.free
+                    .iter()
+                    .zip(&found.free)
+                    .filter(|((moving, _), list)| *moving == organ && !list.is_empty())
+                    .map(|(&(_, other), _)| other),
+            )
             .collect();
         others.sort_unstable();
         others.dedup();
@@ -1207,6 +1562,9 @@ impl Simulation {
             .collect();
         if !found.parts[organ].is_empty() {
             names.push("the parts".to_string());
+        }
+        if !found.selves[organ].is_empty() {
+            names.push("itself".to_string());
         }
         names
     }
@@ -1219,6 +1577,10 @@ impl Simulation {
 struct Found {
     parts: Vec<Vec<Contact>>,
     sides: Vec<Vec<Contact>>,
+    /// Each organ's contacts against itself.
+    selves: Vec<Vec<Contact>>,
+    /// Each free pair's contacts (`Simulation::free`, same order).
+    free: Vec<Vec<Contact>>,
 }
 
 /// One organ's unit normals and nearest-particle lookup where it is:
@@ -1236,6 +1598,27 @@ impl Geometry {
             tracker: Tracker::new(&organ.positions, 2.0 * organ.mean_edge),
         }
     }
+}
+
+/// Every (moving, other) pair of organs with no overlap rule between them
+/// (either way), the moving one growing (a kinematic organ gets no
+/// contacts): issue 35's organs of one whorl, which keep the side of each
+/// other they were on.
+fn free_pairs(organs: &[OrganSim], overlaps: &[(usize, usize)]) -> Vec<(usize, usize)> {
+    let ruled = |a: usize, b: usize| {
+        overlaps
+            .iter()
+            .any(|&(i, o)| (i, o) == (a, b) || (i, o) == (b, a))
+    };
+    let mut pairs = Vec::new();
+    for a in 0..organs.len() {
+        for b in 0..organs.len() {
+            if a != b && !ruled(a, b) && !organs[a].is_kinematic() {
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
 }
 
 /// Nothing known yet of `organs` organs' geometry.

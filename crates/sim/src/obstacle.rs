@@ -109,6 +109,12 @@ impl ObstacleSim {
         }
     }
 
+    /// The piece's name (a part instance's, `-anther` or `-stigma` added
+    /// for a head).
+    pub(crate) fn name(&self) -> &str {
+        &self.source.name
+    }
+
     pub(crate) fn tracker(&self) -> &Tracker {
         &self.tracker
     }

@@ -1,7 +1,7 @@
 //! One organ in a running simulation: its growth maps sampled once per time
 //! key, its elastic state, solver and attachment.
 
-use crate::collide::Surface;
+use crate::collide::{Locality, Surface};
 use anthesis_flower::{Organ, Placement, Template, joint_angle_after};
 use anthesis_maps::{KeySchedule, ScalarMap};
 use anthesis_mesh::nearest::TriangleRings;
@@ -178,6 +178,9 @@ pub(crate) struct OrganSim {
     /// `attached_positions` (see [`OrganSim::energy`]).
     settled: Option<f64>,
     attached_positions: Vec<DVec3>,
+    /// Per particle, its UV scaled to lengths of the bud (see
+    /// [`OrganSim::locality`]).
+    scaled_uv: Vec<DVec2>,
     /// `Some` for an organ of a two-state template: kinematic, its shape at
     /// each keyframe the two-state in-between (template frame), placed;
     /// not grown, not solved, never pushed (see [`OrganSim::is_kinematic`]).
@@ -300,6 +303,7 @@ impl OrganSim {
             saved: None,
             settled: None,
             attached_positions: Vec::new(),
+            scaled_uv: scaled_uvs(&template.mesh, &topology),
             topology,
         };
         sim.update_stiffness(0);
@@ -482,6 +486,24 @@ impl OrganSim {
             rim: &self.rim,
             mean_edge: self.mean_edge,
         }
+    }
+
+    /// Which of this organ's particles are each other's neighbourhood,
+    /// where self-contact does not act: those less than
+    /// [`SELF_CONTACT_LOCAL`] bud edges apart in the UV layout scaled to
+    /// the bud's lengths (growth stretches distances and the mean edge
+    /// alike, so this stays about that many edges along the surface).
+    pub fn locality(&self) -> Locality<'_> {
+        Locality {
+            uv: &self.scaled_uv,
+            local: SELF_CONTACT_LOCAL * self.bud_edge,
+        }
+    }
+
+    /// Positions at the end of the last keyframe (during a step: before
+    /// it; the bud before the first), if the organ has been grown.
+    pub fn previous(&self) -> Option<&[DVec3]> {
+        self.history.back().map(|p| p.as_slice())
     }
 
     /// One Newton iteration with the base held where the receptacle and the
@@ -687,6 +709,48 @@ impl OrganSim {
         self.solver
             .relative_gradient(&self.elastic, contacts, &self.positions)
     }
+}
+
+/// How far apart along the surface, in bud edges, two particles of one
+/// organ must be for self-contact to hold them apart: beyond the reach of
+/// a contact search (two mean edges) and of the triangles searched around
+/// the nearest particle (two rings), so a surface is never held off
+/// itself where it is merely curved.
+pub const SELF_CONTACT_LOCAL: f64 = 6.0;
+
+/// Each particle's UV scaled by the lengths the bud gives a unit of `u`
+/// and of `v` (least squares over the edges: |edge|² ≈ a Δu² + b Δv²), so
+/// that distances between UVs are about distances along the bud's surface.
+fn scaled_uvs(mesh: &Mesh, topology: &Topology) -> Vec<DVec2> {
+    let (mut uuuu, mut uuvv, mut vvvv, mut lu, mut lv, mut ll, mut uv2) =
+        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for e in &topology.edges {
+        let [a, b] = e.vertices.map(|v| v as usize);
+        let d = mesh.uvs[a] - mesh.uvs[b];
+        let (u2, v2) = (d.x * d.x, d.y * d.y);
+        let l2 = mesh.positions[a].distance_squared(mesh.positions[b]);
+        uuuu += u2 * u2;
+        uuvv += u2 * v2;
+        vvvv += v2 * v2;
+        lu += l2 * u2;
+        lv += l2 * v2;
+        ll += l2;
+        uv2 += u2 + v2;
+    }
+    let det = uuuu * vvvv - uuvv * uuvv;
+    let (a, b) = if det > 1e-12 * uuuu * vvvv {
+        ((lu * vvvv - lv * uuvv) / det, (lv * uuuu - lu * uuvv) / det)
+    } else {
+        (0.0, 0.0)
+    };
+    let (a, b) = if a > 0.0 && b > 0.0 {
+        (a, b)
+    } else {
+        let isotropic = if uv2 > 0.0 { ll / uv2 } else { 1.0 };
+        (isotropic, isotropic)
+    };
+    let scale = DVec2::new(a.sqrt(), b.sqrt());
+    mesh.uvs.iter().map(|uv| *uv * scale).collect()
 }
 
 #[cfg(test)]

@@ -5,8 +5,11 @@
 mod common;
 
 use anthesis_flower::Project;
-use anthesis_sim::{Keyframe, Selection};
-use common::{inner_driven_into_outer, inner_driven_into_outer_by, particles_over, run_all};
+use anthesis_sim::crossing::Crossed;
+use anthesis_sim::{Keyframe, Selection, SimError};
+use common::{
+    inner_driven_into_outer, inner_driven_into_outer_by, particles_over, run_all, run_all_warned,
+};
 
 const KEYFRAMES: u32 = 30;
 
@@ -190,42 +193,45 @@ fn an_inner_organ_turned_past_horizontal_into_the_outer_one_still_runs_and_keeps
     // 100 degrees against 10: the inner organ's joint turns through the
     // outer one's base region, so its base particles, which attachment
     // places, end up across; every other particle stays on its side.
+    // Their triangles then cross, which stops a run (issue 35): told to go
+    // on, it keeps its shape, and the crossings found are all at the bases.
     let project = inner_driven_into_outer_by(KEYFRAMES, true, 100.0);
-    let (keyframes, error) = run_all(&project, &Selection::All);
+    let (keyframes, crossings, error) = run_all_warned(&project, &Selection::All);
     assert_eq!(error, None, "the run with collisions failed");
     assert_eq!(keyframes.len(), KEYFRAMES as usize + 1);
     assert_on_their_sides(&project, &keyframes, true);
     assert_eq!(shape_problem(&project, &keyframes), None);
+    assert!(!crossings.is_empty());
+    let near_base = |side: &Crossed| match side {
+        Crossed::Organ { uv, .. } => uv.y < 0.2,
+        Crossed::Part { .. } => false,
+    };
+    for c in &crossings {
+        for (a, b, _) in &c.between {
+            assert!(
+                near_base(a) && near_base(b),
+                "keyframe {}: {a:?} {b:?}",
+                c.keyframe
+            );
+        }
+    }
+    let (_, error) = run_all(&project, &Selection::All);
+    assert!(
+        matches!(&error, Some(SimError::Crossed(c)) if c.keyframe == crossings[0].keyframe),
+        "{error:?}"
+    );
 }
 
 #[test]
-fn without_the_overlap_rule_the_same_organs_cut_through_each_other() {
-    // The same geometry with no overlap rule: the check above must fail,
-    // or it could not catch a broken collision handler.
+fn without_the_overlap_rule_the_same_organs_keep_the_side_they_started_on() {
+    // The same geometry with no overlap rule: the organs keep the side of
+    // each other they were on in the bud (issue 35), so the inner one stays
+    // inside, as with the rule.
     let project = inner_driven_into_outer(KEYFRAMES, false);
-    let offset = project.settings.collision_offset;
-    let (keyframes, error) = run_all(&project, &Selection::All);
+    let (keyframes, crossings, error) = run_all_warned(&project, &Selection::All);
     assert_eq!(error, None);
-    let last = keyframes.last().expect("keyframes");
-    let outer_triangles = &project.flower.templates[1].mesh.triangles;
-    let wrong: Vec<f64> = particles_over(
-        &last.positions_in_world[0],
-        &last.positions_in_world[1],
-        outer_triangles,
-    )
-    .iter()
-    .map(|s| s.along_normal)
-    .filter(|&d| d < offset - 1e-6)
-    .collect();
-    assert!(
-        wrong.len() >= 10,
-        "only {} inner particles ended on the wrong side",
-        wrong.len()
-    );
-    let deepest = wrong.iter().copied().fold(f64::INFINITY, f64::min);
-    // Clearly through, not just short of the offset.
-    assert!(deepest < -0.1, "the deepest was only {deepest:.3}");
-    assert!(last.stats.pushed_particles == 0);
+    assert_eq!(crossings, Vec::new());
+    assert_on_their_sides(&project, &keyframes, false);
 }
 
 #[test]

@@ -149,11 +149,13 @@ fn absurd_growth_ends_in_a_typed_error() {
 fn a_run_that_stops_at_an_organ_names_the_organs_it_was_against() {
     // Two petals, one driven through the other while both grow a third a
     // step: they jam within a few keyframes, and the message points the
-    // painter at the neighbour that held the organ where it stopped.
+    // painter at the neighbour that held the organ where it stopped. (At
+    // the 60 degree drive a corner of the inner tip passes through the
+    // outer petal first, which stops a run too: told to go on past that.)
     for drive_deg in [60.0, 200.0] {
         let mut project = common::inner_driven_into_outer_by(20, true, drive_deg);
         project.flower.templates[0].dg = 0.3;
-        let (keyframes, error) = run_all(&project, &Selection::All);
+        let (keyframes, _, error) = common::run_all_warned(&project, &Selection::All);
         let error = error.unwrap_or_else(|| panic!("drive {drive_deg}: the run finished"));
         let (organ, other) = match &error {
             SimError::Diverged { organ, .. }
@@ -167,9 +169,8 @@ fn a_run_that_stops_at_an_organ_names_the_organs_it_was_against() {
         let message = error.to_string();
         assert!(
             message.contains(&format!("organ `{organ}`: "))
-                && message.contains(&format!(
-                    "; it was against `{other}` there: organs grown around"
-                )),
+                && message.contains(&format!("; it was against `{other}` "))
+                && message.contains(" there: organs grown around"),
             "drive {drive_deg}: {message}"
         );
         assert!(keyframes.len() >= 2, "drive {drive_deg}: stopped at once");

@@ -3,8 +3,9 @@
 
 use anthesis_flower::parts::{Part, PartShape, Tube};
 use anthesis_flower::{Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings};
+use anthesis_sim::crossing::{Crossings, OnCrossing};
 use anthesis_sim::fixtures::petal_template;
-use anthesis_sim::{Keyframe, Selection, SimError, run};
+use anthesis_sim::{Keyframe, Selection, SimError, Simulation, run};
 use glam::DVec3;
 
 /// Mean length of the triangle edges (each interior edge counted twice,
@@ -157,6 +158,27 @@ pub fn run_all(project: &Project, selection: &Selection) -> (Vec<Keyframe>, Opti
     let mut keyframes = Vec::new();
     let result = run(project, selection, &mut |_, k| keyframes.push(k.clone()));
     (keyframes, result.err())
+}
+
+/// [`run_all`] told to go on past crossing keyframes
+/// (`OnCrossing::Warn`), with what the crossing check found.
+pub fn run_all_warned(
+    project: &Project,
+    selection: &Selection,
+) -> (Vec<Keyframe>, Vec<Crossings>, Option<SimError>) {
+    let mut sim = match Simulation::new(project, selection) {
+        Ok(sim) => sim,
+        Err(error) => return (Vec::new(), Vec::new(), Some(error)),
+    };
+    sim.on_crossing(OnCrossing::Warn);
+    let mut keyframes = vec![sim.bud()];
+    while !sim.finished() {
+        match sim.step(&|| false, &mut |_| {}) {
+            Ok(k) => keyframes.push(k),
+            Err(error) => return (keyframes, sim.crossings().to_vec(), Some(error)),
+        }
+    }
+    (keyframes, sim.crossings().to_vec(), None)
 }
 
 /// How far an organ's shape is from looking sane, measured against a
