@@ -2,14 +2,16 @@
 //! selected organ, on a thread named `anthesis-fit`, with its progress
 //! (iteration, RMS and largest distance) and a Cancel button; the fitted
 //! maps replace the organ's template's maps as one undo step when the user
-//! applies them.
+//! applies them. The target is any triangulated OBJ; with "Register" ticked
+//! it is first put on the organ (`anthesis_fit::register_target`), and the
+//! motion found is shown before the fit goes on.
 
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, sync_channel};
 
-use anthesis_fit::{Fit, FitProgress, FitSettings};
+use anthesis_fit::{Fit, FitProgress, FitSettings, Registered};
 use anthesis_flower::Project;
 use anthesis_mesh::obj::MAX_OBJ_BYTES;
 use eframe::egui;
@@ -28,6 +30,7 @@ pub enum FitState {
 }
 
 enum Message {
+    Registered(Registered),
     Progress(FitProgress),
     Done(Result<Fit, anthesis_fit::FitError>),
 }
@@ -45,6 +48,12 @@ pub struct FitDialog {
     pub target: String,
     /// Time keys of the fitted maps.
     pub keys: u32,
+    /// Put the target on the organ first (a scan in its own frame).
+    pub register: bool,
+    /// With the registration, a uniform scale too.
+    pub register_scale: bool,
+    /// The registration of the running or last fit, if it had one.
+    registered: Option<Registered>,
     /// The organ fitted (index into the project's organs) and the
     /// document revision it was started on.
     started: Option<(usize, u64)>,
@@ -58,6 +67,9 @@ impl Default for FitDialog {
             open: false,
             target: String::new(),
             keys: 1,
+            register: false,
+            register_scale: false,
+            registered: None,
             started: None,
             state: FitState::Idle,
             job: None,
@@ -75,6 +87,11 @@ pub struct FitRequests {
 impl FitDialog {
     pub fn state(&self) -> &FitState {
         &self.state
+    }
+
+    /// The running or last fit's registration, if it had one.
+    pub fn registered(&self) -> Option<&Registered> {
+        self.registered.as_ref()
     }
 
     pub fn is_running(&self) -> bool {
@@ -103,10 +120,13 @@ impl FitDialog {
         let text = anthesis_files::read_regular_text(target, MAX_OBJ_BYTES, "an OBJ mesh")
             .map_err(|e| format!("cannot read the target {}: {e}", target.display()))?;
         let mesh = &resolved.flower.template_of(organ).mesh;
-        let positions = anthesis_fit::read_target(&text, &organ_def.name, mesh)
+        let target_surface = anthesis_fit::read_target(&text, &organ_def.name, mesh)
             .map_err(|e| format!("target {}: {e}", target.display()))?;
+        let register = self.register;
+        let scale = self.register && self.register_scale;
         let settings = FitSettings {
             keys: self.keys.clamp(1, resolved.settings.keyframes + 1),
+            refine_placement: register,
             ..FitSettings::default()
         };
         // One message per iteration and the result: the fit's iteration
@@ -119,20 +139,43 @@ impl FitDialog {
             .name("anthesis-fit".into())
             .spawn(move || {
                 let progress_sender = sender.clone();
+                let cancelled = || flag.load(Ordering::Relaxed);
+                let placement = if register {
+                    match anthesis_fit::register_target(
+                        &resolved,
+                        organ,
+                        &target_surface,
+                        scale,
+                        &cancelled,
+                    ) {
+                        Ok(registered) => {
+                            let _ = sender.send(Message::Registered(registered));
+                            registered.registration.placement
+                        }
+                        Err(error) => {
+                            let _ = sender.send(Message::Done(Err(error)));
+                            return;
+                        }
+                    }
+                } else {
+                    anthesis_fit::Similarity::IDENTITY
+                };
                 let result = anthesis_fit::fit(
                     &resolved,
                     organ,
-                    &positions,
+                    &target_surface,
+                    placement,
                     &settings,
                     &mut |p| {
                         let _ = progress_sender.try_send(Message::Progress(p));
                     },
-                    &|| flag.load(Ordering::Relaxed),
+                    &cancelled,
                 );
                 let _ = sender.send(Message::Done(result));
             })
             .map_err(|e| format!("cannot start the fit: {e}"))?;
         self.job = Some(Job { receiver, cancel });
+        self.registered = None;
         self.started = Some((organ, revision));
         self.state = FitState::Running { progress: None };
         Ok(())
@@ -153,6 +196,7 @@ impl FitDialog {
         let mut ended = None;
         while let Ok(message) = job.receiver.try_recv() {
             match message {
+                Message::Registered(registered) => self.registered = Some(registered),
                 Message::Progress(p) => {
                     self.state = FitState::Running { progress: Some(p) };
                 }
@@ -229,8 +273,9 @@ impl FitDialog {
             .show(ctx, |ui| {
                 ui.label(format!(
                     "Finds the growth maps of organ {organ_name}'s template whose simulation \
-                     ends at the target: an OBJ of this organ's vertices in world coordinates, \
-                     as `anthesis simulate --organ {organ_name} --out FOLDER/` writes them."
+                     ends on the target: an OBJ surface of any triangulation, in the \
+                     project's frame and units, or anywhere with Register ticked (a scan or \
+                     a model in its own frame)."
                 ));
                 let running = self.is_running();
                 ui.add_enabled_ui(!running, |ui| {
@@ -246,6 +291,19 @@ impl FitDialog {
                         let label = ui.label("Time keys").id;
                         ui.add(egui::DragValue::new(&mut self.keys).range(1..=5))
                             .labelled_by(label);
+                        ui.end_row();
+                        ui.label("");
+                        ui.checkbox(&mut self.register, "Register the target on the organ first")
+                            .on_hover_text(
+                                "The rigid motion that best lays the target on the organ's \
+                                 current shape with its base on the organ's base",
+                            );
+                        ui.end_row();
+                        ui.label("");
+                        ui.add_enabled(
+                            self.register,
+                            egui::Checkbox::new(&mut self.register_scale, "… and its scale"),
+                        );
                         ui.end_row();
                     });
                 });
@@ -266,6 +324,9 @@ impl FitDialog {
                         requests.apply = true;
                     }
                 });
+                if let Some(registered) = &self.registered {
+                    ui.label(registered.describe());
+                }
                 match &self.state {
                     FitState::Idle => {}
                     FitState::Running { progress: None } => {
