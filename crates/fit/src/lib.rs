@@ -25,7 +25,9 @@
 //! - **First guess** in closed form from the target's stretches and
 //!   curvature changes relative to the bud ([`guess`]), the target read at
 //!   each particle's UV when it has a UV layout, else at the point nearest
-//!   the organ's current final shape.
+//!   the organ's current final shape; the project's own maps, put in the
+//!   basis by least squares, are simulated alongside, and the nearer of
+//!   the two starts.
 //! - **Optimisation**: Levenberg–Marquardt with box bounds (growth maps in
 //!   [0, 1], the angle within ±[`basis::MAX_ANGLE`]) on the surface
 //!   residuals, whose correspondences (nearest points) are found afresh at
@@ -258,8 +260,9 @@ pub struct Fit {
     /// distance of a target vertex (placed) from the centroid of the
     /// organ's base particles.
     pub length: f64,
-    /// RMS surface distance of the closed-form guess's simulation from the
-    /// target, as a fraction of the length.
+    /// RMS surface distance of the first guess's simulation from the
+    /// target, as a fraction of the length (the nearer of the closed-form
+    /// guess and the project's own maps in the fit's basis).
     pub guess_rms: f64,
     /// RMS surface distance between the fitted maps' final shape and the
     /// target, as a fraction of the length.
@@ -807,20 +810,37 @@ pub fn fit(
         thickness: template.thickness,
         steps: project.settings.keyframes,
     };
-    let mut p = match &at_particles {
+    let guessed = match &at_particles {
         Some(at) => guess::guess(&organ_guess, at, &problem.layout),
         None => vec![0.0; problem.layout.len()],
     };
-    simulations += 1;
-    let mut s = match problem.shape(&p, false).map_err(first_error)? {
-        Some(s) => s,
+    // Two starts, simulated at once: the closed-form guess and the
+    // project's own maps in the basis (better where the guess's
+    // correspondences are poor, as for a target without UVs); the nearer
+    // wins, no growth if neither simulates.
+    let own = guess::from_maps(&problem.layout, &template.maps);
+    let (first, second) = rayon::join(
+        || problem.shape(&guessed, false),
+        || problem.shape(&own, false),
+    );
+    simulations += 2;
+    let mut starts = Vec::new();
+    for (q, shape) in [(guessed, first), (own, second)] {
+        if let Some(shape) = shape.map_err(first_error)? {
+            let cost = problem.measure(&shape, placement, None).cost();
+            starts.push((cost, q, shape));
+        }
+    }
+    let (mut p, mut s) = match starts.into_iter().min_by(|a, b| a.0.total_cmp(&b.0)) {
+        Some((_, q, shape)) => (q, shape),
         None => {
-            p.iter_mut().for_each(|x| *x = 0.0);
+            let none = vec![0.0; problem.layout.len()];
             simulations += 1;
-            problem
-                .shape(&p, false)
+            let shape = problem
+                .shape(&none, false)
                 .map_err(first_error)?
-                .ok_or_else(|| FitError::Target("the organ cannot be simulated".into()))?
+                .ok_or_else(|| FitError::Target("the organ cannot be simulated".into()))?;
+            (none, shape)
         }
     };
     let mut placement = placement;
