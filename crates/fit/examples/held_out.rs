@@ -12,7 +12,10 @@
 //! with `--write DIR` the targets are also written as OBJ files
 //! (`DIR/target-N.obj`) for `anthesis fit builtin:eustoma-… --organ
 //! petal-1 --target DIR/target-N.obj [--register]`; `--only N` runs row N
-//! (from 1) alone.
+//! (from 1) alone. For the scan it also prints how far the registration's
+//! turn is from undoing the scan's (known) motion, and with
+//! `HELD_OUT_TRUTH=1` in the environment how far the project's current
+//! shape is from the scan placed by the registration and by the truth.
 
 use std::fmt::Write as _;
 
@@ -216,6 +219,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "  registration: {:.2}° from undoing the scan's turn",
                 left.to_axis_angle().1.to_degrees()
             );
+            if std::env::var_os("HELD_OUT_TRUTH").is_some() {
+                let m = scan_motion();
+                let truth = Similarity {
+                    rotation: m.rotation.inverse(),
+                    scale: 1.0,
+                    translation: -(m.rotation.inverse() * m.translation),
+                };
+                let template = project.flower.template_of(organ);
+                let current = simulate_final(&project, organ, template.maps.clone(), &|| false)?;
+                for (name, at) in [("truth", truth), ("found", placement)] {
+                    let (rms, max) = anthesis_fit::distances(
+                        &current,
+                        &template.mesh.triangles,
+                        &target,
+                        at,
+                        registered.length,
+                    );
+                    eprintln!(
+                        "  {name}: RMS {:.2} %, max {:.2} % from the current shape",
+                        100.0 * rms,
+                        100.0 * max
+                    );
+                }
+            }
             fit_settings.refine_placement = true;
         }
         if let Some(dir) = &write {

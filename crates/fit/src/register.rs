@@ -14,9 +14,14 @@
 //!   its nearest point on the organ and each organ particle with its
 //!   nearest point on the target, the farthest tenth of each side's pairs
 //!   left out (a scan's stray bits, a target longer than the organ is
-//!   now), plus the organ's base particles paired with their nearest target
-//!   points with as much weight as a whole side (so the target's base ends
-//!   on the organ's base, where growth cannot move it); each step the
+//!   now; a pair whose two surfaces face opposite ways is no pair, normal
+//!   compatibility as in Rusinkiewicz and Levoy 2001, so the target's inner
+//!   side, the side its faces wind counter-clockwise around as the organ's
+//!   do, ends on the organ's inner side and a nearly flat petal is not
+//!   laid on upside down), plus the organ's base particles paired with
+//!   their nearest points on the target's outline, with twice a side's
+//!   weight (so the target's base, where its outline meets the organ's
+//!   base, ends there, where growth cannot move it); each step the
 //!   weighted least-squares similarity of the pairs (Umeyama 1991, through
 //!   `nalgebra`'s SVD), until it stops moving.
 //! - The start whose result is nearest (the trimmed cost) wins.
@@ -28,7 +33,7 @@
 use glam::{DMat3, DQuat, DVec3};
 use nalgebra::Matrix3;
 
-use crate::surface::{Placed, Similarity, Surface, vertex_weights};
+use crate::surface::{Placed, Rim, Similarity, Surface, vertex_weights};
 
 /// How a registration went.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,8 +50,18 @@ pub struct Registration {
 pub const KEPT: f64 = 0.9;
 /// At most this many target vertices take part in the ICP (evenly picked).
 const MAX_SAMPLES: usize = 4000;
+/// The base pairs' weight against a whole side's (1).
+const BASE_WEIGHT: f64 = 2.0;
 /// ICP steps per start at most.
 const MAX_STEPS: usize = 60;
+
+/// A target vertex taking part in the ICP: where it is (target frame), its
+/// area weight and its normal.
+struct Sample {
+    x: DVec3,
+    w: f64,
+    normal: DVec3,
+}
 
 /// A pair for the least-squares similarity: `x` in the target's frame,
 /// `y` in the world, and its weight.
@@ -69,13 +84,24 @@ pub fn register(
     let organ_surface = Surface::new(organ.to_vec(), triangles.to_vec());
     let organ_weights = vertex_weights(organ, triangles);
     let target_weights = target.vertex_weights();
-    let stride = target.positions.len().div_ceil(MAX_SAMPLES).max(1);
-    let samples: Vec<(DVec3, f64)> = target
-        .positions
+    let target_normals = anthesis_mesh::vertex_normals(&target.positions, &target.triangles);
+    let rim = Rim::new(&target.positions, &target.triangles);
+    // The base particles on the organ's outline: those the target's
+    // outline passes through (others are inside the surface).
+    let base: Vec<u32> = base
         .iter()
-        .zip(&target_weights)
+        .copied()
+        .filter(|&b| organ_surface.is_rim(b as usize))
+        .collect();
+    let base = base.as_slice();
+    let stride = target.positions.len().div_ceil(MAX_SAMPLES).max(1);
+    let samples: Vec<Sample> = (0..target.positions.len())
         .step_by(stride)
-        .map(|(p, w)| (*p, *w * stride as f64))
+        .map(|i| Sample {
+            x: target.positions[i],
+            w: target_weights[i] * stride as f64,
+            normal: target_normals[i],
+        })
         .collect();
 
     let (organ_centre, organ_axes, organ_spread) = principal_axes(organ, &organ_weights);
@@ -124,10 +150,10 @@ pub fn register(
                 &samples,
                 &organ_surface,
                 &organ_weights,
-                base,
+                Some((base, &rim)),
                 placement,
                 KEPT,
-                true,
+                organ_spread,
             );
             let next = similarity(&pairs, scale.then_some(()), placement.scale);
             let Some(next) = next else { break };
@@ -142,10 +168,10 @@ pub fn register(
             &samples,
             &organ_surface,
             &organ_weights,
-            base,
+            Some((base, &rim)),
             placement,
             KEPT,
-            true,
+            organ_spread,
         );
         if best.is_none_or(|(c, _)| cost < c) {
             best = Some((cost, placement));
@@ -172,11 +198,13 @@ pub fn refine(
     let organ_surface = Surface::new(organ.to_vec(), triangles.to_vec());
     let organ_weights = vertex_weights(organ, triangles);
     let target_weights = target.vertex_weights();
-    let samples: Vec<(DVec3, f64)> = target
-        .positions
-        .iter()
-        .copied()
-        .zip(target_weights)
+    let target_normals = anthesis_mesh::vertex_normals(&target.positions, &target.triangles);
+    let samples: Vec<Sample> = (0..target.positions.len())
+        .map(|i| Sample {
+            x: target.positions[i],
+            w: target_weights[i],
+            normal: target_normals[i],
+        })
         .collect();
     let mut placement = placement;
     for _ in 0..steps {
@@ -185,10 +213,10 @@ pub fn refine(
             &samples,
             &organ_surface,
             &organ_weights,
-            &[],
+            None,
             placement,
             1.0,
-            false,
+            0.0,
         );
         match similarity(&pairs, None, placement.scale) {
             Some(next) => placement = next,
@@ -198,17 +226,21 @@ pub fn refine(
     placement
 }
 
-/// The pairs of one ICP step and their (trimmed) weighted cost.
+/// The pairs of one ICP step and their (trimmed) weighted cost. A pair
+/// whose two surfaces face opposite ways (normal compatibility) is left
+/// out of the least squares and costs its squared distance plus
+/// `facing_penalty`, so a start that lays the target on upside down is
+/// not chosen for its few remaining pairs.
 #[allow(clippy::too_many_arguments)]
 fn pairs(
     target: &Surface,
-    samples: &[(DVec3, f64)],
+    samples: &[Sample],
     organ: &Surface,
     organ_weights: &[f64],
-    base: &[u32],
+    base: Option<(&[u32], &Rim)>,
     placement: Similarity,
     kept: f64,
-    with_base: bool,
+    facing_penalty: f64,
 ) -> (Vec<Pair>, f64) {
     let placed = Placed {
         surface: target,
@@ -217,72 +249,88 @@ fn pairs(
     let mut cost = 0.0;
     let mut out = Vec::new();
     // Target samples to the organ.
-    let mut side: Vec<(f64, Pair)> = samples
+    let organ_normals = anthesis_mesh::vertex_normals(&organ.positions, &organ.triangles);
+    let mut side: Vec<Candidate> = samples
         .iter()
-        .filter_map(|&(x, w)| {
-            let world = placement.apply(x);
+        .filter_map(|sample| {
+            let world = placement.apply(sample.x);
             let near = organ.nearest(world)?;
-            Some((
-                near.point.distance_squared(world),
-                Pair {
-                    x,
+            Some(Candidate {
+                d2: near.point.distance_squared(world),
+                facing: near.normal.dot(placement.rotation * sample.normal) >= 0.0,
+                pair: Pair {
+                    x: sample.x,
                     y: near.point,
-                    w,
+                    w: sample.w,
                 },
-            ))
+            })
         })
         .collect();
-    cost += trim(&mut side, kept, &mut out);
+    cost += trim(&mut side, kept, facing_penalty, &mut out);
     // Organ particles to the target.
-    let mut side: Vec<(f64, Pair)> = organ
+    let mut side: Vec<Candidate> = organ
         .positions
         .iter()
         .zip(organ_weights)
-        .filter_map(|(&y, &w)| {
+        .zip(&organ_normals)
+        .filter_map(|((&y, &w), normal)| {
             let near = placed.nearest(y)?;
-            Some((
-                near.point.distance_squared(y),
-                Pair {
+            Some(Candidate {
+                d2: near.point.distance_squared(y),
+                facing: near.normal.dot(*normal) >= 0.0,
+                pair: Pair {
                     x: placement.invert(near.point),
                     y,
                     w,
                 },
-            ))
+            })
         })
         .collect();
-    cost += trim(&mut side, kept, &mut out);
-    if with_base && !base.is_empty() {
-        let w = 1.0 / base.len() as f64;
+    cost += trim(&mut side, kept, facing_penalty, &mut out);
+    // The organ's base particles to the target's outline: the target's
+    // base is where its outline meets the organ's base.
+    if let Some((base, rim)) = base.filter(|(base, _)| !base.is_empty()) {
+        let w = BASE_WEIGHT / base.len() as f64;
         for &b in base {
             let y = organ.positions[b as usize];
-            if let Some(near) = placed.nearest(y) {
-                cost += w * near.point.distance_squared(y);
-                out.push(Pair {
-                    x: placement.invert(near.point),
-                    y,
-                    w,
-                });
+            if let Some(x) = rim.nearest(placement.invert(y)) {
+                cost += w * placement.apply(x).distance_squared(y);
+                out.push(Pair { x, y, w });
             }
         }
     }
     (out, cost)
 }
 
-/// Keeps the nearest `kept` share (by weight) of `side`'s pairs, moved to
-/// `out`; returns their weighted squared distance, normalised by the
+/// A pair found, its squared distance and whether its surfaces face the
+/// same way.
+struct Candidate {
+    d2: f64,
+    facing: bool,
+    pair: Pair,
+}
+
+/// Keeps the nearest `kept` share (by weight) of `side`'s pairs, those
+/// facing the same way moved to `out`; returns their weighted squared
+/// distance (plus `facing_penalty` for each facing away), normalised by the
 /// weight kept.
-fn trim(side: &mut Vec<(f64, Pair)>, kept: f64, out: &mut Vec<Pair>) -> f64 {
-    side.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let total: f64 = side.iter().map(|(_, p)| p.w).sum();
+fn trim(side: &mut Vec<Candidate>, kept: f64, facing_penalty: f64, out: &mut Vec<Pair>) -> f64 {
+    side.sort_by(|a, b| a.d2.total_cmp(&b.d2));
+    let total: f64 = side.iter().map(|c| c.pair.w).sum();
     let mut weight = 0.0;
     let mut cost = 0.0;
-    for (d2, pair) in side.drain(..) {
+    for candidate in side.drain(..) {
         if weight >= kept * total && weight > 0.0 {
             break;
         }
-        weight += pair.w;
-        cost += pair.w * d2;
-        out.push(pair);
+        let w = candidate.pair.w;
+        weight += w;
+        if candidate.facing {
+            cost += w * candidate.d2;
+            out.push(candidate.pair);
+        } else {
+            cost += w * (candidate.d2 + facing_penalty);
+        }
     }
     if weight > 0.0 { cost / weight } else { 0.0 }
 }
@@ -421,6 +469,37 @@ mod tests {
             .map(|(x, p)| placement.apply(*x).distance(*p))
             .fold(0.0, f64::max);
         assert!(worst < 1e-6, "{worst}: {placement:?}");
+    }
+
+    #[test]
+    fn a_target_cupped_the_other_way_keeps_its_inner_side_on_the_organs() {
+        // The organ cups one way, the target (the same outline, faces
+        // wound alike) the other: turned over about its long axis it
+        // would lie on the organ closer, but inner side on outer side.
+        let mesh = anthesis_mesh::generate::test_petal(10.0, 4.0, 9, 19);
+        let cupped = |k: f64| -> Vec<DVec3> {
+            mesh.positions
+                .iter()
+                .map(|p| DVec3::new(p.x, p.y, p.z + k * p.x * p.x))
+                .collect()
+        };
+        let organ = cupped(0.15);
+        let base: Vec<u32> = (0..organ.len() as u32)
+            .filter(|&i| organ[i as usize].y < 0.3)
+            .collect();
+        let moved = Similarity {
+            rotation: DQuat::from_axis_angle(DVec3::new(0.5, 0.2, -1.0).normalize(), 1.1),
+            scale: 1.0,
+            translation: DVec3::new(-8.0, 3.0, 2.0),
+        };
+        let scan: Vec<DVec3> = cupped(-0.15).iter().map(|&p| moved.apply(p)).collect();
+        let target = Surface::new(scan, mesh.triangles.clone());
+        let placement = register(&target, &organ, &mesh.triangles, &base, false).placement;
+        let left = (placement.rotation * moved.rotation)
+            .to_axis_angle()
+            .1
+            .to_degrees();
+        assert!(left < 10.0, "{left}° from undoing the motion");
     }
 
     #[test]

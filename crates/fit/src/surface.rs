@@ -144,6 +144,90 @@ pub fn vertex_weights(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
     weights
 }
 
+/// One boundary edge in a [`Rim`]'s tree.
+#[derive(Debug, Clone)]
+struct Segment {
+    ends: [DVec3; 2],
+}
+
+impl Segment {
+    fn nearest(&self, p: DVec3) -> DVec3 {
+        let [a, b] = self.ends;
+        let ab = b - a;
+        let t = if ab.length_squared() > 0.0 {
+            ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        a + t * ab
+    }
+}
+
+impl RTreeObject for Segment {
+    type Envelope = AABB<[f64; 3]>;
+
+    fn envelope(&self) -> Self::Envelope {
+        let [a, b] = self.ends;
+        AABB::from_corners(a.min(b).to_array(), a.max(b).to_array())
+    }
+}
+
+impl PointDistance for Segment {
+    fn distance_2(&self, point: &[f64; 3]) -> f64 {
+        let p = DVec3::from_array(*point);
+        self.nearest(p).distance_squared(p)
+    }
+}
+
+/// A surface's outline: its boundary edges (those of one triangle), for
+/// the nearest point on it.
+#[derive(Debug, Clone)]
+pub struct Rim {
+    tree: RTree<Segment>,
+}
+
+impl Rim {
+    /// The outline of `triangles` over `positions`.
+    pub fn new(positions: &[DVec3], triangles: &[[u32; 3]]) -> Rim {
+        let mut edges: std::collections::HashMap<(u32, u32), u32> =
+            std::collections::HashMap::new();
+        for t in triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let mut segments: Vec<Segment> = edges
+            .into_iter()
+            .filter(|&(_, count)| count == 1)
+            .map(|((a, b), _)| Segment {
+                ends: [positions[a as usize], positions[b as usize]],
+            })
+            .collect();
+        // A fixed order whatever the hash map's.
+        segments.sort_by(|s, t| {
+            let key = |s: &Segment| [s.ends[0].to_array(), s.ends[1].to_array()];
+            key(s)
+                .iter()
+                .flatten()
+                .zip(key(t).iter().flatten())
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        Rim {
+            tree: RTree::bulk_load(segments),
+        }
+    }
+
+    /// The point of the outline nearest `p` (`None` for a closed surface).
+    pub fn nearest(&self, p: DVec3) -> Option<DVec3> {
+        self.tree
+            .nearest_neighbor(&p.to_array())
+            .map(|segment| segment.nearest(p))
+    }
+}
+
 /// The vertices on an edge that only one triangle has.
 fn rim_vertices(triangles: &[[u32; 3]], vertex_count: usize) -> Vec<bool> {
     let mut edges: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
@@ -470,6 +554,26 @@ mod tests {
         assert!(apart.organ_mean_square < 1e-24, "{apart:?}");
         assert!((apart.max - 1.0).abs() < 1e-9, "{apart:?}");
         assert!(apart.target_mean_square > 0.05, "{apart:?}");
+    }
+
+    #[test]
+    fn the_rim_is_the_outline_and_its_nearest_point_lies_on_it() {
+        // A 2 x 2 sheet: its outline is the square's four sides.
+        let (t, tt) = sheet(5, 2.0, 0.0);
+        let rim = Rim::new(&t, &tt);
+        // From the middle of the sheet, the nearest outline point is a
+        // side's middle, 1 away; from outside a corner, the corner.
+        let middle = DVec3::new(0.0, 1.0, 0.5);
+        let near = rim.nearest(middle).expect("an outline");
+        assert!(
+            (near.distance(middle) - 0.5f64.hypot(1.0)).abs() < 1e-12,
+            "{near}"
+        );
+        let corner = rim.nearest(DVec3::new(3.0, 4.0, 0.0)).expect("an outline");
+        assert!(
+            (corner - DVec3::new(1.0, 2.0, 0.0)).length() < 1e-12,
+            "{corner}"
+        );
     }
 
     #[test]
