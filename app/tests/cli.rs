@@ -1467,4 +1467,48 @@ fn fit_registers_a_scan_of_another_mesh_and_fits_it() {
     assert_eq!(json["registration"]["scale"], 1.0);
     let rms = json["rms"].as_f64().expect("rms");
     assert!(rms < 0.02, "{json}");
+
+    // The same scan in units ten times smaller (millimetres against
+    // centimetres): --register-scale finds the scale too.
+    let scaled: String = std::fs::read_to_string(&scan)
+        .expect("read")
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(rest) => {
+                let v: Vec<f64> = rest
+                    .split_whitespace()
+                    .map(|w| w.parse().expect("number"))
+                    .collect();
+                format!("v {} {} {}\n", 10.0 * v[0], 10.0 * v[1], 10.0 * v[2])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    let scan_mm = dir.path().join("scan-mm.obj");
+    std::fs::write(&scan_mm, scaled).expect("write");
+    let fitted_mm = dir.path().join("fitted-mm");
+    let out = anthesis(&[
+        "fit",
+        path.to_str().expect("utf-8"),
+        "--organ",
+        "petal-1",
+        "--target",
+        scan_mm.to_str().expect("utf-8"),
+        "--register-scale",
+        "--nodes",
+        "1x3",
+        "--direction-nodes",
+        "0x0",
+        "--max-iterations",
+        "1",
+        "--out",
+        fitted_mm.to_str().expect("utf-8"),
+        "--report",
+        report.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let scale = json["registration"]["scale"].as_f64().expect("scale");
+    assert!((scale - 0.1).abs() < 0.002, "{json}");
 }

@@ -38,6 +38,12 @@ pub struct FitArgs {
     /// current shape and then held.
     #[arg(long)]
     pub register_scale: bool,
+    /// The target's inner side is the other one: its faces wind clockwise
+    /// around the normal of its inner side (an organ's wind
+    /// counter-clockwise). The registration lays a target's inner side on
+    /// the organ's.
+    #[arg(long)]
+    pub flip_inner_side: bool,
     /// Time keys of the fitted maps, spread evenly over the run.
     #[arg(long, default_value_t = 1)]
     pub keys: u32,
@@ -150,8 +156,11 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
     let text = anthesis_files::read_regular_text(&args.target, MAX_OBJ_BYTES, "an OBJ mesh")
         .with_context(|| format!("cannot read the target {}", args.target.display()))?;
     let mesh = &resolved.flower.template_of(organ).mesh;
-    let target = anthesis_fit::read_target(&text, &args.organ, mesh)
+    let mut target = anthesis_fit::read_target(&text, &args.organ, mesh)
         .with_context(|| format!("target {}", args.target.display()))?;
+    if args.flip_inner_side {
+        target = target.flipped();
+    }
     for warning in &target.warnings {
         eprintln!("target {}: {warning}", args.target.display());
     }

@@ -201,6 +201,23 @@ impl Target {
     pub fn vertex_count(&self) -> usize {
         self.surface.positions.len()
     }
+
+    /// The target with its faces wound the other way: its inner side (the
+    /// one its faces wind counter-clockwise around, as an organ's do) the
+    /// other side, for a target exported the other way round. Only the
+    /// registration reads the winding.
+    pub fn flipped(self) -> Target {
+        let triangles = self
+            .surface
+            .triangles
+            .iter()
+            .map(|&[a, b, c]| [a, c, b])
+            .collect();
+        Target {
+            surface: Surface::new(self.surface.positions, triangles),
+            ..self
+        }
+    }
 }
 
 /// Progress of a running fit, reported after each iteration.

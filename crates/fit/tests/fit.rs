@@ -459,3 +459,17 @@ fn the_limits_say_they_stopped_the_fit() {
         "{error}"
     );
 }
+
+#[test]
+fn a_flipped_target_has_its_inner_side_the_other_way() {
+    let project = small_organ();
+    let target = target_of(&project, &KNOWN, &layout(NO_DIRECTION));
+    let normals =
+        |t: &Target| anthesis_mesh::vertex_normals(&t.surface.positions, &t.surface.triangles);
+    let before = normals(&target);
+    let flipped = target.clone().flipped();
+    assert_eq!(flipped.surface.positions, target.surface.positions);
+    for (a, b) in before.iter().zip(normals(&flipped)) {
+        assert!((*a + b).length() < 1e-12, "{a} {b}");
+    }
+}
