@@ -770,6 +770,7 @@ pub fn fit(
         error,
     })?;
     let bud_positions = bud_positions(project, organ)?;
+    let base_particles = template.base_region.particles(&template.mesh);
     let length = organ_length(project, organ, target, placement)?;
 
     let layout = Layout {
@@ -1021,8 +1022,14 @@ pub fn fit(
                 s = shape;
                 apart = a;
                 if settings.refine_placement {
-                    let refined =
-                        register::refine(&target.surface, &s, problem.triangles, placement, 3);
+                    let refined = register::refine(
+                        &target.surface,
+                        &s,
+                        problem.triangles,
+                        &base_particles,
+                        placement,
+                        3,
+                    );
                     let moved = problem.measure(&s, refined, None);
                     if moved.cost() < apart.cost() {
                         placement = refined;

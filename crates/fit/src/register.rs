@@ -184,18 +184,25 @@ pub fn register(
     }
 }
 
-/// A few ICP steps of the rigid part alone (the scale held), untrimmed and
-/// without the base term: the placement that lowers the fit's own cost
+/// A few ICP steps of the rigid part alone (the scale held), untrimmed,
+/// with the base on the target's outline: the placement that lowers the fit's own cost
 /// against the organ's shape now. Returns the placement after `steps`
 /// steps; the caller keeps it only if its cost is lower.
 pub fn refine(
     target: &Surface,
     organ: &[DVec3],
     triangles: &[[u32; 3]],
+    base: &[u32],
     placement: Similarity,
     steps: usize,
 ) -> Similarity {
     let organ_surface = Surface::new(organ.to_vec(), triangles.to_vec());
+    let rim = Rim::new(&target.positions, &target.triangles);
+    let base: Vec<u32> = base
+        .iter()
+        .copied()
+        .filter(|&b| organ_surface.is_rim(b as usize))
+        .collect();
     let organ_weights = vertex_weights(organ, triangles);
     let target_weights = target.vertex_weights();
     let target_normals = anthesis_mesh::vertex_normals(&target.positions, &target.triangles);
@@ -213,7 +220,7 @@ pub fn refine(
             &samples,
             &organ_surface,
             &organ_weights,
-            None,
+            Some((&base, &rim)),
             placement,
             1.0,
             0.0,
