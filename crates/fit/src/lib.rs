@@ -380,10 +380,39 @@ pub fn read_target(text: &str, name: &str, mesh: &Mesh) -> Result<Target, FitErr
             warnings: Vec::new(),
         });
     }
-    let shape = anthesis_mesh::obj::parse_obj_shape(&object)
-        .map_err(|e| FitError::Target(e.to_string()))?;
-    let warnings = shape.warnings.iter().map(|w| w.to_string()).collect();
-    let shape = shape.mesh;
+    // One clean surface, or else (a scan with stray pieces, a non-manifold
+    // edge) its triangles as they are, said in a warning: distances do
+    // not need a manifold.
+    let (shape, unclean) = match anthesis_mesh::obj::parse_obj_shape(&object) {
+        Ok(shape) => (shape, None),
+        Err(error) => (
+            anthesis_mesh::obj::parse_obj_triangles(&object)
+                .map_err(|e| FitError::Target(e.to_string()))?,
+            Some(error),
+        ),
+    };
+    let mut warnings: Vec<String> = shape.warnings.iter().map(|w| w.to_string()).collect();
+    let mut shape = shape.mesh;
+    if let Some(error) = unclean {
+        let before = shape.triangles.len();
+        shape.triangles.retain(|t| {
+            let [a, b, c] = t.map(|v| shape.positions[v as usize]);
+            (b - a).cross(c - a).length_squared() > 0.0
+        });
+        warnings.push(format!(
+            "the target is not one clean surface ({error}); its triangles are measured as they \
+             are{}",
+            match before - shape.triangles.len() {
+                0 => String::new(),
+                n => format!(", but for {n} without area"),
+            }
+        ));
+        if shape.triangles.is_empty() {
+            return Err(FitError::Target(
+                "the target has no triangle with an area".into(),
+            ));
+        }
+    }
     // The UV layout, where the file has one per vertex within the unit
     // square and the same vertices as the shape read.
     let uvs = anthesis_mesh::obj::parse_obj_unvalidated(&object)

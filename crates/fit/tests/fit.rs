@@ -248,6 +248,25 @@ fn the_target_is_the_object_named_like_the_organ_or_the_only_one() {
     assert!(error.to_string().contains("vertex 2"), "{error}");
     let error = read_target(two, "petal-9", &mesh).expect_err("no such object");
     assert!(error.to_string().contains("petal-9"), "{error}");
+    // A scan with a stray piece and a triangle without area: read, said.
+    let stray = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nv 5 5 5\nv 6 5 5\nv 5 6 5\nv 7 5 5\nf 5 6 7\nf 5 6 8\n";
+    let read = read_target(stray, "petal-1", &mesh).expect("a soup");
+    assert_eq!(
+        read.surface.triangles.len(),
+        3,
+        "the triangle without area left out"
+    );
+    assert_eq!(read.warnings.len(), 1, "{:?}", read.warnings);
+    assert!(
+        read.warnings[0].contains("not one clean surface"),
+        "{:?}",
+        read.warnings
+    );
+    assert!(
+        read.warnings[0].contains("1 without area"),
+        "{:?}",
+        read.warnings
+    );
     // UVs over the unit square are kept for the first guess.
     let uv = "v 0 0 0\nv 2 0 0\nv 0 2 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
     let read = read_target(uv, "petal-1", &mesh).expect("with UVs");
