@@ -1278,43 +1278,44 @@ fn fit_finds_maps_for_a_simulated_open_shape_and_refuses_bad_targets() {
     };
     let (got, want) = (
         points(&refit.join("keyframe_0008.obj")),
-        points(&frames.join("keyframe_0008.obj")),
+        std::fs::read_to_string(frames.join("keyframe_0008.obj")).expect("read"),
     );
     let length = json["organ_length"].as_f64().expect("length");
-    let mean_square = got
-        .iter()
-        .zip(&want)
-        .map(|(a, b)| a.distance_squared(*b))
-        .sum::<f64>()
-        / got.len() as f64;
+    let mesh = &project.flower.template_of(0).mesh;
+    let target = anthesis_fit::read_target(&want, "petal-1", mesh).expect("the target");
+    let (surface_rms, _) = anthesis_fit::distances(
+        &got,
+        &mesh.triangles,
+        &target,
+        anthesis_fit::Similarity::IDENTITY,
+        length,
+    );
     // The OBJ files round positions to their printed digits.
     assert!(
-        (mean_square.sqrt() / length - rms).abs() < 1e-6 * (1.0 + rms),
-        "{json}"
+        (surface_rms - rms).abs() < 1e-6 * (1.0 + rms),
+        "{surface_rms} {json}"
     );
+    assert_eq!(json["target_vertices"], mesh.vertex_count());
+    assert!(json["stopped"].is_string(), "{json}");
+    // Nothing of the staging folder is left beside the result.
+    let leftovers = |folder: &Path| -> Vec<String> {
+        std::fs::read_dir(folder)
+            .expect("read")
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|name| name.starts_with(".anthesis-fit"))
+            .collect()
+    };
+    assert!(leftovers(dir.path()).is_empty());
 
     // An existing fit is not overwritten.
     let err = text(&one_line_error(&args).stderr);
     assert!(err.contains("already holds a project"), "{err}");
-    // Another mesh, a NaN, a missing organ: one clear line each.
-    let other = dir.path().join("other.obj");
-    let sheet = anthesis_mesh::generate::flat_sheet(1.0, 1.0, 3, 3);
-    std::fs::write(&other, anthesis_mesh::obj_string(&sheet)).expect("write");
+    // A NaN, a target without faces, outputs that cannot be: one clear
+    // line each, before any fit.
     let new_out = dir.path().join("fitted-2");
-    let args = fit_args(
-        other.to_str().expect("utf-8"),
-        new_out.to_str().expect("utf-8"),
-    );
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let err = text(&one_line_error(&args).stderr);
-    let wrong = format!(
-        "the target has {} vertices but organ `petal-1` has {}",
-        sheet.vertex_count(),
-        project.flower.template_of(0).mesh.vertex_count()
-    );
-    assert!(err.contains(&wrong), "{err}");
     let nan = dir.path().join("nan.obj");
-    let text_obj = std::fs::read_to_string(frames.join("keyframe_0008.obj")).expect("read");
+    let text_obj = want.clone();
     let mut replaced = false;
     let with_nan: String = text_obj
         .lines()
@@ -1339,31 +1340,175 @@ fn fit_finds_maps_for_a_simulated_open_shape_and_refuses_bad_targets() {
         err.contains("target vertex 1 (from 1) has a coordinate that is not a finite number"),
         "{err}"
     );
-    // The same vertices with one triangle turned over: another mesh.
-    let flipped = dir.path().join("flipped.obj");
-    let mut done = false;
-    let turned: String = text_obj
-        .lines()
-        .map(|line| match line.strip_prefix("f ") {
-            Some(corners) if !done => {
-                done = true;
-                let c: Vec<&str> = corners.split_whitespace().collect();
-                format!("f {} {} {}", c[0], c[2], c[1])
-            }
-            _ => line.to_owned(),
-        })
-        .collect::<Vec<_>>()
-        .join("\n");
-    std::fs::write(&flipped, turned).expect("write");
+    let bare = dir.path().join("bare.obj");
+    std::fs::write(&bare, "v 0 0 0\nv 1 0 0\nv 0 1 0\n").expect("write");
     let args = fit_args(
-        flipped.to_str().expect("utf-8"),
+        bare.to_str().expect("utf-8"),
         new_out.to_str().expect("utf-8"),
     );
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let err = text(&one_line_error(&args).stderr);
-    assert!(
-        err.contains("the target's faces are not organ `petal-1`'s triangles"),
-        "{err}"
+    assert!(err.contains("3 vertices and no faces"), "{err}");
+    // --out inside a file, and a folder with something in it.
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "x").expect("write");
+    let busy = dir.path().join("busy");
+    std::fs::create_dir(&busy).expect("mkdir");
+    std::fs::write(busy.join("notes.txt"), "mine").expect("write");
+    for (out, says) in [
+        (file.join("fitted"), "does not exist"),
+        (busy.clone(), "is not empty"),
+    ] {
+        let args = fit_args(open, out.to_str().expect("utf-8"));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let err = text(&one_line_error(&args).stderr);
+        assert!(err.contains(says), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(busy.join("notes.txt")).expect("kept"),
+        "mine"
     );
     assert!(!new_out.exists());
+    assert!(leftovers(dir.path()).is_empty());
+
+    // No iteration allowed: the closest maps so far are written, and the
+    // fit says the limit stopped it, not that the bud cannot get there.
+    let mut args = fit_args(open, new_out.to_str().expect("utf-8"));
+    args.extend(["--max-iterations", "0"].map(str::to_owned));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = anthesis(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let said = text(&out.stdout);
+    assert!(said.contains("the iteration limit (0)"), "{said}");
+    assert!(!said.contains("cannot be grown"), "{said}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    assert_eq!(json["stopped"], "max-iterations");
+    assert!(new_out.join("petal.anthesis.toml").is_file());
+}
+
+#[test]
+fn fit_registers_a_scan_of_another_mesh_and_fits_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut project = anthesis_sim::fixtures::whorl(1, 6, 10, 8);
+    project.flower.templates[0].dg = 0.03;
+    let path = dir.path().join("petal.anthesis.toml");
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    // The scan: the open petal simulated at a finer mesh, its vertices
+    // shuffled, as quads where two triangles make one, without UVs,
+    // turned and moved far from the flower.
+    let mesh = &project.flower.template_of(0).mesh;
+    let edge = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            a.distance(b) + b.distance(c) + c.distance(a)
+        })
+        .sum::<f64>()
+        / (3 * mesh.triangles.len()) as f64;
+    let mut fine = project.clone();
+    fine.settings.resolution = anthesis_flower::resolution::Resolution::MeanEdge(0.7 * edge);
+    let fine = anthesis_flower::resolution::resolve(&fine).expect("remeshes");
+    let fine_mesh = &fine.flower.template_of(0).mesh;
+    let shape =
+        anthesis_fit::simulate_final(&fine, 0, fine.flower.template_of(0).maps.clone(), &|| false)
+            .expect("simulates");
+    let turn = glam::DQuat::from_axis_angle(glam::DVec3::new(0.2, 1.0, -0.6).normalize(), 1.9);
+    let n = shape.len();
+    let order: Vec<usize> = (0..n).map(|i| (i * 53 + 7) % n).collect();
+    let mut new_index = vec![0usize; n];
+    for (new, &old) in order.iter().enumerate() {
+        new_index[old] = new + 1;
+    }
+    let mut obj = String::from("o scan\n");
+    for &old in &order {
+        let p = turn * shape[old] + glam::DVec3::new(50.0, 20.0, -30.0);
+        obj.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    for t in &fine_mesh.triangles {
+        let [a, b, c] = t.map(|v| new_index[v as usize]);
+        obj.push_str(&format!("f {a} {b} {c}\n"));
+    }
+    let scan = dir.path().join("scan.obj");
+    std::fs::write(&scan, obj).expect("write");
+    let fitted = dir.path().join("fitted");
+    let report = dir.path().join("fit.json");
+    let out = anthesis(&[
+        "fit",
+        path.to_str().expect("utf-8"),
+        "--organ",
+        "petal-1",
+        "--target",
+        scan.to_str().expect("utf-8"),
+        "--register",
+        "--nodes",
+        "1x3",
+        "--direction-nodes",
+        "0x0",
+        "--out",
+        fitted.to_str().expect("utf-8"),
+        "--report",
+        report.to_str().expect("utf-8"),
+    ]);
+    let err = text(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    // The registration is said before the fit's iterations.
+    let registered = err.find("registered: turned").expect("registration said");
+    let first = err.find("iteration 0").expect("iterations said");
+    assert!(registered < first, "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    assert_eq!(json["target_vertices"], n);
+    assert_eq!(json["target_has_uvs"], false);
+    // The turn undone: 1.9 rad, about 109°.
+    let angle = json["registration"]["angle_deg"].as_f64().expect("angle");
+    assert!((angle - 1.9f64.to_degrees()).abs() < 3.0, "{json}");
+    assert_eq!(json["registration"]["scale"], 1.0);
+    let rms = json["rms"].as_f64().expect("rms");
+    assert!(rms < 0.02, "{json}");
+
+    // The same scan in units ten times smaller (millimetres against
+    // centimetres): --register-scale finds the scale too.
+    let scaled: String = std::fs::read_to_string(&scan)
+        .expect("read")
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(rest) => {
+                let v: Vec<f64> = rest
+                    .split_whitespace()
+                    .map(|w| w.parse().expect("number"))
+                    .collect();
+                format!("v {} {} {}\n", 10.0 * v[0], 10.0 * v[1], 10.0 * v[2])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    let scan_mm = dir.path().join("scan-mm.obj");
+    std::fs::write(&scan_mm, scaled).expect("write");
+    let fitted_mm = dir.path().join("fitted-mm");
+    let out = anthesis(&[
+        "fit",
+        path.to_str().expect("utf-8"),
+        "--organ",
+        "petal-1",
+        "--target",
+        scan_mm.to_str().expect("utf-8"),
+        "--register-scale",
+        "--nodes",
+        "1x3",
+        "--direction-nodes",
+        "0x0",
+        "--max-iterations",
+        "1",
+        "--out",
+        fitted_mm.to_str().expect("utf-8"),
+        "--report",
+        report.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("JSON");
+    let scale = json["registration"]["scale"].as_f64().expect("scale");
+    assert!((scale - 0.1).abs() < 0.002, "{json}");
 }

@@ -3021,6 +3021,70 @@ fn edit_menu_fits_growth_maps_to_a_target_and_applies_them_as_one_undo_step() {
     );
 }
 
+#[test]
+fn the_fit_dialog_registers_a_target_in_its_own_frame_and_shows_it_over_the_organ() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let project = small_flower();
+    let maps = project.flower.template_of(0).maps.clone();
+    let shape = anthesis_fit::simulate_final(&project, 0, maps, &|| false).expect("simulates");
+    // The organ's open shape turned a quarter about +Y and moved away.
+    let mut obj = format!("o {}\n", project.flower.organs[0].name);
+    for p in &shape {
+        obj.push_str(&format!("v {} {} {}\n", -p.z + 40.0, p.y - 5.0, p.x));
+    }
+    let target = dir.path().join("scan.obj");
+    std::fs::write(&target, obj).expect("write");
+
+    let mut harness = harness(project);
+    harness.run();
+    harness.get_by_label("Edit").click();
+    harness.run();
+    harness.get_by_label("Fit growth maps to a target…").click();
+    harness.run();
+    harness.get_by_label("Target OBJ").click();
+    harness.run();
+    harness
+        .get_by_label("Target OBJ")
+        .type_text(&target.display().to_string());
+    harness.run();
+    harness
+        .get_by_label("Register the target on the organ first")
+        .click();
+    harness.run();
+    harness.get_by_label("Fit").click();
+    harness.step();
+    let started = Instant::now();
+    while harness.state().fit_dialog().is_running() {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "the fit hangs: {:?}",
+            harness.state().fit_dialog().state()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        harness.step();
+    }
+    harness.run();
+    // The motion found is said in the dialog, the fit ends on the target,
+    // and the target is drawn where the registration put it.
+    assert!(
+        harness
+            .query_all_by_label_contains("registered: turned 90.")
+            .next()
+            .is_some(),
+        "{:?}",
+        harness.state().fit_dialog().registered()
+    );
+    assert!(
+        harness
+            .query_all_by_label_contains("fitted: RMS")
+            .next()
+            .is_some(),
+        "{:?}",
+        harness.state().fit_dialog().state()
+    );
+    assert!(harness.state().fit_dialog().target_overlay().0 > 0);
+}
+
 /// Runs frames until the app stops asking for them (the remesher's
 /// thread asks for one more when its preview is ready, at any time).
 fn settle(harness: &mut Harness<'_, AnthesisApp>) {

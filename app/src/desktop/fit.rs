@@ -2,20 +2,27 @@
 //! selected organ, on a thread named `anthesis-fit`, with its progress
 //! (iteration, RMS and largest distance) and a Cancel button; the fitted
 //! maps replace the organ's template's maps as one undo step when the user
-//! applies them.
+//! applies them. The target is any triangulated OBJ; with "Register" ticked
+//! it is first put on the organ (`anthesis_fit::register_target`), and the
+//! motion found is shown before the fit goes on.
 
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, sync_channel};
 
-use anthesis_fit::{Fit, FitProgress, FitSettings};
+use anthesis_fit::{Fit, FitProgress, FitSettings, Registered, Similarity, Target};
 use anthesis_flower::Project;
 use anthesis_mesh::obj::MAX_OBJ_BYTES;
+use anthesis_render::OrganMesh;
 use eframe::egui;
 
 use super::AnthesisApp;
 use super::command::{Command, ProjectEdit};
+
+/// The registered target's colour over the organ (linear RGBA, a cyan no
+/// template uses).
+const TARGET_COLOUR_LINEAR: [f32; 4] = [0.05, 0.6, 0.8, 1.0];
 
 /// Where a fit stands.
 #[derive(Debug, Clone)]
@@ -28,6 +35,7 @@ pub enum FitState {
 }
 
 enum Message {
+    Registered(Registered),
     Progress(FitProgress),
     Done(Result<Fit, anthesis_fit::FitError>),
 }
@@ -45,6 +53,19 @@ pub struct FitDialog {
     pub target: String,
     /// Time keys of the fitted maps.
     pub keys: u32,
+    /// Put the target on the organ first (a scan in its own frame).
+    pub register: bool,
+    /// With the registration, a uniform scale too.
+    pub register_scale: bool,
+    /// The registration of the running or last fit, if it had one.
+    registered: Option<Registered>,
+    /// The target of the running or last fit.
+    target_surface: Option<Arc<Target>>,
+    /// The registered target where the registration (or the fit's
+    /// refinement) put it, as the viewport draws it over the organ, and
+    /// the count of its changes (the viewport's scene key).
+    overlay: Option<OrganMesh>,
+    overlay_revision: u64,
     /// The organ fitted (index into the project's organs) and the
     /// document revision it was started on.
     started: Option<(usize, u64)>,
@@ -58,6 +79,12 @@ impl Default for FitDialog {
             open: false,
             target: String::new(),
             keys: 1,
+            register: false,
+            register_scale: false,
+            registered: None,
+            target_surface: None,
+            overlay: None,
+            overlay_revision: 0,
             started: None,
             state: FitState::Idle,
             job: None,
@@ -75,6 +102,43 @@ pub struct FitRequests {
 impl FitDialog {
     pub fn state(&self) -> &FitState {
         &self.state
+    }
+
+    /// The running or last fit's registration, if it had one.
+    pub fn registered(&self) -> Option<&Registered> {
+        self.registered.as_ref()
+    }
+
+    /// The registered target as the viewport draws it over the organ
+    /// while the dialog is open (a cyan surface, so where it passes the
+    /// organ shows): a number that changes with it (0: nothing shown) and
+    /// the mesh.
+    pub fn target_overlay(&self) -> (u64, Option<&OrganMesh>) {
+        match &self.overlay {
+            Some(mesh) if self.open => (self.overlay_revision, Some(mesh)),
+            _ => (0, None),
+        }
+    }
+
+    /// Shows the target at `placement` over the organ (`None`: nothing).
+    fn set_overlay(&mut self, placement: Option<Similarity>) {
+        self.overlay_revision += 1;
+        self.overlay = match (placement, &self.target_surface) {
+            (Some(placement), Some(target)) => {
+                let positions: Vec<_> = target
+                    .surface
+                    .positions
+                    .iter()
+                    .map(|&x| placement.apply(x))
+                    .collect();
+                Some(OrganMesh::from_positions(
+                    &positions,
+                    &target.surface.triangles,
+                    TARGET_COLOUR_LINEAR,
+                ))
+            }
+            _ => None,
+        };
     }
 
     pub fn is_running(&self) -> bool {
@@ -103,10 +167,16 @@ impl FitDialog {
         let text = anthesis_files::read_regular_text(target, MAX_OBJ_BYTES, "an OBJ mesh")
             .map_err(|e| format!("cannot read the target {}: {e}", target.display()))?;
         let mesh = &resolved.flower.template_of(organ).mesh;
-        let positions = anthesis_fit::read_target(&text, &organ_def.name, mesh)
-            .map_err(|e| format!("target {}: {e}", target.display()))?;
+        let target_surface = Arc::new(
+            anthesis_fit::read_target(&text, &organ_def.name, mesh)
+                .map_err(|e| format!("target {}: {e}", target.display()))?,
+        );
+        self.target_surface = Some(Arc::clone(&target_surface));
+        let register = self.register;
+        let scale = self.register && self.register_scale;
         let settings = FitSettings {
             keys: self.keys.clamp(1, resolved.settings.keyframes + 1),
+            refine_placement: register,
             ..FitSettings::default()
         };
         // One message per iteration and the result: the fit's iteration
@@ -119,20 +189,44 @@ impl FitDialog {
             .name("anthesis-fit".into())
             .spawn(move || {
                 let progress_sender = sender.clone();
+                let cancelled = || flag.load(Ordering::Relaxed);
+                let placement = if register {
+                    match anthesis_fit::register_target(
+                        &resolved,
+                        organ,
+                        &target_surface,
+                        scale,
+                        &cancelled,
+                    ) {
+                        Ok(registered) => {
+                            let _ = sender.send(Message::Registered(registered));
+                            registered.registration.placement
+                        }
+                        Err(error) => {
+                            let _ = sender.send(Message::Done(Err(error)));
+                            return;
+                        }
+                    }
+                } else {
+                    anthesis_fit::Similarity::IDENTITY
+                };
                 let result = anthesis_fit::fit(
                     &resolved,
                     organ,
-                    &positions,
+                    &target_surface,
+                    placement,
                     &settings,
                     &mut |p| {
                         let _ = progress_sender.try_send(Message::Progress(p));
                     },
-                    &|| flag.load(Ordering::Relaxed),
+                    &cancelled,
                 );
                 let _ = sender.send(Message::Done(result));
             })
             .map_err(|e| format!("cannot start the fit: {e}"))?;
         self.job = Some(Job { receiver, cancel });
+        self.registered = None;
+        self.set_overlay(None);
         self.started = Some((organ, revision));
         self.state = FitState::Running { progress: None };
         Ok(())
@@ -151,8 +245,10 @@ impl FitDialog {
             return false;
         };
         let mut ended = None;
+        let mut placed = None;
         while let Ok(message) = job.receiver.try_recv() {
             match message {
+                Message::Registered(registered) => placed = Some(registered),
                 Message::Progress(p) => {
                     self.state = FitState::Running { progress: Some(p) };
                 }
@@ -169,10 +265,18 @@ impl FitDialog {
                 "the fit stopped without a result".into(),
             )));
         }
+        if let Some(registered) = placed {
+            self.registered = Some(registered);
+            self.set_overlay(Some(registered.registration.placement));
+        }
         let Some(result) = ended else {
             return false;
         };
         self.job = None;
+        if let (Ok(fit), Some(_)) = (&result, &self.registered) {
+            // Where the fit's refinement left the registered target.
+            self.set_overlay(Some(fit.placement));
+        }
         self.state = match result {
             Ok(fit) => FitState::Done { fit: Box::new(fit) },
             Err(anthesis_fit::FitError::Cancelled) => FitState::Cancelled,
@@ -229,8 +333,9 @@ impl FitDialog {
             .show(ctx, |ui| {
                 ui.label(format!(
                     "Finds the growth maps of organ {organ_name}'s template whose simulation \
-                     ends at the target: an OBJ of this organ's vertices in world coordinates, \
-                     as `anthesis simulate --organ {organ_name} --out FOLDER/` writes them."
+                     ends on the target: an OBJ surface of any triangulation, in the \
+                     project's frame and units, or anywhere with Register ticked (a scan or \
+                     a model in its own frame)."
                 ));
                 let running = self.is_running();
                 ui.add_enabled_ui(!running, |ui| {
@@ -246,6 +351,19 @@ impl FitDialog {
                         let label = ui.label("Time keys").id;
                         ui.add(egui::DragValue::new(&mut self.keys).range(1..=5))
                             .labelled_by(label);
+                        ui.end_row();
+                        ui.label("");
+                        ui.checkbox(&mut self.register, "Register the target on the organ first")
+                            .on_hover_text(
+                                "The rigid motion that best lays the target on the organ's \
+                                 current shape with its base on the organ's base",
+                            );
+                        ui.end_row();
+                        ui.label("");
+                        ui.add_enabled(
+                            self.register,
+                            egui::Checkbox::new(&mut self.register_scale, "… and its scale"),
+                        );
                         ui.end_row();
                     });
                 });
@@ -266,6 +384,9 @@ impl FitDialog {
                         requests.apply = true;
                     }
                 });
+                if let Some(registered) = &self.registered {
+                    ui.label(registered.describe());
+                }
                 match &self.state {
                     FitState::Idle => {}
                     FitState::Running { progress: None } => {
@@ -385,6 +506,68 @@ mod tests {
         let mut edited = (*project).clone();
         edit.apply(&mut edited);
         assert_eq!(edited.flower.templates[0].maps, fitted_maps);
+    }
+
+    #[test]
+    fn a_registered_target_is_shown_over_the_organ_while_the_dialog_is_open() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let (project, target) = petal_and_target(dir.path());
+        // The target turned about +Y and moved: in its own frame.
+        let text = std::fs::read_to_string(&target).expect("read");
+        let turned: String = text
+            .lines()
+            .map(|line| match line.strip_prefix("v ") {
+                Some(rest) => {
+                    let v: Vec<f64> = rest
+                        .split_whitespace()
+                        .map(|w| w.parse().expect("number"))
+                        .collect();
+                    format!("v {} {} {}\n", -v[2] + 40.0, v[1] - 5.0, v[0])
+                }
+                None => format!("{line}\n"),
+            })
+            .collect();
+        let scan = dir.path().join("scan.obj");
+        std::fs::write(&scan, turned).expect("write");
+        let mut dialog = FitDialog {
+            open: true,
+            register: true,
+            ..FitDialog::default()
+        };
+        assert_eq!(dialog.target_overlay().0, 0);
+        dialog.start(project, 0, 1, &scan).expect("starts");
+        wait(&mut dialog);
+        assert!(
+            matches!(dialog.state(), FitState::Done { .. }),
+            "{:?}",
+            dialog.state()
+        );
+        let registered = dialog.registered().expect("registered");
+        // The quarter turn undone.
+        let angle = registered.registration.placement.angle_deg();
+        assert!((angle - 90.0).abs() < 1.0, "{angle}");
+        let (revision, mesh) = dialog.target_overlay();
+        assert!(revision > 0);
+        let mesh = mesh.expect("shown");
+        // Over the organ: near the fitted shape, not where the file has it.
+        let FitState::Done { fit } = dialog.state() else {
+            unreachable!()
+        };
+        let centre = |points: &mut dyn Iterator<Item = glam::DVec3>| {
+            let all: Vec<glam::DVec3> = points.collect();
+            all.iter().sum::<glam::DVec3>() / all.len() as f64
+        };
+        let shown = centre(
+            &mut mesh
+                .positions_in_world
+                .iter()
+                .map(|p| glam::DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]))),
+        );
+        let organ = centre(&mut fit.shape.iter().copied());
+        assert!(shown.distance(organ) < 0.05 * fit.length, "{shown} {organ}");
+        // Closed: not shown.
+        dialog.open = false;
+        assert_eq!(dialog.target_overlay(), (0, None));
     }
 
     #[test]

@@ -156,6 +156,7 @@ impl AnthesisApp {
     pub(super) fn viewport_panel(&mut self, ui: &mut egui::Ui) {
         self.log.banner_ui(ui);
         let overlay = self.view.overlay.map(|kind| (kind, self.paint.key));
+        let fit_target = self.fit.target_overlay().0;
         let key = viewport::SceneKey {
             document_revision: self.doc.revision(),
             run: self.session.run(),
@@ -165,9 +166,11 @@ impl AnthesisApp {
             selected_organ: self.selected_organ,
             overlay,
             show_others: self.shows_others(),
+            fit_target,
         };
         let resolved = self.resolved_project();
-        let (scene, meshes, revision) = self.scene.get(key, &resolved, &self.session);
+        let fit_mesh = self.fit.target_overlay().1;
+        let (scene, meshes, revision) = self.scene.get(key, &resolved, &self.session, fit_mesh);
         self.frame_automatically(&scene);
         if !self.has_gpu {
             ui.label("The 3D viewport needs the wgpu renderer.");

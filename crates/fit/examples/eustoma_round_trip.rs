@@ -10,7 +10,7 @@
 //! the template's stretch and bend maps (material, not growth) unless
 //! `--uniform-stiffness` resets them to 1 too.
 
-use anthesis_fit::{FitSettings, fit, simulate_final};
+use anthesis_fit::{FitSettings, Similarity, Surface, Target, fit, simulate_final};
 use anthesis_garden::Cultivar;
 use anthesis_maps::{GrowthMaps, KeyedMaps};
 
@@ -44,7 +44,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let project = anthesis_flower::resolution::resolve(&builtin)?;
         let organ = 0;
         let template = project.flower.template_of(organ);
-        let target = simulate_final(&project, organ, template.maps.clone(), &|| false)?;
+        let target = Target {
+            surface: Surface::new(
+                simulate_final(&project, organ, template.maps.clone(), &|| false)?,
+                template.mesh.triangles.clone(),
+            ),
+            uvs: Some(template.mesh.uvs.clone()),
+            warnings: Vec::new(),
+        };
         // The shared bud with uniform growth maps (stiffness kept unless
         // asked).
         let mut start = project.clone();
@@ -64,6 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &start,
                 organ,
                 &target,
+                Similarity::IDENTITY,
                 &settings,
                 &mut |p| {
                     eprintln!(

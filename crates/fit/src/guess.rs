@@ -18,6 +18,8 @@ use anthesis_physics::growth::growth_direction;
 use anthesis_physics::hinge::dihedral_angle;
 use glam::{DVec2, DVec3};
 
+use anthesis_maps::{KeyedMaps, MapKind};
+
 use crate::basis::{ANGLE, Layout};
 use crate::dense::solve;
 
@@ -215,4 +217,93 @@ fn project(unknowns: usize, rows: &[(Vec<f64>, f64, f64)]) -> Vec<f64> {
         b[i] += ridge * mean;
     }
     solve(unknowns, a, b).unwrap_or_else(|| vec![mean; unknowns])
+}
+
+/// The parameters nearest (least squares over a 24 × 24 grid of UV points)
+/// to the growth maps `maps` as they are at each key's step: the project's
+/// own maps in the fit's basis, the other start the fit tries.
+pub fn from_maps(layout: &Layout, maps: &KeyedMaps) -> Vec<f64> {
+    const SAMPLES: usize = 24;
+    let points: Vec<DVec2> = (0..SAMPLES * SAMPLES)
+        .map(|i| {
+            DVec2::new(
+                ((i % SAMPLES) as f64 + 0.5) / SAMPLES as f64,
+                ((i / SAMPLES) as f64 + 0.5) / SAMPLES as f64,
+            )
+        })
+        .collect();
+    let kinds = [
+        MapKind::EGrowth,
+        MapKind::WGrowth,
+        MapKind::EGrowthIn,
+        MapKind::WGrowthIn,
+    ];
+    let mut p = vec![0.0; layout.len()];
+    for (key, &step) in layout.key_steps.iter().enumerate() {
+        let step = f64::from(step);
+        for (field, kind) in kinds.iter().enumerate() {
+            let rows: Vec<(Vec<f64>, f64, f64)> = points
+                .iter()
+                .map(|&uv| {
+                    let value = maps.scalar_triangle_value_at(*kind, step, [uv, uv, uv]);
+                    (layout.growth.weights(uv), value, 1.0)
+                })
+                .collect();
+            let values = project(layout.growth.len(), &rows);
+            p[layout.range(key, field)].copy_from_slice(&values);
+        }
+        if !layout.direction.is_empty() {
+            let rows: Vec<(Vec<f64>, f64, f64)> = points
+                .iter()
+                .map(|&uv| {
+                    let d = maps.direction_triangle_value_at(step, [uv, uv, uv]);
+                    (layout.direction.weights(uv), d.x.atan2(d.y), 1.0)
+                })
+                .collect();
+            let values = project(layout.direction.len(), &rows);
+            p[layout.range(key, ANGLE)].copy_from_slice(&values);
+        }
+    }
+    clamp(layout, &mut p);
+    p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::basis::Grid;
+    use anthesis_maps::{DirectionMap, GrowthMaps, ScalarMap};
+
+    #[test]
+    fn maps_the_basis_can_hold_are_put_in_it_as_they_are() {
+        // e-growth rising linearly from base to tip, the rest constant,
+        // the direction turned 0.3 rad: node values of a 1 x 3 grid.
+        let mut maps = GrowthMaps::uniform();
+        maps.e_growth = ScalarMap::from_fn(64, 64, |uv| (0.2 + 0.6 * uv.y) as f32);
+        maps.w_growth = ScalarMap::constant(0.4);
+        maps.e_growth_in = ScalarMap::constant(0.7);
+        maps.w_growth_in = ScalarMap::constant(0.1);
+        maps.direction = DirectionMap::constant(DVec2::new(0.3f64.sin(), 0.3f64.cos()));
+        let layout = Layout {
+            growth: Grid {
+                nodes_u: 1,
+                nodes_v: 3,
+            },
+            direction: Grid {
+                nodes_u: 1,
+                nodes_v: 1,
+            },
+            key_steps: vec![0],
+        };
+        let p = from_maps(&layout, &KeyedMaps::single(maps));
+        let want = [
+            0.2, 0.5, 0.8, 0.4, 0.4, 0.4, 0.7, 0.7, 0.7, 0.1, 0.1, 0.1, 0.3,
+        ];
+        assert_eq!(p.len(), want.len());
+        for (got, want) in p.iter().zip(want) {
+            // Within the map's 32-bit floats and bilinear sampling near
+            // the edges.
+            assert!((got - want).abs() < 2e-3, "{p:?}");
+        }
+    }
 }

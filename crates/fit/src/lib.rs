@@ -1,13 +1,21 @@
 //! Growth maps fitted to a target: "which maps make it open like this?"
 //!
-//! Given a project, one of its organs and a target shape of that organ (its
-//! template's vertices in the same order, in world coordinates as
-//! `anthesis simulate --out FOLDER/` writes them), [`fit`] finds growth
-//! maps (e-growth, w-growth, their inner versions and the growth direction,
-//! at one or more time keys) whose growth simulation ends at the target.
+//! Given a project, one of its organs and a target shape of that organ (a
+//! triangle mesh of any triangulation: the organ simulated at another
+//! resolution, a model from another program, a scan; with or without
+//! UVs), [`fit`] finds growth maps (e-growth, w-growth, their inner
+//! versions and the growth direction, at one or more time keys) whose
+//! growth simulation ends on the target's surface. A target in its own
+//! frame is first put on the organ by [`register_target`].
 //!
 //! # Method
 //!
+//! - **Distance.** Between surfaces, both ways ([`surface`]): every organ
+//!   particle to its nearest point on the target's triangles and every
+//!   target vertex to its nearest point on the organ's, each side weighted
+//!   by area; the RMS is the root of the two sides' mean squares, the
+//!   largest distance the largest of any vertex. Reported as fractions of
+//!   the organ's length (the farthest target vertex from the organ's base).
 //! - **Basis.** Each map is a sum of bilinear hat functions on a coarse
 //!   grid of nodes over the UV square (default 3 across × 4 from base to
 //!   tip for the four growth maps, 3 × 2 for the direction's angle from
@@ -15,40 +23,53 @@
 //!   rasterised at the template's map size and quantised as a 16-bit PNG
 //!   stores them, so the saved project simulates to the reported shape.
 //! - **First guess** in closed form from the target's stretches and
-//!   curvature changes relative to the bud ([`guess`]).
+//!   curvature changes relative to the bud ([`guess`]), the target read at
+//!   each particle's UV when it has a UV layout, else at the point nearest
+//!   the organ's current final shape; the project's own maps, put in the
+//!   basis by least squares, are simulated alongside, and the nearer of
+//!   the two starts.
 //! - **Optimisation**: Levenberg–Marquardt with box bounds (growth maps in
-//!   [0, 1], the angle within ±[`basis::MAX_ANGLE`]) on the residual
-//!   *simulated final positions − target positions*, all particles, in the
-//!   world frame (the base is attached to the receptacle by the simulation
-//!   itself, so no rigid alignment is made). The Jacobian is by forward
-//!   forward finite differences (step 0.001), one simulation per
-//!   parameter, run in parallel (rayon), on a run of half the keyframes at
-//!   twice the growth per step ([`FitSettings::coarse`]: half the cost,
-//!   derivatives of a shape 0.6 % of the length from the full run's);
-//!   between Jacobians it is kept current by Broyden's rank-one updates
-//!   from the full run's residuals, and taken afresh when a step gains
-//!   little, if it can end within the time allowed. Each iteration tries
-//!   two damping values at once (one per core).
-//! - Residuals are always those of the project's own run (its keyframe
+//!   [0, 1], the angle within ±[`basis::MAX_ANGLE`]) on the surface
+//!   residuals, whose correspondences (nearest points) are found afresh at
+//!   every shape the fit accepts (non-rigid ICP). The Jacobian of the
+//!   simulated positions is by forward finite differences (step 0.001),
+//!   one simulation per parameter, run in parallel (rayon), on a run of
+//!   half the keyframes at twice the growth per step
+//!   ([`FitSettings::coarse`]: half the cost, derivatives of a shape 0.6 %
+//!   of the length from the full run's); between Jacobians it is kept
+//!   current by Broyden's rank-one updates from the full run's shapes, and
+//!   taken afresh when a step gains little, if it can end within the time
+//!   allowed. Each iteration tries two damping values at once (one per
+//!   core). A registered target's rigid placement is refined by a few ICP
+//!   steps after each accepted step (kept when it lowers the distance).
+//! - Distances are always those of the project's own run (its keyframe
 //!   count, resolution, solver, parts): the final shape depends on the
 //!   number of keyframes, so the result is judged on the full run.
+//! - **Limits.** `max_seconds` bounds the whole fit from its start: every
+//!   simulation (the Jacobian's too) stops when it passes, and the fit
+//!   returns the best maps so far saying it was stopped ([`Stop`]); only a
+//!   first guess that cannot be simulated once within it is an error.
 
 #![warn(missing_docs)]
 
 pub mod basis;
 mod dense;
 pub mod guess;
+pub mod register;
+pub mod surface;
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anthesis_flower::Project;
 use anthesis_maps::{KeyedMaps, MapError};
 use anthesis_mesh::Mesh;
 use anthesis_sim::{Selection, SimError, Simulation};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 pub use basis::{Grid, Layout};
+pub use register::Registration;
+pub use surface::{Apart, Similarity, Surface};
 
 /// How a fit runs.
 #[derive(Debug, Clone, PartialEq)]
@@ -62,11 +83,13 @@ pub struct FitSettings {
     pub keys: u32,
     /// Levenberg–Marquardt iterations at most.
     pub max_iterations: u32,
-    /// Stop once the RMS distance is below this fraction of the organ's
-    /// length.
+    /// Stop once the RMS surface distance is below this fraction of the
+    /// organ's length.
     pub goal_rms: f64,
-    /// Stop starting new iterations after this many seconds, and start no
-    /// fresh Jacobian (after the first) that would end later.
+    /// The whole fit's time, in seconds, from its start to its result: the
+    /// simulation running when it passes stops, and the best maps so far
+    /// are returned ([`Stop::Seconds`]). No fresh Jacobian (after the
+    /// first) is started that would end later.
     pub max_seconds: f64,
     /// The finite-difference step of a growth map value (the angle's is
     /// the same in radians).
@@ -76,10 +99,14 @@ pub struct FitSettings {
     /// keys at 1/`coarse` their steps), when that leaves at least
     /// [`MIN_COARSE_KEYFRAMES`]: about `coarse` times cheaper, and near
     /// enough the full run's derivatives (Eustoma, halved: final shapes
-    /// 0.6 % of the length apart). Residuals are always the full run's,
+    /// 0.6 % of the length apart). Distances are always the full run's,
     /// and Broyden's updates carry the Jacobian towards the full run's.
     /// 1: the full run throughout.
     pub coarse: u32,
+    /// Refine the target's placement (rigidly, its scale held) as the fit
+    /// goes: for a registered target, whose first placement was found
+    /// against the organ's shape before the fit.
+    pub refine_placement: bool,
 }
 
 /// The fewest keyframes a coarse Jacobian run may have.
@@ -99,9 +126,10 @@ impl Default for FitSettings {
             keys: 1,
             max_iterations: 30,
             goal_rms: 0.002,
-            max_seconds: 50.0,
+            max_seconds: 100.0,
             step: 0.001,
             coarse: 2,
+            refine_placement: false,
         }
     }
 }
@@ -113,29 +141,18 @@ pub enum FitError {
     /// The organ named does not exist.
     #[error("no organ `{0}` in the project")]
     NoSuchOrgan(String),
-    /// The target has another number of vertices than the organ's mesh.
+    /// The target has no faces, and is not the organ's own vertices either.
     #[error(
-        "the target has {found} vertices but organ `{organ}` has {expected} (at the project's \
-         resolution): the target must be this organ's mesh, vertices in the same order, as \
-         `anthesis simulate --organ {organ} --out FOLDER/` writes it"
+        "the target has {found} vertices and no faces: a target is a surface (an OBJ with \
+         faces); bare vertices are read only as organ `{organ}`'s {expected} particles in order"
     )]
-    VertexCount {
+    NoFaces {
         /// The organ's name.
         organ: String,
         /// Its particles.
         expected: usize,
         /// The target's vertices.
         found: usize,
-    },
-    /// The target has the organ's vertex count but other triangles.
-    #[error(
-        "the target's faces are not organ `{organ}`'s triangles: it is another mesh with as many \
-         vertices; the target must be this organ's mesh, as `anthesis simulate --organ {organ} \
-         --out FOLDER/` writes it"
-    )]
-    Connectivity {
-        /// The organ's name.
-        organ: String,
     },
     /// A target coordinate is NaN or infinite.
     #[error("target vertex {vertex} (from 1) has a coordinate that is not a finite number")]
@@ -152,9 +169,55 @@ pub enum FitError {
     /// Maps could not be built.
     #[error(transparent)]
     Maps(#[from] MapError),
+    /// Not even the first guess could be simulated in the time allowed.
+    #[error(
+        "the time allowed ({seconds} s) ended before the first guess was simulated once; allow \
+         more (one simulation of this organ took longer)"
+    )]
+    OutOfTime {
+        /// The time allowed.
+        seconds: f64,
+    },
     /// The caller cancelled the fit.
     #[error("the fit was cancelled")]
     Cancelled,
+}
+
+/// A target surface read for a fit: any triangulation, in its own frame.
+#[derive(Debug, Clone)]
+pub struct Target {
+    /// The surface (positions in the target's own frame and units).
+    pub surface: Surface,
+    /// A UV per vertex, when the target has a UV layout over the unit
+    /// square (the same convention as the organ's: used for the first
+    /// guess only).
+    pub uvs: Option<Vec<DVec2>>,
+    /// What reading it said (vertices joined, statements read past).
+    pub warnings: Vec<String>,
+}
+
+impl Target {
+    /// The target's vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.surface.positions.len()
+    }
+
+    /// The target with its faces wound the other way: its inner side (the
+    /// one its faces wind counter-clockwise around, as an organ's do) the
+    /// other side, for a target exported the other way round. Only the
+    /// registration reads the winding.
+    pub fn flipped(self) -> Target {
+        let triangles = self
+            .surface
+            .triangles
+            .iter()
+            .map(|&[a, b, c]| [a, c, b])
+            .collect();
+        Target {
+            surface: Surface::new(self.surface.positions, triangles),
+            ..self
+        }
+    }
 }
 
 /// Progress of a running fit, reported after each iteration.
@@ -162,7 +225,8 @@ pub enum FitError {
 pub struct FitProgress {
     /// Iterations done (0: the first guess).
     pub iteration: u32,
-    /// RMS distance to the target, as a fraction of the organ's length.
+    /// RMS surface distance to the target, as a fraction of the organ's
+    /// length.
     pub rms: f64,
     /// Largest distance, as a fraction of the organ's length.
     pub max: f64,
@@ -170,6 +234,36 @@ pub struct FitProgress {
     pub simulations: usize,
     /// Seconds since the fit started.
     pub seconds: f64,
+}
+
+/// Why a fit stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// The RMS went below the goal.
+    Goal,
+    /// No step lowers the distance any more: as close as these maps get.
+    Converged,
+    /// The iteration limit was reached while steps still gained.
+    Iterations,
+    /// The time limit was reached.
+    Seconds,
+}
+
+impl Stop {
+    /// Whether a limit stopped the fit (it might have come closer).
+    pub fn by_limit(self) -> bool {
+        matches!(self, Stop::Iterations | Stop::Seconds)
+    }
+
+    /// A short name (the JSON report's `stopped`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Stop::Goal => "goal",
+            Stop::Converged => "converged",
+            Stop::Iterations => "max-iterations",
+            Stop::Seconds => "max-seconds",
+        }
+    }
 }
 
 /// A fit's result: the maps and how close they come.
@@ -180,14 +274,15 @@ pub struct Fit {
     /// The basis coefficients of the maps.
     pub parameters: Vec<f64>,
     /// The organ's length the distances are fractions of: the largest
-    /// distance of a target vertex from the centroid of the target's base
-    /// particles.
+    /// distance of a target vertex (placed) from the centroid of the
+    /// organ's base particles.
     pub length: f64,
-    /// RMS distance of the closed-form guess's simulation from the target,
-    /// as a fraction of the length.
+    /// RMS surface distance of the first guess's simulation from the
+    /// target, as a fraction of the length (the nearer of the closed-form
+    /// guess and the project's own maps in the fit's basis).
     pub guess_rms: f64,
-    /// RMS distance between the fitted maps' final shape and the target,
-    /// as a fraction of the length.
+    /// RMS surface distance between the fitted maps' final shape and the
+    /// target, as a fraction of the length.
     pub rms: f64,
     /// Largest distance, as a fraction of the length.
     pub max: f64,
@@ -197,6 +292,15 @@ pub struct Fit {
     pub simulations: usize,
     /// Wall time in seconds.
     pub seconds: f64,
+    /// Why it stopped.
+    pub stop: Stop,
+    /// The iteration limit it ran with.
+    pub max_iterations: u32,
+    /// The time limit it ran with.
+    pub max_seconds: f64,
+    /// Where the target was put at the end (the placement given, refined
+    /// when asked).
+    pub placement: Similarity,
     /// The final shape of the fitted maps.
     pub shape: Vec<DVec3>,
 }
@@ -211,8 +315,9 @@ impl Fit {
         self.rms <= REACHED_RMS
     }
 
-    /// A one-line verdict for people: how close the fit came, and when the
-    /// target was not reached, that these are the closest maps found.
+    /// A one-line verdict for people: how close the fit came, why it
+    /// stopped, and when the target was not reached, whether the bud
+    /// cannot reach it or a limit stopped the fit first.
     pub fn verdict(&self) -> String {
         let figures = format!(
             "RMS {:.2} %, max {:.2} % of the organ's length {:.3} ({} iterations, {} simulations, \
@@ -224,81 +329,108 @@ impl Fit {
             self.simulations,
             self.seconds
         );
-        if self.reached() {
-            format!("fitted: {figures}")
-        } else {
-            format!(
+        let limit = match self.stop {
+            Stop::Iterations => format!("the iteration limit ({})", self.max_iterations),
+            Stop::Seconds => format!("the time limit ({} s)", self.max_seconds),
+            Stop::Goal | Stop::Converged => String::new(),
+        };
+        match (self.reached(), self.stop.by_limit()) {
+            (true, false) => format!("fitted: {figures}"),
+            (true, true) => format!("fitted: {figures}; stopped by {limit}"),
+            (false, true) => format!(
+                "stopped by {limit} before the fit converged: the best maps so far end at \
+                 {figures}; more iterations or time may come closer"
+            ),
+            (false, false) => format!(
                 "the bud cannot be grown to this target with these maps: the best fit found ends \
                  at {figures}"
-            )
+            ),
         }
     }
 }
 
-/// The target positions of the organ named `name`, whose mesh (at the
-/// resolution it is simulated at) is `mesh`, from OBJ text: the object
-/// called `name`, or the only object, with as many vertices as the mesh,
-/// every coordinate finite, and, if it has faces, the mesh's triangles (in
-/// any order, each with its winding).
-pub fn read_target(text: &str, name: &str, mesh: &Mesh) -> Result<Vec<DVec3>, FitError> {
+/// The target for the organ named `name`, whose mesh (at the resolution it
+/// is simulated at) is `mesh`, from OBJ text: the object called `name`, or
+/// the only object; any triangulation (polygons are triangulated, vertices
+/// at one place joined), every coordinate finite. Bare vertices without
+/// faces are read as the organ's own particles in order (as older
+/// versions took targets), and refused otherwise.
+pub fn read_target(text: &str, name: &str, mesh: &Mesh) -> Result<Target, FitError> {
     let object = anthesis_mesh::obj::object_text(text, Some(name))
         .or_else(|named| anthesis_mesh::obj::object_text(text, None).map_err(|_| named))
         .map_err(|e| FitError::Target(e.to_string()))?;
     let positions = vertex_lines(&object)?;
-    check_target(&positions, name, mesh.vertex_count())?;
-    let faces = face_lines(&object)?;
-    if !faces.is_empty() && !same_triangles(&faces, &mesh.triangles) {
-        return Err(FitError::Connectivity {
-            organ: name.to_string(),
+    if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(FitError::NotFinite { vertex: vertex + 1 });
+    }
+    let has_faces = object
+        .lines()
+        .any(|line| line.trim_start().starts_with("f "));
+    if !has_faces {
+        if positions.len() != mesh.vertex_count() {
+            return Err(FitError::NoFaces {
+                organ: name.to_string(),
+                expected: mesh.vertex_count(),
+                found: positions.len(),
+            });
+        }
+        return Ok(Target {
+            surface: Surface::new(positions, mesh.triangles.clone()),
+            uvs: Some(mesh.uvs.clone()),
+            warnings: Vec::new(),
         });
     }
-    Ok(positions)
-}
-
-/// The faces of OBJ text whose face indices count from 1 (as
-/// `object_text` renumbers them), as vertex indices from 0.
-fn face_lines(text: &str) -> Result<Vec<Vec<u32>>, FitError> {
-    let mut faces = Vec::new();
-    for (number, line) in text.lines().enumerate() {
-        let Some(rest) = line.trim_start().strip_prefix("f ") else {
-            continue;
-        };
-        let corners = rest
-            .split_whitespace()
-            .map(|corner| {
-                corner
-                    .split('/')
-                    .next()
-                    .and_then(|i| i.parse::<u32>().ok())
-                    .and_then(|i| i.checked_sub(1))
-                    .ok_or_else(|| {
-                        FitError::Target(format!("line {}: bad face corner `{corner}`", number + 1))
-                    })
-            })
-            .collect::<Result<Vec<u32>, _>>()?;
-        faces.push(corners);
-    }
-    Ok(faces)
-}
-
-/// Whether `faces` are the triangles `triangles`, in any order, each
-/// starting at any corner but with the same winding.
-fn same_triangles(faces: &[Vec<u32>], triangles: &[[u32; 3]]) -> bool {
-    if faces.len() != triangles.len() || faces.iter().any(|f| f.len() != 3) {
-        return false;
-    }
-    let canonical = |t: [u32; 3]| {
-        let first = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
-        [t[first], t[(first + 1) % 3], t[(first + 2) % 3]]
+    // One clean surface, or else (a scan with stray pieces, a non-manifold
+    // edge) its triangles as they are, said in a warning: distances do
+    // not need a manifold.
+    let (shape, unclean) = match anthesis_mesh::obj::parse_obj_shape(&object) {
+        Ok(shape) => (shape, None),
+        Err(error) => (
+            anthesis_mesh::obj::parse_obj_triangles(&object)
+                .map_err(|e| FitError::Target(e.to_string()))?,
+            Some(error),
+        ),
     };
-    let mut a: Vec<[u32; 3]> = faces
-        .iter()
-        .map(|f| canonical([f[0], f[1], f[2]]))
-        .collect();
-    let mut b: Vec<[u32; 3]> = triangles.iter().map(|&t| canonical(t)).collect();
-    a.sort_unstable();
-    b.sort_unstable();
-    a == b
+    let mut warnings: Vec<String> = shape.warnings.iter().map(|w| w.to_string()).collect();
+    let mut shape = shape.mesh;
+    if let Some(error) = unclean {
+        let before = shape.triangles.len();
+        shape.triangles.retain(|t| {
+            let [a, b, c] = t.map(|v| shape.positions[v as usize]);
+            (b - a).cross(c - a).length_squared() > 0.0
+        });
+        warnings.push(format!(
+            "the target is not one clean surface ({error}); its triangles are measured as they \
+             are{}",
+            match before - shape.triangles.len() {
+                0 => String::new(),
+                n => format!(", but for {n} without area"),
+            }
+        ));
+        if shape.triangles.is_empty() {
+            return Err(FitError::Target(
+                "the target has no triangle with an area".into(),
+            ));
+        }
+    }
+    // The UV layout, where the file has one per vertex within the unit
+    // square and the same vertices as the shape read.
+    let uvs = anthesis_mesh::obj::parse_obj_unvalidated(&object)
+        .ok()
+        .filter(|with_uvs| {
+            with_uvs.positions == shape.positions
+                && with_uvs
+                    .uvs
+                    .iter()
+                    .all(|uv| (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y))
+                && with_uvs.uvs.iter().any(|uv| *uv != DVec2::ZERO)
+        })
+        .map(|with_uvs| with_uvs.uvs);
+    Ok(Target {
+        surface: Surface::new(shape.positions, shape.triangles),
+        uvs,
+        warnings,
+    })
 }
 
 /// The `v` statements of OBJ text, read here (not by the mesh parser) so
@@ -326,19 +458,152 @@ fn vertex_lines(text: &str) -> Result<Vec<DVec3>, FitError> {
     Ok(positions)
 }
 
-/// Checks a target against the organ: vertex count and finite coordinates.
-pub fn check_target(target: &[DVec3], name: &str, expected: usize) -> Result<(), FitError> {
-    if target.len() != expected {
-        return Err(FitError::VertexCount {
-            organ: name.to_string(),
-            expected,
-            found: target.len(),
-        });
+/// RMS and largest surface distance between the organ's `shape` (on its
+/// mesh's `triangles`) and `target` put where `placement` says, as
+/// fractions of `length` (see [`surface`]).
+pub fn distances(
+    shape: &[DVec3],
+    triangles: &[[u32; 3]],
+    target: &Target,
+    placement: Similarity,
+    length: f64,
+) -> (f64, f64) {
+    let apart = surface::compare(
+        shape,
+        triangles,
+        &surface::Placed {
+            surface: &target.surface,
+            placement,
+        },
+        &target.surface.vertex_weights(),
+        None,
+    );
+    (apart.rms() / length, apart.max / length)
+}
+
+/// The organ's length for `target` at `placement`: the farthest placed
+/// target vertex from the centroid of the organ's base particles in the
+/// bud (where the receptacle holds them).
+pub fn organ_length(
+    project: &Project,
+    organ: usize,
+    target: &Target,
+    placement: Similarity,
+) -> Result<f64, FitError> {
+    let bud = bud_positions(project, organ)?;
+    let base_centre = base_centre(project, organ, &bud);
+    Ok(target
+        .surface
+        .positions
+        .iter()
+        .map(|&x| placement.apply(x).distance(base_centre))
+        .fold(0.0, f64::max)
+        .max(1e-12))
+}
+
+fn bud_positions(project: &Project, organ: usize) -> Result<Vec<DVec3>, FitError> {
+    if organ >= project.flower.organs.len() {
+        return Err(FitError::NoSuchOrgan(format!("#{organ}")));
     }
-    if let Some(vertex) = target.iter().position(|p| !p.is_finite()) {
-        return Err(FitError::NotFinite { vertex: vertex + 1 });
+    Ok(Simulation::new(project, &Selection::Only(organ))?
+        .bud()
+        .positions_in_world
+        .into_iter()
+        .next()
+        .unwrap_or_default())
+}
+
+fn base_centre(project: &Project, organ: usize, bud: &[DVec3]) -> DVec3 {
+    let template = project.flower.template_of(organ);
+    let base = template.base_region.particles(&template.mesh);
+    if base.is_empty() {
+        DVec3::ZERO
+    } else {
+        base.iter().map(|&b| bud[b as usize]).sum::<DVec3>() / base.len() as f64
     }
-    Ok(())
+}
+
+/// A target put on the organ before a fit, and how near it then is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Registered {
+    /// The registration.
+    pub registration: Registration,
+    /// RMS surface distance to the organ's current shape, as a fraction
+    /// of the organ's length (with the target placed).
+    pub rms: f64,
+    /// Largest distance, likewise.
+    pub max: f64,
+    /// The organ's length (see [`Fit::length`]).
+    pub length: f64,
+}
+
+impl Registered {
+    /// One line for people: the motion found and how near it puts the
+    /// target.
+    pub fn describe(&self) -> String {
+        let placement = self.registration.placement;
+        let (axis, angle) = placement.rotation.to_axis_angle();
+        let t = placement.translation;
+        format!(
+            "registered: turned {:.1}° about ({:.3}, {:.3}, {:.3}), scaled {:.4}, moved by \
+             ({:.4}, {:.4}, {:.4}); the target is then RMS {:.2} %, max {:.2} % of the organ's \
+             length {:.3} from the organ's current shape",
+            angle.to_degrees(),
+            axis.x,
+            axis.y,
+            axis.z,
+            placement.scale,
+            t.x,
+            t.y,
+            t.z,
+            100.0 * self.rms,
+            100.0 * self.max,
+            self.length
+        )
+    }
+}
+
+/// Registers `target` (in its own frame) on organ `organ`'s current shape
+/// (its final shape with the project's maps), its base on the organ's base
+/// ([`register`]); with `scale` a uniform scale too.
+pub fn register_target(
+    project: &Project,
+    organ: usize,
+    target: &Target,
+    scale: bool,
+    cancel: &(dyn Fn() -> bool + Sync),
+) -> Result<Registered, FitError> {
+    if organ >= project.flower.organs.len() {
+        return Err(FitError::NoSuchOrgan(format!("#{organ}")));
+    }
+    let template = project.flower.template_of(organ);
+    let current =
+        simulate_final(project, organ, template.maps.clone(), cancel).map_err(|e| match e {
+            SimError::Cancelled => FitError::Cancelled,
+            other => FitError::Simulation(other),
+        })?;
+    let base = template.base_region.particles(&template.mesh);
+    let registration = register::register(
+        &target.surface,
+        &current,
+        &template.mesh.triangles,
+        &base,
+        scale,
+    );
+    let length = organ_length(project, organ, target, registration.placement)?;
+    let (rms, max) = distances(
+        &current,
+        &template.mesh.triangles,
+        target,
+        registration.placement,
+        length,
+    );
+    Ok(Registered {
+        registration,
+        rms,
+        max,
+        length,
+    })
 }
 
 /// The final positions (world frame) of organ `organ` of `project` with
@@ -369,16 +634,18 @@ pub fn simulate_final(
         .unwrap_or_default())
 }
 
-/// RMS and largest distance between `shape` and `target`, as fractions of
-/// `length`.
-pub fn distances(shape: &[DVec3], target: &[DVec3], length: f64) -> (f64, f64) {
-    let n = shape.len().max(1) as f64;
-    let (sum, max) = shape
-        .iter()
-        .zip(target)
-        .map(|(a, b)| a.distance_squared(*b))
-        .fold((0.0, 0.0f64), |(s, m), d| (s + d, m.max(d)));
-    ((sum / n).sqrt() / length, max.sqrt() / length)
+/// A step tried: its damping, parameters and final shape (`None`: the
+/// simulation blew up).
+type Tried = (f64, Vec<f64>, Option<Vec<DVec3>>);
+
+/// What stopped a simulation of the fit other than a blow-up.
+enum Halt {
+    /// The caller cancelled.
+    Cancelled,
+    /// The fit's time ran out.
+    OutOfTime,
+    /// Maps could not be built.
+    Failed(FitError),
 }
 
 /// What a fit works on.
@@ -390,8 +657,11 @@ struct Problem<'a> {
     organ: usize,
     layout: Layout,
     size: (u32, u32),
-    target: &'a [DVec3],
+    triangles: &'a [[u32; 3]],
+    target: &'a Target,
+    target_weights: Vec<f64>,
     length: f64,
+    deadline: Instant,
     cancel: &'a (dyn Fn() -> bool + Sync),
 }
 
@@ -401,94 +671,136 @@ impl Problem<'_> {
         self.layout.maps(p, self.size, &template.maps)
     }
 
-    /// The residual of parameters `p`: simulated minus target, x y z per
-    /// particle; `None` when the simulation fails (a blow-up counts as a
-    /// step too far, not as an error of the fit).
-    fn residual(&self, p: &[f64]) -> Result<Option<Vec<f64>>, FitError> {
-        self.residual_of(p, false)
-    }
-
-    /// [`Problem::residual`] of the full run, or of the coarse run when
-    /// `coarse` and there is one.
-    fn residual_of(&self, p: &[f64], coarse: bool) -> Result<Option<Vec<f64>>, FitError> {
+    /// The final shape of parameters `p` on the full run, or on the coarse
+    /// run when `coarse` and there is one; `None` when the simulation
+    /// fails (a blow-up counts as a step too far, not as an error of the
+    /// fit).
+    fn shape(&self, p: &[f64], coarse: bool) -> Result<Option<Vec<DVec3>>, Halt> {
         let (project, layout) = match &self.coarse {
             Some((project, layout)) if coarse => (project, layout),
             _ => (self.project, &self.layout),
         };
         let template = project.flower.template_of(self.organ);
-        let maps = layout.maps(p, self.size, &template.maps)?;
-        match simulate_final(project, self.organ, maps, self.cancel) {
-            Ok(shape) => Ok(Some(
-                shape
-                    .iter()
-                    .zip(self.target)
-                    .flat_map(|(a, b)| (*a - *b).to_array())
-                    .collect(),
-            )),
-            Err(SimError::Cancelled) => Err(FitError::Cancelled),
+        let maps = layout
+            .maps(p, self.size, &template.maps)
+            .map_err(|e| Halt::Failed(e.into()))?;
+        let stop = || (self.cancel)() || Instant::now() >= self.deadline;
+        match simulate_final(project, self.organ, maps, &stop) {
+            Ok(shape) => Ok(Some(shape)),
+            Err(SimError::Cancelled) if (self.cancel)() => Err(Halt::Cancelled),
+            Err(SimError::Cancelled) => Err(Halt::OutOfTime),
             Err(_) => Ok(None),
         }
     }
 
-    /// RMS and largest distance of residual `r`, as fractions of the length.
-    fn distances(&self, r: &[f64]) -> (f64, f64) {
-        let n = (r.len() / 3).max(1) as f64;
-        let mut sum = 0.0;
-        let mut max = 0.0f64;
-        for d in r.chunks_exact(3) {
-            let squared = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-            sum += squared;
-            max = max.max(squared.sqrt());
-        }
-        ((sum / n).sqrt() / self.length, max / self.length)
+    /// How far shape `s` is from the target placed at `placement`, and the
+    /// Gauss–Newton rows there when asked.
+    fn measure(
+        &self,
+        s: &[DVec3],
+        placement: Similarity,
+        rows: Option<&mut Vec<surface::Row>>,
+    ) -> Apart {
+        surface::compare(
+            s,
+            self.triangles,
+            &surface::Placed {
+                surface: &self.target.surface,
+                placement,
+            },
+            &self.target_weights,
+            rows,
+        )
+    }
+
+    /// RMS and largest distance as fractions of the length.
+    fn fractions(&self, apart: &Apart) -> (f64, f64) {
+        (apart.rms() / self.length, apart.max / self.length)
+    }
+
+    fn seconds_left(&self) -> f64 {
+        self.deadline
+            .saturating_duration_since(Instant::now())
+            .as_secs_f64()
     }
 }
 
-fn cost(r: &[f64]) -> f64 {
-    r.iter().map(|x| x * x).sum()
+/// The target's positions at the organ's particles, for the first guess:
+/// read at each particle's UV on the target's UV layout when it has one,
+/// else the target's points nearest the organ's shape `current`.
+fn target_at_particles(
+    target: &Target,
+    placement: Similarity,
+    mesh: &Mesh,
+    current: impl FnOnce() -> Option<Vec<DVec3>>,
+) -> Option<Vec<DVec3>> {
+    let placed = surface::Placed {
+        surface: &target.surface,
+        placement,
+    };
+    if let Some(uvs) = &target.uvs {
+        let layout = Surface::new(
+            uvs.iter().map(|uv| DVec3::new(uv.x, uv.y, 0.0)).collect(),
+            target.surface.triangles.clone(),
+        );
+        return mesh
+            .uvs
+            .iter()
+            .map(|uv| {
+                let near = layout.nearest(DVec3::new(uv.x, uv.y, 0.0))?;
+                let corners = target.surface.triangles[near.triangle as usize];
+                Some(
+                    (0..3)
+                        .map(|k| {
+                            near.weights[k]
+                                * placement.apply(target.surface.positions[corners[k] as usize])
+                        })
+                        .sum(),
+                )
+            })
+            .collect();
+    }
+    current()?
+        .iter()
+        .map(|&p| placed.nearest(p).map(|near| near.point))
+        .collect()
 }
 
 /// Fits the growth maps of organ `organ` of `project` (at the resolution it
 /// is simulated at, see `anthesis_flower::resolution::resolve`) to
-/// `target`. `progress` hears of every iteration; `cancel` is polled inside
-/// the simulations.
+/// `target`, put in the world where `placement` says (the identity for a
+/// target already in the project's frame, or [`register_target`]'s).
+/// `progress` hears of every iteration; `cancel` is polled inside the
+/// simulations.
 pub fn fit(
     project: &Project,
     organ: usize,
-    target: &[DVec3],
+    target: &Target,
+    placement: Similarity,
     settings: &FitSettings,
     progress: &mut dyn FnMut(FitProgress),
     cancel: &(dyn Fn() -> bool + Sync),
 ) -> Result<Fit, FitError> {
     let started = Instant::now();
+    let deadline = started + Duration::from_secs_f64(settings.max_seconds.clamp(0.0, 1e9));
     let flower = &project.flower;
-    let Some(organ_def) = flower.organs.get(organ) else {
+    if flower.organs.get(organ).is_none() {
         return Err(FitError::NoSuchOrgan(format!("#{organ}")));
-    };
+    }
     let template = flower.template_of(organ);
-    check_target(target, &organ_def.name, template.mesh.vertex_count())?;
+    if target.surface.triangles.is_empty() {
+        return Err(FitError::Target("the target has no triangles".into()));
+    }
+    if let Some(vertex) = target.surface.positions.iter().position(|p| !p.is_finite()) {
+        return Err(FitError::NotFinite { vertex: vertex + 1 });
+    }
     let topology = anthesis_mesh::validate(&template.mesh).map_err(|error| SimError::BadMesh {
         template: template.name.clone(),
         error,
     })?;
-    let bud = Simulation::new(project, &Selection::Only(organ))?.bud();
-    let bud_positions = bud
-        .positions_in_world
-        .into_iter()
-        .next()
-        .unwrap_or_default();
-
-    let base = template.base_region.particles(&template.mesh);
-    let base_centre = if base.is_empty() {
-        DVec3::ZERO
-    } else {
-        base.iter().map(|&b| target[b as usize]).sum::<DVec3>() / base.len() as f64
-    };
-    let length = target
-        .iter()
-        .map(|p| p.distance(base_centre))
-        .fold(0.0, f64::max)
-        .max(1e-12);
+    let bud_positions = bud_positions(project, organ)?;
+    let base_particles = template.base_region.particles(&template.mesh);
+    let length = organ_length(project, organ, target, placement)?;
 
     let layout = Layout {
         growth: settings.growth_nodes,
@@ -503,13 +815,16 @@ pub fn fit(
         organ,
         layout,
         size,
+        triangles: &template.mesh.triangles,
         target,
+        target_weights: target.surface.vertex_weights(),
         length,
+        deadline,
         cancel,
     };
     let mut simulations = 0usize;
-    let report = |iteration: u32, r: &[f64], simulations: usize| {
-        let (rms, max) = problem.distances(r);
+    let report = |iteration: u32, apart: &Apart, simulations: usize| {
+        let (rms, max) = problem.fractions(apart);
         FitProgress {
             iteration,
             rms,
@@ -518,8 +833,22 @@ pub fn fit(
             seconds: started.elapsed().as_secs_f64(),
         }
     };
+    let first_error = |halt: Halt| match halt {
+        Halt::Cancelled => FitError::Cancelled,
+        Halt::OutOfTime => FitError::OutOfTime {
+            seconds: settings.max_seconds,
+        },
+        Halt::Failed(e) => e,
+    };
 
     // The first guess, or no growth when its simulation fails.
+    let mut guess_sims = 0;
+    let at_particles = target_at_particles(target, placement, &template.mesh, || {
+        guess_sims += 1;
+        let stop = || cancel() || Instant::now() >= deadline;
+        simulate_final(project, organ, template.maps.clone(), &stop).ok()
+    });
+    simulations += guess_sims;
     let organ_guess = guess::Organ {
         mesh: &template.mesh,
         topology: &topology,
@@ -528,56 +857,109 @@ pub fn fit(
         thickness: template.thickness,
         steps: project.settings.keyframes,
     };
-    let mut p = guess::guess(&organ_guess, target, &problem.layout);
-    simulations += 1;
-    let mut r = match problem.residual(&p)? {
-        Some(r) => r,
+    let guessed = match &at_particles {
+        Some(at) => guess::guess(&organ_guess, at, &problem.layout),
+        None => vec![0.0; problem.layout.len()],
+    };
+    // Two starts, simulated at once: the closed-form guess and the
+    // project's own maps in the basis (better where the guess's
+    // correspondences are poor, as for a target without UVs); the nearer
+    // wins, no growth if neither simulates.
+    let own = guess::from_maps(&problem.layout, &template.maps);
+    let (first, second) = rayon::join(
+        || problem.shape(&guessed, false),
+        || problem.shape(&own, false),
+    );
+    simulations += 2;
+    let mut starts = Vec::new();
+    for (q, shape) in [(guessed, first), (own, second)] {
+        if let Some(shape) = shape.map_err(first_error)? {
+            let cost = problem.measure(&shape, placement, None).cost();
+            starts.push((cost, q, shape));
+        }
+    }
+    let (mut p, mut s) = match starts.into_iter().min_by(|a, b| a.0.total_cmp(&b.0)) {
+        Some((_, q, shape)) => (q, shape),
         None => {
-            p.iter_mut().for_each(|x| *x = 0.0);
+            let none = vec![0.0; problem.layout.len()];
             simulations += 1;
-            problem
-                .residual(&p)?
-                .ok_or_else(|| FitError::Target("the organ cannot be simulated".into()))?
+            let shape = problem
+                .shape(&none, false)
+                .map_err(first_error)?
+                .ok_or_else(|| FitError::Target("the organ cannot be simulated".into()))?;
+            (none, shape)
         }
     };
-    let guess_rms = problem.distances(&r).0;
-    progress(report(0, &r, simulations));
+    let mut placement = placement;
+    let mut apart = problem.measure(&s, placement, None);
+    let guess_rms = problem.fractions(&apart).0;
+    progress(report(0, &apart, simulations));
 
     let n = p.len();
-    let rows = r.len();
-    let mut jacobian: Option<Vec<f64>> = None; // column-major, rows x n
+    let positions = 3 * s.len();
+    let mut jacobian: Option<Vec<f64>> = None; // of the positions, column-major, positions x n
     let mut fresh = false;
     let mut jacobian_seconds: Option<f64> = None;
     let mut mu = 0.0;
     let mut iterations = 0;
-    while iterations < settings.max_iterations
-        && problem.distances(&r).0 > settings.goal_rms
-        && started.elapsed().as_secs_f64() < settings.max_seconds
-    {
+    let stop = loop {
+        if problem.fractions(&apart).0 <= settings.goal_rms {
+            break Stop::Goal;
+        }
+        if iterations >= settings.max_iterations {
+            break Stop::Iterations;
+        }
+        if problem.seconds_left() <= 0.0 {
+            break Stop::Seconds;
+        }
         let j = match jacobian.take() {
             Some(j) => j,
             None => {
                 // A fresh Jacobian is the dearest part; after the first,
                 // only when it can end within the time allowed.
-                let elapsed = started.elapsed().as_secs_f64();
-                if jacobian_seconds.is_some_and(|s| elapsed + s > settings.max_seconds) {
-                    break;
+                if jacobian_seconds.is_some_and(|t| t > problem.seconds_left()) {
+                    break Stop::Seconds;
                 }
-                let (j, runs) = finite_differences(&problem, &p, &r, settings.step)?;
-                jacobian_seconds = Some(started.elapsed().as_secs_f64() - elapsed);
+                let before = Instant::now();
+                let (j, runs) = match finite_differences(&problem, &p, &s, settings.step) {
+                    Ok(done) => done,
+                    Err(Halt::OutOfTime) => break Stop::Seconds,
+                    Err(Halt::Cancelled) => return Err(FitError::Cancelled),
+                    Err(Halt::Failed(e)) => return Err(e),
+                };
+                jacobian_seconds = Some(before.elapsed().as_secs_f64());
                 simulations += runs;
                 fresh = true;
                 j
             }
         };
+        // The residual rows at the shape now, and their Jacobian through
+        // the positions'.
+        let mut rows = Vec::new();
+        problem.measure(&s, placement, Some(&mut rows));
+        let r: Vec<f64> = rows.iter().map(|row| row.value(&s)).collect();
+        let m = rows.len();
+        let mut jr = vec![0.0; m * n]; // column-major, m x n
+        for (col, column) in j.chunks_exact(positions).enumerate() {
+            let out = &mut jr[col * m..(col + 1) * m];
+            for (value, row) in out.iter_mut().zip(&rows) {
+                *value = (0..3)
+                    .map(|k| {
+                        let i = 3 * row.particles[k] as usize;
+                        row.weights[k]
+                            * DVec3::new(column[i], column[i + 1], column[i + 2]).dot(row.direction)
+                    })
+                    .sum();
+            }
+        }
         // Normal equations.
         let mut jtj = vec![0.0; n * n];
         let mut jtr = vec![0.0; n];
         for a in 0..n {
-            let ca = &j[a * rows..(a + 1) * rows];
+            let ca = &jr[a * m..(a + 1) * m];
             jtr[a] = ca.iter().zip(&r).map(|(x, y)| x * y).sum();
             for b in a..n {
-                let cb = &j[b * rows..(b + 1) * rows];
+                let cb = &jr[b * m..(b + 1) * m];
                 let dot: f64 = ca.iter().zip(cb).map(|(x, y)| x * y).sum();
                 jtj[a * n + b] = dot;
                 jtj[b * n + a] = dot;
@@ -603,53 +985,91 @@ pub fn fit(
             .iter()
             .filter_map(|&d| step_for(d).map(|q| (d, q)))
             .collect();
-        let tried: Vec<(f64, Vec<f64>, Option<Vec<f64>>)> = candidates
+        let tried: Result<Vec<Tried>, Halt> = candidates
             .into_par_iter()
-            .map(|(d, q)| problem.residual(&q).map(|res| (d, q, res)))
-            .collect::<Result<_, _>>()?;
+            .map(|(d, q)| problem.shape(&q, false).map(|shape| (d, q, shape)))
+            .collect();
+        let tried = match tried {
+            Ok(tried) => tried,
+            Err(Halt::OutOfTime) => break Stop::Seconds,
+            Err(Halt::Cancelled) => return Err(FitError::Cancelled),
+            Err(Halt::Failed(e)) => return Err(e),
+        };
         simulations += tried.len();
-        let now = cost(&r);
+        let now = apart.cost();
         let best = tried
             .into_iter()
-            .filter_map(|(d, q, res)| res.map(|res| (cost(&res), d, q, res)))
-            .min_by(|a, b| a.0.total_cmp(&b.0));
+            .filter_map(|(d, q, shape)| {
+                shape.map(|shape| {
+                    let a = problem.measure(&shape, placement, None);
+                    (a, d, q, shape)
+                })
+            })
+            .min_by(|a, b| a.0.cost().total_cmp(&b.0.cost()));
         iterations += 1;
+        let mut converged = false;
         match best {
-            Some((c, d, q, res)) if c < now => {
-                // Broyden's update of the Jacobian with the step taken.
+            Some((a, d, q, shape)) if a.cost() < now => {
+                // Broyden's update of the positions' Jacobian with the
+                // step taken.
                 let dp: Vec<f64> = q.iter().zip(&p).map(|(a, b)| a - b).collect();
                 let dp2: f64 = dp.iter().map(|x| x * x).sum();
                 let mut j = j;
                 if dp2 > 0.0 {
-                    let mut predicted = vec![0.0; rows];
+                    let mut predicted = vec![0.0; positions];
                     for (col, step) in dp.iter().enumerate() {
                         if *step != 0.0 {
-                            for (pr, jv) in
-                                predicted.iter_mut().zip(&j[col * rows..(col + 1) * rows])
+                            for (pr, jv) in predicted
+                                .iter_mut()
+                                .zip(&j[col * positions..(col + 1) * positions])
                             {
                                 *pr += jv * step;
                             }
                         }
                     }
-                    let miss: Vec<f64> = (0..rows).map(|i| res[i] - r[i] - predicted[i]).collect();
+                    let moved: Vec<f64> = shape
+                        .iter()
+                        .zip(&s)
+                        .flat_map(|(a, b)| (*a - *b).to_array())
+                        .collect();
+                    let miss: Vec<f64> = (0..positions).map(|i| moved[i] - predicted[i]).collect();
                     for (col, step) in dp.iter().enumerate() {
                         if *step != 0.0 {
                             let f = step / dp2;
-                            for (jv, m) in j[col * rows..(col + 1) * rows].iter_mut().zip(&miss) {
+                            for (jv, m) in j[col * positions..(col + 1) * positions]
+                                .iter_mut()
+                                .zip(&miss)
+                            {
                                 *jv += m * f;
                             }
                         }
                     }
                 }
-                let gain = 1.0 - c / now;
+                let gain = 1.0 - a.cost() / now;
                 mu = if d == mu { mu / 3.0 } else { d };
                 p = q;
-                r = res;
+                s = shape;
+                apart = a;
+                if settings.refine_placement {
+                    let refined = register::refine(
+                        &target.surface,
+                        &s,
+                        problem.triangles,
+                        &base_particles,
+                        placement,
+                        3,
+                    );
+                    let moved = problem.measure(&s, refined, None);
+                    if moved.cost() < apart.cost() {
+                        placement = refined;
+                        apart = moved;
+                    }
+                }
                 // A poor gain on an updated Jacobian: take a fresh one.
                 jacobian = if gain < 0.05 && !fresh { None } else { Some(j) };
                 fresh = false;
                 if gain < 1e-4 && jacobian.is_some() {
-                    break;
+                    converged = true;
                 }
             }
             _ => {
@@ -658,7 +1078,7 @@ pub fn fit(
                     // A fresh Jacobian and still no descent: try harder
                     // damping once more before giving up.
                     if mu > 1e8 {
-                        break;
+                        converged = true;
                     }
                     jacobian = Some(j);
                 } else {
@@ -666,16 +1086,14 @@ pub fn fit(
                 }
             }
         }
-        progress(report(iterations, &r, simulations));
-    }
+        progress(report(iterations, &apart, simulations));
+        if converged {
+            break Stop::Converged;
+        }
+    };
 
-    let (rms, max) = problem.distances(&r);
+    let (rms, max) = problem.fractions(&apart);
     let maps = problem.maps(&p)?;
-    let shape = r
-        .chunks_exact(3)
-        .zip(target)
-        .map(|(d, t)| *t + DVec3::new(d[0], d[1], d[2]))
-        .collect();
     Ok(Fit {
         maps,
         parameters: p,
@@ -686,30 +1104,36 @@ pub fn fit(
         iterations,
         simulations,
         seconds: started.elapsed().as_secs_f64(),
-        shape,
+        stop,
+        max_iterations: settings.max_iterations,
+        max_seconds: settings.max_seconds,
+        placement,
+        shape: s,
     })
 }
 
-/// The Jacobian of the residual at `p` (residual `r`) by forward
-/// differences, on the coarse run if there is one, column-major; a column whose step leaves the bounds steps
-/// the other way, and one whose simulation fails is left zero. Returns the
+/// The Jacobian of the final positions at `p` (whose full run's shape is
+/// `s`) by forward differences, on the coarse run if there is one,
+/// column-major; a column whose step leaves the bounds steps the other
+/// way, and one whose simulation fails is left zero. Returns the
 /// simulations run.
 fn finite_differences(
     problem: &Problem<'_>,
     p: &[f64],
-    r: &[f64],
+    s: &[DVec3],
     step: f64,
-) -> Result<(Vec<f64>, usize), FitError> {
+) -> Result<(Vec<f64>, usize), Halt> {
     let n = p.len();
+    let rows = 3 * s.len();
     let coarse = problem.coarse.is_some();
     // The differences are taken from the run they are made with.
     let base = if coarse {
-        problem.residual_of(p, true)?
+        problem.shape(p, true)?
     } else {
-        Some(r.to_vec())
+        Some(s.to_vec())
     };
     let Some(base) = base else {
-        return Ok((vec![0.0; n * r.len()], 1));
+        return Ok((vec![0.0; n * rows], 1));
     };
     let columns: Vec<Vec<f64>> = (0..n)
         .into_par_iter()
@@ -718,12 +1142,16 @@ fn finite_differences(
             let h = if p[i] + step > hi { -step } else { step };
             let mut q = p.to_vec();
             q[i] += h;
-            Ok(match problem.residual_of(&q, coarse)? {
-                Some(res) => res.iter().zip(&base).map(|(a, b)| (a - b) / h).collect(),
-                None => vec![0.0; r.len()],
+            Ok(match problem.shape(&q, coarse)? {
+                Some(shape) => shape
+                    .iter()
+                    .zip(&base)
+                    .flat_map(|(a, b)| ((*a - *b) / h).to_array())
+                    .collect(),
+                None => vec![0.0; rows],
             })
         })
-        .collect::<Result<_, FitError>>()?;
+        .collect::<Result<_, Halt>>()?;
     Ok((columns.concat(), n + usize::from(coarse)))
 }
 
@@ -775,8 +1203,9 @@ mod tests {
     use super::*;
 
     /// The gradient of the fit's cost, `2 Jᵀ r` with the Jacobian the fit
-    /// uses (forward differences on the coarse run), against central
-    /// differences of the cost of the full run (issue 15 item 6).
+    /// uses (forward differences of the positions on the coarse run, through
+    /// the surface rows), against central differences of the surface cost
+    /// of the full run (issue 15 item 6; issue 36: surface distances).
     #[test]
     fn the_fits_gradient_agrees_with_central_differences_of_the_full_run() {
         let keyframes = 40;
@@ -794,12 +1223,17 @@ mod tests {
             key_steps: basis::key_steps(1, keyframes),
         };
         let size = (32, 32);
-        let template = project.flower.template_of(0);
+        let template = project.flower.template_of(0).clone();
         let maps_of = |p: &[f64]| layout.maps(p, size, &template.maps).expect("maps");
         // The target: the organ grown from other maps than the point the
         // gradient is taken at, so the residual is not zero.
         let known = [0.2, 0.8, 0.5, 0.3, 0.35, 0.95, 0.5, 0.45];
-        let target = simulate_final(&project, 0, maps_of(&known), &|| false).expect("target");
+        let shape = simulate_final(&project, 0, maps_of(&known), &|| false).expect("target");
+        let target = Target {
+            surface: Surface::new(shape, template.mesh.triangles.clone()),
+            uvs: None,
+            warnings: Vec::new(),
+        };
         let coarse = coarse_run(&project, 0, &layout, FitSettings::default().coarse);
         assert!(coarse.is_some(), "40 keyframes have a coarse run");
         let problem = Problem {
@@ -808,19 +1242,44 @@ mod tests {
             organ: 0,
             layout: layout.clone(),
             size,
+            triangles: &template.mesh.triangles,
             target: &target,
+            target_weights: target.surface.vertex_weights(),
             length: 1.0,
+            deadline: Instant::now() + Duration::from_secs(3600),
             cancel: &|| false,
         };
+        let shape_of = |p: &[f64]| -> Vec<DVec3> {
+            match problem.shape(p, false) {
+                Ok(Some(s)) => s,
+                _ => panic!("simulates"),
+            }
+        };
         let p = [0.3, 0.6, 0.45, 0.4, 0.4, 0.8, 0.5, 0.5];
-        let r = problem.residual(&p).expect("runs").expect("simulates");
-        let (jacobian, _) =
-            finite_differences(&problem, &p, &r, FitSettings::default().step).expect("runs");
-        let rows = r.len();
+        let s = shape_of(&p);
+        let Ok((jacobian, _)) = finite_differences(&problem, &p, &s, FitSettings::default().step)
+        else {
+            panic!("runs");
+        };
+        let mut rows = Vec::new();
+        problem.measure(&s, Similarity::IDENTITY, Some(&mut rows));
+        let positions = 3 * s.len();
         let fits: Vec<f64> = (0..p.len())
             .map(|i| {
-                2.0 * (0..rows)
-                    .map(|k| jacobian[i * rows + k] * r[k])
+                let column = &jacobian[i * positions..(i + 1) * positions];
+                2.0 * rows
+                    .iter()
+                    .map(|row| {
+                        let d: f64 = (0..3)
+                            .map(|k| {
+                                let at = 3 * row.particles[k] as usize;
+                                row.weights[k]
+                                    * DVec3::new(column[at], column[at + 1], column[at + 2])
+                                        .dot(row.direction)
+                            })
+                            .sum();
+                        d * row.value(&s)
+                    })
                     .sum::<f64>()
             })
             .collect();
@@ -830,7 +1289,9 @@ mod tests {
                 let at = |d: f64| {
                     let mut q = p.to_vec();
                     q[i] += d;
-                    cost(&problem.residual(&q).expect("runs").expect("simulates"))
+                    problem
+                        .measure(&shape_of(&q), Similarity::IDENTITY, None)
+                        .cost()
                 };
                 (at(h) - at(-h)) / (2.0 * h)
             })
@@ -845,9 +1306,9 @@ mod tests {
             .sum::<f64>()
             .sqrt()
             / norm(&central);
-        // Measured: cosine 0.99984, relative difference 2.5 % (the coarse
-        // run's final shapes lie within a few tenths of a per cent of the
-        // full run's).
+        // Measured (positions in the same order): cosine 0.99984, relative
+        // difference 2.5 % (the coarse run's final shapes lie within a few
+        // tenths of a per cent of the full run's).
         assert!(
             cosine > 0.999 && relative < 0.06,
             "cosine {cosine:.4}, relative difference {relative:.3}\nfit's {fits:?}\ncentral {central:?}"

@@ -161,6 +161,19 @@ pub fn parse_obj_shape(text: &str) -> Result<ObjFile, MeshError> {
     })
 }
 
+/// Parses OBJ text as triangles to measure against, not to simulate: like
+/// [`parse_obj_shape`] (no UVs needed, vertices at one place joined, syntax
+/// and index errors naming the line) but without its checks of the
+/// surface (several pieces, non-manifold edges or vertices, mixed winding,
+/// degenerate triangles are all kept): a scan as it comes.
+pub fn parse_obj_triangles(text: &str) -> Result<ObjFile, MeshError> {
+    let parsed = parse(text, false)?.welded();
+    Ok(ObjFile {
+        mesh: parsed.mesh,
+        warnings: parsed.warnings,
+    })
+}
+
 /// The OBJ text of one object of `text` alone (its `v`, `vt` and `f`
 /// statements, face indices renumbered from 1), for files that hold several
 /// organs such as `anthesis simulate --out FOLDER/` writes: the object

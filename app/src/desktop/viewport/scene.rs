@@ -157,6 +157,9 @@ pub struct SceneKey {
     /// The overlaid map and its time key.
     pub overlay: Option<(MapKind, usize)>,
     pub show_others: bool,
+    /// The registered fit target shown over the organ
+    /// (`crate::desktop::fit::FitDialog::target_overlay`; 0: none).
+    pub fit_target: u64,
 }
 
 /// What a scene needs from its project that does not change with the
@@ -215,13 +218,15 @@ pub struct SceneCache {
 impl SceneCache {
     /// The scene of `project` (the project as simulated and shown) and
     /// `session` for `key`, the meshes handed to the renderer (the
-    /// organs, then the parts) and their revision; built again only when
+    /// organs, then the parts, then the fit's registered target if shown)
+    /// and their revision; built again only when
     /// `key` differs from the previous call's.
     pub fn get(
         &mut self,
         key: SceneKey,
         project: &Arc<Project>,
         session: &SimSession,
+        fit_target: Option<&OrganMesh>,
     ) -> (Arc<Vec<SceneOrgan>>, Arc<Vec<OrganMesh>>, u64) {
         self.get_or_build(key, |statics| {
             let statics = match statics.take() {
@@ -237,6 +242,9 @@ impl SceneCache {
                 &mut statics.looks,
             );
             meshes.extend(statics.part_meshes(key.time_in_keyframes));
+            // The fit dialog's registered target, last (`key.fit_target`
+            // changes with it).
+            meshes.extend(fit_target.cloned());
             (scene, meshes)
         })
     }
@@ -283,6 +291,7 @@ mod tests {
             selected_organ: 1,
             overlay: None,
             show_others: true,
+            fit_target: 0,
         }
     }
 
