@@ -557,7 +557,10 @@ impl eframe::App for AnthesisApp {
             self.paint.end_stroke();
         }
 
-        let dt = f64::from(ctx.input(|i| i.stable_dt)).min(0.1);
+        // The time since the last frame while playing (egui's stable_dt
+        // is that when the last frame asked for the next); Playback
+        // bounds it.
+        let dt = f64::from(ctx.input(|i| i.stable_dt));
         self.playback
             .advance(dt, self.session.shown_end(), self.session.total());
 

@@ -15,6 +15,16 @@ pub const BASE_KEYFRAMES_PER_SECOND: f64 = 24.0;
 /// Speeds offered in the speed menu.
 pub const SPEEDS: [f64; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
 
+/// The longest frame playback advances by in full: keyframes go on in
+/// real time down to four frames per second (skipping the keyframes not
+/// drawn); a slower frame advances as if it were this long, so playback
+/// slows down rather than jumping by seconds, and the timeline says so.
+pub const MAX_FRAME_SECONDS: f64 = 0.25;
+
+/// How long the keyframe rate playback reached is averaged over, in
+/// seconds (an exponential average).
+const RATE_SECONDS: f64 = 1.0;
+
 /// Playback state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Playback {
@@ -27,6 +37,10 @@ pub struct Playback {
     /// Show the newest keyframe as it arrives (on until the user scrubs,
     /// steps or plays).
     pub follow: bool,
+    /// The keyframes per second of wall time playback reached lately
+    /// (while playing and not waiting for the simulation), as
+    /// exponentially decayed sums: keyframes, seconds.
+    pub(super) reached: (f64, f64),
 }
 
 impl Default for Playback {
@@ -37,12 +51,14 @@ impl Default for Playback {
             looping: true,
             speed: 1.0,
             follow: true,
+            reached: (0.0, 0.0),
         }
     }
 }
 
 impl Playback {
-    /// Advances by `seconds` of wall time. `computed` is the newest
+    /// Advances by `seconds` of wall time (the time since the last frame;
+    /// at most [`MAX_FRAME_SECONDS`] count). `computed` is the newest
     /// keyframe available and `total` the last keyframe of the run.
     /// Playing stops at the newest computed keyframe and waits there;
     /// with loop on, a finished run starts again from the bud.
@@ -58,27 +74,55 @@ impl Playback {
         }
         let Some(computed) = computed else {
             self.time_in_keyframes = 0.0;
+            self.reached = (0.0, 0.0);
             return;
         };
         let end = f64::from(computed);
         if self.follow {
             self.time_in_keyframes = end;
+            self.reached = (0.0, 0.0);
             return;
         }
         if self.playing {
-            self.time_in_keyframes += seconds * self.speed * BASE_KEYFRAMES_PER_SECOND;
+            let seconds = seconds.max(0.0);
+            let step = seconds.min(MAX_FRAME_SECONDS) * self.speed * BASE_KEYFRAMES_PER_SECOND;
+            self.time_in_keyframes += step;
+            let mut waiting = false;
             if self.time_in_keyframes >= end {
                 if self.looping && computed >= total && total > 0 {
                     self.time_in_keyframes %= end.max(1.0);
                 } else {
                     self.time_in_keyframes = end;
+                    waiting = true;
                     if computed >= total {
                         self.playing = false;
                     }
                 }
             }
+            if !waiting {
+                let decay = (-seconds / RATE_SECONDS).exp();
+                self.reached = (
+                    self.reached.0 * decay + step,
+                    self.reached.1 * decay + seconds,
+                );
+            }
+        } else {
+            self.reached = (0.0, 0.0);
         }
         self.time_in_keyframes = self.time_in_keyframes.clamp(0.0, end);
+    }
+
+    /// The keyframe rate playing reached over about the last second, in
+    /// keyframes per second of wall time; `None` when not playing or not
+    /// measured yet (under half a second played).
+    pub fn reached_keyframes_per_second(&self) -> Option<f64> {
+        let (keyframes, seconds) = self.reached;
+        (self.playing && seconds >= 0.5 * RATE_SECONDS).then(|| keyframes / seconds)
+    }
+
+    /// The keyframe rate the speed asks for.
+    pub fn wanted_keyframes_per_second(&self) -> f64 {
+        self.speed * BASE_KEYFRAMES_PER_SECOND
     }
 
     pub fn toggle_play(&mut self, computed: Option<u32>) {
@@ -290,6 +334,19 @@ pub fn timeline_ui(
             .on_hover_text(format!(
                 "Playback speed; 1× plays {BASE_KEYFRAMES_PER_SECOND} keyframes per second"
             ));
+        if let Some(reached) = playback.reached_keyframes_per_second()
+            && reached < 0.95 * playback.wanted_keyframes_per_second()
+        {
+            ui.label(
+                egui::RichText::new(format!("{reached:.0} keyframes/s reached")).color(STALE_COLOR),
+            )
+            .on_hover_text(format!(
+                "Playback reaches {reached:.1} of the {:.0} keyframes per second the speed \
+                 asks for: the window draws fewer than {:.0} frames per second here",
+                playback.wanted_keyframes_per_second(),
+                1.0 / MAX_FRAME_SECONDS
+            ));
+        }
         ui.separator();
         ui.label(format!(
             "keyframe {:.1} / {}",
@@ -537,12 +594,19 @@ mod tests {
             playing: true,
             ..Playback::default()
         };
-        // One second at 1x is 24 keyframes; only 10 are computed of 100.
-        p.advance(1.0, Some(10), 100);
+        // One second at 1x (four frames of a quarter second) is 24
+        // keyframes; only 10 are computed of 100.
+        let second = |p: &mut Playback, computed| {
+            for _ in 0..4 {
+                p.advance(0.25, Some(computed), 100);
+            }
+        };
+        second(&mut p, 10);
         assert_eq!(p.time_in_keyframes, 10.0);
         assert!(p.playing, "waits for more keyframes");
         p.time_in_keyframes = 95.0;
-        p.advance(0.5, Some(100), 100);
+        p.advance(0.25, Some(100), 100);
+        p.advance(0.25, Some(100), 100);
         assert!(
             (p.time_in_keyframes - 7.0).abs() < 1e-9,
             "looped to {}",
@@ -550,9 +614,47 @@ mod tests {
         );
         p.looping = false;
         p.time_in_keyframes = 95.0;
-        p.advance(0.5, Some(100), 100);
+        p.advance(0.25, Some(100), 100);
+        p.advance(0.25, Some(100), 100);
         assert_eq!(p.time_in_keyframes, 100.0);
         assert!(!p.playing);
+    }
+
+    #[test]
+    fn playing_keeps_real_time_down_to_four_frames_a_second_and_says_when_slower() {
+        let mut p = Playback {
+            follow: false,
+            playing: true,
+            ..Playback::default()
+        };
+        // 5 frames per second: every frame advances 0.2 s of keyframes.
+        for _ in 0..10 {
+            p.advance(0.2, Some(100), 100);
+        }
+        assert!((p.time_in_keyframes - 48.0).abs() < 1e-9);
+        let reached = p.reached_keyframes_per_second().expect("measured");
+        assert!((reached - 24.0).abs() < 1e-9, "{reached}");
+        // 2 frames per second: each frame counts only 0.25 s.
+        p.time_in_keyframes = 0.0;
+        for _ in 0..10 {
+            p.advance(0.5, Some(100), 100);
+        }
+        assert!((p.time_in_keyframes - 60.0).abs() < 1e-9);
+        let reached = p.reached_keyframes_per_second().expect("measured");
+        assert!((reached - 12.0).abs() < 0.5, "{reached}");
+        // Waiting for the simulation is not the window's slowness.
+        let mut waiting = Playback {
+            follow: false,
+            playing: true,
+            ..Playback::default()
+        };
+        for _ in 0..10 {
+            waiting.advance(0.2, Some(3), 100);
+        }
+        assert_eq!(waiting.reached_keyframes_per_second(), None);
+        p.playing = false;
+        p.advance(0.2, Some(100), 100);
+        assert_eq!(p.reached_keyframes_per_second(), None);
     }
 
     #[test]
