@@ -563,6 +563,9 @@ impl eframe::App for AnthesisApp {
         let dt = f64::from(ctx.input(|i| i.stable_dt));
         self.playback
             .advance(dt, self.session.shown_end(), self.session.total());
+        let viewed = (!self.playback.playing && !self.playback.follow)
+            .then(|| self.playback.time_in_keyframes.max(0.0).ceil() as u32);
+        self.session.set_viewed_keyframe(viewed);
 
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("timeline")

@@ -242,6 +242,16 @@ impl SimSession {
         self.run
     }
 
+    /// Tells the worker which keyframe the view waits for (`None` while
+    /// playing or following the newest): it wakes the window at once for
+    /// that one and paces the others, so the window's redraws leave the
+    /// solver its cores.
+    pub fn set_viewed_keyframe(&self, keyframe: Option<u32>) {
+        if let Source::Worker(worker) = &self.source {
+            worker.set_viewed_keyframe(keyframe);
+        }
+    }
+
     /// Forgets everything shown (a new or opened document: the old
     /// project's frames must not stand in for the new one's).
     pub fn forget_shown(&mut self) {

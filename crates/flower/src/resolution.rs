@@ -185,12 +185,15 @@ fn outline_length(mesh: &Mesh) -> f64 {
 
 /// The particles an organ's interactive proxy aims at. A proxy is the same
 /// template remeshed coarser, simulated before the converged run so that an
-/// edit shows at once (the window's "proxy first"). Measured on the
-/// built-in lily (README "Speed"): six organs of about this size compute
-/// 100 keyframes in well under half a second on two cores, which is what
-/// a stroke that reruns from the bud may take before its proxy is on
-/// screen.
-pub const PROXY_PARTICLES: usize = 250;
+/// edit shows at once (the window's "proxy first"). Chosen by the latency
+/// budget (README "Speed"): an edit on the built-in lily's early key reruns
+/// from the bud, and its proxy (six organs of about this size, 100
+/// keyframes, 0.44 s of solver time) must be on screen within 0.6 s while
+/// the window draws on the same two cores; at 250 particles it took 0.76 s.
+/// What that costs in shape is measured by the `refine` example's
+/// `--proxy` (the lily petal's tip 12.5 % of its midrib away from the
+/// converged one at keyframe 100, the Eustoma's 1.3–3.4 %).
+pub const PROXY_PARTICLES: usize = 180;
 
 /// The mean edge at which `mesh` is remeshed to about `particles`
 /// particles (the inverse of [`predicted_size`]), or `None` for a mesh

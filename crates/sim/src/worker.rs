@@ -201,19 +201,58 @@ type Wake = Box<dyn Fn() + Send + Sync>;
 /// Shortest time between two wakes for `Progress` events alone.
 pub const PROGRESS_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(100);
 
-/// Whether an event wakes the owner: every event but progress does;
-/// progress when [`PROGRESS_WAKE_EVERY`] has passed since the last wake.
+/// Shortest time between two wakes for keyframes other than the one the
+/// owner views (see [`Worker::set_viewed_keyframe`]).
+pub const OTHER_KEYFRAME_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(250);
+
+/// What an event is, as far as waking the owner goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Wakes {
+    /// A Newton iteration.
+    Progress,
+    /// A keyframe (converged or proxy) of this index.
+    Keyframe(u32),
+    /// A run started, its proxy ended, or it ended.
+    Lifecycle,
+}
+
+impl Wakes {
+    fn of(event: &Event) -> Wakes {
+        match event {
+            Event::Progress { .. } => Wakes::Progress,
+            Event::Keyframe { keyframe, .. } | Event::Proxy { keyframe, .. } => {
+                Wakes::Keyframe(keyframe.index)
+            }
+            _ => Wakes::Lifecycle,
+        }
+    }
+}
+
+/// Whether an event wakes the owner. A run's start and end, and the
+/// keyframe the owner views, wake it at once; other keyframes when
+/// [`OTHER_KEYFRAME_WAKE_EVERY`] has passed since the last wake (at once
+/// when the owner views none in particular); progress when
+/// [`PROGRESS_WAKE_EVERY`] has. A window redraws on each wake, and on a
+/// software renderer that takes a core from the solver.
 #[derive(Debug, Default)]
 struct WakeGate {
     last_wake: Option<Instant>,
 }
 
 impl WakeGate {
-    fn wakes(&mut self, progress: bool, now: Instant) -> bool {
-        let due = self
-            .last_wake
-            .is_none_or(|at| now.saturating_duration_since(at) >= PROGRESS_WAKE_EVERY);
-        let wakes = !progress || due;
+    fn wakes(&mut self, event: Wakes, viewed: Option<u32>, now: Instant) -> bool {
+        let since = |every| {
+            self.last_wake
+                .is_none_or(|at| now.saturating_duration_since(at) >= every)
+        };
+        let wakes = match event {
+            Wakes::Lifecycle => true,
+            Wakes::Keyframe(index) => match viewed {
+                None => true,
+                Some(viewed) => index == viewed || since(OTHER_KEYFRAME_WAKE_EVERY),
+            },
+            Wakes::Progress => since(PROGRESS_WAKE_EVERY),
+        };
         if wakes {
             self.last_wake = Some(now);
         }
@@ -221,9 +260,15 @@ impl WakeGate {
     }
 }
 
+/// "No keyframe viewed in particular" in [`Worker::set_viewed_keyframe`]'s
+/// atomic.
+const NOTHING_VIEWED: u64 = u64::MAX;
+
 /// Handle to the worker thread.
 pub struct Worker {
     mailbox: Arc<Mailbox>,
+    /// The keyframe the owner views ([`NOTHING_VIEWED`]: none in particular).
+    viewed: Arc<AtomicU64>,
     events: Receiver<Event>,
     /// The newest run requested; a job whose id differs is stale and stops.
     current: Arc<AtomicU64>,
@@ -246,15 +291,27 @@ impl Worker {
         let current = Arc::new(AtomicU64::new(0));
         let shared = Arc::clone(&current);
         let wake: Wake = Box::new(wake);
+        let viewed = Arc::new(AtomicU64::new(NOTHING_VIEWED));
+        let owner_views = Arc::clone(&viewed);
         let thread = std::thread::Builder::new()
             .name("anthesis-sim".into())
-            .spawn(move || serve(&inbox, event_tx, shared, wake))?;
+            .spawn(move || serve(&inbox, event_tx, shared, wake, &owner_views))?;
         Ok(Worker {
             mailbox,
+            viewed,
             events,
             current,
             thread: Some(thread),
         })
+    }
+
+    /// Tells the worker which keyframe the owner views (`None`: none in
+    /// particular, e.g. while playing or following the newest): that
+    /// keyframe wakes the owner at once, others at most every
+    /// [`OTHER_KEYFRAME_WAKE_EVERY`]. Cheap; call it every frame.
+    pub fn set_viewed_keyframe(&self, keyframe: Option<u32>) {
+        let value = keyframe.map_or(NOTHING_VIEWED, u64::from);
+        self.viewed.store(value, Ordering::Relaxed);
     }
 
     /// Starts simulating `project`, cancelling whatever runs now. Returns the
@@ -339,16 +396,20 @@ impl Drop for Worker {
     }
 }
 
-fn serve(mailbox: &Mailbox, events: Sender<Event>, current: Arc<AtomicU64>, wake: Wake) {
-    // Progress (one event per Newton iteration) wakes the owner at most
-    // every `PROGRESS_WAKE_EVERY`: a window redraws on each wake, and on a
-    // software renderer that takes a core from the solver. Every other
-    // event wakes it at once.
+fn serve(
+    mailbox: &Mailbox,
+    events: Sender<Event>,
+    current: Arc<AtomicU64>,
+    wake: Wake,
+    viewed: &AtomicU64,
+) {
     let mut gate = WakeGate::default();
     let send = Mutex::new(move |event: Event| {
-        let progress = matches!(event, Event::Progress { .. });
+        let wakes = Wakes::of(&event);
         let _ = events.send(event);
-        if gate.wakes(progress, Instant::now()) {
+        let viewed = viewed.load(Ordering::Relaxed);
+        let viewed = (viewed != NOTHING_VIEWED).then(|| viewed as u32);
+        if gate.wakes(wakes, viewed, Instant::now()) {
             wake();
         }
     });
@@ -703,17 +764,54 @@ mod tests {
     }
 
     #[test]
-    fn progress_wakes_the_owner_at_most_every_tenth_of_a_second() {
+    fn the_viewed_keyframe_wakes_the_owner_at_once_and_the_rest_are_paced() {
         let mut gate = WakeGate::default();
         let t0 = Instant::now();
         let at = |ms| t0 + Duration::from_millis(ms);
-        assert!(gate.wakes(true, at(0)), "the first progress wakes");
-        assert!(!gate.wakes(true, at(30)));
-        assert!(!gate.wakes(true, at(99)));
-        assert!(gate.wakes(false, at(99)), "a keyframe always wakes");
-        assert!(!gate.wakes(true, at(150)), "counted from the last wake");
-        assert!(gate.wakes(true, at(199)));
-        assert!(gate.wakes(false, at(200)) && gate.wakes(false, at(201)));
+        // Progress: at most every tenth of a second.
+        assert!(gate.wakes(Wakes::Progress, None, at(0)), "the first wakes");
+        assert!(!gate.wakes(Wakes::Progress, None, at(30)));
+        assert!(!gate.wakes(Wakes::Progress, None, at(99)));
+        assert!(
+            gate.wakes(Wakes::Lifecycle, None, at(99)),
+            "a start or end always wakes"
+        );
+        assert!(
+            !gate.wakes(Wakes::Progress, None, at(150)),
+            "counted from the last wake"
+        );
+        assert!(gate.wakes(Wakes::Progress, None, at(199)));
+        // Keyframes: every one when nothing in particular is viewed.
+        assert!(gate.wakes(Wakes::Keyframe(3), None, at(200)));
+        assert!(gate.wakes(Wakes::Keyframe(4), None, at(201)));
+        // The viewed one at once; others a quarter second apart.
+        assert!(!gate.wakes(Wakes::Keyframe(5), Some(54), at(300)));
+        assert!(gate.wakes(Wakes::Keyframe(54), Some(54), at(301)));
+        assert!(!gate.wakes(Wakes::Keyframe(55), Some(54), at(500)));
+        assert!(gate.wakes(Wakes::Keyframe(56), Some(54), at(551)));
+    }
+
+    #[test]
+    fn the_worker_paces_wakes_by_the_keyframe_viewed() {
+        let wakes = Arc::new(AtomicUsize::new(0));
+        let counter = Arc::clone(&wakes);
+        let worker = Worker::spawn(move || {
+            counter.fetch_add(1, Ordering::SeqCst);
+        })
+        .expect("thread");
+        worker.set_viewed_keyframe(Some(40));
+        let run = worker.start(Arc::new(whorl(1, 4, 6, 40)), Selection::All);
+        let events = collect_until_end(&worker, run);
+        let keyframes = keyframes_of(&events).len();
+        // The start, the end, keyframe 40, and the others at most four
+        // times a second (the small run takes well under a second).
+        let deadline = Instant::now() + Duration::from_secs(10);
+        while wakes.load(Ordering::SeqCst) < 3 && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        let woken = wakes.load(Ordering::SeqCst);
+        assert!(woken >= 3, "{woken}");
+        assert!(woken < keyframes, "{woken} wakes for {keyframes} keyframes");
     }
 
     /// The keyframes of `events`, in the order they came.
