@@ -408,7 +408,7 @@ fn serve(
         let wakes = Wakes::of(&event);
         let _ = events.send(event);
         let viewed = viewed.load(Ordering::Relaxed);
-        let viewed = (viewed != NOTHING_VIEWED).then(|| viewed as u32);
+        let viewed = (viewed != NOTHING_VIEWED).then_some(viewed as u32);
         if gate.wakes(wakes, viewed, Instant::now()) {
             wake();
         }
