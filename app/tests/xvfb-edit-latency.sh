@@ -178,10 +178,16 @@ stroke() {
   while busy; do :; done
 }
 
+# Each stroke is undone (Ctrl+Z) and the window left to settle before the
+# next, so every stroke edits the shipped maps: strokes piled on one
+# another drive the lily's petals through its sepals, and the run then
+# stops at the crossing instead of reaching the viewed keyframe.
 strokes_case() {
   local name="$1" i
   for i in $(seq 1 "$strokes"); do
     stroke $((250 + (i % 7) * 25)) | record "$name"
+    focus; xdotool key ctrl+z; xdotool mousemove $park
+    settled
   done
 }
 
