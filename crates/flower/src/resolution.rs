@@ -189,7 +189,8 @@ fn outline_length(mesh: &Mesh) -> f64 {
 /// budget (README "Speed"): an edit on the built-in lily's early key reruns
 /// from the bud, and its proxy (six organs of about this size, 100
 /// keyframes, 0.44 s of solver time) must be on screen within 0.6 s while
-/// the window draws on the same two cores; at 250 particles it took 0.76 s.
+/// the window draws on the same two cores; at 250 particles it took
+/// 0.76–0.84 s, at this size 0.55–0.76 s (runs of 7 strokes, from pixels).
 /// What that costs in shape is measured by the `refine` example's
 /// `--proxy` (the lily petal's tip 12.5 % of its midrib away from the
 /// converged one at keyframe 100, the Eustoma's 1.3–3.4 %).
