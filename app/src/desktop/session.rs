@@ -522,12 +522,6 @@ impl SimSession {
         self.state_at(time_in_keyframes) == Some(FrameState::Stale)
     }
 
-    /// Whether the view at `time_in_keyframes` shows the current run's
-    /// converged keyframes (the view is final).
-    pub fn is_current_at(&self, time_in_keyframes: f64) -> bool {
-        (time_in_keyframes.max(0.0).ceil() as usize) < self.keyframes.len()
-    }
-
     /// The organs at `time_in_keyframes`, interpolated linearly between the
     /// two keyframes around it where both are on the same meshes (else the
     /// nearer one); times past the newest shown keyframe show the newest.
@@ -693,11 +687,11 @@ mod tests {
         let second = session.start(Arc::clone(&project), Selection::All);
         assert_eq!(session.last_index(), None, "nothing of the new run yet");
         assert_eq!(session.shown_end(), Some(5), "the old run stays shown");
-        assert!(session.is_stale_at(3.0) && !session.is_current_at(3.0));
+        assert!(session.is_stale_at(3.0) && session.state_at(3.0) != Some(FrameState::Converged));
         assert_eq!(x_at(&session, 3.0), 3.0);
 
         feed(&mut session, &project, second, &[0.0, 10.0, 20.0, 30.0]);
-        assert!(!session.is_stale_at(3.0) && session.is_current_at(3.0));
+        assert!(!session.is_stale_at(3.0) && session.state_at(3.0) == Some(FrameState::Converged));
         assert_eq!(x_at(&session, 3.0), 30.0, "the new keyframe replaces it");
         assert!(session.is_stale_at(3.5) && session.is_stale_at(5.0));
         assert_eq!(
@@ -962,7 +956,10 @@ mod tests {
             session.shown_at(2.6).expect("shown").positions[0][0].x,
             30.0
         );
-        assert!(!session.is_current_at(3.0) && session.is_current_at(2.0));
+        assert!(
+            session.state_at(3.0) != Some(FrameState::Converged)
+                && session.state_at(2.0) == Some(FrameState::Converged)
+        );
         assert_eq!(
             crate::desktop::timeline::stale_line(&session, 3.0).as_deref(),
             Some("proxy: coarse preview until the full-resolution run reaches 3")
