@@ -917,10 +917,12 @@ impl Simulation {
             energy += e;
         }
         // No silent crossing (see `crossing`).
-        if let Some(crossings) = self.find_crossings(step) {
+        if self.on_crossing != OnCrossing::Skip
+            && let Some(crossings) = self.find_crossings(step)
+        {
             match self.on_crossing {
                 OnCrossing::Stop => return Err(SimError::Crossed(Box::new(crossings))),
-                OnCrossing::Warn => self.crossings.push(crossings),
+                OnCrossing::Warn | OnCrossing::Skip => self.crossings.push(crossings),
             }
         }
         self.next_step += 1;
