@@ -371,7 +371,11 @@ impl PyProject {
         let view = readonly.as_array();
         let shape = view.shape().to_vec();
         let direction = name == anthesis_maps::DIRECTION_MAP_NAME;
-        let kind = if direction { None } else { Some(map_kind(name)?) };
+        let kind = if direction {
+            None
+        } else {
+            Some(map_kind(name)?)
+        };
         let wanted = if direction { "[h, w, 2]" } else { "[h, w]" };
         let shape_ok = if direction {
             shape.len() == 3 && shape[2] == 2
@@ -487,9 +491,12 @@ impl PyProject {
     ) -> PyResult<Py<PyAny>> {
         let parameter = parameter(name, template)?;
         let settings = &self.project.settings;
-        let value = |v: f64| -> PyResult<Py<PyAny>> { Ok(v.into_pyobject(py)?.into_any().unbind()) };
+        let value =
+            |v: f64| -> PyResult<Py<PyAny>> { Ok(v.into_pyobject(py)?.into_any().unbind()) };
         match (parameter, template) {
-            (Parameter::Keyframes, _) => Ok(settings.keyframes.into_pyobject(py)?.into_any().unbind()),
+            (Parameter::Keyframes, _) => {
+                Ok(settings.keyframes.into_pyobject(py)?.into_any().unbind())
+            }
             (Parameter::MaxIterations, _) => Ok(settings
                 .solver
                 .max_iterations
@@ -533,9 +540,9 @@ impl PyProject {
             None => None,
         };
         let count = |value: &Bound<'_, PyAny>| -> PyResult<u32> {
-            let number: f64 = value.extract().map_err(|_| {
-                PyTypeError::new_err(format!("`{name}` takes a whole number"))
-            })?;
+            let number: f64 = value
+                .extract()
+                .map_err(|_| PyTypeError::new_err(format!("`{name}` takes a whole number")))?;
             if !(number.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&number)) {
                 return Err(PyValueError::new_err(format!(
                     "`{name}` takes a whole number of 0 or more, got {number}"
@@ -802,8 +809,7 @@ fn run(
 ) -> PyResult<RunData> {
     anthesis_sim::memory::check_run(&project, &selection, KeyframeCost::Kept)
         .map_err(|e| simulation_error(&e))?;
-    let project =
-        anthesis_flower::resolution::resolve(&project).map_err(|e| project_error(&e))?;
+    let project = anthesis_flower::resolution::resolve(&project).map_err(|e| project_error(&e))?;
     anthesis_sim::memory::check_run(&project, &selection, KeyframeCost::Kept)
         .map_err(|e| simulation_error(&e))?;
     let mut sim = Simulation::new(&project, &selection).map_err(|e| simulation_error(&e))?;
@@ -821,13 +827,15 @@ fn run(
         let Some(cancel) = cancel else {
             return false;
         };
-        Python::attach(|py| match cancel.call0(py).and_then(|v| v.is_truthy(py)) {
-            Ok(set) => set,
-            Err(error) => {
-                keep(error);
-                true
-            }
-        })
+        Python::attach(
+            |py| match cancel.call0(py).and_then(|v| v.bind(py).is_truthy()) {
+                Ok(set) => set,
+                Err(error) => {
+                    keep(error);
+                    true
+                }
+            },
+        )
     };
     let total = sim.keyframe_count();
     let mut frames = vec![sim.bud().positions_in_world];
@@ -1091,7 +1099,11 @@ impl PyRunResult {
 
 fn export(data: &RunData, path: &Path, fps: f64, subdivide: u32, normals: bool) -> PyResult<()> {
     let failed = |error: &dyn StdError| {
-        ExportError::new_err(format!("cannot write {}: {}", path.display(), message(error)))
+        ExportError::new_err(format!(
+            "cannot write {}: {}",
+            path.display(),
+            message(error)
+        ))
     };
     let tracks = anthesis_export::flower_tracks(
         &data.project.flower,
@@ -1128,7 +1140,9 @@ fn export(data: &RunData, path: &Path, fps: f64, subdivide: u32, normals: bool) 
         if !path.is_dir() {
             std::fs::create_dir(path).map_err(|e| failed(&e))?;
         }
-        anthesis_export::write_obj_sequence(path, &tracks).map_err(|e| failed(&e))
+        anthesis_export::write_obj_sequence(path, &tracks)
+            .map(drop)
+            .map_err(|e| failed(&e))
     }
 }
 
