@@ -1,5 +1,6 @@
 """The tutorial of docs/python.md as one script: load the lily, paint a
-growth map, simulate, plot the opening over time, export.
+growth map, simulate a tepal both ways, measure and plot its midrib and
+margin over time, export.
 
     python docs/python/tutorial.py [OUT_FOLDER] [KEYFRAMES]
 
@@ -13,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 import anthesis
+from anthesis.measure import organ_measures
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "lily-out")
 keyframes = int(sys.argv[2]) if len(sys.argv) > 2 else 100
@@ -25,37 +27,39 @@ print("organs:", lily.organs)
 print("petal parameters:", lily.parameters(template="petal"))
 
 # 2. Change a map. Maps are arrays on the UV grid in image order: row 0 is
-#    the tip of the petal (v = 1), the last row its base (v = 0); u runs
+#    the tip of the tepal (v = 1), the last row its base (v = 0); u runs
 #    across, from column 0. map_grid gives u and v of every pixel, so a map
-#    can be written as a formula. Here the petals' outer layer grows more
-#    along the margins (|2u - 1| near 1) than along the midrib (u = 0.5).
-key = len(lily.map_keys("petal")) - 1          # the last key of the maps
-u, v = lily.map_grid("petal", "e_growth", key=key)
-before = lily.get_map("petal", "e_growth", key=key)
-edge_weighted = np.clip(before * (0.6 + 0.8 * np.abs(2 * u - 1)), 0.0, 1.0)
-changed = lily.copy()
-changed.set_map("petal", "e_growth", edge_weighted, key=key)
+#    can be written as a formula. Here the outer layer grows more along the
+#    margins (|2u - 1| near 1) than along the midrib (u = 0.5), the
+#    hypothesis of Liang and Mahadevan (2011). The lily's maps have two keys
+#    in time (steps 40 and 50; before the first key its maps hold): change
+#    both.
+margins = lily.copy()
+for key, step in enumerate(lily.map_keys("petal")):
+    u, v = lily.map_grid("petal", "e_growth", key=key)
+    before = lily.get_map("petal", "e_growth", key=key)
+    margins.set_map("petal", "e_growth", np.clip(before * (0.6 + 0.8 * np.abs(2 * u - 1)), 0, 1),
+                    key=key)
 
-# 3. Simulate both, with a progress line.
+# 3. Simulate one tepal alone (no collisions: the neighbours' margins would
+#    cross once one tepal grows differently), as built and changed, with a
+#    progress line.
 def progress(k, total):
     print(f"\rkeyframe {k}/{total}", end="", flush=True)
 
 runs = {}
-for name, project in [("as built", lily), ("margins grow more", changed)]:
-    runs[name] = project.simulate(keyframes=keyframes, progress=progress)
+for name, project in [("as built", lily), ("margins grow more", margins)]:
+    runs[name] = project.simulate(keyframes=keyframes, organ="petal-1", progress=progress)
     print(f"  {name}: done")
 
-# 4. A quantity over time: how far the petal tips open from the flower axis
-#    (the y axis), in the project's units (cm), per keyframe.
-def tip_distance(result, organ="petal-1"):
-    positions = result.positions(organ)               # [keyframes + 1, n, 3]
-    tip = np.argmax(positions[0, :, 1])               # highest particle in the bud
-    xz = positions[:, tip, [0, 2]]
-    return np.hypot(xz[:, 0], xz[:, 1])
-
-table = {name: tip_distance(run) for name, run in runs.items()}
-for name, series in table.items():
-    print(f"{name}: tip from axis {series[0]:.3f} -> {series[-1]:.3f} cm")
+# 4. Quantities over time (anthesis.measure): the midrib's and the margin's
+#    length in the project's length units, and the median Gaussian
+#    curvature over the tepal (positive: cup, negative: saddle).
+measures = {name: organ_measures(run, "petal-1") for name, run in runs.items()}
+for name, m in measures.items():
+    print(f"{name}: midrib {m['midrib_length'][0]:.2f} -> {m['midrib_length'][-1]:.2f}, "
+          f"margin {m['margin_length'][0]:.2f} -> {m['margin_length'][-1]:.2f}, "
+          f"median K {m['median_gaussian'][-1]:+.2e}")
 
 try:
     import matplotlib
@@ -63,21 +67,27 @@ try:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(5, 3.2))
-    for name, series in table.items():
-        ax.plot(series, label=name)
-    ax.set_xlabel("keyframe")
-    ax.set_ylabel("petal-1 tip from axis (cm)")
-    ax.legend()
+    fig, axes = plt.subplots(1, 2, figsize=(8, 3.2))
+    for name, m in measures.items():
+        axes[0].plot(m["margin_length"] / m["margin_length"][0], label=f"margin, {name}")
+        axes[0].plot(m["midrib_length"] / m["midrib_length"][0], "--", label=f"midrib, {name}")
+        axes[1].plot(m["median_gaussian"], label=name)
+    axes[0].set_xlabel("keyframe")
+    axes[0].set_ylabel("length / length in the bud")
+    axes[0].legend(fontsize=7)
+    axes[1].set_xlabel("keyframe")
+    axes[1].set_ylabel("median Gaussian curvature")
+    axes[1].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "tip-distance.png", dpi=120)
-    print("wrote", out / "tip-distance.png")
+    fig.savefig(out / "petal-1.png", dpi=120)
+    print("wrote", out / "petal-1.png")
 except ImportError:
     print("matplotlib is not installed: no plot (pip install matplotlib)")
 
-# 5. Export the changed run for Blender, three.js or a USD pipeline.
-runs["margins grow more"].export(out / "lily.glb")
-runs["margins grow more"].export(out / "lily.usdc")
+# 5. Export the changed run for Blender, three.js or a USD pipeline, and
+#    save the changed project (its maps as PNGs beside it).
+runs["margins grow more"].export(out / "petal-1.glb")
+runs["margins grow more"].export(out / "petal-1.usdc")
 (out / "project").mkdir(exist_ok=True)
-changed.save(out / "project" / "lily-margins.anthesis.toml")  # maps saved as PNGs beside it
-print("wrote", out / "lily.glb", out / "lily.usdc", out / "project")
+margins.save(out / "project" / "lily-margins.anthesis.toml")
+print("wrote", out / "petal-1.glb", out / "petal-1.usdc", out / "project")

@@ -4,8 +4,7 @@ Load a project (a file, its folder or ``"builtin:NAME"``), change its growth
 maps (numpy arrays on the UV grid) and parameters, simulate, and get every
 keyframe as numpy arrays; export (.glb, .usda, .usdc, OBJ) and render.
 
-Units: lengths in the project's units (the built-in flowers use
-centimetres), angles in degrees, time in keyframes (0 is the bud). The
+Units: lengths in the project's length units, angles in degrees, time in keyframes (0 is the bud). The
 engine is the one the ``anthesis`` command line runs: the same project and
 keyframe count give the same bits, on any machine and in any process.
 

@@ -18,8 +18,15 @@ class ProjectError(AnthesisError):
 class SimulationError(AnthesisError):
     """A run that stopped: no convergence, organs crossing, too little memory."""
 
+    result: Result
+    """The keyframes computed before the stop (the bud included); absent
+    when the run did not start."""
+
 class Cancelled(AnthesisError):
     """The run was cancelled through ``Project.simulate(cancel=...)``."""
+
+    result: Result
+    """The keyframes computed before the cancellation (the bud included)."""
 
 class ExportError(AnthesisError):
     """An export that could not be written."""
@@ -80,7 +87,10 @@ class Project:
         cancel: threading.Event | Callable[[], bool] | None = None,
         allow_crossings: bool = False,
     ) -> Result:
-        """Run as ``anthesis simulate``; the GIL is released while it runs."""
+        """Run as ``anthesis simulate``; the GIL is released while it runs.
+
+        A run that stops raises with the keyframes before the stop as the
+        exception's ``result``."""
 
 class Result:
     """Every keyframe of a run (0 is the bud), world frame, project units."""

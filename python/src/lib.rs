@@ -143,6 +143,9 @@ fn load(py: Python<'_>, source: &Bound<'_, PyAny>) -> PyResult<PyProject> {
     })
 }
 
+/// A float64 numpy array of two dimensions.
+type Floats2<'py> = Bound<'py, PyArray2<f64>>;
+
 /// A flower project: its organs, templates, growth maps and parameters.
 /// Changes are checked by the rules a project file obeys.
 #[pyclass(name = "Project", module = "anthesis")]
@@ -305,11 +308,7 @@ impl PyProject {
         &self,
         py: Python<'py>,
         template: &str,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<f64>>,
-        Bound<'py, PyArray2<u32>>,
-        Bound<'py, PyArray2<f64>>,
-    )> {
+    ) -> PyResult<(Floats2<'py>, Bound<'py, PyArray2<u32>>, Floats2<'py>)> {
         let t = self.template_index(template)?;
         let mesh = &self.project.flower.templates[t].mesh;
         Ok((
@@ -456,7 +455,7 @@ impl PyProject {
         template: &str,
         name: &str,
         key: usize,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    ) -> PyResult<(Floats2<'py>, Floats2<'py>)> {
         let t = self.template_index(template)?;
         let key = self.key_index(t, key)?;
         let maps = &self.project.flower.templates[t].maps.keys()[key].maps;
@@ -665,8 +664,11 @@ impl PyProject {
     /// `organ` simulates one organ alone (no collisions). `progress` is
     /// called as progress(keyframe, total) after each keyframe; `cancel` is
     /// a threading.Event (or a callable returning True) polled between
-    /// solver iterations: when set the run raises Cancelled. The GIL is
-    /// released while the engine runs. Same inputs, same bits.
+    /// solver iterations: when set the run raises Cancelled. A run that
+    /// stops (Cancelled, SimulationError, an error in `progress`) carries
+    /// the keyframes computed before the stop as the exception's `result`
+    /// attribute. The GIL is released while the engine runs. Same inputs,
+    /// same bits.
     #[pyo3(signature = (keyframes = None, organ = None, progress = None, cancel = None, allow_crossings = false))]
     fn simulate(
         &self,
@@ -730,9 +732,24 @@ impl PyProject {
         if let Some(error) = python_error.lock().ok().and_then(|mut e| e.take()) {
             return Err(error);
         }
-        outcome.map(|data| PyRunResult {
-            data: Arc::new(data),
-        })
+        match outcome {
+            Ok(data) => Ok(PyRunResult {
+                data: Arc::new(data),
+            }),
+            Err(Stopped { error, partial }) => {
+                // The keyframes computed before the stop, on the exception.
+                if let Some(data) = partial {
+                    let result = Py::new(
+                        py,
+                        PyRunResult {
+                            data: Arc::new(*data),
+                        },
+                    )?;
+                    error.value(py).setattr("result", result)?;
+                }
+                Err(error)
+            }
+        }
     }
 
     fn __repr__(&self) -> String {
@@ -796,6 +813,22 @@ struct RunData {
     stats: Vec<KeyframeStats>,
 }
 
+/// Why a run stopped, and the keyframes computed before (the bud
+/// included), kept as the command line keeps them.
+struct Stopped {
+    error: PyErr,
+    partial: Option<Box<RunData>>,
+}
+
+impl From<PyErr> for Stopped {
+    fn from(error: PyErr) -> Stopped {
+        Stopped {
+            error,
+            partial: None,
+        }
+    }
+}
+
 /// The run of `anthesis simulate` (app/src/cli/simulate.rs): the same
 /// checks, the same resolution and the same stepping, with Python's
 /// progress and cancellation instead of the terminal's.
@@ -806,7 +839,7 @@ fn run(
     cancel: Option<&Py<PyAny>>,
     progress: Option<&Py<PyAny>>,
     python_error: &Mutex<Option<PyErr>>,
-) -> PyResult<RunData> {
+) -> Result<RunData, Stopped> {
     anthesis_sim::memory::check_run(&project, &selection, KeyframeCost::Kept)
         .map_err(|e| simulation_error(&e))?;
     let project = anthesis_flower::resolution::resolve(&project).map_err(|e| project_error(&e))?;
@@ -837,31 +870,38 @@ fn run(
             },
         )
     };
+    let organs = selection.organs(project.flower.organs.len());
     let total = sim.keyframe_count();
     let mut frames = vec![sim.bud().positions_in_world];
     let mut stats = vec![sim.bud().stats];
+    let mut failure = None;
     while !sim.finished() {
+        let done = frames.len() - 1;
         if cancelled() {
-            return Err(Cancelled::new_err(format!(
-                "cancelled after keyframe {} of {total}",
-                frames.len() - 1
+            failure = Some(Cancelled::new_err(format!(
+                "cancelled after keyframe {done} of {total}"
             )));
+            break;
         }
         let keyframe = match sim.step(&cancelled, &mut |_| {}) {
             Ok(keyframe) => keyframe,
             Err(SimError::Cancelled) => {
-                return Err(Cancelled::new_err(format!(
-                    "cancelled after keyframe {} of {total}",
-                    frames.len() - 1
+                failure = Some(Cancelled::new_err(format!(
+                    "cancelled after keyframe {done} of {total}"
                 )));
+                break;
             }
             Err(error @ SimError::Crossed(_)) => {
-                return Err(SimulationError::new_err(format!(
+                failure = Some(SimulationError::new_err(format!(
                     "the run stopped where organs cross (allow_crossings=True goes on): {}",
                     message(&error)
                 )));
+                break;
             }
-            Err(error) => return Err(simulation_error(&error)),
+            Err(error) => {
+                failure = Some(simulation_error(&error));
+                break;
+            }
         };
         let index = keyframe.index;
         stats.push(keyframe.stats);
@@ -869,16 +909,23 @@ fn run(
         if let Some(progress) = progress
             && let Err(error) = Python::attach(|py| progress.call1(py, (index, total)).map(drop))
         {
-            return Err(error);
+            failure = Some(error);
+            break;
         }
     }
-    let organs = selection.organs(project.flower.organs.len());
-    Ok(RunData {
+    let data = RunData {
         project,
         organs,
         frames,
         stats,
-    })
+    };
+    match failure {
+        None => Ok(data),
+        Some(error) => Err(Stopped {
+            error,
+            partial: Some(Box::new(data)),
+        }),
+    }
 }
 
 fn points_array<'py>(py: Python<'py>, points: &[DVec3]) -> Bound<'py, PyArray2<f64>> {

@@ -119,3 +119,4 @@ def test_measures_of_a_run(five_petal):
     assert m["margin_length"][0] == pytest.approx(margin_length(positions, faces, uvs), rel=1e-9)
     # The petal grows: its midrib lengthens.
     assert m["midrib_length"][-1] > m["midrib_length"][0]
+

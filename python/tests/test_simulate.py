@@ -63,8 +63,13 @@ def test_progress_is_reported_and_cancel_stops_the_run(five_petal):
         if k == 2:
             event.set()
 
-    with pytest.raises(anthesis.Cancelled, match="cancelled after keyframe 2 of 10"):
+    with pytest.raises(anthesis.Cancelled, match="cancelled after keyframe 2 of 10") as stopped:
         five_petal.simulate(keyframes=10, progress=stop_after_two, cancel=event)
+    # The keyframes before the stop are kept, the same bits as a full run's.
+    partial = stopped.value.result
+    assert partial.keyframes == 2
+    full = five_petal.simulate(keyframes=10)
+    assert partial.positions(0).tobytes() == full.positions(0)[:3].tobytes()
     with pytest.raises(anthesis.Cancelled, match="after keyframe 0"):
         five_petal.simulate(keyframes=10, cancel=lambda: True)
 
