@@ -28,6 +28,9 @@ class Cancelled(AnthesisError):
     result: Result
     """The keyframes computed before the cancellation (the bud included)."""
 
+class FitError(AnthesisError):
+    """A fit that could not start or go on (a bad target, a failed simulation)."""
+
 class ExportError(AnthesisError):
     """An export that could not be written."""
 
@@ -91,6 +94,29 @@ class Project:
 
         A run that stops raises with the keyframes before the stop as the
         exception's ``result``."""
+
+    def fit(
+        self,
+        organ: str,
+        target: str | os.PathLike[str],
+        *,
+        register: bool = False,
+        register_scale: bool = False,
+        flip_inner_side: bool = False,
+        keys: int = 1,
+        nodes: tuple[int, int] = (3, 4),
+        direction_nodes: tuple[int, int] = (3, 2),
+        max_seconds: float = 100.0,
+        max_iterations: int = 30,
+        progress: Callable[[int, float, float], object] | None = None,
+        cancel: threading.Event | Callable[[], bool] | None = None,
+    ) -> tuple[Project, dict[str, Any]]:
+        """Fit the maps of ``organ``'s template to an OBJ target, as ``anthesis fit``.
+
+        Returns the fitted project and a report (``rms``, ``max``,
+        ``guess_rms`` as fractions of the organ's length, ``reached``,
+        ``stopped``, ``iterations``, ``simulations``, ``seconds``,
+        ``verdict``)."""
 
 class Result:
     """Every keyframe of a run (0 is the bud), world frame, project units."""

@@ -50,6 +50,12 @@ pyo3::create_exception!(
 );
 pyo3::create_exception!(
     _anthesis,
+    FitError,
+    AnthesisError,
+    "A fit that could not start or go on (a bad target, a failed simulation)."
+);
+pyo3::create_exception!(
+    _anthesis,
     ExportError,
     AnthesisError,
     "An export (.glb, .usda, .usdc, OBJ folder) that could not be written."
@@ -703,21 +709,7 @@ impl PyProject {
                 }
             },
         };
-        let cancel = match cancel {
-            None => None,
-            Some(object) => {
-                let bound = object.bind(py);
-                if bound.hasattr("is_set")? {
-                    Some(bound.getattr("is_set")?.unbind())
-                } else if bound.is_callable() {
-                    Some(object)
-                } else {
-                    return Err(PyTypeError::new_err(
-                        "cancel must be a threading.Event or a callable returning a bool",
-                    ));
-                }
-            }
-        };
+        let cancel = cancel_function(py, cancel)?;
         let python_error: Mutex<Option<PyErr>> = Mutex::new(None);
         let outcome = py.detach(|| {
             run(
@@ -752,6 +744,216 @@ impl PyProject {
         }
     }
 
+    /// Fits the growth maps of `organ`'s template to a target open shape,
+    /// as `anthesis fit` does: `target` is an OBJ whose object named like
+    /// the organ (or its only object) is a surface of any triangulation,
+    /// in the project's world frame and units (`register=True`: anywhere,
+    /// laid on the organ first; `register_scale=True`: in other units
+    /// too). Returns the fitted project (this one with the template's maps
+    /// replaced; every organ of that template takes them) and a report:
+    /// distances as fractions of the organ's length (`rms`, `max`,
+    /// `guess_rms`, figured by simulating the fitted project), `reached`,
+    /// `stopped`, `iterations`, `simulations`, `seconds`, `verdict`.
+    /// `progress(iteration, rms, max)` hears of every iteration; `cancel`
+    /// as in `simulate`. The GIL is released while it runs.
+    #[pyo3(signature = (organ, target, *, register = false, register_scale = false, flip_inner_side = false, keys = 1, nodes = (3, 4), direction_nodes = (3, 2), max_seconds = 100.0, max_iterations = 30, progress = None, cancel = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn fit<'py>(
+        &self,
+        py: Python<'py>,
+        organ: &str,
+        target: PathBuf,
+        register: bool,
+        register_scale: bool,
+        flip_inner_side: bool,
+        keys: u32,
+        nodes: (usize, usize),
+        direction_nodes: (usize, usize),
+        max_seconds: f64,
+        max_iterations: u32,
+        progress: Option<Py<PyAny>>,
+        cancel: Option<Py<PyAny>>,
+    ) -> PyResult<(PyProject, Bound<'py, PyDict>)> {
+        if !(max_seconds.is_finite() && max_seconds > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "max_seconds must be a positive number, got {max_seconds}"
+            )));
+        }
+        if nodes.0 == 0 || nodes.1 == 0 {
+            return Err(PyValueError::new_err(
+                "nodes needs at least one node each way, e.g. (1, 3)",
+            ));
+        }
+        if keys == 0 {
+            return Err(PyValueError::new_err("keys must be at least 1"));
+        }
+        let Some(organ_index) = self.project.flower.organ_index(organ) else {
+            return Err(PyKeyError::new_err(format!(
+                "no organ named `{organ}` (organs: {})",
+                self.organs().join(", ")
+            )));
+        };
+        if keys > self.project.settings.keyframes + 1 {
+            return Err(PyValueError::new_err(format!(
+                "keys {keys} is more than the run's {} keyframes and the bud",
+                self.project.settings.keyframes
+            )));
+        }
+        let cancel = cancel_function(py, cancel)?;
+        let settings = anthesis_fit::FitSettings {
+            growth_nodes: anthesis_fit::Grid {
+                nodes_u: nodes.0,
+                nodes_v: nodes.1,
+            },
+            direction_nodes: anthesis_fit::Grid {
+                nodes_u: direction_nodes.0,
+                nodes_v: direction_nodes.1,
+            },
+            keys,
+            max_iterations,
+            max_seconds,
+            refine_placement: register || register_scale,
+            ..anthesis_fit::FitSettings::default()
+        };
+        let python_error: Mutex<Option<PyErr>> = Mutex::new(None);
+        let project = self.project.clone();
+        let outcome = py.detach(|| {
+            let keep = |error: PyErr| {
+                if let Ok(mut slot) = python_error.lock()
+                    && slot.is_none()
+                {
+                    *slot = Some(error);
+                }
+            };
+            let stopped = || python_error.lock().map(|e| e.is_some()).unwrap_or(true);
+            let cancelled = || -> bool {
+                if stopped() {
+                    return true;
+                }
+                let Some(cancel) = cancel.as_ref() else {
+                    return false;
+                };
+                Python::attach(
+                    |py| match cancel.call0(py).and_then(|v| v.bind(py).is_truthy()) {
+                        Ok(set) => set,
+                        Err(error) => {
+                            keep(error);
+                            true
+                        }
+                    },
+                )
+            };
+            let fit_error = |error: &dyn StdError| FitError::new_err(message(error));
+            let resolved =
+                anthesis_flower::resolution::resolve(&project).map_err(|e| project_error(&e))?;
+            let text = anthesis_files::read_regular_text(
+                &target,
+                anthesis_mesh::obj::MAX_OBJ_BYTES,
+                "an OBJ mesh",
+            )
+            .map_err(|e| {
+                FitError::new_err(format!(
+                    "cannot read the target {}: {}",
+                    target.display(),
+                    message(&e)
+                ))
+            })?;
+            let mesh = &resolved.flower.template_of(organ_index).mesh;
+            let mut shape = anthesis_fit::read_target(&text, organ, mesh).map_err(|e| {
+                FitError::new_err(format!("target {}: {}", target.display(), message(&e)))
+            })?;
+            if flip_inner_side {
+                shape = shape.flipped();
+            }
+            let registered = if register || register_scale {
+                Some(
+                    anthesis_fit::register_target(
+                        &resolved,
+                        organ_index,
+                        &shape,
+                        register_scale,
+                        &cancelled,
+                    )
+                    .map_err(|e| fit_error(&e))?,
+                )
+            } else {
+                None
+            };
+            let placement = registered
+                .as_ref()
+                .map_or(anthesis_fit::Similarity::IDENTITY, |r| {
+                    r.registration.placement
+                });
+            let mut result = anthesis_fit::fit(
+                &resolved,
+                organ_index,
+                &shape,
+                placement,
+                &settings,
+                &mut |p| {
+                    if let Some(progress) = progress.as_ref()
+                        && let Err(error) = Python::attach(|py| {
+                            progress.call1(py, (p.iteration, p.rms, p.max)).map(drop)
+                        })
+                    {
+                        keep(error);
+                    }
+                },
+                &cancelled,
+            )
+            .map_err(|e| fit_error(&e))?;
+            // The project as it was, with the template's maps replaced
+            // (they live in UV, so they apply at its own resolution), and
+            // the figures of that project simulated, as the command line
+            // reports them.
+            let mut fitted = project.clone();
+            let template = fitted.flower.organs[organ_index].template;
+            fitted.flower.templates[template].maps = result.maps.clone();
+            let written =
+                anthesis_flower::resolution::resolve(&fitted).map_err(|e| project_error(&e))?;
+            let final_shape = anthesis_fit::simulate_final(
+                &written,
+                organ_index,
+                written.flower.template_of(organ_index).maps.clone(),
+                &cancelled,
+            )
+            .map_err(|e| simulation_error(&e))?;
+            (result.rms, result.max) = anthesis_fit::distances(
+                &final_shape,
+                &written.flower.template_of(organ_index).mesh.triangles,
+                &shape,
+                result.placement,
+                result.length,
+            );
+            Ok::<_, PyErr>((fitted, result, registered.map(|r| r.describe())))
+        });
+        if let Some(error) = python_error.lock().ok().and_then(|mut e| e.take()) {
+            return Err(error);
+        }
+        let (fitted, result, registration) = outcome?;
+        let report = PyDict::new(py);
+        report.set_item("organ", organ)?;
+        report.set_item("organ_length", result.length)?;
+        report.set_item("guess_rms", result.guess_rms)?;
+        report.set_item("rms", result.rms)?;
+        report.set_item("max", result.max)?;
+        report.set_item("reached", result.reached())?;
+        report.set_item("stopped", result.stop.name())?;
+        report.set_item("iterations", result.iterations)?;
+        report.set_item("simulations", result.simulations)?;
+        report.set_item("seconds", result.seconds)?;
+        report.set_item("parameters", result.parameters.len())?;
+        report.set_item("registration", registration)?;
+        report.set_item("verdict", result.verdict())?;
+        Ok((
+            PyProject {
+                project: fitted,
+                source: format!("{} (fitted)", self.source),
+            },
+            report,
+        ))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<anthesis.Project '{}' from {}: {} organs, {} templates>",
@@ -760,6 +962,24 @@ impl PyProject {
             self.project.flower.organs.len(),
             self.project.flower.templates.len()
         )
+    }
+}
+
+/// `cancel` as a function to call: a threading.Event's `is_set`, or the
+/// callable itself.
+fn cancel_function(py: Python<'_>, cancel: Option<Py<PyAny>>) -> PyResult<Option<Py<PyAny>>> {
+    let Some(object) = cancel else {
+        return Ok(None);
+    };
+    let bound = object.bind(py);
+    if bound.hasattr("is_set")? {
+        Ok(Some(bound.getattr("is_set")?.unbind()))
+    } else if bound.is_callable() {
+        Ok(Some(object))
+    } else {
+        Err(PyTypeError::new_err(
+            "cancel must be a threading.Event or a callable returning a bool",
+        ))
     }
 }
 
@@ -1251,6 +1471,7 @@ fn _anthesis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add("Cancelled", py.get_type::<Cancelled>())?;
     m.add("ExportError", py.get_type::<ExportError>())?;
+    m.add("FitError", py.get_type::<FitError>())?;
     m.add("RenderError", py.get_type::<RenderError>())?;
     m.add("MAX_KEYFRAMES", MAX_KEYFRAMES)?;
     Ok(())
