@@ -15,6 +15,10 @@ Discrete differential geometry on the triangle meshes of a run, numpy only:
   (v = 0) to the tip (v = 1), traced through the UV layout.
 - :func:`margin_length`: the length of the organ's outline without its base
   (boundary edges with an end above ``base_v``).
+- :func:`principal_stretches`: per triangle, the principal stretches of the
+  deformation from the bud (the singular values of the map from the bud
+  triangle to the current one; 1 = unchanged, 1.4 = 40 % longer), largest
+  first.
 - :func:`organ_measures`: all of them for every keyframe of a run.
 """
 
@@ -24,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["vertex_curvatures", "angle_defects_and_areas", "midrib_length", "margin_length", "organ_measures"]
+__all__ = ["vertex_curvatures", "angle_defects_and_areas", "principal_stretches", "midrib_length", "margin_length", "organ_measures"]
 
 
 def _cot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -111,6 +115,26 @@ def _parts(x: np.ndarray, f: np.ndarray):
     return angle_sum, area, laplacian, normal
 
 
+def principal_stretches(rest: np.ndarray, current: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Principal stretches per triangle from `rest` to `current` positions
+    ([n, 3] each): float [m, 2], largest first. Rigid motions leave them at
+    1; they are the square roots of the eigenvalues of the right
+    Cauchy-Green tensor of the in-plane deformation."""
+    x0 = np.asarray(rest, dtype=np.float64)
+    x1 = np.asarray(current, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    e1, e2 = x0[f[:, 1]] - x0[f[:, 0]], x0[f[:, 2]] - x0[f[:, 0]]
+    # An orthonormal frame in each rest triangle: the edges in 2D.
+    t1 = e1 / np.linalg.norm(e1, axis=1, keepdims=True)
+    normal = np.cross(e1, e2)
+    t2 = np.cross(normal / np.linalg.norm(normal, axis=1, keepdims=True), t1)
+    rest_2d = np.stack([np.stack([np.einsum("ij,ij->i", e, t1), np.einsum("ij,ij->i", e, t2)],
+                                 axis=1) for e in (e1, e2)], axis=2)  # [m, 2, 2], columns = edges
+    now = np.stack([x1[f[:, 1]] - x1[f[:, 0]], x1[f[:, 2]] - x1[f[:, 0]]], axis=2)  # [m, 3, 2]
+    gradient = now @ np.linalg.inv(rest_2d)  # [m, 3, 2]
+    return np.linalg.svd(gradient, compute_uv=False)
+
+
 def _trace_uv(positions: np.ndarray, faces: np.ndarray, uvs: np.ndarray,
               points_uv: np.ndarray) -> np.ndarray:
     """The 3D points at `points_uv` [s, 2] through the UV layout (each in the
@@ -162,14 +186,16 @@ def margin_length(positions: np.ndarray, faces: np.ndarray, uvs: np.ndarray,
 def organ_measures(result: Any, organ: str | int, base_v: float = 0.05) -> dict[str, np.ndarray]:
     """Per keyframe of `result` (an ``anthesis.Result``) for one organ:
     ``mean_curvature`` and ``gaussian_curvature`` [k + 1, n] (NaN on the
-    boundary), their area-free medians over the interior
-    ``median_gaussian`` [k + 1], and ``midrib_length``, ``margin_length``
-    [k + 1]."""
+    boundary), the median of the Gaussian curvature over the interior
+    vertices ``median_gaussian`` [k + 1], ``midrib_length`` and
+    ``margin_length`` [k + 1], and ``principal_stretches`` [k + 1, m, 2]
+    against the bud (keyframe 0)."""
     positions = result.positions(organ)
     faces = result.faces(organ).astype(np.int64)
     uvs = result.uvs(organ)
-    hs, ks, midrib, margin = [], [], [], []
+    hs, ks, midrib, margin, stretches = [], [], [], [], []
     for frame in positions:
+        stretches.append(principal_stretches(positions[0], frame, faces))
         h, k = vertex_curvatures(frame, faces)
         hs.append(h)
         ks.append(k)
@@ -182,4 +208,5 @@ def organ_measures(result: Any, organ: str | int, base_v: float = 0.05) -> dict[
         "median_gaussian": np.nanmedian(ks, axis=1),
         "midrib_length": np.array(midrib),
         "margin_length": np.array(margin),
+        "principal_stretches": np.array(stretches),
     }

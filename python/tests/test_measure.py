@@ -4,7 +4,7 @@ curvature, and the lengths on shapes with known lengths."""
 import numpy as np
 import pytest
 
-from anthesis.measure import angle_defects_and_areas, margin_length, midrib_length, organ_measures, vertex_curvatures
+from anthesis.measure import angle_defects_and_areas, margin_length, principal_stretches, midrib_length, organ_measures, vertex_curvatures
 
 
 def icosphere(radius: float, levels: int):
@@ -107,6 +107,32 @@ def test_midrib_and_margin_of_a_flat_and_a_rolled_petal():
     assert margin_length(rolled, f, uv) == pytest.approx(2 * chord + width, rel=1e-12)
 
 
+def test_principal_stretches_of_known_deformations():
+    uv, f = grid(5, 7)
+    sheet = np.column_stack([uv, np.zeros(len(uv))])
+    # Stretched 1.4 along v and 0.9 along u, then turned and moved: every
+    # triangle has stretches (1.4, 0.9).
+    stretched = np.column_stack([0.9 * uv[:, 0], 1.4 * uv[:, 1], np.zeros(len(uv))])
+    angle = 0.7
+    turn = np.array([[1, 0, 0], [0, np.cos(angle), -np.sin(angle)], [0, np.sin(angle), np.cos(angle)]])
+    moved = stretched @ turn.T + [3.0, -1.0, 2.0]
+    s = principal_stretches(sheet, moved, f)
+    assert s.shape == (len(f), 2)
+    np.testing.assert_allclose(s, np.tile([1.4, 0.9], (len(f), 1)), rtol=1e-12)
+    # A simple shear x += k y: stretches sqrt(1 + k^2/4) +- k/2.
+    k = 0.5
+    sheared = np.column_stack([uv[:, 0] + k * uv[:, 1], uv[:, 1], np.zeros(len(uv))])
+    s = principal_stretches(sheet, sheared, f)
+    root = np.sqrt(1 + k * k / 4)
+    np.testing.assert_allclose(s, np.tile([root + k / 2, root - k / 2], (len(f), 1)), rtol=1e-12)
+    # Rolled up without stretching: a cylinder's developable bend keeps 1.
+    radius = 0.5
+    rolled = np.column_stack([radius * np.sin(uv[:, 0] / radius), uv[:, 1],
+                              radius * (1 - np.cos(uv[:, 0] / radius))])
+    s = principal_stretches(sheet, rolled, f)
+    assert np.abs(s - 1).max() < 0.02  # chords of the arc: a little shorter
+
+
 def test_measures_of_a_run(five_petal):
     result = five_petal.simulate(keyframes=3, organ="petal-1")
     m = organ_measures(result, "petal-1")
@@ -117,6 +143,9 @@ def test_measures_of_a_run(five_petal):
     # on the receptacle moves it rigidly).
     assert m["midrib_length"][0] == pytest.approx(midrib_length(positions, faces, uvs), rel=1e-9)
     assert m["margin_length"][0] == pytest.approx(margin_length(positions, faces, uvs), rel=1e-9)
-    # The petal grows: its midrib lengthens.
+    # The petal grows: its midrib lengthens, its triangles stretch.
     assert m["midrib_length"][-1] > m["midrib_length"][0]
+    np.testing.assert_allclose(m["principal_stretches"][0], 1.0, rtol=1e-9)
+    assert m["principal_stretches"][-1].shape == (200, 2)
+    assert m["principal_stretches"][-1, :, 0].max() > 1.0
 
