@@ -2,10 +2,26 @@
 
 import os
 import threading
-from typing import Any, Callable
+from typing import Any, Callable, final
 
 import numpy as np
 import numpy.typing as npt
+
+__all__ = [
+    "AnthesisError",
+    "Cancelled",
+    "ExportError",
+    "FitError",
+    "MAX_KEYFRAMES",
+    "Project",
+    "ProjectError",
+    "RenderError",
+    "Result",
+    "SimulationError",
+    "builtins",
+    "load",
+    "map_names",
+]
 
 MAX_KEYFRAMES: int
 
@@ -46,6 +62,7 @@ def builtins() -> list[str]:
 def map_names() -> list[str]:
     """The six scalar map names and ``"direction"``."""
 
+@final
 class Project:
     """A flower project; edits are checked by the rules of the project file."""
 
@@ -118,6 +135,7 @@ class Project:
         ``stopped``, ``iterations``, ``simulations``, ``seconds``,
         ``verdict``)."""
 
+@final
 class Result:
     """Every keyframe of a run (0 is the bud), world frame, project units."""
 
