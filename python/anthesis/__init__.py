@@ -6,7 +6,8 @@ keyframe as numpy arrays; export (.glb, .usda, .usdc, OBJ) and render.
 
 Units: lengths in the project's length units, angles in degrees, time in keyframes (0 is the bud). The
 engine is the one the ``anthesis`` command line runs: the same project and
-keyframe count give the same bits, on any machine and in any process.
+keyframe count give the same bits, in any process (on machines whose CPUs
+offer the same vector instructions).
 
 >>> import anthesis
 >>> lily = anthesis.load("builtin:lily")

@@ -9,8 +9,9 @@ returns plain numpy arrays; :func:`run_on_dask` submits every member to a
 failure with its error: nothing is lost, and a member that fails does not
 stop the others. Dask does the scheduling; this module only describes the
 work. The engine is deterministic, so a member's arrays are the same bits
-whichever worker, machine or process count ran it (:func:`run_serial` runs
-the same function in this process, for comparison).
+whichever worker or process ran it, and on whichever machine where the
+CPUs offer the same vector instructions (:func:`run_serial` runs the same
+function in this process, for comparison).
 
 Workers need the ``anthesis`` wheel installed (``pip install anthesis-*.whl``
 in the workers' environment); nothing else is shipped to them.
