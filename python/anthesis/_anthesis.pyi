@@ -112,6 +112,18 @@ class Project:
         A run that stops raises with the keyframes before the stop as the
         exception's ``result``."""
 
+    def export(
+        self,
+        path: str | os.PathLike[str],
+        keyframes: int | None = None,
+        organ: str | None = None,
+        fps: float = 24.0,
+        subdivide: int = 0,
+        normals: bool = True,
+        progress: Callable[[int, int], object] | None = None,
+        cancel: threading.Event | Callable[[], bool] | None = None,
+    ) -> Result:
+        """Simulate and write the run as ``anthesis simulate --out PATH``; returns the run."""
     def fit(
         self,
         organ: str,

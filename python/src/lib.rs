@@ -744,6 +744,28 @@ impl PyProject {
         }
     }
 
+    /// Simulates and writes the run, as `anthesis simulate --out PATH`:
+    /// .glb, .usda or .usdc by extension, any other path a folder of one
+    /// OBJ per keyframe (see `Result.export`). Returns the run.
+    #[pyo3(signature = (path, keyframes = None, organ = None, fps = 24.0, subdivide = 0, normals = true, progress = None, cancel = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn export(
+        &self,
+        py: Python<'_>,
+        path: PathBuf,
+        keyframes: Option<u32>,
+        organ: Option<&str>,
+        fps: f64,
+        subdivide: u32,
+        normals: bool,
+        progress: Option<Py<PyAny>>,
+        cancel: Option<Py<PyAny>>,
+    ) -> PyResult<PyRunResult> {
+        let result = self.simulate(py, keyframes, organ, progress, cancel, false)?;
+        result.export(py, path, fps, subdivide, normals)?;
+        Ok(result)
+    }
+
     /// Fits the growth maps of `organ`'s template to a target open shape,
     /// as `anthesis fit` does: `target` is an OBJ whose object named like
     /// the organ (or its only object) is a surface of any triangulation,

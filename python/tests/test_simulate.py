@@ -115,6 +115,10 @@ def test_exports_by_extension(five_petal, tmp_path):
     assert len(files) == 3
     last = read_obj_positions(files[-1])
     assert last["petal-1"].tobytes() == result.positions("petal-1")[-1].tobytes()
+    # Project.export is simulate then export, as `anthesis simulate --out`.
+    again = five_petal.export(tmp_path / "again.glb", keyframes=2)
+    assert (tmp_path / "again.glb").read_bytes() == (tmp_path / "open.glb").read_bytes()
+    assert again.positions(0).tobytes() == result.positions(0).tobytes()
     with pytest.raises(anthesis.ExportError, match="cannot write"):
         result.export(tmp_path / "missing" / "open.glb")
     with pytest.raises(ValueError, match="fps must be a positive number"):
