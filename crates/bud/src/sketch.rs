@@ -342,11 +342,6 @@ impl PetalSketch {
         }
     }
 
-    /// Whether the two outline strokes and the vein are all drawn.
-    pub fn has_outline(&self) -> bool {
-        !(self.left.is_empty() || self.right.is_empty() || self.vein.is_empty())
-    }
-
     /// The sketch with `points` drawn with `tool` (see [`SketchTool`]):
     /// an outline stroke or the vein replaces the one of its role, a
     /// cross-section one on the same row. The outline slots are sorted
