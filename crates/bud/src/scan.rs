@@ -1,4 +1,4 @@
-//! Scanned petals (issue 14 item 6; `pde-surfaces-lily.txt` §III.C–§IV:
+//! Scanned petals (issue 14 item 6; Chaudhry et al. §III.C–§IV:
 //! reconstructed polygon models turned into curve-defined PDE surfaces).
 //!
 //! A petal mesh of any triangulation and without UVs (a photogrammetry or

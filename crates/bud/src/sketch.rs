@@ -1,4 +1,4 @@
-//! The sketched petal (`sketch-based-floral-blossom.txt` §3.1): three
+//! The sketched petal (the floral blossom paper §3.1): three
 //! strokes on the base plane (the two margins and the primary vein) give a
 //! flat bicubic B-spline surface whose control points are spread evenly
 //! across and along the petal; a cross-section stroke drawn over a row of
