@@ -125,7 +125,7 @@ pub enum Command {
     Blossom(blossom::BlossomArgs),
     /// Animate a swept organ between two PDE sweep surfaces (its bud and
     /// its open state) by the PDE-driven in-betweening of
-    /// pde-surfaces-lily.txt §V: each generator's deformation from the
+    /// Chaudhry et al. §V: each generator's deformation from the
     /// dynamic equation (13), its force corrected (eq. 21) until the open
     /// state is met.
     PdeBlossom(pde_blossom::PdeBlossomArgs),

@@ -1,5 +1,5 @@
 //! The bad-input catalogue: every bad file and argument named in issue 17
-//! and in DESIGN.md §6, given to the `anthesis` binary the way a user would,
+//! and in the project's design brief, given to the `anthesis` binary the way a user would,
 //! each with the message it must get. Every case must end within
 //! [`MAX_SECONDS`] (a FIFO or `/dev/zero` once hung or filled the memory),
 //! with exit code 1 (an error, not a panic's 101 or a kill) and a last

@@ -1,5 +1,5 @@
 //! `anthesis pde-blossom`: a swept organ animated between two states by the
-//! PDE-driven in-betweening of `pde-surfaces-lily.txt` §V
+//! PDE-driven in-betweening of Chaudhry et al. §V
 //! (`anthesis_bud::dynamic`), written as the same animation files
 //! `anthesis simulate` writes.
 

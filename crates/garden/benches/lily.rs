@@ -1,5 +1,5 @@
-//! The built-in Asiatic lily, 100 keyframes (DESIGN.md §6: a single lily
-//! petal and the whole lily, next to the paper's 2.5 and 11.5 minutes).
+//! The built-in Asiatic lily, 100 keyframes (the project's speed target: a
+//! single lily petal and the whole lily, next to the paper's 2.5 and 11.5 minutes).
 //! The `*_keyframes` benchmarks run from the bud to the last keyframe; the
 //! `stroke_*` ones measure what a user waits for after a stroke on the
 //! petals' late (step-50) key: the edit, then every keyframe from the first

@@ -14,6 +14,7 @@ pub mod collide;
 pub mod crossing;
 #[cfg(any(test, feature = "fault-hook"))]
 pub mod fault;
+#[cfg(any(test, feature = "fixtures"))]
 pub mod fixtures;
 pub mod memory;
 mod obstacle;

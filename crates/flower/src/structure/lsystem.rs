@@ -1,4 +1,4 @@
-//! Bracketed parametric L-systems as `lsystem-bezier-flower.txt` §2–§3
+//! Bracketed parametric L-systems as Qin and Chen 2006 §2–§3
 //! writes them: an axiom, productions rewritten in parallel for a number
 //! of derivation steps, and named constants.
 //!

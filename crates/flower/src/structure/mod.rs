@@ -1,6 +1,6 @@
 //! Where a flower's organs go, as data: whorls, contorted whorls and
 //! golden-angle spirals on the receptacle ([`whorl`]), and the bracketed
-//! parametric L-systems and turtle of `lsystem-bezier-flower.txt` §2–§3
+//! parametric L-systems and turtle of Qin and Chen 2006 §2–§3
 //! ([`lsystem`], [`turtle`]). A project's `[structure]` is one of them
 //! ([`Structure`]); its organs and overlap rules are made when the project
 //! loads ([`Structure::arrange`]).

@@ -11,7 +11,7 @@ use crate::{Organ, Overlap, Placement};
 use glam::DVec3;
 
 /// The golden divergence angle of spiral phyllotaxis, 360° (1 − 1/φ)
-/// (`sketch-based-floral-blossom.txt` §3.2).
+/// (the floral blossom paper §3.2).
 pub const GOLDEN_ANGLE_DEG: f64 = 137.507_764_050_037_85;
 
 /// A ring of identical organs around the axis.
@@ -142,7 +142,7 @@ pub fn contorted_whorl(whorl: &Whorl) -> Option<Arrangement> {
     })
 }
 
-/// A phyllotactic spiral (`sketch-based-floral-blossom.txt` §3.2).
+/// A phyllotactic spiral (the floral blossom paper §3.2).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spiral {
     /// Organ names are `<name>-1`, `<name>-2`, … from the first (outermost)
