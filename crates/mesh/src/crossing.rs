@@ -107,107 +107,9 @@ impl CrossingSearch {
         cell: f64,
         tested: &dyn Fn(usize, usize) -> bool,
     ) -> Vec<Crossing> {
-        self.boxes.clear();
-        self.owner.clear();
-        self.first.clear();
-        self.corners.clear();
-        self.vertices.clear();
-        for (b, body) in bodies.iter().enumerate() {
-            self.first.push(self.boxes.len());
-            for t in body.triangles {
-                let corners = t.map(|v| body.positions[v as usize]);
-                let [p, q, r] = corners;
-                // `min` and `max` pass NaN over: a broken corner is
-                // marked so that the triangle is left out.
-                let broken = !(p.is_finite() && q.is_finite() && r.is_finite());
-                let (lo, hi) = if broken {
-                    (DVec3::NAN, DVec3::NAN)
-                } else {
-                    (p.min(q).min(r), p.max(q).max(r))
-                };
-                self.boxes.push((lo, hi));
-                self.owner.push(b as u32);
-                self.corners.push(corners);
-                self.vertices.push(*t);
-            }
-        }
-        let n = self.boxes.len();
-        let mut cell = if cell.is_finite() && cell > 0.0 {
-            cell
-        } else {
-            1.0
-        };
-        // Each triangle's range of cells; the cell grows until the boxes
-        // cover few enough of them (a box too large for `i32` cells counts
-        // as too many).
-        let limit = f64::from(i32::MAX / 2);
-        let entries = loop {
-            self.ranges.clear();
-            let mut total = 0usize;
-            let mut fits = true;
-            for &(lo, hi) in &self.boxes {
-                if !(lo.is_finite() && hi.is_finite()) {
-                    // Left out: an empty range.
-                    self.ranges.push((IVec3::ONE, IVec3::ZERO));
-                    continue;
-                }
-                let (a, b) = ((lo / cell).floor(), (hi / cell).floor());
-                if a.abs().max_element() >= limit || b.abs().max_element() >= limit {
-                    fits = false;
-                    break;
-                }
-                let (a, b) = (a.as_ivec3(), b.as_ivec3());
-                let d = (b - a + IVec3::ONE).as_i64vec3();
-                total = total.saturating_add((d.x * d.y * d.z) as usize);
-                if total > MAX_CELLS_PER_TRIANGLE * n.max(1) {
-                    fits = false;
-                    break;
-                }
-                self.ranges.push((a, b));
-            }
-            if fits {
-                break total;
-            }
-            cell *= 2.0;
-        };
-        // The hash table: a power of two of buckets, at least the entries.
-        let buckets = entries.max(1).next_power_of_two();
-        let mask = buckets as u64 - 1;
-        let bucket = |c: IVec3| {
-            let h = (c.x as u32 as u64).wrapping_mul(73_856_093)
-                ^ (c.y as u32 as u64).wrapping_mul(19_349_663)
-                ^ (c.z as u32 as u64).wrapping_mul(83_492_791);
-            // Mix the high bits down, so that the mask sees them.
-            ((h ^ (h >> 17)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32 & mask) as usize
-        };
-        let cells = |(a, b): (IVec3, IVec3)| {
-            (a.x..=b.x).flat_map(move |x| {
-                (a.y..=b.y).flat_map(move |y| (a.z..=b.z).map(move |z| IVec3::new(x, y, z)))
-            })
-        };
-        // Counting sort of the entries by bucket.
-        self.starts.clear();
-        self.starts.resize(buckets + 1, 0);
-        for &range in &self.ranges {
-            for c in cells(range) {
-                self.starts[bucket(c) + 1] += 1;
-            }
-        }
-        for i in 0..buckets {
-            self.starts[i + 1] += self.starts[i];
-        }
-        self.entries.clear();
-        self.entries.resize(entries, (0, IVec3::ZERO));
-        self.next.clear();
-        self.next.extend_from_slice(&self.starts[..buckets]);
-        for (t, &range) in self.ranges.iter().enumerate() {
-            for c in cells(range) {
-                let slot = &mut self.next[bucket(c)];
-                self.entries[*slot as usize] = (t as u32, c);
-                *slot += 1;
-            }
-        }
-
+        self.gather(bodies);
+        let entries = self.cover(cell);
+        let buckets = self.fill(entries);
         // Which bodies may cross, looked up per pair.
         let count = bodies.len();
         self.tested.clear();
@@ -233,6 +135,108 @@ impl CrossingSearch {
             .collect();
         found.sort_unstable_by_key(|c| (c.a, c.b));
         found
+    }
+
+    /// Every triangle of `bodies` in order: its bounding box (NaN for a
+    /// triangle with a non-finite corner), body, corners and vertices.
+    fn gather(&mut self, bodies: &[Body<'_>]) {
+        self.boxes.clear();
+        self.owner.clear();
+        self.first.clear();
+        self.corners.clear();
+        self.vertices.clear();
+        for (b, body) in bodies.iter().enumerate() {
+            self.first.push(self.boxes.len());
+            for t in body.triangles {
+                let corners = t.map(|v| body.positions[v as usize]);
+                let [p, q, r] = corners;
+                // `min` and `max` pass NaN over: a broken corner is
+                // marked so that the triangle is left out.
+                let broken = !(p.is_finite() && q.is_finite() && r.is_finite());
+                let (lo, hi) = if broken {
+                    (DVec3::NAN, DVec3::NAN)
+                } else {
+                    (p.min(q).min(r), p.max(q).max(r))
+                };
+                self.boxes.push((lo, hi));
+                self.owner.push(b as u32);
+                self.corners.push(corners);
+                self.vertices.push(*t);
+            }
+        }
+    }
+
+    /// Each triangle's range of cells of size `cell` or larger: the cell
+    /// grows until the boxes cover few enough of them (a box too large for
+    /// `i32` cells counts as too many). Returns how many cells they cover.
+    fn cover(&mut self, cell: f64) -> usize {
+        let n = self.boxes.len();
+        let mut cell = if cell.is_finite() && cell > 0.0 {
+            cell
+        } else {
+            1.0
+        };
+        let limit = f64::from(i32::MAX / 2);
+        loop {
+            self.ranges.clear();
+            let mut total = 0usize;
+            let mut fits = true;
+            for &(lo, hi) in &self.boxes {
+                if !(lo.is_finite() && hi.is_finite()) {
+                    // Left out: an empty range.
+                    self.ranges.push((IVec3::ONE, IVec3::ZERO));
+                    continue;
+                }
+                let (a, b) = ((lo / cell).floor(), (hi / cell).floor());
+                if a.abs().max_element() >= limit || b.abs().max_element() >= limit {
+                    fits = false;
+                    break;
+                }
+                let (a, b) = (a.as_ivec3(), b.as_ivec3());
+                let d = (b - a + IVec3::ONE).as_i64vec3();
+                total = total.saturating_add((d.x * d.y * d.z) as usize);
+                if total > MAX_CELLS_PER_TRIANGLE * n.max(1) {
+                    fits = false;
+                    break;
+                }
+                self.ranges.push((a, b));
+            }
+            if fits {
+                return total;
+            }
+            cell *= 2.0;
+        }
+    }
+
+    /// The hash table of the `entries` cells the ranges cover: a power of
+    /// two of buckets, at least the entries, filled by a counting sort.
+    /// Returns the buckets.
+    fn fill(&mut self, entries: usize) -> usize {
+        let buckets = entries.max(1).next_power_of_two();
+        let mask = buckets as u64 - 1;
+        // Counting sort of the entries by bucket.
+        self.starts.clear();
+        self.starts.resize(buckets + 1, 0);
+        for &range in &self.ranges {
+            for c in cells(range) {
+                self.starts[bucket(c, mask) + 1] += 1;
+            }
+        }
+        for i in 0..buckets {
+            self.starts[i + 1] += self.starts[i];
+        }
+        self.entries.clear();
+        self.entries.resize(entries, (0, IVec3::ZERO));
+        self.next.clear();
+        self.next.extend_from_slice(&self.starts[..buckets]);
+        for (t, &range) in self.ranges.iter().enumerate() {
+            for c in cells(range) {
+                let slot = &mut self.next[bucket(c, mask)];
+                self.entries[*slot as usize] = (t as u32, c);
+                *slot += 1;
+            }
+        }
+        buckets
     }
 
     /// The crossings among the entries of bucket `k` (of a search over
@@ -283,6 +287,22 @@ impl CrossingSearch {
             }
         }
     }
+}
+
+/// The bucket of cell `c` in a table of `mask + 1` buckets.
+fn bucket(c: IVec3, mask: u64) -> usize {
+    let h = (c.x as u32 as u64).wrapping_mul(73_856_093)
+        ^ (c.y as u32 as u64).wrapping_mul(19_349_663)
+        ^ (c.z as u32 as u64).wrapping_mul(83_492_791);
+    // Mix the high bits down, so that the mask sees them.
+    ((h ^ (h >> 17)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32 & mask) as usize
+}
+
+/// The cells of the range `(a, b)` (inclusive), x slowest.
+fn cells((a, b): (IVec3, IVec3)) -> impl Iterator<Item = IVec3> {
+    (a.x..=b.x).flat_map(move |x| {
+        (a.y..=b.y).flat_map(move |y| (a.z..=b.z).map(move |z| IVec3::new(x, y, z)))
+    })
 }
 
 /// Whether triangles `a` and `b` cross (an edge of either passes through
