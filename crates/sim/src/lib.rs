@@ -109,6 +109,9 @@ pub struct Simulation {
     crossing_search: CrossingSearch,
     /// What [`OnCrossing::Warn`] let through, per keyframe in order.
     crossings: Vec<Crossings>,
+    /// Whether contacts between organs push both (see
+    /// [`Simulation::two_sided_contact`]).
+    two_sided: bool,
     /// Particles held off their own organ by a self-contact while the
     /// organs settled, summed over the keyframes computed.
     self_pressed: u64,
@@ -169,6 +172,7 @@ impl Simulation {
             on_crossing: OnCrossing::Stop,
             crossing_search: CrossingSearch::new(),
             crossings: Vec::new(),
+            two_sided: false,
             self_pressed: 0,
             #[cfg(all(feature = "fault-hook", not(test)))]
             fault: fault::Fault::from_env(),
@@ -230,9 +234,10 @@ impl Simulation {
         if !rewound {
             let keep = self.checkpoints.is_some();
             let selection = self.selection.clone();
-            let on_crossing = self.on_crossing;
+            let (on_crossing, two_sided) = (self.on_crossing, self.two_sided);
             *self = Simulation::new(after, &selection)?;
             self.on_crossing = on_crossing;
+            self.two_sided = two_sided;
             if keep {
                 self.keep_checkpoints();
             }
@@ -286,6 +291,17 @@ impl Simulation {
     /// and keep what it found ([`Simulation::crossings`]).
     pub fn on_crossing(&mut self, choice: OnCrossing) {
         self.on_crossing = choice;
+    }
+
+    /// Two-sided contact (issue 35): with `on`, a contact between organs
+    /// acts on both, equal and opposite: a particle pressed less than half
+    /// a mean edge into a neighbour pushes the neighbour's triangle under
+    /// it back (its corners, by their barycentric weights), and the two
+    /// meet half way, so a petal pressing a neighbour moves it. Off by
+    /// default: it doubled the whole lily's factorisations (645 -> 1,140;
+    /// README, "Contact"), far over issue 35's cost budget.
+    pub fn two_sided_contact(&mut self, on: bool) {
+        self.two_sided = on;
     }
 
     /// How many particles a self-contact held off their own organ while

@@ -22,23 +22,23 @@ pub(super) fn first_fraction(
     direction: &[f64],
     slope: f64,
 ) -> f64 {
-    // (violation now, its rate along the step) of contacts the full step
-    // would cross.
-    let crossed: Vec<(f64, f64)> = contacts
+    // (violation now, its rate along the step, its share of the
+    // stiffness) of contacts the full step would cross.
+    let crossed: Vec<(f64, f64, f64)> = contacts
         .iter()
         .filter_map(|c| {
             let p = c.particle as usize;
             let step = DVec3::from_slice(&direction[3 * p..3 * p + 3]);
             let now = c.violation(positions[p]);
             let rate = -c.normal.dot(step);
-            (now <= 0.0 && now + rate > 0.0).then_some((now, rate))
+            (now <= 0.0 && now + rate > 0.0).then_some((now, rate, c.weight))
         })
         .collect();
     let derivative = |t: f64| {
         slope * (1.0 - t)
             + crossed
                 .iter()
-                .map(|&(v, w)| k * (v + t * w).max(0.0) * w)
+                .map(|&(v, w, share)| (k * share) * (v + t * w).max(0.0) * w)
                 .sum::<f64>()
     };
     if crossed.is_empty() || derivative(1.0) <= 0.0 {

@@ -104,6 +104,7 @@ fn floor() -> Contact {
         point: DVec3::ZERO,
         normal: DVec3::Y,
         offset: 0.0,
+        weight: 1.0,
     }
 }
 
@@ -118,6 +119,7 @@ fn the_factor_holds_the_contacts_violated_where_it_was_made() {
         point: positions[p as usize],
         normal: DVec3::Z,
         offset,
+        weight: 1.0,
     };
     let contacts = [plane(0, 1e-3), plane(1, -1e-3)];
     let mut solver = NewtonSolver::new(positions.len(), &elastic).expect("analysis");
@@ -226,6 +228,7 @@ fn a_step_refactorises_when_the_last_one_left_a_contact() {
         point: positions[tip],
         normal: DVec3::Z,
         offset: 1e-6,
+        weight: 1.0,
     }];
     assert!(contacts[0].violation(positions[tip]) > 0.0);
     let settings = SolverSettings::default();
@@ -283,6 +286,7 @@ fn a_step_from_an_evaluated_start_is_the_step_that_evaluates_it() {
         point: bent[tip] + DVec3::Z * 0.01,
         normal: DVec3::Z,
         offset: 0.0,
+        weight: 1.0,
     }];
     let settings = SolverSettings::default();
     let bits = |x: &[DVec3]| {

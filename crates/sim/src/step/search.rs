@@ -11,10 +11,14 @@ use rayon::prelude::*;
 
 use crate::Simulation;
 use crate::collide::{
-    Surface, Tracker, Violated, contacts_against, contacts_of, kept_side_contacts, move_half,
-    self_contacts,
+    Held, Surface, Tracker, Violated, contacts_against, contacts_of, held_where,
+    kept_side_contacts, move_half, reactions, self_contacts,
 };
 use crate::organ::OrganSim;
+
+/// How deep, in mean edges of the pressed organ, a contact may be violated
+/// and still push the other organ back (two-sided contact).
+const REACTION_DEPTH: f64 = 0.5;
 
 impl Simulation {
     /// Every overlap side's contacts and every organ's against the parts,
@@ -26,7 +30,6 @@ impl Simulation {
         let mut parts = vec![Vec::new(); self.organs.len()];
         self.obstacle_contacts(&mut parts, &vec![true; self.organs.len()]);
         self.drop_base_contacts(&mut parts);
-        let mut sides = vec![Vec::new(); 2 * self.overlaps.len()];
         geometry
             .par_iter_mut()
             .zip(&self.organs)
@@ -40,35 +43,65 @@ impl Simulation {
             .par_iter()
             .map(|&(moving, other)| self.free_contacts_of(moving, other, geometry[other]))
             .collect();
-        if self.overlaps.is_empty() {
-            return Found {
-                parts,
-                sides,
-                selves,
-                free,
-            };
+        let mut sides = vec![Vec::new(); 2 * self.overlaps.len()];
+        if !self.overlaps.is_empty() {
+            // A kinematic organ (two-state) gets no contacts.
+            let keys: Vec<(usize, usize, usize, f64)> = self
+                .sides()
+                .filter(|&(_, moving, _, _)| !self.organs[moving].is_kinematic())
+                .collect();
+            // Each side's contacts on its own thread.
+            let found: Vec<Vec<Contact>> = keys
+                .par_iter()
+                .map(|&(_, moving, other, side)| {
+                    self.contacts_between(moving, other, side, geometry[other])
+                })
+                .collect();
+            for (&(key, ..), list) in keys.iter().zip(found) {
+                sides[key] = list;
+            }
         }
-        // A kinematic organ (two-state) gets no contacts.
-        let keys: Vec<(usize, usize, usize, f64)> = self
+        let side_held = self
             .sides()
-            .filter(|&(_, moving, _, _)| !self.organs[moving].is_kinematic())
-            .collect();
-        // Each side's contacts on its own thread.
-        let found: Vec<Vec<Contact>> = keys
+            .collect::<Vec<_>>()
             .par_iter()
-            .map(|&(_, moving, other, side)| {
-                self.contacts_between(moving, other, side, geometry[other])
-            })
+            .map(|&(key, moving, other, _)| self.held(moving, other, &sides[key], geometry[other]))
             .collect();
-        for (&(key, ..), list) in keys.iter().zip(found) {
-            sides[key] = list;
-        }
+        let free_held = self
+            .free
+            .par_iter()
+            .zip(&free)
+            .map(
+                |(&(moving, other), list): (&(usize, usize), &Vec<Contact>)| {
+                    self.held(moving, other, list, geometry[other])
+                },
+            )
+            .collect();
         Found {
             parts,
             sides,
             selves,
             free,
+            side_held,
+            free_held,
         }
+    }
+
+    /// Where the violated contacts of `list` (organ `moving`'s against
+    /// organ `other`, whose geometry is `known`) press on `other`, for
+    /// their reactions (none on a kinematic organ, which does not give
+    /// way).
+    fn held(&self, moving: usize, other: usize, list: &[Contact], known: &Geometry) -> Vec<Held> {
+        let o = &self.organs[other];
+        if !self.two_sided || o.is_kinematic() || list.is_empty() {
+            return Vec::new();
+        }
+        held_where(
+            list,
+            &self.organs[moving].positions,
+            &o.surface(&known.normals),
+            &known.tracker,
+        )
     }
 
     /// Organ `moving`'s contacts against organ `other` (a free pair;
@@ -210,8 +243,66 @@ impl Simulation {
                     Violated::MoveAll => c,
                 }));
             }
+            if violated == Violated::MoveHalf && self.two_sided {
+                self.add_reactions(found, &mut contacts);
+            }
         }
         contacts
+    }
+
+    /// Two-sided contact (issue 35): each violated contact of a side or a
+    /// free pair against an organ that gives way pushes that organ back,
+    /// at the triangle it presses on (see `collide::reactions`), so a
+    /// petal pressing a neighbour moves it. Appended to the pressed
+    /// organ's list after its own contacts; its base particles, which
+    /// attachment places, are left out.
+    fn add_reactions(&self, found: &Found, contacts: &mut [Vec<Contact>]) {
+        let lists = self
+            .sides()
+            .map(|(key, moving, other, _)| {
+                (moving, other, &found.sides[key], &found.side_held[key])
+            })
+            .chain(
+                self.free
+                    .iter()
+                    .zip(found.free.iter().zip(&found.free_held))
+                    .map(|(&(moving, other), (list, held))| (moving, other, list, held)),
+            );
+        for (moving, other, list, held) in lists {
+            let (m, o) = (&self.organs[moving], &self.organs[other]);
+            let mut pushed = Vec::new();
+            // A triangle with a base corner is placed by attachment and
+            // gets no reaction (driven through a neighbour's base region,
+            // the pressing organ was stretched 24 % against it:
+            // `collisions.rs`, the organ turned past horizontal).
+            for h in held
+                .iter()
+                .filter(|h| h.corners.iter().all(|&k| !o.is_base[k as usize]))
+            {
+                let c = &list[h.contact as usize];
+                // Only a contact pressed in less than REACTION_DEPTH pushes
+                // back: a particle grown or driven deep into a neighbour in
+                // one keyframe is put on its side by the presser alone, as
+                // before (its reaction moved the neighbour's triangles by
+                // half that depth at once, and Newton found no descent
+                // from there: `crossings.rs`, the jammed petals).
+                if c.violation(m.positions[c.particle as usize]) > REACTION_DEPTH * o.mean_edge {
+                    continue;
+                }
+                reactions(
+                    c,
+                    h,
+                    m.positions[c.particle as usize],
+                    &o.positions,
+                    &mut pushed,
+                );
+            }
+            contacts[other].extend(
+                pushed
+                    .into_iter()
+                    .filter(|c| !o.is_base[c.particle as usize]),
+            );
+        }
     }
 
     /// Base particles sit on the receptacle, where organs meet by design;
@@ -379,6 +470,11 @@ pub(crate) struct Found {
     pub(crate) selves: Vec<Vec<Contact>>,
     /// Each free pair's contacts (`Simulation::free`, same order).
     pub(crate) free: Vec<Vec<Contact>>,
+    /// Where the violated contacts of each side press on the other organ
+    /// (two-sided contact; see `collide::held_where`).
+    pub(crate) side_held: Vec<Vec<Held>>,
+    /// The same for each free pair's.
+    pub(crate) free_held: Vec<Vec<Held>>,
 }
 
 /// One organ's unit normals and nearest-particle lookup where it is:
