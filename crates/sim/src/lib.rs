@@ -299,7 +299,7 @@ impl Simulation {
     /// it back (its corners, by their barycentric weights), and the two
     /// meet half way, so a petal pressing a neighbour moves it. Off by
     /// default: it doubled the whole lily's factorisations (645 -> 1,140;
-    /// README, "Contact"), far over issue 35's cost budget.
+    /// README, "Two-sided contact"), far over issue 35's cost budget.
     pub fn two_sided_contact(&mut self, on: bool) {
         self.two_sided = on;
     }
