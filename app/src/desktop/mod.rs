@@ -495,6 +495,9 @@ impl AnthesisApp {
         for note in drained.notes {
             self.log.info(note);
         }
+        for warning in drained.warnings {
+            self.log.warn(warning);
+        }
         for failure in drained.failures {
             self.log.error_about(
                 Topic::Simulation,

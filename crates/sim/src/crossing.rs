@@ -54,7 +54,8 @@ pub enum Crossed {
 }
 
 impl Crossed {
-    fn name(&self) -> &str {
+    /// The organ's or part's name.
+    pub fn name(&self) -> &str {
         match self {
             Crossed::Organ { name, .. } | Crossed::Part { name } => name,
         }

@@ -29,7 +29,7 @@ use std::time::Instant;
 
 use anthesis_flower::Project;
 
-use crate::crossing::OnCrossing;
+use crate::crossing::{Crossings, OnCrossing};
 #[cfg(any(test, feature = "fault-hook"))]
 use crate::fault::Fault;
 use crate::{IterationProgress, Keyframe, Selection, SimError, Simulation, panic_message};
@@ -73,6 +73,17 @@ pub enum Event {
         run: RunId,
         /// The proxy keyframe.
         keyframe: Arc<Keyframe>,
+    },
+    /// Organs cross in a converged keyframe (see [`crate::crossing`]). The
+    /// worker's converged runs warn and go on, so a window keeps the whole
+    /// opening and says where it is wrong; the event follows the keyframe's
+    /// own, and is sent again for reused keyframes after `Started`. Proxy
+    /// runs do not look (their converged run does).
+    Crossed {
+        /// The run.
+        run: RunId,
+        /// What crosses, where.
+        crossings: Arc<Crossings>,
     },
     /// The proxy pass is over: every proxy keyframe was sent, or the proxy
     /// stopped (`error`: a coarse mesh may fail where the converged one does
@@ -122,6 +133,7 @@ impl Event {
             Event::Started { run, .. }
             | Event::Keyframe { run, .. }
             | Event::Proxy { run, .. }
+            | Event::Crossed { run, .. }
             | Event::ProxyEnded { run, .. }
             | Event::Progress { run, .. }
             | Event::Finished { run, .. }
@@ -233,6 +245,7 @@ impl Wakes {
             Event::Keyframe { keyframe, .. } | Event::Proxy { keyframe, .. } => {
                 Wakes::Keyframe(keyframe.index)
             }
+            Event::Crossed { crossings, .. } => Wakes::Keyframe(crossings.keyframe),
             Event::Started { proxy: true, .. } => Wakes::ProxyRunStarted,
             _ => Wakes::Lifecycle,
         }
@@ -539,10 +552,12 @@ fn simulation_for(
     }
     let mut sim = Simulation::new(project, &lane.selection)?;
     sim.keep_checkpoints();
-    if lane.proxy {
+    sim.on_crossing(if lane.proxy {
         // The converged run that follows checks for crossings.
-        sim.on_crossing(OnCrossing::Skip);
-    }
+        OnCrossing::Skip
+    } else {
+        OnCrossing::Warn
+    });
     Ok((sim, Vec::new()))
 }
 
@@ -572,8 +587,15 @@ fn step_to_end(
         match result {
             Ok(made) => {
                 let made = Arc::new(made);
+                let index = made.index;
                 keyframes.push(Arc::clone(&made));
                 emit(keyframe(made));
+                if let Some(crossings) = sim.crossings().last().filter(|c| c.keyframe == index) {
+                    emit(Event::Crossed {
+                        run,
+                        crossings: Arc::new(crossings.clone()),
+                    });
+                }
             }
             Err(SimError::Cancelled) => return Steps::Cancelled,
             Err(SimError::Panicked {
@@ -683,11 +705,18 @@ fn run_job(request: &RunRequest, kept: &mut Kept, current: &AtomicU64, emit: &dy
     if keyframes.is_empty() {
         keyframes.push(Arc::new(sim.bud()));
     }
-    // The keyframes the edit left as they were, at once.
+    // The keyframes the edit left as they were, at once, and what crosses
+    // in them.
     for keyframe in &keyframes {
         emit(Event::Keyframe {
             run,
             keyframe: Arc::clone(keyframe),
+        });
+    }
+    for crossings in sim.crossings() {
+        emit(Event::Crossed {
+            run,
+            crossings: Arc::new(crossings.clone()),
         });
     }
     if let Some(proxy) = proxy {
