@@ -9,6 +9,7 @@ mod import_scan;
 mod pde_blossom;
 mod render;
 mod simulate;
+pub(crate) mod stream;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -20,6 +21,7 @@ use anthesis_sim::Selection;
 use anthesis_sim::memory::KeyframeCost;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
+use stream::say;
 
 pub use bud::{BudArgs, Example, InnerSideArg};
 pub use render::RenderArgs;
@@ -171,29 +173,44 @@ impl From<EncodingArg> for Encoding {
 }
 
 pub fn main() -> ExitCode {
+    stream::guard();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
             // Help and version are not errors.
             let code = if e.use_stderr() {
                 ExitCode::from(2)
+            } else if stream::stdout_closed() {
+                // The help had nowhere to go.
+                say!("error: cannot write to standard output: it is closed");
+                ExitCode::FAILURE
             } else {
                 ExitCode::SUCCESS
             };
-            let _ = e.print();
-            return code;
+            return match e.print() {
+                Ok(()) => code,
+                Err(_) if e.use_stderr() => code,
+                Err(error) => {
+                    say!("error: cannot write to standard output: {error}");
+                    ExitCode::FAILURE
+                }
+            };
         }
     };
     if !cli.no_cache {
         install_remesh_cache();
     }
+    let command = cli.command.is_some();
     match run(cli) {
+        // A command that could not say what it did on standard error
+        // (`2>/dev/full`) has still written its files; it ends non-zero.
+        Ok(()) if command && stream::stderr_failure().is_some() => ExitCode::FAILURE,
         Ok(()) => ExitCode::SUCCESS,
         // A reader that stopped reading (`anthesis info … | head -1`) is not
         // an error worth a message.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", one_line(&error_message(&e)));
+            say!("error: {}", one_line(&error_message(&e)));
             ExitCode::FAILURE
         }
     }
@@ -211,7 +228,7 @@ fn install_remesh_cache() {
 /// (the command goes on without it).
 pub(crate) fn warn_about_the_cache() {
     if let Some(warning) = anthesis_flower::remesh_cache::installed().take_warning() {
-        eprintln!("warning: {warning}");
+        say!("warning: {warning}");
     }
 }
 
@@ -342,7 +359,7 @@ fn load_with_warnings(path: &Path) -> Result<(Project, Vec<String>)> {
     // The project error names the file itself.
     let loaded = load_project_with_warnings(path).context("cannot open project")?;
     for warning in &loaded.warnings {
-        eprintln!("warning: {warning}");
+        say!("warning: {warning}");
     }
     check_units(&loaded.project)?;
     Ok((loaded.project, loaded.warnings))
@@ -394,7 +411,7 @@ fn new_project(from: &str, dir: &Path) -> Result<()> {
         anthesis_flower::project::PROJECT_EXTENSION
     ));
     anthesis_flower::project::save_project(&project, &path)?;
-    eprintln!("wrote {}", path.display());
+    say!("wrote {}", path.display());
     Ok(())
 }
 

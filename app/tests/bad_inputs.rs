@@ -737,3 +737,74 @@ fn the_readme_lists_the_limits_the_code_enforces() {
         assert!(readme.contains(&row), "README lacks the row `{row}`");
     }
 }
+
+/// The binary run on the valid project with its standard streams as given.
+fn run_with_streams(dir: &Path, args: &[String], stdout: Stdio, stderr: Stdio) -> (i32, String) {
+    let output = common::command()
+        .args(args)
+        .current_dir(dir)
+        .env("RUST_BACKTRACE", "0")
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(stderr)
+        .output()
+        .expect("the binary runs");
+    (output.status.code().unwrap_or(-1), text(&output.stderr))
+}
+
+fn dev_full() -> Stdio {
+    Stdio::from(std::fs::File::create("/dev/full").expect("/dev/full"))
+}
+
+#[test]
+fn a_full_standard_error_loses_no_result_and_panics_nowhere() {
+    // Issue 38: any command with `2>/dev/full` panicked (exit 101); a
+    // successful `simulate --out x.glb` panicked at its last line and
+    // wrote no .glb.
+    let dir = tempfile::tempdir().expect("tempdir");
+    valid_project(dir.path());
+    let glb = in_dir(dir.path(), "x.glb");
+    let args = simulate(dir.path(), &["--keyframes", "1", "--out", &glb]);
+    let (code, _) = run_with_streams(dir.path(), &args, Stdio::null(), dev_full());
+    assert_eq!(code, 1, "a message that could not be said is an error");
+    let bytes = std::fs::read(&glb).expect("the .glb is written");
+    assert!(bytes.starts_with(b"glTF"), "a .glb");
+    // A failing command as well: exit 1, not a panic's 101.
+    let (code, _) = run_with_streams(
+        dir.path(),
+        &["info".into(), in_dir(dir.path(), "missing.anthesis.toml")],
+        Stdio::null(),
+        dev_full(),
+    );
+    assert_eq!(code, 1);
+}
+
+#[test]
+fn a_full_or_closed_standard_output_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    valid_project(dir.path());
+    let (code, stderr) =
+        run_with_streams(dir.path(), &info(dir.path()), dev_full(), Stdio::piped());
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("error: cannot write to standard output: No space left on device"),
+        "{stderr}"
+    );
+    // `info >&-` exited 0 having written nothing.
+    let output = Command::new("sh")
+        .args([
+            "-c",
+            "exec \"$0\" \"$@\" >&-",
+            env!("CARGO_BIN_EXE_anthesis"),
+        ])
+        .args(info(dir.path()))
+        .env("ANTHESIS_CACHE_DIR", "")
+        .output()
+        .expect("sh runs");
+    let stderr = text(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("error: cannot write to standard output: it is closed"),
+        "{stderr}"
+    );
+}

@@ -2,7 +2,6 @@
 //! open state) by the two-state blossom of `anthesis-twostate`, written as
 //! the same animation files `anthesis simulate` writes.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -15,6 +14,7 @@ use clap::Args;
 
 use super::EncodingArg;
 use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
+use super::stream::{out, say};
 
 /// `anthesis blossom BUD.obj OPEN.obj`.
 #[derive(Debug, Args)]
@@ -110,8 +110,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
         .zip(&open.positions)
         .map(|(p, q)| p.distance(*q))
         .fold(0.0, f64::max);
-    writeln!(
-        std::io::stdout().lock(),
+    out!(
         "{} cells, {} base particles; adaxial variation median {:.3} (min {:.3}, max {:.3}), \
          abaxial median {:.3} (min {:.3}, max {:.3}); largest turn {turn_deg:.1} degrees; \
          last keyframe within {miss:.2e} of the open state; {} keyframes in {seconds:.2} s",
@@ -142,7 +141,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             rigid: None,
         };
         write_tracks(out, OutputKind::of(out), &[track], &glb)?;
-        eprintln!(
+        say!(
             "wrote {} (keyframes 0 to {})",
             out.display(),
             args.keyframes

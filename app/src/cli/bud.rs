@@ -2,9 +2,9 @@
 //! petal, a bicubic Bézier patch or a PDE sweep surface), remeshed by
 //! `anthesis-bud` and written as OBJ, with its quality on one line.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use super::stream::{out, say};
 use anthesis_bud::{
     BezierCurve, BezierPatch, Bud, InnerSide, MAX_STRETCH_TO_BEND, MeshQuality, PdeSweep,
     RemeshOptions, Surface, build_organ, eustoma_petal_surface, lily_petal_surface,
@@ -167,9 +167,9 @@ pub fn bud(args: &BudArgs) -> Result<()> {
     if let Some(out) = &args.out {
         anthesis_files::write_atomic(out, anthesis_mesh::obj_string(&mesh).as_bytes())?;
     }
-    writeln!(std::io::stdout().lock(), "{}", quality_line(&quality))?;
+    out!("{}", quality_line(&quality))?;
     if let Some(out) = &args.out {
-        eprintln!("wrote {}", out.display());
+        say!("wrote {}", out.display());
     }
     Ok(())
 }

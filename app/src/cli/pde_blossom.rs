@@ -3,7 +3,6 @@
 //! (`anthesis_bud::dynamic`), written as the same animation files
 //! `anthesis simulate` writes.
 
-use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -17,6 +16,7 @@ use glam::DVec2;
 use super::EncodingArg;
 use super::bud::read_pde;
 use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
+use super::stream::{out, say};
 
 /// `anthesis pde-blossom BUD.json OPEN.json`.
 #[derive(Debug, Args)]
@@ -123,8 +123,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
         .collect();
     let seconds = started.elapsed().as_secs_f64();
     let summary = motion.summary();
-    writeln!(
-        std::io::stdout().lock(),
+    out!(
         "{} generators of {} intervals, {} keyframes: force corrections (eq. 21) at most {}{}, \
          final error {:.2e} of the largest deformation (tolerance {:.0e}); {} particles; {seconds:.2} s",
         motion.rows.len(),
@@ -169,7 +168,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
             rigid: None,
         };
         write_tracks(out, OutputKind::of(out), &[track], &glb)?;
-        eprintln!("wrote {} (keyframes 0 to {steps})", out.display());
+        say!("wrote {} (keyframes 0 to {steps})", out.display());
     }
     Ok(())
 }

@@ -15,6 +15,7 @@ use clap::Args;
 use image::RgbaImage;
 
 use super::simulate::{run_keyframes, set_keyframes};
+use super::stream::{say, say_part};
 use super::{at_resolution, load, selection};
 use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
@@ -173,13 +174,13 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         let show_progress = std::io::stderr().is_terminal();
         animation::write_animation(&mut renderer, &organs, options, target, &mut |done| {
             if show_progress {
-                eprint!("\rrendered frame {done}/{count}   ");
+                say_part!("\rrendered frame {done}/{count}   ");
             }
         })?;
         if show_progress {
-            eprintln!();
+            say!();
         }
-        eprintln!(
+        say!(
             "wrote {count} frame(s) of {width}x{height} to {}",
             target.path().display()
         );
@@ -213,7 +214,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         write_png(&out.join("tiled.png"), &side_by_side(&pictures))?;
         written += 1;
     }
-    eprintln!(
+    say!(
         "wrote {written} picture(s) of {width}x{height} and camera.json to {}",
         out.display()
     );
