@@ -6,7 +6,7 @@ mod blossom;
 mod bud;
 mod fit;
 mod import_scan;
-mod pde_blossom;
+pub mod pde_blossom;
 mod render;
 mod simulate;
 pub(crate) mod stream;
@@ -68,7 +68,7 @@ pub enum Command {
         organ: Option<String>,
         /// Number of keyframes (default: the project's).
         #[arg(long)]
-        keyframes: Option<u32>,
+        keyframes: Option<i64>,
         /// Simulate every template remeshed at this mean edge length, in
         /// project units (the painted maps apply unchanged), or `as-built`
         /// for the meshes as they are (default: the project's
@@ -174,7 +174,7 @@ impl From<EncodingArg> for Encoding {
 
 pub fn main() -> ExitCode {
     stream::guard();
-    let cli = match Cli::try_parse() {
+    let cli = match parse() {
         Ok(cli) => cli,
         Err(e) => {
             // Help and version are not errors.
@@ -214,6 +214,24 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The command line, with every option's value allowed to be a negative
+/// number (`--keyframes -5`, `--edge -1`: read as values and refused with
+/// their range, not taken for unknown options).
+fn parse() -> Result<Cli, clap::Error> {
+    use clap::{CommandFactory, FromArgMatches};
+    let negative_values = |arg: clap::Arg| {
+        if arg.get_action().takes_values() {
+            arg.allow_negative_numbers(true)
+        } else {
+            arg
+        }
+    };
+    let command = Cli::command()
+        .mut_args(negative_values)
+        .mut_subcommands(|sub| sub.mut_args(negative_values));
+    Cli::from_arg_matches(&command.try_get_matches()?)
 }
 
 /// Keeps remeshed templates in the user's cache for this process (the
@@ -277,6 +295,7 @@ pub fn run(cli: Cli) -> Result<()> {
         None => match cli.project.as_deref() {
             None => crate::desktop::run(None, Vec::new()),
             Some(path) => {
+                refuse_unknown_subcommand(path)?;
                 let (project, file, warnings) = open(path)?;
                 crate::desktop::run(Some((project, file)), warnings)
             }
@@ -297,11 +316,19 @@ pub fn run(cli: Cli) -> Result<()> {
             subdivide,
             allow_crossings,
         }) => {
+            let keyframes = keyframes
+                .map(|n| check_count("--keyframes", n, 1, anthesis_flower::MAX_KEYFRAMES as usize))
+                .transpose()?
+                .map(|n| n as u32);
             let timing = match (fps, duration) {
                 (_, Some(d)) if d > 0.0 && d.is_finite() => Timing::Duration(d),
-                (_, Some(d)) => bail!("--duration must be a positive number of seconds, got {d}"),
+                (_, Some(d)) => {
+                    bail!("--duration must be a number of seconds above 0 (and finite), got {d}")
+                }
                 (Some(f), None) if f > 0.0 && f.is_finite() => Timing::FramesPerSecond(f),
-                (Some(f), None) => bail!("--fps must be positive, got {f}"),
+                (Some(f), None) => bail!(
+                    "--fps must be a number of keyframes per second above 0 (and finite), got {f}"
+                ),
                 (None, None) => Timing::FramesPerSecond(anthesis_export::DEFAULT_FRAMES_PER_SECOND),
             };
             let glb = GlbOptions {
@@ -332,6 +359,34 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Fit(args)) => fit::fit(&args),
         Some(Command::New { from, dir }) => new_project(&from, &dir),
     }
+}
+
+/// Refuses a first word that is neither a subcommand nor a project
+/// (`anthesis grow` said "grow: it does not exist"): a plain word with no
+/// file or folder of that name is taken for a mistyped subcommand. A path
+/// that exists still opens as a project.
+fn refuse_unknown_subcommand(path: &Path) -> Result<()> {
+    use clap::CommandFactory;
+    let Some(word) = path.to_str() else {
+        return Ok(());
+    };
+    let plain = !word.is_empty()
+        && word
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    if !plain || path.exists() {
+        return Ok(());
+    }
+    let names: Vec<String> = Cli::command()
+        .get_subcommands()
+        .map(|sub| sub.get_name().to_owned())
+        .filter(|name| name != "help")
+        .collect();
+    bail!(
+        "`{word}` is not a subcommand (they are: {}) and no project file or folder of that name \
+         exists",
+        names.join(", ")
+    );
 }
 
 /// Loads a project file, or a flower built into the binary when the path
@@ -439,15 +494,94 @@ fn at_resolution(
     edge: Option<Resolution>,
     memory: Option<(&Selection, KeyframeCost)>,
 ) -> Result<Project> {
+    let from_command_line = edge.is_some();
     if let Some(edge) = edge {
         project.settings.resolution = edge;
     }
+    check_particle_limit(&project, from_command_line)?;
     if let Some((selection, cost)) = memory {
         anthesis_sim::memory::check_run(&project, selection, cost)?;
     }
     let resolved = anthesis_flower::resolution::resolve(&project);
     warn_about_the_cache();
     Ok(resolved?)
+}
+
+/// Refuses a mean edge that would remesh a template into more particles
+/// than [`anthesis_flower::resolution::MAX_PARTICLES_PER_TEMPLATE`], with
+/// the finest edge the limit allows, before anything is remeshed (`--edge
+/// 1e-9` was refused by the memory check with "16384 PiB" of capped
+/// figures, or overflowed in the remesher).
+fn check_particle_limit(project: &Project, from_command_line: bool) -> Result<()> {
+    use anthesis_flower::resolution::{
+        MAX_PARTICLES_PER_TEMPLATE, edge_for_particles, predicted_size,
+    };
+    let Some(edge) = project.settings.resolution.mean_edge() else {
+        return Ok(());
+    };
+    for template in &project.flower.templates {
+        let (particles, _) = predicted_size(&template.mesh, edge);
+        if particles > MAX_PARTICLES_PER_TEMPLATE {
+            let what = if from_command_line {
+                format!("--edge {edge}")
+            } else {
+                format!("the project's mean_edge {edge}")
+            };
+            let finest = edge_for_particles(&template.mesh, MAX_PARTICLES_PER_TEMPLATE)
+                .map(|finest| format!("; give a mean edge of at least {}", round_up(finest)))
+                .unwrap_or_default();
+            bail!(
+                "{what} would remesh template \"{}\" into about {} particles, more than the \
+                 limit of {} per template{finest}",
+                template.name,
+                crate::desktop::params::grouped(particles as u64),
+                crate::desktop::params::grouped(MAX_PARTICLES_PER_TEMPLATE as u64),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `value` rounded up to three significant digits (an edge the limit
+/// allows, said in a message).
+fn round_up(value: f64) -> f64 {
+    if !(value > 0.0 && value.is_finite()) {
+        return value;
+    }
+    let scale = 10f64.powi(2 - value.log10().floor() as i32);
+    (value * scale).ceil() / scale
+}
+
+/// Refuses a count given on the command line outside `min..=max`, naming
+/// the option and the range.
+/// (Counts are read as any whole number, so `--keyframes -5` is refused
+/// with its range, not taken for an unknown option.)
+pub(crate) fn check_count(option: &str, value: i64, min: usize, max: usize) -> Result<usize> {
+    match usize::try_from(value) {
+        Ok(count) if (min..=max).contains(&count) => Ok(count),
+        _ => bail!(
+            "{option} must be a whole number from {min} to {}, got {value}",
+            crate::desktop::params::grouped(max as u64)
+        ),
+    }
+}
+
+/// Refuses an animation of `vertices` per keyframe over `keyframes` (and
+/// the first shape) that holds more positions than an export may
+/// ([`anthesis_export::MAX_RENDER_POSITIONS`]), before any is computed.
+pub(crate) fn check_positions(vertices: usize, keyframes: u32) -> Result<()> {
+    let positions = (vertices as u64).saturating_mul(u64::from(keyframes) + 1);
+    if positions > anthesis_export::MAX_RENDER_POSITIONS {
+        bail!(
+            "{} vertices x {} shapes is {} positions, more than the limit of {}: use fewer \
+             keyframes or a coarser mesh",
+            vertices,
+            u64::from(keyframes) + 1,
+            crate::desktop::params::grouped(positions),
+            crate::desktop::params::grouped(anthesis_export::MAX_RENDER_POSITIONS),
+        );
+    }
+    Ok(())
 }
 
 /// Refuses a project with a mesh in another unit than the project (see

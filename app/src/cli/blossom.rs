@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anthesis_export::Track;
+use anthesis_flower::MAX_KEYFRAMES;
 use anthesis_mesh::Mesh;
 use anthesis_mesh::obj::{MAX_OBJ_BYTES, object_text, parse_obj};
 use anthesis_twostate::{GrowthFunction, TwoState};
@@ -30,9 +31,9 @@ pub struct BlossomArgs {
     /// object).
     #[arg(long)]
     pub object: Option<String>,
-    /// Keyframes after the bud (the open state is the last).
+    /// Keyframes after the bud (the open state is the last), 1 to 10,000.
     #[arg(long, default_value_t = 100)]
-    pub keyframes: u32,
+    pub keyframes: i64,
     /// The growth rate g of G(t; g, T) (eq. 4): 6 reaches the open state's
     /// ratios at the last keyframe, more overshoots them, less stops short.
     #[arg(long, default_value_t = 6.0)]
@@ -57,12 +58,11 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     if !(args.g.is_finite() && args.g > 0.0) {
         bail!("--g must be a positive number, got {}", args.g);
     }
-    if args.keyframes == 0 {
-        bail!("--keyframes must be at least 1");
-    }
+    let keyframes =
+        super::check_count("--keyframes", args.keyframes, 1, MAX_KEYFRAMES as usize)? as u32;
     let glb = animation_options(args.fps, args.encoding)?;
     if let Some(out) = &args.out {
-        check_output(out, &glb, args.keyframes)?;
+        check_output(out, &glb, keyframes)?;
     }
     let read = |path: &Path, what: &str| -> Result<Mesh> {
         let text = anthesis_files::read_regular_text(path, MAX_OBJ_BYTES, "an OBJ mesh")
@@ -73,6 +73,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     };
     let bud = read(&args.bud, "bud")?;
     let open = read(&args.open, "open state")?;
+    super::check_positions(bud.vertex_count(), keyframes)?;
     let base: Vec<u32> = (0..bud.uvs.len() as u32)
         .filter(|&i| bud.uvs[i as usize].y <= args.base_v)
         .collect();
@@ -86,9 +87,9 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     })?;
     two.growth = GrowthFunction {
         g: args.g,
-        duration: f64::from(args.keyframes),
+        duration: f64::from(keyframes),
     };
-    let keyframes: Vec<_> = (0..=args.keyframes)
+    let shapes: Vec<_> = (0..=keyframes)
         .map(|k| two.shape_at(f64::from(k)))
         .collect();
     let seconds = started.elapsed().as_secs_f64();
@@ -104,7 +105,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
         .iter()
         .map(|c| c.direction.to_axis_angle().1.to_degrees())
         .fold(0.0, f64::max);
-    let last = &keyframes[keyframes.len() - 1];
+    let last = &shapes[shapes.len() - 1];
     let miss = last
         .iter()
         .zip(&open.positions)
@@ -122,7 +123,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
         median(&mut abaxial),
         abaxial[0],
         abaxial[abaxial.len() - 1],
-        keyframes.len(),
+        shapes.len(),
     )?;
 
     if let Some(out) = &args.out {
@@ -136,16 +137,12 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             triangles: bud.triangles.clone(),
             uvs: bud.uvs.clone(),
             base_color: [0.95, 0.6, 0.3, 1.0],
-            keyframes,
+            keyframes: shapes,
             base_color_png: None,
             rigid: None,
         };
         write_tracks(out, OutputKind::of(out), &[track], &glb)?;
-        say!(
-            "wrote {} (keyframes 0 to {})",
-            out.display(),
-            args.keyframes
-        );
+        say!("wrote {} (keyframes 0 to {})", out.display(), keyframes);
     }
     Ok(())
 }

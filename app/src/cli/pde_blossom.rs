@@ -9,6 +9,7 @@ use std::time::Instant;
 use anthesis_bud::dynamic::{Dynamics, SweepInBetween};
 use anthesis_bud::{RemeshOptions, Surface, build_organ};
 use anthesis_export::Track;
+use anthesis_flower::MAX_KEYFRAMES;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::DVec2;
@@ -18,6 +19,19 @@ use super::bud::read_pde;
 use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
 use super::stream::{out, say};
 
+/// The fewest intervals of a generator (`--nodes`; the dynamics need 4).
+const MIN_NODES: usize = 4;
+/// The most intervals of a generator (`--nodes`).
+pub const MAX_NODES: usize = 1024;
+/// The most generators solved along the sweep (`--rows`).
+pub const MAX_ROWS: usize = 1024;
+/// The most force corrections (`--max-corrections`).
+pub const MAX_CORRECTIONS: usize = 1000;
+/// The most node-steps of a run: (rows + 1) x (nodes + 1) x keyframes,
+/// each kept as a deformation (the defaults make 82,500; this is 120 times
+/// that, about a gigabyte with the solver's working copies).
+pub const MAX_NODE_STEPS: usize = 10_000_000;
+
 /// `anthesis pde-blossom BUD.json OPEN.json`.
 #[derive(Debug, Args)]
 pub struct PdeBlossomArgs {
@@ -26,16 +40,17 @@ pub struct PdeBlossomArgs {
     /// The open state: a PDE sweep surface of the same organ (the same
     /// parameters: u across from margin to margin, v from base to tip).
     pub open: PathBuf,
-    /// Keyframes after the bud (the open state is the last).
+    /// Keyframes after the bud (the open state is the last), 1 to 10,000.
     #[arg(long, default_value_t = 100)]
-    pub keyframes: u32,
-    /// Intervals of the generator (across, in u).
+    pub keyframes: i64,
+    /// Intervals of the generator (across, in u), 4 to 1024.
     #[arg(long, default_value_t = 32)]
-    pub nodes: usize,
-    /// Generators solved along the sweep (in v); between them the
-    /// deformation is interpolated.
+    pub nodes: i64,
+    /// Generators solved along the sweep (in v), 1 to 1024; between them
+    /// the deformation is interpolated. Rows x nodes x keyframes is at most
+    /// 10,000,000.
     #[arg(long, default_value_t = 24)]
-    pub rows: usize,
+    pub rows: i64,
     /// k_b of eq. (13).
     #[arg(long, default_value_t = 1.0)]
     pub bend: f64,
@@ -49,9 +64,9 @@ pub struct PdeBlossomArgs {
     /// largest deformation.
     #[arg(long, default_value_t = 1e-6)]
     pub tolerance: f64,
-    /// Corrections of the force (eq. 21) at most.
+    /// Corrections of the force (eq. 21) at most, 0 to 1000.
     #[arg(long, default_value_t = 30)]
-    pub max_corrections: usize,
+    pub max_corrections: i64,
     /// Mean edge of the organ's mesh (default: a 40th of its length).
     #[arg(long)]
     pub edge: Option<f64>,
@@ -71,15 +86,36 @@ pub struct PdeBlossomArgs {
 }
 
 pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
-    if args.keyframes == 0 {
-        bail!("--keyframes must be at least 1");
+    let keyframes = super::check_count("--keyframes", args.keyframes, 1, MAX_KEYFRAMES as usize)?;
+    let nodes = super::check_count("--nodes", args.nodes, MIN_NODES, MAX_NODES)?;
+    let rows = super::check_count("--rows", args.rows, 1, MAX_ROWS)?;
+    let max_corrections = super::check_count(
+        "--max-corrections",
+        args.max_corrections,
+        0,
+        MAX_CORRECTIONS,
+    )?;
+    // Each generator keeps its nodes' deformation at every keyframe.
+    let work = (rows + 1) * (nodes + 1) * keyframes;
+    if work > MAX_NODE_STEPS {
+        bail!(
+            "(--rows {rows} + 1) x (--nodes {nodes} + 1) x --keyframes {keyframes} is {} \
+             node-steps, more than the limit of {}: use fewer rows, nodes or keyframes",
+            crate::desktop::params::grouped(work as u64),
+            crate::desktop::params::grouped(MAX_NODE_STEPS as u64),
+        );
+    }
+    if let Some(edge) = args.edge
+        && !(edge.is_finite() && edge > 0.0)
+    {
+        bail!("--edge must be a positive length, got {edge}");
     }
     if !(args.tolerance >= 0.0 && args.tolerance.is_finite()) {
         bail!("--tolerance must be 0 or more, got {}", args.tolerance);
     }
     let glb = animation_options(args.fps, args.encoding)?;
     if let Some(out) = &args.out {
-        check_output(out, &glb, args.keyframes)?;
+        check_output(out, &glb, keyframes as u32)?;
     }
     let bud = read_pde(&args.bud)?;
     let open = read_pde(&args.open)?;
@@ -90,13 +126,14 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
     let mesh = build_organ(&bud, &RemeshOptions::new(edge))
         .with_context(|| format!("cannot mesh the bud {}", args.bud.display()))?
         .mesh;
+    super::check_positions(mesh.vertex_count(), keyframes as u32)?;
     let started = Instant::now();
-    let steps = args.keyframes as usize;
+    let steps = keyframes;
     let motion = SweepInBetween::new(
         &bud,
         &open,
-        args.nodes,
-        args.rows,
+        nodes,
+        rows,
         Dynamics {
             bend: args.bend,
             stretch: args.stretch,
@@ -104,7 +141,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
         },
         steps,
         args.tolerance,
-        args.max_corrections,
+        max_corrections,
     )
     .with_context(|| {
         format!(
@@ -127,7 +164,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
         "{} generators of {} intervals, {} keyframes: force corrections (eq. 21) at most {}{}, \
          final error {:.2e} of the largest deformation (tolerance {:.0e}); {} particles; {seconds:.2} s",
         motion.rows.len(),
-        args.nodes,
+        nodes,
         steps,
         summary.corrections,
         if summary.solved {
@@ -142,7 +179,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
     if let Some(path) = &args.report {
         let report = serde_json::json!({
             "generators": motion.rows.len(),
-            "intervals": args.nodes,
+            "intervals": nodes,
             "keyframes": steps,
             "corrections": summary.corrections,
             "force_solved": summary.solved,

@@ -343,7 +343,7 @@ pub(super) fn check_creatable_folder(out: &Path) -> Result<()> {
 pub(super) fn animation_options(fps: Option<f64>, encoding: EncodingArg) -> Result<GlbOptions> {
     let fps = fps.unwrap_or(anthesis_export::DEFAULT_FRAMES_PER_SECOND);
     if !(fps.is_finite() && fps > 0.0) {
-        bail!("--fps must be positive, got {fps}");
+        bail!("--fps must be a number of keyframes per second above 0 (and finite), got {fps}");
     }
     Ok(GlbOptions {
         timing: anthesis_export::Timing::FramesPerSecond(fps),
