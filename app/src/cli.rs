@@ -143,7 +143,8 @@ pub enum Command {
         #[arg(long = "from", value_name = "NAME")]
         from: String,
         /// The folder to write (created if missing; refused if it already
-        /// holds a project, so nothing is overwritten).
+        /// holds a project or any file the project would write, so nothing
+        /// is overwritten).
         dir: PathBuf,
     },
 }
@@ -456,18 +457,85 @@ fn refuse_project_folder(dir: &Path) -> Result<()> {
 
 /// `anthesis new --from NAME DIR`: the built-in flower NAME saved as
 /// `DIR/NAME.anthesis.toml` with its meshes and maps.
+///
+/// Decided: `new` writes only files it creates. The project is written into
+/// a staging folder inside DIR first; if any of its files (the project,
+/// `meshes/…`, `maps/…`) is already in DIR, nothing is written and the
+/// error names that file (a user's own `meshes/petal.obj` was replaced with
+/// exit 0). Each file is then linked into place, which fails rather than
+/// replace a file made meanwhile.
 fn new_project(from: &str, dir: &Path) -> Result<()> {
     let project = load(Path::new(&format!("builtin:{from}")))?;
     if dir.is_dir() {
         refuse_project_folder(dir)?;
+    } else {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
     }
-    let path = dir.join(format!(
-        "{from}{}",
-        anthesis_flower::project::PROJECT_EXTENSION
-    ));
-    anthesis_flower::project::save_project(&project, &path)?;
-    say!("wrote {}", path.display());
+    let name = format!("{from}{}", anthesis_flower::project::PROJECT_EXTENSION);
+    let staging = tempfile::Builder::new()
+        .prefix(".anthesis-new-")
+        .tempdir_in(dir)
+        .with_context(|| format!("cannot write in the folder {}", dir.display()))?;
+    anthesis_flower::project::save_project(&project, &staging.path().join(&name))?;
+    let files = files_under(staging.path())?;
+    if let Some(existing) = files
+        .iter()
+        .map(|relative| dir.join(relative))
+        .find(|path| path.symlink_metadata().is_ok())
+    {
+        bail!(
+            "{} already exists; `new` writes only files it creates: choose an empty or new \
+             folder, or move that file away",
+            existing.display()
+        );
+    }
+    for relative in &files {
+        let target = dir.join(relative);
+        if let Some(parent) = target.parent() {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create the folder {}", parent.display()))?;
+        }
+        std::fs::hard_link(staging.path().join(relative), &target)
+            .or_else(|_| move_if_absent(&staging.path().join(relative), &target))
+            .with_context(|| format!("cannot write {}", target.display()))?;
+    }
+    say!("wrote {}", dir.join(&name).display());
     Ok(())
+}
+
+/// Moves `from` to `to` unless `to` exists (where hard links are not
+/// supported).
+fn move_if_absent(from: &Path, to: &Path) -> std::io::Result<()> {
+    if to.symlink_metadata().is_ok() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            "the file already exists",
+        ));
+    }
+    std::fs::rename(from, to)
+}
+
+/// The files under `root`, as paths relative to it.
+fn files_under(root: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    let mut folders = vec![PathBuf::new()];
+    while let Some(relative) = folders.pop() {
+        let folder = root.join(&relative);
+        for entry in std::fs::read_dir(&folder)
+            .with_context(|| format!("cannot read the folder {}", folder.display()))?
+        {
+            let entry = entry.with_context(|| format!("cannot read {}", folder.display()))?;
+            let path = relative.join(entry.file_name());
+            if entry.file_type().is_ok_and(|t| t.is_dir()) {
+                folders.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    Ok(files)
 }
 
 /// `--edge`: a positive length, or `as-built`.

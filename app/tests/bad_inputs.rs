@@ -783,6 +783,61 @@ fn catalogue() -> Vec<Case> {
             |d| pde_pair(d, same, &["--rows", "1000", "--nodes", "1000"]),
             "is 100,200,100 node-steps, more than the limit of 10,000,000"
         ),
+        // ------------------------------ silent wrong results (issue 38)
+        case!(
+            "new --from into a folder holding the user's own petal",
+            |d| {
+                let folder = d.join("mine");
+                std::fs::create_dir_all(folder.join("meshes")).expect("mkdir");
+                std::fs::write(folder.join("meshes/petal.obj"), "my own petal\n").expect("write");
+                vec![
+                    "new".into(),
+                    "--from".into(),
+                    "lily".into(),
+                    folder.display().to_string(),
+                ]
+            },
+            "meshes/petal.obj already exists; `new` writes only files it creates"
+        ),
+        case!(
+            "pde-blossom with the open state's margins swapped",
+            |d| pde_pair(
+                d,
+                |open| {
+                    let swap = |open: &mut serde_json::Value, a: &str, b: &str| {
+                        let first = open[a].take();
+                        open[a] = open[b].take();
+                        open[b] = first;
+                    };
+                    swap(open, "margin0", "margin1");
+                    swap(open, "tangent0", "tangent1");
+                },
+                &[]
+            ),
+            "the open state's margins are the other way round from the bud's"
+        ),
+        case!(
+            "two [[overlaps]] entries that contradict each other",
+            |d| {
+                let mut args = five_petal_with_structure(
+                    d,
+                    "[structure]\nkind = \"whorls\"\n[[structure.whorls]]\nname = \"petal\"\n\
+                     template = \"petal\"\ncount = 5\nradius = 4.0\nhalf_span_deg = 25.0",
+                );
+                let file = std::path::PathBuf::from(args.pop().expect("the project"));
+                let text = std::fs::read_to_string(&file).expect("read");
+                let text = text.replacen(
+                    "overlaps = []",
+                    "overlaps = [{ inner = \"petal-1\", outer = \"petal-2\" }, \
+                     { inner = \"petal-2\", outer = \"petal-1\" }]",
+                    1,
+                );
+                std::fs::write(&file, text).expect("write");
+                args.push(file.display().to_string());
+                args
+            },
+            "[[overlaps]] 1 puts \"petal-1\" inside \"petal-2\", but [[overlaps]] 2 puts \"petal-2\" inside \"petal-1\"; keep one of them"
+        ),
         case!(
             "a solver that does not converge",
             |d| {

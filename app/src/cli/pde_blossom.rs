@@ -12,7 +12,7 @@ use anthesis_export::Track;
 use anthesis_flower::MAX_KEYFRAMES;
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 use super::EncodingArg;
 use super::bud::read_pde;
@@ -119,6 +119,13 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
     }
     let bud = read_pde(&args.bud)?;
     let open = read_pde(&args.open)?;
+    check_margins_correspond(&bud, &open).with_context(|| {
+        format!(
+            "cannot in-between {} and {}",
+            args.bud.display(),
+            args.open.display()
+        )
+    })?;
     let length = bud
         .point(DVec2::new(0.5, 1.0))
         .distance(bud.point(DVec2::new(0.5, 0.0)));
@@ -206,6 +213,61 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
         };
         write_tracks(out, OutputKind::of(out), &[track], &glb)?;
         say!("wrote {} (keyframes 0 to {steps})", out.display());
+    }
+    Ok(())
+}
+
+/// Where along the organ (v) the margins are compared: from near the base
+/// to near the tip (a pointed tip has no width).
+const MARGIN_SAMPLES: usize = 18;
+
+/// Refuses two states whose margins do not correspond, before anything is
+/// solved: the open state's `margin0` must be on the bud's `margin0` side
+/// at the base (where the organ is held), and neither state may fold
+/// across itself (its width, margin to margin, turning back or vanishing
+/// along the organ). Margins swapped in the open state were in-betweened
+/// through a petal of zero width into a mirrored one, with "final error
+/// 1.56e-14".
+fn check_margins_correspond(bud: &impl Surface, open: &impl Surface) -> Result<()> {
+    let across =
+        |s: &dyn Surface, v: f64| s.point(DVec2::new(1.0, v)) - s.point(DVec2::new(0.0, v));
+    let v_at = |k: usize| 0.05 + 0.9 * k as f64 / MARGIN_SAMPLES as f64;
+    for (state, name) in [
+        (bud as &dyn Surface, "bud"),
+        (open as &dyn Surface, "open state"),
+    ] {
+        let length = state
+            .point(DVec2::new(0.5, 1.0))
+            .distance(state.point(DVec2::new(0.5, 0.0)));
+        let mut before: Option<(f64, DVec3)> = None;
+        for k in 0..=MARGIN_SAMPLES {
+            let v = v_at(k);
+            let width = across(state, v);
+            if width.length().is_nan() || width.length() <= 1e-6 * length {
+                bail!(
+                    "the {name}'s margins meet at v = {v:.2} (no width between margin0 and \
+                     margin1 there)"
+                );
+            }
+            if let Some((v_before, width_before)) = before
+                && width.dot(width_before) <= 0.0
+            {
+                bail!(
+                    "the {name} folds across itself between v = {v_before:.2} and v = {v:.2} \
+                     (margin0 and margin1 change sides)"
+                );
+            }
+            before = Some((v, width));
+        }
+    }
+    let (bud_width, open_width) = (across(bud, v_at(0)), across(open, v_at(0)));
+    if bud_width.dot(open_width) <= 0.0 {
+        bail!(
+            "the open state's margins are the other way round from the bud's: at the base its \
+             margin0 lies where the bud's margin1 is (the organ would pass through zero width \
+             and open mirrored); swap margin0 with margin1 and tangent0 with tangent1 in one of \
+             the files"
+        );
     }
     Ok(())
 }
