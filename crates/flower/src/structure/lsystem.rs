@@ -231,7 +231,8 @@ impl LSystem {
                             .next()
                             .unwrap_or("")
                             .trim()
-                            .to_owned(),
+                            .escape_debug()
+                            .to_string(),
                         value,
                     });
                 }
@@ -368,9 +369,10 @@ fn column_of(line: &str, part: &str) -> usize {
 }
 
 fn first_char(s: &str) -> String {
-    s.chars()
-        .next()
-        .map_or_else(|| "the end of the line".to_owned(), |c| format!("`{c}`"))
+    s.chars().next().map_or_else(
+        || "the end of the line".to_owned(),
+        |c| format!("`{}`", c.escape_debug()),
+    )
 }
 
 fn syntax(line: usize, column: usize, expected: &str, found: String) -> LSystemError {
@@ -491,7 +493,10 @@ impl Parser {
             self.line,
             self.pos + 1,
             expected,
-            found.map_or_else(|| "the end of the line".to_owned(), |c| format!("`{c}`")),
+            found.map_or_else(
+                || "the end of the line".to_owned(),
+                |c| format!("`{}`", c.escape_debug()),
+            ),
         )
     }
 
@@ -565,7 +570,8 @@ impl Parser {
                                     .iter()
                                     .collect::<String>()
                                     .trim()
-                                    .to_owned(),
+                                    .escape_debug()
+                                    .to_string(),
                                 value,
                             });
                         }
