@@ -5,6 +5,8 @@
 mod blossom;
 mod bud;
 mod fit;
+#[cfg(test)]
+mod fuzz;
 mod import_scan;
 pub mod pde_blossom;
 mod render;

@@ -839,6 +839,24 @@ fn catalogue() -> Vec<Case> {
             "[[overlaps]] 1 puts \"petal-1\" inside \"petal-2\", but [[overlaps]] 2 puts \"petal-2\" inside \"petal-1\"; keep one of them"
         ),
         case!(
+            "pde-blossom reading /dev/zero as a surface",
+            |d| {
+                let mut args = pde_pair(d, same, &[]);
+                args[1] = "/dev/zero".into();
+                args
+            },
+            "cannot read PDE sweep surface /dev/zero: it is a character device"
+        ),
+        case!(
+            "pde-blossom with a control point at 1e308 (found by fuzzing)",
+            |d| pde_pair(
+                d,
+                |open| open["margin0"][1][1] = serde_json::json!(-1e308),
+                &[]
+            ),
+            "coordinates must be finite and within ±1e6"
+        ),
+        case!(
             "a solver that does not converge",
             |d| {
                 replace(d, PROJECT, "max_iterations = 50", "max_iterations = 1");

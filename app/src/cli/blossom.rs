@@ -146,3 +146,45 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The open state's OBJ reader and the two-state blossom on random
+    /// edits of a valid open state: a clean error or finite keyframes,
+    /// never a panic.
+    #[test]
+    fn fuzz_blossom_open_state_reader_and_animation() {
+        let bud = anthesis_mesh::generate::test_petal(4.0, 1.5, 4, 6);
+        let mut open = bud.clone();
+        for p in &mut open.positions {
+            *p = glam::DVec3::new(p.x * 1.3, p.y * 1.2, p.z + 0.1 * p.y * p.y);
+        }
+        let valid = anthesis_mesh::obj_string(&open);
+        let base: Vec<u32> = (0..bud.uvs.len() as u32)
+            .filter(|&i| bud.uvs[i as usize].y <= 0.06)
+            .collect();
+        let mut accepted = 0;
+        super::super::fuzz::run("blossom", |rng| {
+            let text = super::super::fuzz::mutate(&valid, rng);
+            let Ok(open) = parse_obj(&text) else {
+                return;
+            };
+            match TwoState::from_meshes(&bud, &open, &base) {
+                Ok(two) => {
+                    for k in 0..=4 {
+                        let shape = two.shape_at(f64::from(k) * 25.0);
+                        assert!(
+                            shape.iter().all(|p| p.is_finite()),
+                            "keyframe {k} not finite from:\n{text}"
+                        );
+                    }
+                    accepted += 1;
+                }
+                Err(error) => assert!(error.to_string().chars().count() < 800),
+            }
+        });
+        assert!(accepted > 0, "some edits keep a valid open state");
+    }
+}

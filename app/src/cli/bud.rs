@@ -240,8 +240,14 @@ pub(super) fn pde_json(sweep: &PdeSweep) -> Result<String> {
 }
 
 /// Reads a surface file and parses it with `parse`; errors name the file.
+/// The largest surface file read (`--bezier`, `--pde`, `pde-blossom`): a
+/// surface is a few dozen numbers.
+pub const MAX_SURFACE_BYTES: u64 = 1 << 20;
+
 fn read_surface<T>(path: &Path, what: &str, parse: fn(&str) -> Result<T>) -> Result<T> {
-    let text = std::fs::read_to_string(path)
+    // A regular file of at most 1 MiB (a FIFO hung, /dev/zero filled the
+    // memory).
+    let text = anthesis_files::read_regular_text(path, MAX_SURFACE_BYTES, "a JSON surface")
         .with_context(|| format!("cannot read {what} {}", path.display()))?;
     parse(&text).with_context(|| {
         format!(

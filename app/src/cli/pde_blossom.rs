@@ -165,6 +165,14 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
                 .collect()
         })
         .collect();
+    if keyframes.iter().flatten().any(|p| !p.is_finite()) {
+        bail!(
+            "the in-betweening of {} and {} gave positions that are not finite numbers; try a \
+             larger --mass or fewer --keyframes",
+            args.bud.display(),
+            args.open.display()
+        );
+    }
     let seconds = started.elapsed().as_secs_f64();
     let summary = motion.summary();
     out!(
@@ -239,6 +247,26 @@ fn check_margins_correspond(bud: &impl Surface, open: &impl Surface) -> Result<(
         let length = state
             .point(DVec2::new(0.5, 1.0))
             .distance(state.point(DVec2::new(0.5, 0.0)));
+        // Coordinates as large as a mesh may hold (1e308 overflowed the
+        // dynamics into NaN without an error).
+        let limit = anthesis_mesh::validate::MAX_COORDINATE;
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let uv = DVec2::new(f64::from(i) / 8.0, f64::from(j) / 8.0);
+                let p = state.point(uv);
+                if !(p.is_finite() && p.abs().max_element() <= limit) {
+                    bail!(
+                        "the {name} reaches ({:.3e}, {:.3e}, {:.3e}) at u = {:.2}, v = {:.2}; \
+                         coordinates must be finite and within ±{limit:e}",
+                        p.x,
+                        p.y,
+                        p.z,
+                        uv.x,
+                        uv.y
+                    );
+                }
+            }
+        }
         let mut before: Option<(f64, DVec3)> = None;
         for k in 0..=MARGIN_SAMPLES {
             let v = v_at(k);
@@ -270,4 +298,62 @@ fn check_margins_correspond(bud: &impl Surface, open: &impl Surface) -> Result<(
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The PDE reader, the margin check and the in-betweening on random
+    /// edits of a valid pair: a valid result or a clean error, never a
+    /// panic or a result that is not finite.
+    #[test]
+    fn fuzz_pde_blossom_reader_and_in_betweening() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let valid = super::super::bud::pde_json(&anthesis_bud::lily_petal_surface())
+            .expect("the lily petal as JSON");
+        let bud_path = dir.path().join("bud.json");
+        std::fs::write(&bud_path, &valid).expect("write");
+        let bud = read_pde(&bud_path).expect("the valid surface reads");
+        let open_path = dir.path().join("open.json");
+        let mut accepted = 0;
+        super::super::fuzz::run("pde-blossom", |rng| {
+            let text = super::super::fuzz::mutate(&valid, rng);
+            std::fs::write(&open_path, &text).expect("write");
+            let outcome = read_pde(&open_path).and_then(|open| {
+                check_margins_correspond(&bud, &open)?;
+                let motion = SweepInBetween::new(
+                    &bud,
+                    &open,
+                    8,
+                    4,
+                    Dynamics {
+                        bend: 1.0,
+                        stretch: 0.0,
+                        mass: 1.0,
+                    },
+                    5,
+                    1e-6,
+                    5,
+                )?;
+                for level in 0..=5 {
+                    let d = motion.deformation(DVec2::new(0.3, 0.7), level);
+                    anyhow::ensure!(d.is_finite(), "deformation {d} at level {level}");
+                }
+                Ok(())
+            });
+            match outcome {
+                Ok(()) => accepted += 1,
+                Err(error) => {
+                    let message = format!("{error:#}");
+                    assert!(
+                        !message.contains("deformation"),
+                        "a result that is not finite from {text}: {message}"
+                    );
+                    assert!(message.chars().count() < 800, "{message}");
+                }
+            }
+        });
+        assert!(accepted > 0, "some edits keep a valid surface");
+    }
 }
