@@ -68,7 +68,7 @@ pub enum Command {
         /// Simulate only this organ (single-organ preview, no collisions).
         #[arg(long)]
         organ: Option<String>,
-        /// Number of keyframes (default: the project's).
+        /// Number of keyframes, 1 to 10,000 (default: the project's).
         #[arg(long)]
         keyframes: Option<i64>,
         /// Simulate every template remeshed at this mean edge length, in
