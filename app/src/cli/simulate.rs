@@ -1,7 +1,7 @@
 //! `anthesis info` and `anthesis simulate`, and the keyframe loop with
 //! progress that `anthesis render` shares.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
@@ -13,24 +13,31 @@ use anthesis_sim::{Keyframe, KeyframeStats, SimError, Simulation};
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 
+use super::stream::{out, say, say_part};
 use super::{EncodingArg, at_resolution, load, selection};
 
 pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
     let project = at_resolution(load(path)?, edge, None)?;
     let flower = &project.flower;
-    let mut stdout = std::io::stdout().lock();
+    // Each template's mesh checked once, not once per organ (10,000 organs).
+    let edges = flower
+        .templates
+        .iter()
+        .map(|template| {
+            anthesis_mesh::validate(&template.mesh)
+                .map(|topology| topology.edges.len())
+                .with_context(|| format!("template `{}` has a bad mesh", template.name))
+        })
+        .collect::<Result<Vec<_>>>()?;
     for (i, organ) in flower.organs.iter().enumerate() {
         let template = flower.template_of(i);
-        let topology = anthesis_mesh::validate(&template.mesh)
-            .with_context(|| format!("template `{}` has a bad mesh", template.name))?;
-        writeln!(
-            stdout,
+        out!(
             "{} {} {} {} {}",
             organ.name,
             template.name,
             template.mesh.vertex_count(),
             template.mesh.triangle_count(),
-            topology.edges.len()
+            edges[organ.template]
         )?;
     }
     Ok(())
@@ -136,7 +143,7 @@ pub(super) fn simulate(
             render_level,
         )?;
         write_tracks(out, OutputKind::of(out), &tracks, glb)?;
-        eprintln!("wrote {} (keyframes 0 to {done})", out.display());
+        say!("wrote {} (keyframes 0 to {done})", out.display());
         written = Some(out);
     }
     match (run.failure, written) {
@@ -219,25 +226,24 @@ pub(super) fn run_keyframes(
         };
         for crossing in &sim.crossings()[warned..] {
             if show_progress {
-                eprintln!();
+                say!();
             }
-            eprintln!("warning: {crossing}");
+            say!("warning: {crossing}");
         }
         done = keyframe.index;
         if show_progress {
             let elapsed = started.elapsed().as_secs_f64();
             let left = elapsed / f64::from(done) * f64::from(last - done);
-            eprint!("\rkeyframe {done}/{last}  {elapsed:.1} s, about {left:.1} s left   ");
-            let _ = std::io::stderr().flush();
+            say_part!("\rkeyframe {done}/{last}  {elapsed:.1} s, about {left:.1} s left   ");
         }
         on_keyframe(keyframe);
     }
     let seconds = started.elapsed().as_secs_f64();
     if show_progress && done > 0 {
-        eprintln!();
+        say!();
     }
     if failure.is_none() {
-        eprintln!(
+        say!(
             "simulated {done} keyframes of {} organ(s) in {seconds:.2} s ({} Hessian factorisations)",
             sim.organs().len(),
             sim.factorisations()
@@ -345,7 +351,7 @@ pub(super) fn check_creatable_folder(out: &Path) -> Result<()> {
 pub(super) fn animation_options(fps: Option<f64>, encoding: EncodingArg) -> Result<GlbOptions> {
     let fps = fps.unwrap_or(anthesis_export::DEFAULT_FRAMES_PER_SECOND);
     if !(fps.is_finite() && fps > 0.0) {
-        bail!("--fps must be positive, got {fps}");
+        bail!("--fps must be a number of keyframes per second above 0 (and finite), got {fps}");
     }
     Ok(GlbOptions {
         timing: anthesis_export::Timing::FramesPerSecond(fps),

@@ -143,7 +143,8 @@ impl Lengths {
             });
         }
         // An equilateral lattice has one vertex per sqrt(3)/2 h^2 of area.
-        let estimated = (area / (spacing * h)).round() as usize + 2 * gaps;
+        let estimated =
+            ((area / (spacing * h)).round() as usize).saturating_add(gaps.saturating_mul(2));
         if estimated > options.max_vertices {
             return Err(BudError::TooManyVertices {
                 target_edge: h,
