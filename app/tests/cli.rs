@@ -24,8 +24,17 @@ fn info_prints_one_line_per_organ_with_counts() {
     let stdout = text(&out.stdout);
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(
-        lines,
+        lines[..2],
         ["petal-1 petal 112 182 293", "sepal-1 sepal 112 182 293"]
+    );
+    // Then the size, in units: the fixture does not say what its unit is.
+    assert!(
+        lines[2..].iter().all(|l| l.starts_with("size ")),
+        "{stdout}"
+    );
+    assert!(
+        lines[2].contains("units") && lines[2].contains("one metre"),
+        "{stdout}"
     );
 }
 
@@ -42,7 +51,11 @@ fn what_loading_reads_past_is_said_and_the_command_goes_on() {
     std::fs::write(&obj, mesh).expect("write");
     let out = anthesis(&["info", path.to_str().expect("utf-8")]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert_eq!(text(&out.stdout).lines().count(), 2);
+    let organ_lines = text(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("size "))
+        .count();
+    assert_eq!(organ_lines, 2);
     let stderr = text(&out.stderr);
     let warnings: Vec<&str> = stderr
         .lines()
@@ -66,6 +79,7 @@ fn edge_remeshes_what_info_counts_and_what_simulate_runs() {
         assert!(out.status.success(), "{}", text(&out.stderr));
         text(&out.stdout)
             .lines()
+            .filter(|l| !l.starts_with("size "))
             .map(|l| {
                 l.split(' ')
                     .nth(2)

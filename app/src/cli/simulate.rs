@@ -33,6 +33,9 @@ pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
             topology.edges.len()
         )?;
     }
+    for line in anthesis_flower::unit::size_lines(flower) {
+        writeln!(stdout, "{line}")?;
+    }
     Ok(())
 }
 

@@ -69,6 +69,7 @@ mod usdc;
 
 use std::path::Path;
 
+use anthesis_flower::Unit;
 use glam::{DQuat, DVec2, DVec3};
 
 pub use between::KeyframeBlend;
@@ -81,7 +82,8 @@ pub use tracks::{
     MAX_RENDER_POSITIONS, TrackLook, check_render_level, flower_tracks, organ_tracks, part_track,
 };
 pub use usd::{
-    USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, usdc_bytes, write_usd,
+    USD_ROOT_PRIM, UsdFiles, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, usd_files,
+    usd_texture_folder, usdc_bytes, write_usd,
 };
 
 /// One organ (or the receptacle) over time: a fixed triangulation and UV
@@ -108,6 +110,11 @@ pub struct Track {
     /// of storing a morph target per keyframe; other formats use
     /// `keyframes`.
     pub rigid: Option<RigidMotion>,
+    /// What one length of `keyframes` (and `rigid`) is in the real world:
+    /// the .glb and USD layers write metres (each length times
+    /// [`Unit::metres`]), OBJ files the lengths as they are with the unit
+    /// in a comment. Default one metre.
+    pub unit: Unit,
 }
 
 /// A rigid track's mesh in its own frame and its pose at every keyframe.

@@ -248,6 +248,7 @@ mod tests {
             keyframes,
             base_color_png: None,
             rigid: None,
+            unit: anthesis_flower::Unit::METRE,
         }
     }
 

@@ -675,6 +675,7 @@ fn meshopt_steps_do_not_accumulate_rounding() {
             .collect(),
         base_color_png: None,
         rigid: None,
+        unit: anthesis_flower::Unit::METRE,
     };
     let options = GlbOptions {
         encoding: Encoding::Meshopt,
@@ -711,4 +712,61 @@ fn meshopt_steps_do_not_accumulate_rounding() {
         worst <= half_step * 1.001,
         "worst error {worst}, half a grid step {half_step}"
     );
+}
+
+/// A track whose unit is 1.8 mm arrives in metres in every encoding: its
+/// bud and its last keyframe are the project's positions times 0.0018.
+#[test]
+fn a_stated_unit_is_written_in_metres() {
+    let unit = anthesis_flower::Unit::parse("1.8 mm").expect("unit");
+    let mut tracks = fixture(KEYFRAMES);
+    for track in &mut tracks {
+        track.unit = unit;
+    }
+    for encoding in Encoding::ALL {
+        let glb = parse_glb(&export(
+            &tracks,
+            &GlbOptions {
+                encoding,
+                ..GlbOptions::default()
+            },
+        ));
+        let json = &glb.json;
+        let output = json["animations"][0]["samplers"][0]["output"]
+            .as_u64()
+            .expect("output") as usize;
+        let weights: Vec<f64> = read_accessor(&glb, output).iter().map(|w| w[0]).collect();
+        for (i, track) in tracks.iter().enumerate() {
+            let (translation, scale) = node_transform(&json["nodes"][i]);
+            let primitive = &json["meshes"][i]["primitives"][0];
+            let read = |index: &serde_json::Value| {
+                vec3s(&read_accessor(
+                    &glb,
+                    index.as_u64().expect("accessor") as usize,
+                ))
+            };
+            let base = read(&primitive["attributes"]["POSITION"]);
+            let tolerance = if is_quantized(encoding) {
+                scale / 32767.0
+            } else {
+                1e-8
+            };
+            let in_metres = |k: usize| -> Vec<DVec3> {
+                track.keyframes[k].iter().map(|p| *p * 0.0018).collect()
+            };
+            let world = |ps: &[DVec3]| -> Vec<DVec3> {
+                ps.iter().map(|p| translation + *p * scale).collect()
+            };
+            let what = format!("{} {encoding}", track.name);
+            assert_close(&world(&base), &in_metres(0), tolerance, &what);
+            let Some(targets) = primitive["targets"].as_array() else {
+                continue;
+            };
+            let deltas: Vec<Vec<DVec3>> = targets.iter().map(|t| read(&t["POSITION"])).collect();
+            let last = KEYFRAMES - 1;
+            let w = &weights[last * (KEYFRAMES - 1)..(last + 1) * (KEYFRAMES - 1)];
+            let rebuilt = world(&morphed(&base, &deltas, w));
+            assert_close(&rebuilt, &in_metres(last), tolerance, &what);
+        }
+    }
 }

@@ -461,6 +461,8 @@ pub(crate) fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
             overlaps: arrangement.overlaps,
             structure: None,
             parts: crate::parts::lily_parts(),
+            // Tepals about 9 cm long when open (about 50 units).
+            unit: anthesis_flower::Unit::millimetres(1.8),
         },
         settings: SimulationSettings::default(),
     })
@@ -807,6 +809,8 @@ pub fn eustoma_of(
             overlaps: arrangement.overlaps,
             structure: None,
             parts: crate::parts::eustoma_parts(),
+            // Petals about 5 cm long when open (about 50 units).
+            unit: anthesis_flower::Unit::millimetres(1.0),
         },
         settings: SimulationSettings::default(),
     })

@@ -66,6 +66,7 @@ pub fn organ_track(
             .collect(),
         base_color_png: None,
         rigid: None,
+        unit: anthesis_flower::Unit::METRE,
     }
 }
 

@@ -20,7 +20,7 @@ use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::structure::{Arrangement, Spiral, Structure, Whorl};
 use crate::{
     BaseRegion, ColourLayer, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project,
-    Template, TwoStateAnimation,
+    Template, TwoStateAnimation, Unit,
 };
 use anthesis_twostate::{GrowthFunction, VelocityCurve};
 
@@ -293,6 +293,7 @@ impl Loader<'_> {
             .iter()
             .map(|part| part.part().map_err(|message| self.invalid(message)))
             .collect::<Result<Vec<_>, _>>()?;
+        let unit = self.unit(file.unit.as_deref())?;
         Ok(Project {
             name: file.name,
             flower: Flower {
@@ -301,9 +302,18 @@ impl Loader<'_> {
                 overlaps,
                 structure,
                 parts,
+                unit,
             },
             settings: file.simulation.settings(file.version),
         })
+    }
+
+    /// The project's `unit`, if it states one (one that does not keeps the
+    /// meaning every project had before units: one unit is one metre in
+    /// the exports; see [`crate::unit::unstated_note`]).
+    fn unit(&self, text: Option<&str>) -> Result<Option<Unit>, ProjectError> {
+        text.map(|text| Unit::parse(text).map_err(|error| self.invalid(format!("unit: {error}"))))
+            .transpose()
     }
 
     fn template(&self, file: TemplateFile) -> Result<Template, ProjectError> {

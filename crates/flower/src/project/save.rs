@@ -66,6 +66,7 @@ pub(super) fn plan_save(
         format: FORMAT_NAME.to_string(),
         version: file_version(project),
         name: project.name.clone(),
+        unit: flower.unit.map(|unit| unit.to_string()),
         simulation: SimulationFile::from(&project.settings),
         templates,
         organs,
@@ -90,9 +91,13 @@ pub(super) fn plan_save(
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
 /// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
 /// `[templates.two_state]` and `[templates.source]`, version 8
-/// `[templates.vein]` and a sketched or PDE petal's `[templates.source]`).
+/// `[templates.vein]` and a sketched or PDE petal's `[templates.source]`,
+/// version 9 the project's `unit`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
+    if flower.unit.is_some() {
+        return FORMAT_VERSION;
+    }
     if flower.templates.iter().any(|t| {
         t.vein.is_some()
             || matches!(
@@ -100,7 +105,7 @@ fn file_version(project: &Project) -> u32 {
                 Some(crate::TemplateSource::Sketch { .. } | crate::TemplateSource::Pde { .. })
             )
     }) {
-        return FORMAT_VERSION;
+        return 8;
     }
     if flower
         .templates

@@ -16,6 +16,10 @@ pub(super) struct ProjectFile {
     pub(super) format: String,
     pub(super) version: u32,
     pub(super) name: String,
+    /// Version 9: what one length is in the real world (`"1.8 mm"`, see
+    /// [`crate::Unit`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) unit: Option<String>,
     #[serde(default)]
     pub(super) simulation: SimulationFile,
     #[serde(default)]
