@@ -58,6 +58,7 @@ impl Track {
             base_color_png: None,
             rigid: None,
             unit: anthesis_flower::Unit::METRE,
+            outer_color_png: None,
         }
     }
 }
@@ -82,6 +83,7 @@ pub fn organ_tracks<'a, 'k>(
             base_color_png: None,
             rigid: None,
             unit: anthesis_flower::Unit::METRE,
+            outer_color_png: None,
         })
         .collect();
     for organs in keyframes {
@@ -270,6 +272,7 @@ pub fn part_track(piece: &PartPiece, keyframe_count: usize) -> Track {
             poses,
         }),
         unit: anthesis_flower::Unit::METRE,
+        outer_color_png: None,
     }
 }
 
@@ -321,6 +324,7 @@ impl Track {
             base_color_png: self.base_color_png.clone(),
             rigid: None,
             unit: self.unit,
+            outer_color_png: self.outer_color_png.clone(),
         })
     }
 }
@@ -386,6 +390,7 @@ mod tests {
             base_color_png: None,
             rigid: None,
             unit: anthesis_flower::Unit::METRE,
+            outer_color_png: None,
         }
     }
 

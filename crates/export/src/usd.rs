@@ -188,52 +188,74 @@ fn build_layer(
 
     let total_work = tracks
         .iter()
-        .map(|t| t.keyframes.len())
+        .map(|t| t.keyframes.len() * if t.outer_color_png.is_some() { 2 } else { 1 })
         .sum::<usize>()
         .max(1) as f32;
     let mut work_done = 0usize;
     let mut textures = TextureFiles::new();
     for (index, (track, name)) in tracks.iter().zip(&names).enumerate() {
-        let colours =
-            crate::colour::vertex_colours(track).map_err(|problem| ExportError::InvalidTrack {
-                track: index,
-                name: track.name.clone(),
-                problem,
-            })?;
-        let texture = track.base_color_png.as_ref().map(|png| {
-            let known = textures.iter().find(|(_, bytes)| bytes == png);
-            let file = match known {
-                Some((file, _)) => file.clone(),
-                None => {
-                    let file = format!("{texture_folder}/{name}.png");
-                    textures.push((file.clone(), png.clone()));
-                    file
+        let mut sides = vec![(track.clone(), name.clone())];
+        if let Some(outer) = &track.outer_color_png {
+            // The outer side: the same surface wound the other way, with
+            // the outer texture (each side's mesh single-sided).
+            sides.push((
+                Track {
+                    triangles: track.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+                    base_color_png: Some(outer.clone()),
+                    ..track.clone()
+                },
+                format!("{name}_outer"),
+            ));
+        }
+        for (side, name) in &sides {
+            let colours = crate::colour::vertex_colours(side).map_err(|problem| {
+                ExportError::InvalidTrack {
+                    track: index,
+                    name: track.name.clone(),
+                    problem,
                 }
-            };
-            format!("./{file}")
-        });
-        let material = write_material(
-            &mut layer,
-            &materials,
-            name,
-            track.base_color,
-            texture.as_deref(),
-        )?;
-        let mesh = layer.prim(&flower, name, "Mesh")?;
-        write_mesh(
-            &mut layer,
-            &mesh,
-            &material,
-            track,
-            colours.as_deref(),
-            options.normals,
-            &mut || {
-                work_done += 1;
-                progress(0.95 * work_done as f32 / total_work);
-            },
-        )?;
+            })?;
+            let texture = side
+                .base_color_png
+                .as_ref()
+                .map(|png| texture_file(&mut textures, texture_folder, name, png));
+            let material = write_material(
+                &mut layer,
+                &materials,
+                name,
+                side.base_color,
+                texture.as_deref(),
+            )?;
+            let mesh = layer.prim(&flower, name, "Mesh")?;
+            write_mesh(
+                &mut layer,
+                &mesh,
+                &material,
+                side,
+                colours.as_deref(),
+                options.normals,
+                &mut || {
+                    work_done += 1;
+                    progress(0.95 * work_done as f32 / total_work);
+                },
+            )?;
+        }
     }
     Ok((layer, textures))
+}
+
+/// The asset path (`./<folder>/<name>.png`) of `png`, added to `textures`
+/// unless the same PNG is there already (organs of one template share it).
+fn texture_file(textures: &mut TextureFiles, folder: &str, name: &str, png: &[u8]) -> String {
+    let file = match textures.iter().find(|(_, bytes)| bytes == png) {
+        Some((file, _)) => file.clone(),
+        None => {
+            let file = format!("{folder}/{name}.png");
+            textures.push((file.clone(), png.to_vec()));
+            file
+        }
+    };
+    format!("./{file}")
 }
 
 /// The layer's metadata: default prim, +Y up, metres, the time codes.
@@ -382,7 +404,15 @@ fn write_mesh(
         Value::TokenListOp(ListOp::prepended(["MaterialBindingAPI".into()])),
     )?;
     let uniform = Some(Variability::Uniform);
-    layer.attribute(mesh, "doubleSided", "bool", uniform, Value::Bool(true))?;
+    // A track whose sides look different is two single-sided meshes.
+    let double_sided = track.outer_color_png.is_none();
+    layer.attribute(
+        mesh,
+        "doubleSided",
+        "bool",
+        uniform,
+        Value::Bool(double_sided),
+    )?;
     layer.attribute(
         mesh,
         "orientation",

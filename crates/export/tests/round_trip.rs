@@ -676,6 +676,7 @@ fn meshopt_steps_do_not_accumulate_rounding() {
         base_color_png: None,
         rigid: None,
         unit: anthesis_flower::Unit::METRE,
+        outer_color_png: None,
     };
     let options = GlbOptions {
         encoding: Encoding::Meshopt,

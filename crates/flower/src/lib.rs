@@ -17,7 +17,7 @@ pub mod structure;
 pub mod unit;
 
 pub use colour::{
-    COLOUR_PAINT_SIZE, ColourLayer, Colouring, DEFAULT_SECOND_COLOR, MAX_BAKED_SIDE, srgb8,
+    COLOUR_PAINT_SIZE, ColourLayer, Colouring, DEFAULT_SECOND_COLOR, MAX_BAKED_SIDE, Side, srgb8,
     srgb8_to_linear,
 };
 pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};

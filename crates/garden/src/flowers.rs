@@ -393,6 +393,8 @@ fn lily_colouring(seed: u64, count: usize) -> Colouring {
         layers: vec![ColourLayer {
             color: LILY_CRIMSON,
             mix: colour_map(spotted),
+            // The spots are inside the flower only.
+            side: anthesis_flower::Side::Inner,
         }],
     }
 }

@@ -77,14 +77,18 @@ pub fn glb_bytes(
     for (index, track) in tracks.iter().enumerate() {
         let rigid = track.rigid.as_ref().filter(|_| track.keyframes.len() > 1);
         let frames = frames_in_metres(track, &sample_at);
-        materials.push(material(&mut gltf, &mut textures, track));
+        let inner_material = materials.len();
+        materials.push(material(&mut gltf, &mut textures, track, Face::Inner));
 
+        // A two-sided track's outer primitive shares every accessor whose
+        // data is the same as the inner one's (all but normals and indices).
+        gltf.share_accessors(track.outer_color_png.is_some());
         let encoded = encode_mesh(&mut gltf, track, &frames, options, &mut || tick(progress));
 
         let mut primitive = json!({
             "attributes": encoded.attributes,
             "indices": encoded.indices,
-            "material": index,
+            "material": inner_material,
             "mode": TRIANGLES,
         });
         let mut mesh = json!({ "name": track.name });
@@ -94,7 +98,30 @@ pub fn glb_bytes(
             mesh["extras"] = json!({ "targetNames": target_names });
             animated_nodes.push(nodes.len());
         }
-        mesh["primitives"] = json!([primitive]);
+        let mut primitives = vec![primitive];
+        if track.outer_color_png.is_some() {
+            // The outer side: the same surface wound the other way (its
+            // normals point outwards), drawn with the outer texture.
+            let outer_material = materials.len();
+            materials.push(material(&mut gltf, &mut textures, track, Face::Outer));
+            let flipped = Track {
+                triangles: track.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+                ..track.clone()
+            };
+            let outer = encode_mesh(&mut gltf, &flipped, &frames, options, &mut || {});
+            let mut primitive = json!({
+                "attributes": outer.attributes,
+                "indices": outer.indices,
+                "material": outer_material,
+                "mode": TRIANGLES,
+            });
+            if !outer.targets.is_empty() {
+                primitive["targets"] = Value::Array(outer.targets);
+            }
+            primitives.push(primitive);
+        }
+        gltf.share_accessors(false);
+        mesh["primitives"] = Value::Array(primitives);
         meshes.push(mesh);
 
         let top = nodes.len();
@@ -229,25 +256,51 @@ impl<'a> Textures<'a> {
     }
 }
 
-/// The material of `track`: its base colour (blended when not opaque),
-/// its texture if it has one, non-metallic, double-sided.
-fn material<'a>(gltf: &mut GltfBuilder, textures: &mut Textures<'a>, track: &'a Track) -> Value {
+/// Which faces of a track a material is for.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Face {
+    /// The track's triangles as they are: both sides, or the inner side of
+    /// a track whose sides differ.
+    Inner,
+    /// The outer side of a track whose sides differ.
+    Outer,
+}
+
+/// The material of `track` (of its `face`): its base colour (blended when
+/// not opaque), its texture if it has one, non-metallic, double-sided
+/// unless its sides differ ([`Track::outer_color_png`]), when each side's
+/// material is single-sided.
+fn material<'a>(
+    gltf: &mut GltfBuilder,
+    textures: &mut Textures<'a>,
+    track: &'a Track,
+    face: Face,
+) -> Value {
+    let two_sided = track.outer_color_png.is_none();
+    let name = match face {
+        Face::Inner => track.name.clone(),
+        Face::Outer => format!("{} outer", track.name),
+    };
     let mut material = json!({
-        "name": track.name,
+        "name": name,
         "pbrMetallicRoughness": {
             "baseColorFactor": track.base_color.map(f32_json),
             "metallicFactor": 0.0,
             "roughnessFactor": 0.7,
         },
-        "doubleSided": true,
+        "doubleSided": two_sided,
     });
     if track.base_color[3] < 1.0 {
         material["alphaMode"] = json!("BLEND");
     }
-    if let Some(png) = &track.base_color_png {
+    let png = match face {
+        Face::Inner => &track.base_color_png,
+        Face::Outer => &track.outer_color_png,
+    };
+    if let Some(png) = png {
         // Organs of one template share its colour map: one image and
         // texture for each distinct PNG.
-        let texture = textures.texture(gltf, png, &track.name);
+        let texture = textures.texture(gltf, png, &name);
         material["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": texture });
     }
     material

@@ -67,6 +67,7 @@ pub fn organ_track(
         base_color_png: None,
         rigid: None,
         unit: anthesis_flower::Unit::METRE,
+        outer_color_png: None,
     }
 }
 
