@@ -40,10 +40,17 @@
 //! - Each mesh is bound (`MaterialBindingAPI`, `material:binding`) to a
 //!   `Material` whose `UsdPreviewSurface` has the base colour as
 //!   `diffuseColor`, its alpha as `opacity`, roughness 0.7 and metallic 0,
-//!   like the .glb's material. Base-colour textures are not written (a USD
-//!   texture is a separate file next to the layer): with one, the
-//!   `diffuseColor` is connected to a `UsdPrimvarReader_float3` shader
-//!   (`displayColor` under the material) reading `displayColor`.
+//!   like the .glb's material. A base-colour texture is written as a PNG
+//!   beside the layer (`<layer stem>_textures/<prim>.png`, one per distinct
+//!   image, see [`usd_files`]) and read by a `UsdUVTexture` (`colourMap`,
+//!   sRGB, clamped, scaled by the base colour) at the mesh's `st`
+//!   (`UsdPrimvarReader_float2` `stReader`) into `diffuseColor`.
+//! - A track whose sides look different ([`Track::outer_color_png`]) is two
+//!   single-sided meshes: its own and `<name>_outer`, which references the
+//!   first in this layer (points and extent stored once), winds the
+//!   triangles the other way, blocks the normals (clients make them from
+//!   the points, facing out) and is bound to a material with the outer
+//!   texture.
 
 use std::path::Path;
 
@@ -188,7 +195,7 @@ fn build_layer(
 
     let total_work = tracks
         .iter()
-        .map(|t| t.keyframes.len() * if t.outer_color_png.is_some() { 2 } else { 1 })
+        .map(|t| t.keyframes.len())
         .sum::<usize>()
         .max(1) as f32;
     let mut work_done = 0usize;
@@ -207,6 +214,7 @@ fn build_layer(
                 format!("{name}_outer"),
             ));
         }
+        let mut inner_mesh: Option<sdf::Path> = None;
         for (side, name) in &sides {
             let colours = crate::colour::vertex_colours(side).map_err(|problem| {
                 ExportError::InvalidTrack {
@@ -227,21 +235,82 @@ fn build_layer(
                 texture.as_deref(),
             )?;
             let mesh = layer.prim(&flower, name, "Mesh")?;
-            write_mesh(
-                &mut layer,
-                &mesh,
-                &material,
-                side,
-                colours.as_deref(),
-                options.normals,
-                &mut || {
-                    work_done += 1;
-                    progress(0.95 * work_done as f32 / total_work);
-                },
-            )?;
+            match &inner_mesh {
+                None => {
+                    write_mesh(
+                        &mut layer,
+                        &mesh,
+                        &material,
+                        side,
+                        colours.as_deref(),
+                        options.normals,
+                        &mut || {
+                            work_done += 1;
+                            progress(0.95 * work_done as f32 / total_work);
+                        },
+                    )?;
+                    inner_mesh = Some(mesh);
+                }
+                Some(inner) => {
+                    write_outer_mesh(&mut layer, &mesh, inner, &material, side, colours)?;
+                }
+            }
         }
     }
     Ok((layer, textures))
+}
+
+/// The outer side of a two-sided track: a mesh that references the inner
+/// side's `inner` mesh in this layer (so its points and extent are stored
+/// once) and overrides the triangles (`outer`'s, wound the other way), its
+/// colours, its material, and blocks the inner side's normals (clients make
+/// them from the points, facing out with the reversed winding).
+fn write_outer_mesh(
+    layer: &mut LayerBuilder,
+    mesh: &sdf::Path,
+    inner: &sdf::Path,
+    material: &sdf::Path,
+    outer: &Track,
+    colours: Option<Vec<[f32; 4]>>,
+) -> Result<(), ExportError> {
+    let reference = sdf::Reference {
+        prim_path: inner.clone(),
+        ..sdf::Reference::default()
+    };
+    layer.set_field(
+        mesh,
+        FieldKey::References,
+        Value::ReferenceListOp(ListOp::prepended([reference])),
+    )?;
+    let indices: Vec<i32> = outer
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&i| i32::try_from(i).unwrap_or(i32::MAX))
+        .collect();
+    layer.attribute(
+        mesh,
+        "faceVertexIndices",
+        "int[]",
+        None,
+        Value::IntVec(indices),
+    )?;
+    layer.attribute(mesh, "normals", "normal3f[]", None, Value::ValueBlock)?;
+    if let Some(colours) = colours {
+        let rgb = colours
+            .iter()
+            .map(|c| gf::vec3f(c[0], c[1], c[2]))
+            .collect();
+        let color = layer.attribute(
+            mesh,
+            "primvars:displayColor",
+            "color3f[]",
+            None,
+            Value::Vec3fVec(rgb),
+        )?;
+        layer.set_field(&color, "interpolation", Value::Token("vertex".into()))?;
+    }
+    layer.relationship(mesh, "material:binding", material)
 }
 
 /// The asset path (`./<folder>/<name>.png`) of `png`, added to `textures`

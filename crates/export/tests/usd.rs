@@ -477,3 +477,68 @@ fn a_stated_unit_is_written_in_metres() {
         }
     }
 }
+
+/// A PNG of one colour, 2 x 2 pixels.
+fn plain_png(rgba: [u8; 4]) -> Vec<u8> {
+    let image = image::RgbaImage::from_pixel(2, 2, image::Rgba(rgba));
+    let mut png = Vec::new();
+    image::DynamicImage::ImageRgba8(image)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("encode");
+    png
+}
+
+/// A track whose sides look different is two single-sided meshes: the
+/// outer one references the inner one's points, winds its triangles the
+/// other way and has its own texture.
+#[test]
+fn a_two_sided_track_gets_an_outer_mesh_over_the_same_points() {
+    let mut tracks = fixture(3);
+    tracks[0].base_color_png = Some(plain_png([230, 20, 20, 255]));
+    tracks[0].outer_color_png = Some(plain_png([20, 40, 220, 255]));
+    tracks[0].base_color = [1.0; 4];
+    for file in ["two.usda", "two.usdc"] {
+        let report = write_and_read(&tracks, &UsdOptions::default(), file);
+        assert_eq!(
+            report["validation_findings"],
+            serde_json::json!([]),
+            "{file}"
+        );
+        let meshes = report["meshes"].as_array().expect("meshes");
+        let mesh = |path: &str| {
+            meshes
+                .iter()
+                .find(|m| m["path"] == path)
+                .unwrap_or_else(|| panic!("{path} in {file}"))
+        };
+        let (inner, outer) = (mesh("/flower/petal"), mesh("/flower/petal_outer"));
+        assert_eq!(
+            (&inner["double_sided"], &outer["double_sided"]),
+            (&false.into(), &false.into())
+        );
+        assert_eq!(outer["points"], inner["points"], "{file}: the same points");
+        assert!(
+            outer["normals"].is_null(),
+            "{file}: normals left to the client"
+        );
+        let reversed: Vec<i64> = inner["face_vertex_indices"]
+            .as_array()
+            .expect("indices")
+            .chunks(3)
+            .flat_map(|t| [t[0].as_i64(), t[2].as_i64(), t[1].as_i64()])
+            .map(|i| i.expect("index"))
+            .collect();
+        assert_eq!(outer["face_vertex_indices"], serde_json::json!(reversed));
+        assert_eq!(
+            inner["material"]["diffuse_source"]["file"],
+            "./two_textures/petal.png"
+        );
+        assert_eq!(
+            outer["material"]["diffuse_source"]["file"],
+            "./two_textures/petal_outer.png"
+        );
+        // The sepal, one colour on both sides, stays one double-sided mesh.
+        assert_eq!(mesh("/flower/sepal")["double_sided"], true);
+        assert!(meshes.iter().all(|m| m["path"] != "/flower/sepal_outer"));
+    }
+}
