@@ -33,7 +33,11 @@ pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
             topology.edges.len()
         )?;
     }
-    for line in anthesis_flower::unit::size_lines(flower) {
+    let parts = anthesis_flower::parts::part_lines(flower);
+    for line in parts
+        .iter()
+        .chain(&anthesis_flower::unit::size_lines(flower))
+    {
         writeln!(stdout, "{line}")?;
     }
     Ok(())

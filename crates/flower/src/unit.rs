@@ -9,11 +9,17 @@ use std::fmt;
 
 /// A real length: a positive amount of one of the units people measure
 /// flowers in, kept as written (`1.8 mm` stays `1.8 mm`, not `0.0018 m`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The amount is a decimal, `digits` / 10^`decimals` (trailing zeros
+/// dropped), so it is exact and a `Flower` grows by only 8 bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Unit {
-    amount: f64,
+    digits: u32,
+    decimals: u8,
     symbol: Symbol,
 }
+
+/// The most decimals an amount may have.
+const MAX_DECIMALS: usize = 9;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Symbol {
@@ -74,22 +80,22 @@ impl Unit {
     /// One metre: what a unit meant to every export before projects stated
     /// their unit, and what a project that states none still means.
     pub const METRE: Unit = Unit {
-        amount: 1.0,
+        digits: 1,
+        decimals: 0,
         symbol: Symbol::Metre,
     };
 
     /// One millimetre.
     pub const MILLIMETRE: Unit = Unit {
-        amount: 1.0,
+        digits: 1,
+        decimals: 0,
         symbol: Symbol::Millimetre,
     };
 
-    /// `amount` millimetres; `None` unless it is a positive, finite number.
+    /// `amount` millimetres (as its shortest decimal, `1.8`); `None` unless
+    /// it is a positive number of at most nine decimals.
     pub fn millimetres(amount: f64) -> Option<Unit> {
-        (amount.is_finite() && amount > 0.0).then_some(Unit {
-            amount,
-            symbol: Symbol::Millimetre,
-        })
+        Unit::parse(&format!("{amount} mm")).ok()
     }
 
     /// Reads `"1.8 mm"`, `"1.8mm"` or `"mm"` (one of it): a positive,
@@ -105,20 +111,33 @@ impl Unit {
         let (number, symbol) = trimmed.split_at(split);
         let symbol = Symbol::parse(symbol.trim()).ok_or_else(error)?;
         let number = number.trim();
-        let amount = if number.is_empty() {
-            1.0
-        } else {
-            number.parse::<f64>().map_err(|_| error())?
+        let (whole, fraction) = match number.split_once('.') {
+            _ if number.is_empty() => ("1", ""),
+            Some((whole, fraction)) => (whole, fraction.trim_end_matches('0')),
+            None => (number, ""),
         };
-        if !(amount.is_finite() && amount > 0.0 && (amount / symbol.per_metre()).is_normal()) {
+        let all_digits = |s: &str| s.chars().all(|c| c.is_ascii_digit());
+        if !(all_digits(whole) && all_digits(fraction))
+            || (whole.is_empty() && fraction.is_empty())
+            || fraction.len() > MAX_DECIMALS
+        {
             return Err(error());
         }
-        Ok(Unit { amount, symbol })
+        let digits: u32 = format!("{whole}{fraction}").parse().map_err(|_| error())?;
+        if digits == 0 {
+            return Err(error());
+        }
+        Ok(Unit {
+            digits,
+            decimals: fraction.len() as u8,
+            symbol,
+        })
     }
 
-    /// The unit in metres (how glTF and USD want lengths).
+    /// The unit in metres (how glTF and USD want lengths): one division of
+    /// exact numbers, so correctly rounded (`1.8 mm` is 0.0018).
     pub fn metres(&self) -> f64 {
-        self.amount / self.symbol.per_metre()
+        f64::from(self.digits) / (10f64.powi(i32::from(self.decimals)) * self.symbol.per_metre())
     }
 
     /// `length` project units as a real length people read: in mm below
@@ -154,7 +173,17 @@ impl Default for Unit {
 impl fmt::Display for Unit {
     /// As the project file writes it: `1.8 mm`, `1 m`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} {}", self.amount, self.symbol.text())
+        let scale = 10u32.pow(u32::from(self.decimals));
+        let (whole, fraction) = (self.digits / scale, self.digits % scale);
+        match self.decimals {
+            0 => write!(f, "{whole} {}", self.symbol.text()),
+            d => write!(
+                f,
+                "{whole}.{fraction:0width$} {}",
+                self.symbol.text(),
+                width = usize::from(d)
+            ),
+        }
     }
 }
 
@@ -251,6 +280,11 @@ mod tests {
         assert_eq!(Unit::MILLIMETRE.to_string(), "1 mm");
         assert_eq!(Unit::millimetres(1.8), Unit::parse("1.8 mm").ok());
         assert_eq!(Unit::millimetres(-1.0), None);
+        assert_eq!(Unit::parse("1.80 mm"), Unit::parse("1.8 mm"));
+        assert_eq!(Unit::parse("0.05 cm").expect("cm").to_string(), "0.05 cm");
+        assert_eq!(Unit::parse(".5 cm").expect("cm").metres(), 0.005);
+        // A flower keeps its unit in 8 bytes.
+        assert_eq!(std::mem::size_of::<Option<Unit>>(), 8);
     }
 
     #[test]
