@@ -196,7 +196,7 @@ impl std::str::FromStr for Unit {
 }
 
 /// What a project that states no unit is taken to mean, for the places
-/// that write or show real sizes (`anthesis info`, the export dialog):
+/// that show real sizes (`anthesis info`):
 /// projects made before units existed keep their meaning.
 pub fn unstated_note() -> &'static str {
     "the project does not say what its unit is, so one unit is taken as one metre, as \

@@ -10,8 +10,7 @@
 //!                              # the real world (a number and µm, mm, cm or
 //!                              # m); exports write the flower at that size.
 //!                              # Absent: one unit is one metre, as before
-//!                              # (`anthesis info` and the export dialog
-//!                              # say so)
+//!                              # (`anthesis info` says so)
 //!
 //! [simulation]                 # optional; each field defaults as shown
 //! keyframes = 100
