@@ -100,25 +100,15 @@ pub fn glb_bytes(
         }
         let mut primitives = vec![primitive];
         if track.outer_color_png.is_some() {
-            // The outer side: the same surface wound the other way (its
-            // normals point outwards), drawn with the outer texture.
             let outer_material = materials.len();
             materials.push(material(&mut gltf, &mut textures, track, Face::Outer));
-            let flipped = Track {
-                triangles: track.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
-                ..track.clone()
-            };
-            let outer = encode_mesh(&mut gltf, &flipped, &frames, options, &mut || {});
-            let mut primitive = json!({
-                "attributes": outer.attributes,
-                "indices": outer.indices,
-                "material": outer_material,
-                "mode": TRIANGLES,
-            });
-            if !outer.targets.is_empty() {
-                primitive["targets"] = Value::Array(outer.targets);
-            }
-            primitives.push(primitive);
+            primitives.push(outer_primitive(
+                &mut gltf,
+                track,
+                &frames,
+                options,
+                outer_material,
+            ));
         }
         gltf.share_accessors(false);
         mesh["primitives"] = Value::Array(primitives);
@@ -137,17 +127,7 @@ pub fn glb_bytes(
         if let Some(rigid) = rigid {
             // The mesh (with its dequantisation) hangs below a node that
             // carries the rigid motion.
-            let metres = track.unit.metres();
-            let poses: Vec<Pose> = sample_at
-                .iter()
-                .map(|&x| {
-                    let pose = sample_pose(&rigid.poses, x);
-                    Pose {
-                        translation: pose.translation * metres,
-                        ..pose
-                    }
-                })
-                .collect();
+            let poses = poses_in_metres(&rigid.poses, &sample_at, track.unit.metres());
             let mover_index = nodes.len();
             let mut mover = json!({ "name": track.name, "children": [mover_index + 1] });
             set_pose(&mut mover, &poses[0]);
@@ -190,6 +170,49 @@ pub fn glb_bytes(
     let bytes = gltf.finish(root)?;
     progress(1.0);
     Ok(bytes)
+}
+
+/// The outer side of a two-sided track: the same surface wound the other
+/// way (its normals point outwards), drawn with `material` (the outer
+/// texture); its accessors with the same data as the inner side's are the
+/// inner side's while the builder shares them.
+fn outer_primitive(
+    gltf: &mut GltfBuilder,
+    track: &Track,
+    frames: &[Vec<DVec3>],
+    options: &GlbOptions,
+    material: usize,
+) -> Value {
+    let flipped = Track {
+        triangles: track.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+        ..track.clone()
+    };
+    let outer = encode_mesh(gltf, &flipped, frames, options, &mut || {});
+    let mut primitive = json!({
+        "attributes": outer.attributes,
+        "indices": outer.indices,
+        "material": material,
+        "mode": TRIANGLES,
+    });
+    if !outer.targets.is_empty() {
+        primitive["targets"] = Value::Array(outer.targets);
+    }
+    primitive
+}
+
+/// A rigid track's poses at the exported keyframe positions `sample_at`,
+/// their translations in metres.
+fn poses_in_metres(poses: &[Pose], sample_at: &[f64], metres: f64) -> Vec<Pose> {
+    sample_at
+        .iter()
+        .map(|&x| {
+            let pose = sample_pose(poses, x);
+            Pose {
+                translation: pose.translation * metres,
+                ..pose
+            }
+        })
+        .collect()
 }
 
 /// The positions of `track` the .glb stores, in metres: a rigid track's
