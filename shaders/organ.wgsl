@@ -41,7 +41,9 @@ struct Organ {
     // Linear RGB; alpha is written but blending is off.
     color_linear: vec4<f32>,
     // x: how much the per-vertex overlay ramp replaces the organ colour
-    // (0 = overlay off, 1 = overlay only). yzw: unused.
+    // (0 = overlay off, 1 = overlay only). y: 1 when the texture holds the
+    // two sides, the inner (front) side on its left half and the outer
+    // (back) side on its right half. zw: unused.
     overlay_mix: vec4<f32>,
 }
 
@@ -121,8 +123,19 @@ fn to_target(linear: vec3<f32>) -> vec3<f32> {
 // in the petal's colour instead of going dark and muddy.
 @fragment
 fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0) vec4<f32> {
-    // Sampled first, in uniform control flow.
-    let painted = textureSample(colour_texture, colour_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
+    // Sampled first, in uniform control flow: the whole texture, and each
+    // half of a two-sided one (kept half a texel inside its half, so
+    // bilinear filtering does not mix the sides).
+    let v = 1.0 - in.uv.y;
+    let whole = textureSample(colour_texture, colour_sampler, vec2<f32>(in.uv.x, v));
+    let half_texel = 0.5 / f32(textureDimensions(colour_texture).x);
+    let u_half = clamp(0.5 * in.uv.x, half_texel, 0.5 - half_texel);
+    let inner = textureSample(colour_texture, colour_sampler, vec2<f32>(u_half, v));
+    let outer = textureSample(colour_texture, colour_sampler, vec2<f32>(u_half + 0.5, v));
+    var painted = whole;
+    if organ.overlay_mix.y > 0.5 {
+        painted = select(outer, inner, is_front);
+    }
     var normal = normalize(in.normal_in_world);
     var side_brightness = 1.0;
     if !is_front {

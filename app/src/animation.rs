@@ -201,9 +201,21 @@ pub fn cameras(scenes: &[Vec<OrganMesh>], options: &AnimationOptions) -> Option<
         };
         options.azimuth_deg + options.turn_deg * fraction
     };
-    let cameras: Vec<Camera> = (0..count)
-        .map(|i| Camera::framing(lo, hi, azimuth_at(i), options.elevation_deg))
+    // Framed as the viewport's F frames: the points, 80 % of the way out.
+    let points: Vec<DVec3> = scenes
+        .iter()
+        .flatten()
+        .flat_map(|o| &o.positions_in_world)
+        .map(|p| DVec3::from_array(p.map(f64::from)))
         .collect();
+    let cameras: Vec<Camera> = (0..count)
+        .map(|i| Camera::framing_points(&points, azimuth_at(i), options.elevation_deg, 0.8))
+        .collect::<Option<_>>()
+        .unwrap_or_else(|| {
+            (0..count)
+                .map(|i| Camera::framing(lo, hi, azimuth_at(i), options.elevation_deg))
+                .collect()
+        });
     // Framing depends on the direction; the farthest fits every direction.
     let distance = cameras
         .iter()
@@ -269,7 +281,11 @@ pub fn write_animation(
                 let mut encoder = GifEncoder::new_with_speed(&mut bytes, 10);
                 encoder.set_repeat(Repeat::Infinite)?;
                 for index in 0..scenes.len() {
-                    let picture = render(index)?;
+                    let mut picture = render(index)?;
+                    // Floyd-Steinberg onto the frame's own palette: no bands
+                    // (the encoder keeps a frame of 256 colours as it is).
+                    let palette = color_quant::NeuQuant::new(10, 256, picture.as_raw());
+                    image::imageops::dither(&mut picture, &palette);
                     let hold = if index + 1 == scenes.len() {
                         GIF_FINAL_HOLD_CENTISECONDS
                     } else {

@@ -483,7 +483,7 @@ fn catalogue() -> Vec<Case> {
                 replace(d, PROJECT, "version = 2", "version = 99");
                 info(d)
             },
-            "was written by a newer Anthesis (format version 99; this build reads up to 8)"
+            "was written by a newer Anthesis (format version 99; this build reads up to 9)"
         ),
         case!(
             "NaN parameter",

@@ -311,7 +311,19 @@ fn blender_imports_the_lily_and_shows_anthesis_renders_colours() {
             eprintln!(
                 "{what}: {ours_n} pixels in anthesis render, {theirs_n} in Blender, overlap {agree:.3}"
             );
-            assert!(ours_n >= 50, "{what}: only {ours_n} pixels");
+            if matches!(kind, Tissue::Spot) && keyframe == 0 {
+                // The spots are on the inner side only, inside the closed
+                // bud: neither shows them.
+                assert!(
+                    ours_n < 50 && theirs_n < 50,
+                    "{what}: spots outside the bud"
+                );
+                continue;
+            }
+            // Half open (keyframe 50), most of the inner side, and so of the
+            // spots, is still hidden: about 20 pixels at this size.
+            let least = if matches!(kind, Tissue::Spot) { 10 } else { 50 };
+            assert!(ours_n >= least, "{what}: only {ours_n} pixels");
             assert!(
                 (0.8..=1.25).contains(&(theirs_n as f64 / ours_n as f64)),
                 "{what}: {ours_n} pixels in anthesis render, {theirs_n} in Blender"

@@ -24,8 +24,19 @@ fn info_prints_one_line_per_organ_with_counts() {
     let stdout = text(&out.stdout);
     let lines: Vec<&str> = stdout.lines().collect();
     assert_eq!(
-        lines,
+        lines[..2],
         ["petal-1 petal 112 182 293", "sepal-1 sepal 112 182 293"]
+    );
+    // Then its parts (the receptacle it sits on), then the size, in units:
+    // the fixture does not say what its unit is.
+    assert!(lines[2].starts_with("part receptacle "), "{stdout}");
+    assert!(
+        lines[3..].iter().all(|l| l.starts_with("size ")),
+        "{stdout}"
+    );
+    assert!(
+        lines[3].contains("units") && lines[3].contains("one metre"),
+        "{stdout}"
     );
 }
 
@@ -42,7 +53,11 @@ fn what_loading_reads_past_is_said_and_the_command_goes_on() {
     std::fs::write(&obj, mesh).expect("write");
     let out = anthesis(&["info", path.to_str().expect("utf-8")]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert_eq!(text(&out.stdout).lines().count(), 2);
+    let organ_lines = text(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("size ") && !l.starts_with("part "))
+        .count();
+    assert_eq!(organ_lines, 2);
     let stderr = text(&out.stderr);
     let warnings: Vec<&str> = stderr
         .lines()
@@ -66,6 +81,7 @@ fn edge_remeshes_what_info_counts_and_what_simulate_runs() {
         assert!(out.status.success(), "{}", text(&out.stderr));
         text(&out.stdout)
             .lines()
+            .filter(|l| !l.starts_with("size ") && !l.starts_with("part "))
             .map(|l| {
                 l.split(' ')
                     .nth(2)
@@ -494,7 +510,10 @@ fn the_built_in_lily_needs_no_files() {
         .expect("the binary runs");
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stdout = text(&out.stdout);
-    let lines: Vec<&str> = stdout.lines().collect();
+    let lines: Vec<&str> = stdout
+        .lines()
+        .filter(|l| !l.starts_with("size ") && !l.starts_with("part "))
+        .collect();
     assert_eq!(lines.len(), 6, "{stdout}");
     assert_eq!(
         lines
@@ -751,7 +770,12 @@ fn a_flower_made_elsewhere_loads_with_every_particle_and_triangle_of_its_files()
     assert!(out.status.success(), "{}", text(&out.stderr));
     let (narrow_v, narrow_t) = obj_counts(&folder.join("geo/narrow.obj"));
     let (broad_v, broad_t) = obj_counts(&folder.join("geo/broad.obj"));
-    let lines: Vec<String> = text(&out.stdout).lines().map(str::to_owned).collect();
+    // The organ lines (parts and sizes follow).
+    let lines: Vec<String> = text(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("size ") && !l.starts_with("part "))
+        .map(str::to_owned)
+        .collect();
     assert_eq!(lines.len(), 9, "{lines:?}");
     for line in &lines {
         let words: Vec<&str> = line.split(' ').collect();
@@ -1091,6 +1115,7 @@ fn organs_placed_by_whorls_or_an_lsystem_load_and_simulate() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     let names: Vec<String> = text(&out.stdout)
         .lines()
+        .filter(|l| !l.starts_with("size ") && !l.starts_with("part "))
         .map(|l| l.split(' ').next().expect("name").to_owned())
         .collect();
     assert_eq!(
@@ -1116,7 +1141,11 @@ fn organs_placed_by_whorls_or_an_lsystem_load_and_simulate() {
     let l = lsystem.to_str().expect("utf-8");
     let out = anthesis(&["info", l]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    let by_lsystem: Vec<String> = text(&out.stdout).lines().map(str::to_owned).collect();
+    let by_lsystem: Vec<String> = text(&out.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("size ") && !l.starts_with("part "))
+        .map(str::to_owned)
+        .collect();
     assert_eq!(by_lsystem.len(), 6);
     // The organs are where the whorls put them: same names, bases, tips and
     // joint axes.

@@ -146,7 +146,9 @@ def main():
     scene.view_settings.exposure = 0.0
     scene.view_settings.gamma = 1.0
     shading = scene.display.shading
-    shading.show_backface_culling = False
+    # Each side of an organ whose sides differ is its own single-sided
+    # primitive: culling back faces shows each side its own colours.
+    shading.show_backface_culling = True
     shading.show_cavity = False
     shading.show_shadows = False
     shading.show_object_outline = False

@@ -80,11 +80,30 @@ def mesh_report(mesh):
         if shader and shader.GetInput("diffuseColor").HasConnectedSource():
             source = shader.GetInput("diffuseColor").GetConnectedSources()[0][0]
             reader = UsdShade.Shader(source.source.GetPrim())
-            report["material"]["diffuse_source"] = {
+            found = {
                 "shader_id": reader.GetIdAttr().Get(),
-                "varname": reader.GetInput("varname").Get(),
                 "output": source.sourceName,
             }
+            if reader.GetInput("varname"):
+                found["varname"] = reader.GetInput("varname").Get()
+            # A texture: its file as written and as USD resolves it (None
+            # when the file is not there), its colour space, wrap modes and
+            # scale, and what its st input reads.
+            if reader.GetInput("file"):
+                asset = reader.GetInput("file").Get()
+                found["file"] = asset.path
+                found["resolved_file"] = asset.resolvedPath or None
+                for name in ["sourceColorSpace", "wrapS", "wrapT"]:
+                    found[name] = reader.GetInput(name).Get()
+                found["scale"] = list(reader.GetInput("scale").Get())
+                st = reader.GetInput("st")
+                if st and st.HasConnectedSource():
+                    st_reader = UsdShade.Shader(st.GetConnectedSources()[0][0].source.GetPrim())
+                    found["st"] = {
+                        "shader_id": st_reader.GetIdAttr().Get(),
+                        "varname": st_reader.GetInput("varname").Get(),
+                    }
+            report["material"]["diffuse_source"] = found
     return report
 
 

@@ -138,8 +138,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             uvs: bud.uvs.clone(),
             base_color: [0.95, 0.6, 0.3, 1.0],
             keyframes: shapes,
-            base_color_png: None,
-            rigid: None,
+            ..Track::default()
         };
         write_tracks(out, OutputKind::of(out), &[track], &glb)?;
         say!("wrote {} (keyframes 0 to {})", out.display(), keyframes);

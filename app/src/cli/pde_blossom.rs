@@ -216,8 +216,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
             uvs: mesh.uvs.clone(),
             base_color: [0.95, 0.93, 0.88, 1.0],
             keyframes,
-            base_color_png: None,
-            rigid: None,
+            ..Track::default()
         };
         write_tracks(out, OutputKind::of(out), &[track], &glb)?;
         say!("wrote {} (keyframes 0 to {steps})", out.display());

@@ -40,6 +40,13 @@ pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
             edges[organ.template]
         )?;
     }
+    let parts = anthesis_flower::parts::part_lines(flower);
+    for line in parts
+        .iter()
+        .chain(&anthesis_flower::unit::size_lines(flower))
+    {
+        writeln!(stdout, "{line}")?;
+    }
     Ok(())
 }
 

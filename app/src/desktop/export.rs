@@ -155,10 +155,7 @@ fn write_gif(
     };
     let keyframes = animation::keyframes_every(step, last as u32);
     // Each track's colour map, decoded once.
-    let textures: Vec<_> = tracks
-        .iter()
-        .map(|t| crate::look::png_texture(t.base_color_png.as_deref()))
-        .collect();
+    let textures: Vec<_> = tracks.iter().map(crate::look::track_texture).collect();
     let scenes: Vec<Vec<OrganMesh>> = keyframes
         .iter()
         .map(|&k| {
@@ -824,6 +821,9 @@ impl ExportDialog {
                              meshopt: quantized and compressed (EXT_meshopt_compression), \
                              the smallest, for three.js with its meshopt decoder",
                         );
+                        ui.end_row();
+                        ui.label("Opens in");
+                        ui.label(self.encoding.clients());
                         ui.end_row();
                     });
                 let after_bud = keyframes_ready.saturating_sub(1);

@@ -89,6 +89,26 @@ pub fn render_lily(renders: &str, keyframes: &[u32], width: u32, height: u32) ->
         renders,
     ]);
     let camera = std::path::Path::new(renders).join("camera.json");
-    serde_json::from_str(&std::fs::read_to_string(camera).expect("camera.json"))
-        .expect("camera JSON")
+    let camera: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(camera).expect("camera.json"))
+            .expect("camera JSON");
+    in_metres(camera)
+}
+
+/// `anthesis render`'s camera (in the lily's units) in metres, as the
+/// exports write the lily (one unit is its `unit`).
+fn in_metres(mut camera: serde_json::Value) -> serde_json::Value {
+    let lily = anthesis_garden::builtin_lily().expect("the built-in lily");
+    let metres = lily.flower.unit.unwrap_or_default().metres();
+    for key in ["eye", "target"] {
+        if let Some(v) = camera[key].as_array_mut() {
+            for x in v.iter_mut() {
+                *x = (x.as_f64().expect("a number") * metres).into();
+            }
+        }
+    }
+    if let Some(near) = camera["near"].as_f64() {
+        camera["near"] = (near * metres).into();
+    }
+    camera
 }

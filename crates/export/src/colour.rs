@@ -3,7 +3,7 @@
 //! `base_color` so the texture carries the colour), and sampled at each
 //! vertex's UV for USD's per-vertex `primvars:displayColor`.
 
-use anthesis_flower::{Flower, Template, srgb8_to_linear};
+use anthesis_flower::{Flower, Side, Template, srgb8_to_linear};
 use glam::DVec2;
 use image::ImageEncoder;
 
@@ -14,11 +14,17 @@ use crate::{ExportError, Track, TrackProblem};
 /// `None` when the template has no colour map (its one colour is the
 /// track's `base_color`).
 pub fn colour_png(template: &Template) -> Result<Option<Vec<u8>>, ExportError> {
+    colour_png_on(template, Side::Inner)
+}
+
+/// [`colour_png`] of one side of the organ (the inner side is what
+/// [`colour_png`] gives).
+pub fn colour_png_on(template: &Template, side: Side) -> Result<Option<Vec<u8>>, ExportError> {
     if template.colouring.is_none() {
         return Ok(None);
     }
     let (width, height) = template.colour_image_size();
-    let image = template.colour_image(width, height);
+    let image = template.colour_image_on(side, width, height);
     let mut bytes = Vec::new();
     image::codecs::png::PngEncoder::new(&mut bytes)
         .write_image(
@@ -35,21 +41,30 @@ pub fn colour_png(template: &Template) -> Result<Option<Vec<u8>>, ExportError> {
 }
 
 /// Gives each organ track (`tracks[i]` is organ `organs[i]`) whose template
-/// has a colour map that map's PNG as its texture and a white base colour.
-/// Each template's PNG is encoded once.
+/// has a colour map that map's PNG as its texture and a white base colour,
+/// and the outer side's PNG where the sides differ
+/// ([`Template::is_two_sided`]). Each template's PNGs are encoded once.
 pub(crate) fn paint_tracks(
     tracks: &mut [Track],
     flower: &Flower,
     organs: &[usize],
 ) -> Result<(), ExportError> {
-    let mut pngs: Vec<Option<Option<Vec<u8>>>> = vec![None; flower.templates.len()];
+    type Pngs = (Option<Vec<u8>>, Option<Vec<u8>>);
+    let mut pngs: Vec<Option<Pngs>> = vec![None; flower.templates.len()];
     for (track, &organ) in tracks.iter_mut().zip(organs) {
         let index = flower.organs[organ].template;
+        let template = &flower.templates[index];
         if pngs[index].is_none() {
-            pngs[index] = Some(colour_png(&flower.templates[index])?);
+            let outer = if template.is_two_sided() {
+                colour_png_on(template, Side::Outer)?
+            } else {
+                None
+            };
+            pngs[index] = Some((colour_png(template)?, outer));
         }
-        if let Some(Some(png)) = &pngs[index] {
+        if let Some((Some(png), outer)) = &pngs[index] {
             track.base_color_png = Some(png.clone());
+            track.outer_color_png = outer.clone();
             track.base_color = [1.0; 4];
         }
     }

@@ -69,10 +69,11 @@ mod usdc;
 
 use std::path::Path;
 
+use anthesis_flower::Unit;
 use glam::{DQuat, DVec2, DVec3};
 
 pub use between::KeyframeBlend;
-pub use colour::colour_png;
+pub use colour::{colour_png, colour_png_on};
 pub use error::{ExportError, TrackProblem};
 pub use glb::glb_bytes;
 pub use obj::{obj_file_name, write_obj_sequence};
@@ -81,7 +82,8 @@ pub use tracks::{
     MAX_RENDER_POSITIONS, TrackLook, check_render_level, flower_tracks, organ_tracks, part_track,
 };
 pub use usd::{
-    USD_ROOT_PRIM, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, usdc_bytes, write_usd,
+    USD_ROOT_PRIM, UsdFiles, UsdOptions, check_usd_destination, is_usd_path, usd_bytes, usd_files,
+    usd_texture_folder, usdc_bytes, write_usd,
 };
 
 /// One organ (or the receptacle) over time: a fixed triangulation and UV
@@ -108,6 +110,18 @@ pub struct Track {
     /// of storing a morph target per keyframe; other formats use
     /// `keyframes`.
     pub rigid: Option<RigidMotion>,
+    /// What one length of `keyframes` (and `rigid`) is in the real world:
+    /// the .glb and USD layers write metres (each length times
+    /// [`Unit::metres`]), OBJ files the lengths as they are with the unit
+    /// in a comment. Default one metre.
+    pub unit: Unit,
+    /// The outer side's base-colour texture (a PNG), when the sides look
+    /// different (a template's colour layer on one side only):
+    /// `base_color_png` is then the inner side's. The .glb gives such a
+    /// mesh a second primitive of the same triangles wound the other way
+    /// with this texture, the USD layer a second mesh `<name>_outer`, each
+    /// side single-sided, so every client shows each side its own colours.
+    pub outer_color_png: Option<Vec<u8>>,
 }
 
 /// A rigid track's mesh in its own frame and its pose at every keyframe.
@@ -190,8 +204,9 @@ pub enum Encoding {
     /// with its `MeshoptDecoder` (`GLTFLoader.setMeshoptDecoder`); three.js
     /// sizes a mesh's bounds as if one target at a time were on, so with
     /// steps they cover the bud and one step: set `frustumCulled = false`
-    /// on the meshes for close-ups. Blender 3.4 and the `gltf` crate do not
-    /// read it.
+    /// on the meshes for close-ups. Blender (3.4 and 4.5: "Extension
+    /// EXT_meshopt_compression is not available") and the `gltf` crate do
+    /// not read it.
     Meshopt,
 }
 
@@ -203,6 +218,25 @@ impl Encoding {
         Encoding::Quantized,
         Encoding::Meshopt,
     ];
+
+    /// Which clients import a file of this encoding, as checked by this
+    /// project's tests and by hand (three.js r187, Blender 4.5 LTS as a
+    /// Python module and Blender 3.4), for export dialogs.
+    pub fn clients(&self) -> &'static str {
+        match self {
+            Encoding::Dense | Encoding::Sparse => {
+                "opens everywhere: three.js, Blender 3.4 and 4.5, any glTF 2.0 reader"
+            }
+            Encoding::Quantized => {
+                "three.js and Blender 3.4 and 4.5 (Blender shows the dequantization as the \
+                 object's scale)"
+            }
+            Encoding::Meshopt => {
+                "three.js with its MeshoptDecoder only: Blender (3.4 and 4.5) cannot import \
+                 it, so export quantized for Blender"
+            }
+        }
+    }
 }
 
 impl std::fmt::Display for Encoding {

@@ -20,8 +20,11 @@ pub fn obj_file_name(keyframe: usize, keyframe_count: usize) -> String {
 /// holds every track as an object (`o name`) with positions, UVs (`vt`, in
 /// the Anthesis convention, which is also OBJ's: `v = 0` at the bottom of an
 /// image), area-weighted normals and `v/vt/vn` triangles; a static track
-/// (one keyframe) appears unchanged in every file. Each file is written
-/// atomically.
+/// (one keyframe) appears unchanged in every file. Lengths are in the
+/// tracks' unit ([`Track::unit`], the project's: the unit Anthesis reads
+/// meshes and fit targets in), which a comment near the top states
+/// (`# Lengths in project units: one unit is 1.8 mm (0.0018 m)`). Each file
+/// is written atomically.
 ///
 /// Anthesis's own OBJ reader (`anthesis_mesh::obj`) reads these files back
 /// (as one mesh with all objects merged).
@@ -79,9 +82,21 @@ fn keyframe_obj(
         "# Anthesis keyframe {keyframe} of {keyframe_count} (keyframes 0 to {})",
         keyframe_count - 1
     );
+    // OBJ has no unit: say it where people and importers' notes look.
+    let unit_line = |unit: anthesis_flower::Unit| {
+        format!(
+            "# Lengths in project units: one unit is {unit} ({:?} m)",
+            unit.metres()
+        )
+    };
+    let first_unit = tracks.first().map(|t| t.unit).unwrap_or_default();
+    let _ = writeln!(text, "{}", unit_line(first_unit));
     let mut offset = 1usize; // OBJ indices start at 1 and run across objects
     for (track, name) in tracks.iter().zip(names) {
         let positions = &track.keyframes[keyframe.min(track.keyframes.len() - 1)];
+        if track.unit != first_unit {
+            let _ = writeln!(text, "{}", unit_line(track.unit));
+        }
         let _ = writeln!(text, "o {name}");
         // `{:?}` prints the shortest decimal that reads back as the same f64.
         for p in positions {

@@ -74,6 +74,11 @@ fn check_track(track: &Track) -> Result<(), TrackProblem> {
     {
         return Err(TrackProblem::TextureNotPng);
     }
+    if let Some(png) = &track.outer_color_png
+        && !png.starts_with(&PNG_SIGNATURE)
+    {
+        return Err(TrackProblem::TextureNotPng);
+    }
     if let Some(rigid) = &track.rigid {
         let finite = rigid.poses.iter().all(|p| {
             p.translation.is_finite() && p.rotation.is_finite() && p.rotation.length() > 0.5
@@ -248,6 +253,8 @@ mod tests {
             keyframes,
             base_color_png: None,
             rigid: None,
+            unit: anthesis_flower::Unit::METRE,
+            outer_color_png: None,
         }
     }
 

@@ -57,6 +57,8 @@ impl Track {
             keyframes: vec![mesh.positions],
             base_color_png: None,
             rigid: None,
+            unit: anthesis_flower::Unit::METRE,
+            outer_color_png: None,
         }
     }
 }
@@ -80,6 +82,8 @@ pub fn organ_tracks<'a, 'k>(
             keyframes: Vec::new(),
             base_color_png: None,
             rigid: None,
+            unit: anthesis_flower::Unit::METRE,
+            outer_color_png: None,
         })
         .collect();
     for organs in keyframes {
@@ -164,7 +168,8 @@ fn edge_count(triangles: &[[u32; 3]]) -> u64 {
 /// still or, where its schedule turns it, rigid ([`part_track`]).
 ///
 /// `keyframes` are as [`organ_tracks`] takes them: keyframe 0 (the bud)
-/// first. Without keyframes there is nothing to export: no tracks.
+/// first. Without keyframes there is nothing to export: no tracks. Every
+/// track's [`Track::unit`] is the flower's (one metre where it states none).
 ///
 /// `render_level` above 0 exports each organ as its render mesh
 /// ([`Track::subdivided`]): the simulated mesh after that many levels of
@@ -217,6 +222,10 @@ pub fn flower_tracks<'k>(
             .iter()
             .map(|piece| part_track(piece, count)),
     );
+    let unit = flower.unit.unwrap_or_default();
+    for track in &mut tracks {
+        track.unit = unit;
+    }
     Ok(tracks)
 }
 
@@ -262,6 +271,8 @@ pub fn part_track(piece: &PartPiece, keyframe_count: usize) -> Track {
             local: piece.mesh.positions.clone(),
             poses,
         }),
+        unit: anthesis_flower::Unit::METRE,
+        outer_color_png: None,
     }
 }
 
@@ -312,6 +323,8 @@ impl Track {
             keyframes,
             base_color_png: self.base_color_png.clone(),
             rigid: None,
+            unit: self.unit,
+            outer_color_png: self.outer_color_png.clone(),
         })
     }
 }
@@ -376,6 +389,8 @@ mod tests {
             keyframes,
             base_color_png: None,
             rigid: None,
+            unit: anthesis_flower::Unit::METRE,
+            outer_color_png: None,
         }
     }
 

@@ -14,8 +14,10 @@
 //! # The stage
 //!
 //! - Layer metadata: `defaultPrim = "flower"`, `upAxis = "Y"` (the flower
-//!   axis), `metersPerUnit = 1` (one project unit is one metre, as in the
-//!   .glb, so both import at the same size), `startTimeCode = 0`,
+//!   axis), `metersPerUnit = 1`: points are written in metres (each
+//!   length times the track's [`Unit::metres`](anthesis_flower::Unit::metres)),
+//!   as in the .glb, so the flower imports at its real size whether or not a
+//!   client applies `metersPerUnit`, `startTimeCode = 0`,
 //!   `endTimeCode = K - 1` and `timeCodesPerSecond = framesPerSecond =` the
 //!   keyframes per second: keyframe `k` is time code (frame) `k`.
 //! - `/flower` is an `Xform` (kind `component`) holding one `Mesh` per
@@ -38,10 +40,17 @@
 //! - Each mesh is bound (`MaterialBindingAPI`, `material:binding`) to a
 //!   `Material` whose `UsdPreviewSurface` has the base colour as
 //!   `diffuseColor`, its alpha as `opacity`, roughness 0.7 and metallic 0,
-//!   like the .glb's material. Base-colour textures are not written (a USD
-//!   texture is a separate file next to the layer): with one, the
-//!   `diffuseColor` is connected to a `UsdPrimvarReader_float3` shader
-//!   (`displayColor` under the material) reading `displayColor`.
+//!   like the .glb's material. A base-colour texture is written as a PNG
+//!   beside the layer (`<layer stem>_textures/<prim>.png`, one per distinct
+//!   image, see [`usd_files`]) and read by a `UsdUVTexture` (`colourMap`,
+//!   sRGB, clamped, scaled by the base colour) at the mesh's `st`
+//!   (`UsdPrimvarReader_float2` `stReader`) into `diffuseColor`.
+//! - A track whose sides look different ([`Track::outer_color_png`]) is two
+//!   single-sided meshes: its own and `<name>_outer`, which references the
+//!   first in this layer (points and extent stored once), winds the
+//!   triangles the other way, blocks the normals (clients make them from
+//!   the points, facing out) and is bound to a material with the outer
+//!   texture.
 
 use std::path::Path;
 
@@ -88,19 +97,62 @@ impl Default for UsdOptions {
 /// Name of the root `Xform` (also the layer's `defaultPrim`).
 pub const USD_ROOT_PRIM: &str = "flower";
 
-/// Builds the USD layer of `tracks` in memory, as `.usda` text. `progress` rises
-/// from 0 to 1, about once per keyframe of each track. Fails with a typed
-/// error, before any work, on the same invalid input as
-/// [`glb_bytes`](crate::glb_bytes).
+/// A USD export in memory: the layer and the colour maps it names.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UsdFiles {
+    /// The layer, `.usda` text or a `.usdc` crate file.
+    pub layer: Vec<u8>,
+    /// Each distinct colour map as a PNG file, by its path relative to the
+    /// layer's folder (`<layer stem>_textures/<prim>.png`, the path the
+    /// layer's `UsdUVTexture` names with `./` in front).
+    pub textures: TextureFiles,
+}
+
+/// Files by their path relative to a layer's folder, with their bytes.
+pub type TextureFiles = Vec<(String, Vec<u8>)>;
+
+/// The folder beside a layer named `layer_file` that holds its colour maps:
+/// `lily.usdc` keeps them in `lily_textures/`.
+pub fn usd_texture_folder(layer_file: &Path) -> String {
+    let stem = layer_file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    format!("{stem}_textures")
+}
+
+/// Builds the USD export of `tracks` in memory for a layer named
+/// `layer_file` (which sets the textures' folder, see
+/// [`usd_texture_folder`]): `.usdc` binary when `binary`, else `.usda`
+/// text. `progress` rises from 0 to 1, about once per keyframe of each
+/// track. Fails with a typed error, before any work, on the same invalid
+/// input as [`glb_bytes`](crate::glb_bytes).
+pub fn usd_files(
+    tracks: &[Track],
+    options: &UsdOptions,
+    layer_file: &Path,
+    binary: bool,
+    progress: &mut dyn FnMut(f32),
+) -> Result<UsdFiles, ExportError> {
+    let (layer, textures) =
+        build_layer(tracks, options, &usd_texture_folder(layer_file), progress)?;
+    let layer = if binary {
+        crate::usdc::crate_bytes(&layer.data)?
+    } else {
+        layer.into_text()?.into_bytes()
+    };
+    progress(1.0);
+    Ok(UsdFiles { layer, textures })
+}
+
+/// The `.usda` text of [`usd_files`] for a layer `flower.usda` (its
+/// textures, if any, named in `flower_textures/`).
 pub fn usd_bytes(
     tracks: &[Track],
     options: &UsdOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<Vec<u8>, ExportError> {
-    let layer = build_layer(tracks, options, progress)?;
-    let bytes = layer.into_text()?.into_bytes();
-    progress(1.0);
-    Ok(bytes)
+    usd_files(tracks, options, Path::new("flower.usda"), false, progress).map(|f| f.layer)
 }
 
 /// The same layer as [`usd_bytes`], as a binary crate file (`.usdc`).
@@ -109,18 +161,17 @@ pub fn usdc_bytes(
     options: &UsdOptions,
     progress: &mut dyn FnMut(f32),
 ) -> Result<Vec<u8>, ExportError> {
-    let layer = build_layer(tracks, options, progress)?;
-    let bytes = crate::usdc::crate_bytes(&layer.data)?;
-    progress(1.0);
-    Ok(bytes)
+    usd_files(tracks, options, Path::new("flower.usdc"), true, progress).map(|f| f.layer)
 }
 
-/// The layer of [`usd_bytes`], with `progress` rising to 0.95.
+/// The layer of [`usd_files`] and its textures, with `progress` rising to
+/// 0.95.
 fn build_layer(
     tracks: &[Track],
     options: &UsdOptions,
+    texture_folder: &str,
     progress: &mut dyn FnMut(f32),
-) -> Result<LayerBuilder, ExportError> {
+) -> Result<(LayerBuilder, TextureFiles), ExportError> {
     let keyframe_count = validate_tracks(tracks)?;
     validate_timing(options.timing)?;
     let frames_per_second = match options.timing {
@@ -136,6 +187,152 @@ fn build_layer(
     progress(0.0);
 
     let mut layer = LayerBuilder::new();
+    write_stage_metadata(&mut layer, keyframe_count, frames_per_second)?;
+    let names = prim_names(tracks);
+    let flower = layer.prim(&sdf::Path::abs_root(), USD_ROOT_PRIM, "Xform")?;
+    layer.set_field(&flower, FieldKey::Kind, Value::Token("component".into()))?;
+    let materials = layer.prim(&flower, "materials", "Scope")?;
+
+    let total_work = tracks
+        .iter()
+        .map(|t| t.keyframes.len())
+        .sum::<usize>()
+        .max(1) as f32;
+    let mut work_done = 0usize;
+    let mut textures = TextureFiles::new();
+    for (index, (track, name)) in tracks.iter().zip(&names).enumerate() {
+        let mut sides = vec![(track.clone(), name.clone())];
+        if let Some(outer) = &track.outer_color_png {
+            // The outer side: the same surface wound the other way, with
+            // the outer texture (each side's mesh single-sided).
+            sides.push((
+                Track {
+                    triangles: track.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+                    base_color_png: Some(outer.clone()),
+                    ..track.clone()
+                },
+                format!("{name}_outer"),
+            ));
+        }
+        let mut inner_mesh: Option<sdf::Path> = None;
+        for (side, name) in &sides {
+            let colours = crate::colour::vertex_colours(side).map_err(|problem| {
+                ExportError::InvalidTrack {
+                    track: index,
+                    name: track.name.clone(),
+                    problem,
+                }
+            })?;
+            let texture = side
+                .base_color_png
+                .as_ref()
+                .map(|png| texture_file(&mut textures, texture_folder, name, png));
+            let material = write_material(
+                &mut layer,
+                &materials,
+                name,
+                side.base_color,
+                texture.as_deref(),
+            )?;
+            let mesh = layer.prim(&flower, name, "Mesh")?;
+            match &inner_mesh {
+                None => {
+                    write_mesh(
+                        &mut layer,
+                        &mesh,
+                        &material,
+                        side,
+                        colours.as_deref(),
+                        options.normals,
+                        &mut || {
+                            work_done += 1;
+                            progress(0.95 * work_done as f32 / total_work);
+                        },
+                    )?;
+                    inner_mesh = Some(mesh);
+                }
+                Some(inner) => {
+                    write_outer_mesh(&mut layer, &mesh, inner, &material, side, colours)?;
+                }
+            }
+        }
+    }
+    Ok((layer, textures))
+}
+
+/// The outer side of a two-sided track: a mesh that references the inner
+/// side's `inner` mesh in this layer (so its points and extent are stored
+/// once) and overrides the triangles (`outer`'s, wound the other way), its
+/// colours, its material, and blocks the inner side's normals (clients make
+/// them from the points, facing out with the reversed winding).
+fn write_outer_mesh(
+    layer: &mut LayerBuilder,
+    mesh: &sdf::Path,
+    inner: &sdf::Path,
+    material: &sdf::Path,
+    outer: &Track,
+    colours: Option<Vec<[f32; 4]>>,
+) -> Result<(), ExportError> {
+    let reference = sdf::Reference {
+        prim_path: inner.clone(),
+        ..sdf::Reference::default()
+    };
+    layer.set_field(
+        mesh,
+        FieldKey::References,
+        Value::ReferenceListOp(ListOp::prepended([reference])),
+    )?;
+    let indices: Vec<i32> = outer
+        .triangles
+        .iter()
+        .flatten()
+        .map(|&i| i32::try_from(i).unwrap_or(i32::MAX))
+        .collect();
+    layer.attribute(
+        mesh,
+        "faceVertexIndices",
+        "int[]",
+        None,
+        Value::IntVec(indices),
+    )?;
+    layer.attribute(mesh, "normals", "normal3f[]", None, Value::ValueBlock)?;
+    if let Some(colours) = colours {
+        let rgb = colours
+            .iter()
+            .map(|c| gf::vec3f(c[0], c[1], c[2]))
+            .collect();
+        let color = layer.attribute(
+            mesh,
+            "primvars:displayColor",
+            "color3f[]",
+            None,
+            Value::Vec3fVec(rgb),
+        )?;
+        layer.set_field(&color, "interpolation", Value::Token("vertex".into()))?;
+    }
+    layer.relationship(mesh, "material:binding", material)
+}
+
+/// The asset path (`./<folder>/<name>.png`) of `png`, added to `textures`
+/// unless the same PNG is there already (organs of one template share it).
+fn texture_file(textures: &mut TextureFiles, folder: &str, name: &str, png: &[u8]) -> String {
+    let file = match textures.iter().find(|(_, bytes)| bytes == png) {
+        Some((file, _)) => file.clone(),
+        None => {
+            let file = format!("{folder}/{name}.png");
+            textures.push((file.clone(), png.to_vec()));
+            file
+        }
+    };
+    format!("./{file}")
+}
+
+/// The layer's metadata: default prim, +Y up, metres, the time codes.
+fn write_stage_metadata(
+    layer: &mut LayerBuilder,
+    keyframe_count: usize,
+    frames_per_second: f64,
+) -> Result<(), ExportError> {
     let root = layer.pseudo_root()?;
     root.add(FieldKey::DefaultPrim, Value::Token(USD_ROOT_PRIM.into()));
     root.add("upAxis", Value::Token("Y".into()));
@@ -154,54 +351,15 @@ fn build_layer(
         FieldKey::Documentation,
         Value::String(concat!("Anthesis (anthesis-export ", env!("CARGO_PKG_VERSION"), ")").into()),
     );
-
-    let names = prim_names(tracks);
-    let flower = layer.prim(&sdf::Path::abs_root(), USD_ROOT_PRIM, "Xform")?;
-    layer.set_field(&flower, FieldKey::Kind, Value::Token("component".into()))?;
-    let materials = layer.prim(&flower, "materials", "Scope")?;
-
-    let total_work = tracks
-        .iter()
-        .map(|t| t.keyframes.len())
-        .sum::<usize>()
-        .max(1) as f32;
-    let mut work_done = 0usize;
-    for (index, (track, name)) in tracks.iter().zip(&names).enumerate() {
-        let colours =
-            crate::colour::vertex_colours(track).map_err(|problem| ExportError::InvalidTrack {
-                track: index,
-                name: track.name.clone(),
-                problem,
-            })?;
-        let material = write_material(
-            &mut layer,
-            &materials,
-            name,
-            track.base_color,
-            colours.is_some(),
-        )?;
-        let mesh = layer.prim(&flower, name, "Mesh")?;
-        write_mesh(
-            &mut layer,
-            &mesh,
-            &material,
-            track,
-            colours.as_deref(),
-            options.normals,
-            &mut || {
-                work_done += 1;
-                progress(0.95 * work_done as f32 / total_work);
-            },
-        )?;
-    }
-    Ok(layer)
+    Ok(())
 }
 
-/// Builds the USD layer (see [`usd_bytes`]) and writes it to `path`
-/// atomically (see [`anthesis_files::write_atomic`]): an existing file at
-/// `path` is replaced only by a completely written one. A `.usda` or `.usd`
-/// file gets the text form, a `.usdc` file the binary crate form
-/// ([`usdc_bytes`]).
+/// Builds the USD export (see [`usd_files`]) and writes it to `path`: the
+/// colour maps first, into [`usd_texture_folder`] beside it (made when
+/// missing), then the layer, each atomically (see
+/// [`anthesis_files::write_atomic`]): an existing file is replaced only by
+/// a completely written one. A `.usda` or `.usd` file gets the text form,
+/// a `.usdc` file the binary crate form.
 pub fn write_usd(
     path: &Path,
     tracks: &[Track],
@@ -209,12 +367,17 @@ pub fn write_usd(
     progress: &mut dyn FnMut(f32),
 ) -> Result<(), ExportError> {
     check_usd_destination(path)?;
-    let bytes = if usd_extension(path).as_deref() == Some("usdc") {
-        usdc_bytes(tracks, options, progress)?
-    } else {
-        usd_bytes(tracks, options, progress)?
-    };
-    Ok(anthesis_files::write_atomic(path, &bytes)?)
+    let binary = usd_extension(path).as_deref() == Some("usdc");
+    let files = usd_files(tracks, options, path, binary, progress)?;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    for (relative, png) in &files.textures {
+        let file = folder.join(relative);
+        if let Some(parent) = file.parent() {
+            anthesis_files::create_folder(parent, &file)?;
+        }
+        anthesis_files::write_atomic(&file, png)?;
+    }
+    Ok(anthesis_files::write_atomic(path, &files.layer)?)
 }
 
 /// The checks [`write_usd`] makes before any work, for callers that want
@@ -264,16 +427,17 @@ fn vec3f(v: DVec3) -> gf::Vec3f {
     gf::vec3f(v.x, v.y, v.z)
 }
 
-fn vec3fs(values: &[DVec3]) -> Value {
-    Value::Vec3fVec(values.iter().map(|&v| vec3f(v)).collect())
+/// `values` times `scale` as single-precision vectors.
+fn vec3fs(values: &[DVec3], scale: f64) -> Value {
+    Value::Vec3fVec(values.iter().map(|&v| vec3f(v * scale)).collect())
 }
 
-/// `[min, max]` of the points, as USD's `extent` wants it.
-fn extent(points: &[DVec3]) -> Value {
+/// `[min, max]` of the points times `scale`, as USD's `extent` wants it.
+fn extent(points: &[DVec3], scale: f64) -> Value {
     let (mut min, mut max) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
     for p in points {
-        min = min.min(*p);
-        max = max.max(*p);
+        min = min.min(*p * scale);
+        max = max.max(*p * scale);
     }
     Value::Vec3fVec(vec![vec3f(min), vec3f(max)])
 }
@@ -309,7 +473,15 @@ fn write_mesh(
         Value::TokenListOp(ListOp::prepended(["MaterialBindingAPI".into()])),
     )?;
     let uniform = Some(Variability::Uniform);
-    layer.attribute(mesh, "doubleSided", "bool", uniform, Value::Bool(true))?;
+    // A track whose sides look different is two single-sided meshes.
+    let double_sided = track.outer_color_png.is_none();
+    layer.attribute(
+        mesh,
+        "doubleSided",
+        "bool",
+        uniform,
+        Value::Bool(double_sided),
+    )?;
     layer.attribute(
         mesh,
         "orientation",
@@ -346,14 +518,16 @@ fn write_mesh(
     )?;
 
     let frames = &track.keyframes;
+    let metres = track.unit.metres();
     let points = Sampled::of(frames, |f| {
         tick();
-        vec3fs(f)
+        vec3fs(f, metres)
     });
     layer.sampled_attribute(mesh, "points", "point3f[]", points)?;
-    layer.sampled_attribute(mesh, "extent", "float3[]", Sampled::of(frames, extent))?;
+    let extents = Sampled::of(frames, |f| extent(f, metres));
+    layer.sampled_attribute(mesh, "extent", "float3[]", extents)?;
     if normals {
-        let values = Sampled::of(frames, |f| vec3fs(&unit_normals(f, &track.triangles)));
+        let values = Sampled::of(frames, |f| vec3fs(&unit_normals(f, &track.triangles), 1.0));
         let normals = layer.sampled_attribute(mesh, "normals", "normal3f[]", values)?;
         layer.set_field(&normals, "interpolation", Value::Token("vertex".into()))?;
     }
@@ -416,26 +590,22 @@ fn write_mesh(
 }
 
 /// A `Material` with a `UsdPreviewSurface` of `color` under `scope`;
-/// returns the material's path. With `vertex_colours`, its `diffuseColor`
-/// is connected to a `UsdPrimvarReader_float3` of the mesh's
-/// `displayColor` (`color` stays its value where readers are not
-/// followed).
+/// returns the material's path. With a `texture` (an asset path), its
+/// `diffuseColor` comes from a `UsdUVTexture` of that file (sRGB, clamped,
+/// scaled by `color`) read at the mesh's `st` by a
+/// `UsdPrimvarReader_float2`; `color` stays its value where shader
+/// networks are not followed (and the mesh's per-vertex `displayColor`
+/// where materials are not).
 fn write_material(
     layer: &mut LayerBuilder,
     scope: &sdf::Path,
     name: &str,
     color: [f32; 4],
-    vertex_colours: bool,
+    texture: Option<&str>,
 ) -> Result<sdf::Path, ExportError> {
     let material = layer.prim(scope, name, "Material")?;
     let shader = layer.prim(&material, "surface", "Shader")?;
-    layer.attribute(
-        &shader,
-        "info:id",
-        "token",
-        Some(Variability::Uniform),
-        Value::Token("UsdPreviewSurface".into()),
-    )?;
+    layer.shader_id(&shader, "UsdPreviewSurface")?;
     let [r, g, b, a] = color;
     let diffuse = layer.attribute(
         &shader,
@@ -444,27 +614,12 @@ fn write_material(
         None,
         Value::Vec3f(gf::vec3f(r, g, b)),
     )?;
-    if vertex_colours {
-        let reader = layer.prim(&material, "displayColor", "Shader")?;
-        layer.attribute(
-            &reader,
-            "info:id",
-            "token",
-            Some(Variability::Uniform),
-            Value::Token("UsdPrimvarReader_float3".into()),
-        )?;
-        layer.attribute(
-            &reader,
-            "inputs:varname",
-            "string",
-            None,
-            Value::String("displayColor".into()),
-        )?;
-        let result = layer.declared_attribute(&reader, "outputs:result", "float3")?;
+    if let Some(file) = texture {
+        let rgb = write_texture(layer, &material, file, color)?;
         layer.set_field(
             &diffuse,
             FieldKey::ConnectionPaths,
-            Value::PathListOp(ListOp::explicit([result])),
+            Value::PathListOp(ListOp::explicit([rgb])),
         )?;
     }
     layer.attribute(&shader, "inputs:opacity", "float", None, Value::Float(a))?;
@@ -484,6 +639,62 @@ fn write_material(
         Value::PathListOp(ListOp::explicit([shader_output])),
     )?;
     Ok(material)
+}
+
+/// The texture network under `material`: a `UsdPrimvarReader_float2` of
+/// `st` feeding a `UsdUVTexture` of `file`; returns the texture's
+/// `outputs:rgb`.
+fn write_texture(
+    layer: &mut LayerBuilder,
+    material: &sdf::Path,
+    file: &str,
+    color: [f32; 4],
+) -> Result<sdf::Path, ExportError> {
+    let reader = layer.prim(material, "stReader", "Shader")?;
+    layer.shader_id(&reader, "UsdPrimvarReader_float2")?;
+    layer.attribute(
+        &reader,
+        "inputs:varname",
+        "string",
+        None,
+        Value::String("st".into()),
+    )?;
+    let st = layer.declared_attribute(&reader, "outputs:result", "float2")?;
+    let texture = layer.prim(material, "colourMap", "Shader")?;
+    layer.shader_id(&texture, "UsdUVTexture")?;
+    layer.attribute(
+        &texture,
+        "inputs:file",
+        "asset",
+        None,
+        Value::AssetPath(file.into()),
+    )?;
+    let st_input = layer.declared_attribute(&texture, "inputs:st", "float2")?;
+    layer.set_field(
+        &st_input,
+        FieldKey::ConnectionPaths,
+        Value::PathListOp(ListOp::explicit([st])),
+    )?;
+    let token = |t: &str| Value::Token(t.into());
+    layer.attribute(
+        &texture,
+        "inputs:sourceColorSpace",
+        "token",
+        None,
+        token("sRGB"),
+    )?;
+    layer.attribute(&texture, "inputs:wrapS", "token", None, token("clamp"))?;
+    layer.attribute(&texture, "inputs:wrapT", "token", None, token("clamp"))?;
+    let [r, g, b, a] = color;
+    layer.attribute(
+        &texture,
+        "inputs:scale",
+        "float4",
+        None,
+        Value::Vec4f(gf::vec4f(r, g, b, a)),
+    )?;
+    layer.declared_attribute(&texture, "outputs:a", "float")?;
+    layer.declared_attribute(&texture, "outputs:rgb", "float3")
 }
 
 /// An `sdf::Data` layer built top-down, keeping each spec's lists of prim
@@ -554,6 +765,18 @@ impl LayerBuilder {
         spec.add(FieldKey::TypeName, Value::Token(type_name.into()));
         self.add_child(parent, ChildrenKey::PrimChildren, name)?;
         Ok(path)
+    }
+
+    /// A shader's uniform `info:id`.
+    fn shader_id(&mut self, shader: &sdf::Path, id: &str) -> Result<(), ExportError> {
+        self.attribute(
+            shader,
+            "info:id",
+            "token",
+            Some(Variability::Uniform),
+            Value::Token(id.into()),
+        )
+        .map(|_| ())
     }
 
     /// A non-custom attribute of `type_name` without a value (an output).

@@ -65,6 +65,7 @@ fn flower() -> Flower {
         overlaps: Vec::new(),
         structure: None,
         parts: Vec::new(),
+        unit: None,
     }
 }
 

@@ -155,3 +155,26 @@ fn obj_sequence_rejects_invalid_tracks() {
     );
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
 }
+
+/// The unit goes into a comment (OBJ has no field for it); the lengths stay
+/// in project units, the unit Anthesis reads meshes and fit targets in.
+#[test]
+fn the_unit_is_stated_and_lengths_stay_in_project_units() {
+    let unit = anthesis_flower::Unit::parse("1.8 mm").expect("unit");
+    let mut tracks = fixture(2);
+    for track in &mut tracks {
+        track.unit = unit;
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let paths = write_obj_sequence(dir.path(), &tracks).expect("written");
+    let text = std::fs::read_to_string(&paths[1]).expect("read");
+    assert!(
+        text.lines()
+            .take(3)
+            .any(|l| l == "# Lengths in project units: one unit is 1.8 mm (0.0018 m)"),
+        "{}",
+        &text[..200]
+    );
+    let (_, objects) = parse(&text);
+    assert_eq!(objects["petal"].positions[0], tracks[0].keyframes[1][0]);
+}

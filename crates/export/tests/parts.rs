@@ -55,6 +55,7 @@ fn tracks() -> Vec<Track> {
         overlaps: Vec::new(),
         structure: None,
         parts: vec![stamens],
+        unit: None,
     };
     let mut tracks = fixture(KEYFRAMES);
     // The fixture's receptacle is replaced by the flower's pieces.

@@ -675,6 +675,8 @@ fn meshopt_steps_do_not_accumulate_rounding() {
             .collect(),
         base_color_png: None,
         rigid: None,
+        unit: anthesis_flower::Unit::METRE,
+        outer_color_png: None,
     };
     let options = GlbOptions {
         encoding: Encoding::Meshopt,
@@ -711,4 +713,141 @@ fn meshopt_steps_do_not_accumulate_rounding() {
         worst <= half_step * 1.001,
         "worst error {worst}, half a grid step {half_step}"
     );
+}
+
+/// A track whose unit is 1.8 mm arrives in metres in every encoding: its
+/// bud and its last keyframe are the project's positions times 0.0018.
+#[test]
+fn a_stated_unit_is_written_in_metres() {
+    let unit = anthesis_flower::Unit::parse("1.8 mm").expect("unit");
+    let mut tracks = fixture(KEYFRAMES);
+    for track in &mut tracks {
+        track.unit = unit;
+    }
+    for encoding in Encoding::ALL {
+        let glb = parse_glb(&export(
+            &tracks,
+            &GlbOptions {
+                encoding,
+                ..GlbOptions::default()
+            },
+        ));
+        let json = &glb.json;
+        let output = json["animations"][0]["samplers"][0]["output"]
+            .as_u64()
+            .expect("output") as usize;
+        let weights: Vec<f64> = read_accessor(&glb, output).iter().map(|w| w[0]).collect();
+        for (i, track) in tracks.iter().enumerate() {
+            let (translation, scale) = node_transform(&json["nodes"][i]);
+            let primitive = &json["meshes"][i]["primitives"][0];
+            let read = |index: &serde_json::Value| {
+                vec3s(&read_accessor(
+                    &glb,
+                    index.as_u64().expect("accessor") as usize,
+                ))
+            };
+            let base = read(&primitive["attributes"]["POSITION"]);
+            let tolerance = if is_quantized(encoding) {
+                scale / 32767.0
+            } else {
+                1e-8
+            };
+            let in_metres = |k: usize| -> Vec<DVec3> {
+                track.keyframes[k].iter().map(|p| *p * 0.0018).collect()
+            };
+            let world = |ps: &[DVec3]| -> Vec<DVec3> {
+                ps.iter().map(|p| translation + *p * scale).collect()
+            };
+            let what = format!("{} {encoding}", track.name);
+            assert_close(&world(&base), &in_metres(0), tolerance, &what);
+            let Some(targets) = primitive["targets"].as_array() else {
+                continue;
+            };
+            let deltas: Vec<Vec<DVec3>> = targets.iter().map(|t| read(&t["POSITION"])).collect();
+            let last = KEYFRAMES - 1;
+            let w = &weights[last * (KEYFRAMES - 1)..(last + 1) * (KEYFRAMES - 1)];
+            let rebuilt = world(&morphed(&base, &deltas, w));
+            assert_close(&rebuilt, &in_metres(last), tolerance, &what);
+        }
+    }
+}
+
+/// A track whose sides look different gets a second primitive for its
+/// outer side: the same positions, UVs and position targets (the same
+/// accessors), triangles wound the other way, normals pointing the other
+/// way, and single-sided materials with each side's texture.
+#[test]
+fn a_two_sided_track_shares_its_data_between_its_two_primitives() {
+    let png = |rgba: [u8; 4]| {
+        let image = image::RgbaImage::from_pixel(2, 2, image::Rgba(rgba));
+        let mut png = Vec::new();
+        image::DynamicImage::ImageRgba8(image)
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .expect("encode");
+        png
+    };
+    let mut tracks = fixture(KEYFRAMES);
+    tracks[0].base_color_png = Some(png([230, 20, 20, 255]));
+    tracks[0].outer_color_png = Some(png([20, 40, 220, 255]));
+    for encoding in Encoding::ALL {
+        let bytes = export(
+            &tracks,
+            &GlbOptions {
+                encoding,
+                ..GlbOptions::default()
+            },
+        );
+        assert_valid_glb(&bytes, &format!("two-sided {encoding}"));
+        let glb = parse_glb(&bytes);
+        let json = &glb.json;
+        let primitives = json["meshes"][0]["primitives"]
+            .as_array()
+            .expect("primitives");
+        assert_eq!(primitives.len(), 2, "{encoding}");
+        let (inner, outer) = (&primitives[0], &primitives[1]);
+        for attribute in ["POSITION", "TEXCOORD_0"] {
+            assert_eq!(
+                inner["attributes"][attribute],
+                outer["attributes"][attribute]
+            );
+        }
+        let targets = |p: &serde_json::Value| p["targets"].as_array().expect("targets").clone();
+        for (a, b) in targets(inner).iter().zip(&targets(outer)) {
+            assert_eq!(a["POSITION"], b["POSITION"], "{encoding}");
+        }
+        let read = |index: &serde_json::Value| {
+            read_accessor(&glb, index.as_u64().expect("accessor") as usize)
+        };
+        let normals = |p: &serde_json::Value| vec3s(&read(&p["attributes"]["NORMAL"]));
+        for (n, m) in normals(inner).iter().zip(&normals(outer)) {
+            assert!((*n + *m).length() < 1e-6, "{encoding}: {n} and {m}");
+        }
+        let indices = |p: &serde_json::Value| read(&p["indices"]);
+        let (a, b) = (indices(inner), indices(outer));
+        // The same triangles the other way round (meshopt may start a
+        // triangle at another corner).
+        for (s, t) in a.chunks(3).zip(b.chunks(3)) {
+            let flipped = [&s[0], &s[2], &s[1]];
+            let turns = [
+                [&t[0], &t[1], &t[2]],
+                [&t[1], &t[2], &t[0]],
+                [&t[2], &t[0], &t[1]],
+            ];
+            assert!(turns.contains(&flipped), "{encoding}: {s:?} and {t:?}");
+        }
+        let materials = json["materials"].as_array().expect("materials");
+        let (mi, mo) = (
+            inner["material"].as_u64().expect("m"),
+            outer["material"].as_u64().expect("m"),
+        );
+        assert_ne!(mi, mo);
+        for m in [mi, mo] {
+            assert_eq!(materials[m as usize]["doubleSided"], false);
+        }
+        // The other tracks stay one double-sided primitive.
+        assert_eq!(
+            json["meshes"][1]["primitives"].as_array().expect("p").len(),
+            1
+        );
+    }
 }

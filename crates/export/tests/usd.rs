@@ -372,7 +372,7 @@ fn srgb_to_linear(code: u8) -> f32 {
 }
 
 #[test]
-fn a_textured_track_gets_its_colours_per_vertex() {
+fn a_textured_track_gets_its_colour_map_as_a_texture_and_per_vertex() {
     let mut tracks = fixture(3);
     // 2 x 2 pixels, row 0 the top: the left column red, the right blue.
     let (red, blue) = ([230u8, 20, 20, 255], [20u8, 40, 220, 255]);
@@ -409,9 +409,40 @@ fn a_textured_track_gets_its_colours_per_vertex() {
         );
     }
     assert_eq!(mesh["display_opacity"]["interpolation"], "vertex");
+    // The material reads the colour map as a texture at `st`; the file
+    // is beside the layer, where USD finds it.
     let source = &mesh["material"]["diffuse_source"];
-    assert_eq!(source["shader_id"], "UsdPrimvarReader_float3");
-    assert_eq!(source["varname"], "displayColor");
+    assert_eq!(source["shader_id"], "UsdUVTexture", "{source}");
+    assert_eq!(source["output"], "rgb");
+    assert_eq!(source["file"], "./coloured_textures/petal.png");
+    let resolved = source["resolved_file"]
+        .as_str()
+        .expect("USD finds the file");
+    assert!(
+        resolved.ends_with("coloured_textures/petal.png"),
+        "{resolved}"
+    );
+    let files = anthesis_export::usd_files(
+        &tracks,
+        &UsdOptions::default(),
+        Path::new("coloured.usda"),
+        false,
+        &mut |_| {},
+    )
+    .expect("export");
+    let png = tracks[0].base_color_png.clone().expect("textured");
+    assert_eq!(
+        files.textures,
+        [("coloured_textures/petal.png".to_owned(), png)]
+    );
+    assert_eq!(source["sourceColorSpace"], "sRGB");
+    assert_eq!(
+        (&source["wrapS"], &source["wrapT"]),
+        (&"clamp".into(), &"clamp".into())
+    );
+    assert_eq!(source["scale"], serde_json::json!([1.0, 1.0, 1.0, 1.0]));
+    assert_eq!(source["st"]["shader_id"], "UsdPrimvarReader_float2");
+    assert_eq!(source["st"]["varname"], "st");
     // Untextured tracks keep one constant colour and no reader.
     assert_eq!(
         report["meshes"][1]["display_color"]["interpolation"],
@@ -422,4 +453,92 @@ fn a_textured_track_gets_its_colours_per_vertex() {
             .get("diffuse_source")
             .is_none()
     );
+}
+
+/// A track whose unit is 1.8 mm is written in metres with `metersPerUnit`
+/// 1, so a client that ignores `metersPerUnit` still gets the real size.
+#[test]
+fn a_stated_unit_is_written_in_metres() {
+    let unit = anthesis_flower::Unit::parse("1.8 mm").expect("unit");
+    let mut tracks = fixture(3);
+    for track in &mut tracks {
+        track.unit = unit;
+    }
+    let report = write_and_read(&tracks, &UsdOptions::default(), "flower.usdc");
+    assert_eq!(report["meters_per_unit"], 1.0);
+    assert_eq!(report["validation_findings"], serde_json::json!([]));
+    let meshes = report["meshes"].as_array().expect("meshes");
+    for (mesh, track) in meshes.iter().zip(&tracks) {
+        let points = mesh["points"].as_array().expect("samples");
+        let last = points.len() - 1;
+        for (sample, k) in [(0, 0), (last, track.keyframes.len() - 1)] {
+            let expected: Vec<DVec3> = track.keyframes[k].iter().map(|p| *p * 0.0018).collect();
+            assert_close(&vec3s_of(&points[sample]), &expected, 1e-8, &track.name);
+        }
+    }
+}
+
+/// A PNG of one colour, 2 x 2 pixels.
+fn plain_png(rgba: [u8; 4]) -> Vec<u8> {
+    let image = image::RgbaImage::from_pixel(2, 2, image::Rgba(rgba));
+    let mut png = Vec::new();
+    image::DynamicImage::ImageRgba8(image)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("encode");
+    png
+}
+
+/// A track whose sides look different is two single-sided meshes: the
+/// outer one references the inner one's points, winds its triangles the
+/// other way and has its own texture.
+#[test]
+fn a_two_sided_track_gets_an_outer_mesh_over_the_same_points() {
+    let mut tracks = fixture(3);
+    tracks[0].base_color_png = Some(plain_png([230, 20, 20, 255]));
+    tracks[0].outer_color_png = Some(plain_png([20, 40, 220, 255]));
+    tracks[0].base_color = [1.0; 4];
+    for file in ["two.usda", "two.usdc"] {
+        let report = write_and_read(&tracks, &UsdOptions::default(), file);
+        assert_eq!(
+            report["validation_findings"],
+            serde_json::json!([]),
+            "{file}"
+        );
+        let meshes = report["meshes"].as_array().expect("meshes");
+        let mesh = |path: &str| {
+            meshes
+                .iter()
+                .find(|m| m["path"] == path)
+                .unwrap_or_else(|| panic!("{path} in {file}"))
+        };
+        let (inner, outer) = (mesh("/flower/petal"), mesh("/flower/petal_outer"));
+        assert_eq!(
+            (&inner["double_sided"], &outer["double_sided"]),
+            (&false.into(), &false.into())
+        );
+        assert_eq!(outer["points"], inner["points"], "{file}: the same points");
+        assert!(
+            outer["normals"].is_null(),
+            "{file}: normals left to the client"
+        );
+        let reversed: Vec<i64> = inner["face_vertex_indices"]
+            .as_array()
+            .expect("indices")
+            .chunks(3)
+            .flat_map(|t| [t[0].as_i64(), t[2].as_i64(), t[1].as_i64()])
+            .map(|i| i.expect("index"))
+            .collect();
+        assert_eq!(outer["face_vertex_indices"], serde_json::json!(reversed));
+        assert_eq!(
+            inner["material"]["diffuse_source"]["file"],
+            "./two_textures/petal.png"
+        );
+        assert_eq!(
+            outer["material"]["diffuse_source"]["file"],
+            "./two_textures/petal_outer.png"
+        );
+        // The sepal, one colour on both sides, stays one double-sided mesh.
+        assert_eq!(mesh("/flower/sepal")["double_sided"], true);
+        assert!(meshes.iter().all(|m| m["path"] != "/flower/sepal_outer"));
+    }
 }

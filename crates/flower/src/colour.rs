@@ -33,6 +33,30 @@ pub struct ColourLayer {
     pub color: [f32; 4],
     /// How much of `color` shows, values in `[0, 1]`, any size.
     pub mix: ScalarMap,
+    /// The side of the organ it is painted on (the lily's spots are on the
+    /// inner side only).
+    pub side: Side,
+}
+
+/// A side of an organ: the inner (adaxial) side faces the flower axis in
+/// the bud (the side mesh normals point to), the outer (abaxial) side away.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Side {
+    /// Both sides alike.
+    #[default]
+    Both,
+    /// The inner side only.
+    Inner,
+    /// The outer side only.
+    Outer,
+}
+
+impl Side {
+    /// Whether something on this side shows on `seen` (`Inner` or `Outer`;
+    /// `Both` sees everything).
+    pub fn shows_on(self, seen: Side) -> bool {
+        self == Side::Both || seen == Side::Both || self == seen
+    }
 }
 
 /// `under` blended towards `over` by `t` in `[0, 1]`.
@@ -59,16 +83,37 @@ impl Template {
     /// towards the second colour by the mix map's (bilinear) value there
     /// (then towards each further layer's colour by its map), or the base
     /// colour when the template has no colouring.
+    ///
+    /// This is the inner side (what the paint panel shows): see
+    /// [`Template::colour_on`] for either side.
     pub fn colour_at(&self, uv: DVec2) -> [f32; 4] {
+        self.colour_on(Side::Inner, uv)
+    }
+
+    /// The linear RGBA colour at `uv` on `side`, as [`Template::colour_at`]
+    /// with only the layers painted on that side.
+    pub fn colour_on(&self, side: Side, uv: DVec2) -> [f32; 4] {
         match &self.colouring {
             None => self.color,
             Some(colouring) => {
                 let second = blend(self.color, colouring.second_color, colouring.mix.sample(uv));
-                colouring.layers.iter().fold(second, |under, layer| {
-                    blend(under, layer.color, layer.mix.sample(uv))
-                })
+                colouring
+                    .layers
+                    .iter()
+                    .filter(|layer| layer.side.shows_on(side))
+                    .fold(second, |under, layer| {
+                        blend(under, layer.color, layer.mix.sample(uv))
+                    })
             }
         }
+    }
+
+    /// Whether the two sides of the organ look different (a colour layer on
+    /// one side only).
+    pub fn is_two_sided(&self) -> bool {
+        self.colouring
+            .as_ref()
+            .is_some_and(|c| c.layers.iter().any(|layer| layer.side != Side::Both))
     }
 
     /// The template's colouring, ready to paint: made when missing (the
@@ -108,13 +153,34 @@ impl Template {
     /// (`v` near 1), so `v = 0` is the bottom row, as map images are; alpha
     /// is stored linearly.
     pub fn colour_image(&self, width: u32, height: u32) -> image::RgbaImage {
+        self.colour_image_on(Side::Inner, width, height)
+    }
+
+    /// [`Template::colour_image`] of `side`.
+    pub fn colour_image_on(&self, side: Side, width: u32, height: u32) -> image::RgbaImage {
         let (width, height) = (width.max(1), height.max(1));
         image::RgbaImage::from_fn(width, height, |x, y| {
             let uv = DVec2::new(
                 (f64::from(x) + 0.5) / f64::from(width),
                 1.0 - (f64::from(y) + 0.5) / f64::from(height),
             );
-            image::Rgba(srgb8(self.colour_at(uv)))
+            image::Rgba(srgb8(self.colour_on(side, uv)))
+        })
+    }
+
+    /// Both sides in one image for the renderer: the inner side's
+    /// [`Template::colour_image_on`] on the left half, the outer side's on
+    /// the right (`2 width` x `height` pixels).
+    pub fn colour_atlas(&self, width: u32, height: u32) -> image::RgbaImage {
+        let inner = self.colour_image_on(Side::Inner, width, height);
+        let outer = self.colour_image_on(Side::Outer, width, height);
+        let (w, h) = inner.dimensions();
+        image::RgbaImage::from_fn(2 * w, h, |x, y| {
+            if x < w {
+                *inner.get_pixel(x, y)
+            } else {
+                *outer.get_pixel(x - w, y)
+            }
         })
     }
 }
@@ -215,12 +281,45 @@ mod tests {
             layers: vec![ColourLayer {
                 color: [0.0, 0.0, 1.0, 1.0],
                 mix: ScalarMap::from_fn(4, 16, |uv| if uv.y < 0.5 { 1.0 } else { 0.0 }),
+                side: Side::Both,
             }],
         }));
+        assert!(!t.is_two_sided());
         assert_eq!(t.colour_at(DVec2::new(0.1, 0.9)), [0.0, 1.0, 0.0, 1.0]);
         assert_eq!(t.colour_at(DVec2::new(0.9, 0.9)), [1.0, 0.0, 0.0, 1.0]);
         assert_eq!(t.colour_at(DVec2::new(0.1, 0.1)), [0.0, 0.0, 1.0, 1.0]);
         assert_eq!(t.colour_at(DVec2::new(0.9, 0.1)), [0.0, 0.0, 1.0, 1.0]);
         assert_eq!(t.colour_image_size(), (8, 16));
+    }
+
+    #[test]
+    fn a_layer_on_one_side_shows_on_that_side_only() {
+        // Blue spots over the bottom half of the inner side; green over the
+        // left half of both sides.
+        let t = template(Some(Colouring {
+            second_color: [0.0, 1.0, 0.0, 1.0],
+            mix: ScalarMap::from_fn(8, 8, |uv| if uv.x < 0.5 { 1.0 } else { 0.0 }),
+            layers: vec![ColourLayer {
+                color: [0.0, 0.0, 1.0, 1.0],
+                mix: ScalarMap::from_fn(4, 16, |uv| if uv.y < 0.5 { 1.0 } else { 0.0 }),
+                side: Side::Inner,
+            }],
+        }));
+        assert!(t.is_two_sided());
+        let bottom_left = DVec2::new(0.1, 0.1);
+        assert_eq!(t.colour_on(Side::Inner, bottom_left), [0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(t.colour_at(bottom_left), [0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(t.colour_on(Side::Outer, bottom_left), [0.0, 1.0, 0.0, 1.0]);
+        assert_eq!(
+            t.colour_on(Side::Outer, DVec2::new(0.9, 0.1)),
+            [1.0, 0.0, 0.0, 1.0]
+        );
+        // The atlas: inner on the left, outer on the right; row 15 is v near 0.
+        let atlas = t.colour_atlas(8, 16);
+        assert_eq!(atlas.dimensions(), (16, 16));
+        assert_eq!(atlas.get_pixel(0, 15).0, [0, 0, 255, 255]);
+        assert_eq!(atlas.get_pixel(8, 15).0, [0, 255, 0, 255]);
+        assert_eq!(atlas.get_pixel(15, 15).0, [255, 0, 0, 255]);
+        assert_eq!(atlas.get_pixel(8, 0).0, [0, 255, 0, 255]);
     }
 }

@@ -14,13 +14,15 @@ pub mod resolution;
 pub mod scale;
 pub mod sketched_bud;
 pub mod structure;
+pub mod unit;
 
 pub use colour::{
-    COLOUR_PAINT_SIZE, ColourLayer, Colouring, DEFAULT_SECOND_COLOR, MAX_BAKED_SIDE, srgb8,
+    COLOUR_PAINT_SIZE, ColourLayer, Colouring, DEFAULT_SECOND_COLOR, MAX_BAKED_SIDE, Side, srgb8,
     srgb8_to_linear,
 };
 pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
 pub use resolution::Resolution;
+pub use unit::{Unit, UnitError};
 
 use anthesis_maps::KeyedMaps;
 use anthesis_mesh::Mesh;
@@ -339,6 +341,11 @@ pub struct Flower {
     /// receptacle): shown, exported, and obstacles to the growing organs
     /// (see [`parts`]).
     pub parts: Vec<parts::Part>,
+    /// What one of its lengths is in the real world (`unit = "1.8 mm"` in
+    /// the project file); `None` where the project does not say, which
+    /// exports take as one metre, as they did before projects said. Only
+    /// what leaves the program is scaled by it (see [`unit`]).
+    pub unit: Option<Unit>,
 }
 
 impl Flower {

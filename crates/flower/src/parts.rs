@@ -524,6 +524,22 @@ pub fn part_pieces(flower: &Flower) -> Vec<PartPiece> {
     pieces
 }
 
+/// One line per piece of [`part_pieces`], as `anthesis info` lists them
+/// after the organs: `part NAME VERTICES TRIANGLES`.
+pub fn part_lines(flower: &Flower) -> Vec<String> {
+    part_pieces(flower)
+        .iter()
+        .map(|piece| {
+            format!(
+                "part {} {} {}",
+                piece.name,
+                piece.mesh.vertex_count(),
+                piece.mesh.triangle_count()
+            )
+        })
+        .collect()
+}
+
 /// The tubes the flower's L-system draws with `F` (see
 /// [`crate::structure::Structure::segments`]), named `segment-1`, … in the
 /// word's order, in the colour `;` set (the stem's colour by default);

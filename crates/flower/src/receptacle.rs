@@ -137,6 +137,7 @@ mod tests {
             overlaps: Vec::new(),
             structure: None,
             parts: Vec::new(),
+            unit: None,
         };
         // The farthest base is 5 from the axis (its height does not count).
         assert_eq!(

@@ -450,6 +450,7 @@ mod tests {
             overlaps: Vec::new(),
             structure: None,
             parts: Vec::new(),
+            unit: None,
         }
     }
 

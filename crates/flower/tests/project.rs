@@ -171,6 +171,7 @@ fn lily() -> Project {
             overlaps: vec![Overlap { inner: 0, outer: 2 }],
             structure: None,
             parts: Vec::new(),
+            unit: None,
         },
         settings: SimulationSettings {
             keyframes: 80,
@@ -221,6 +222,47 @@ fn files_under(folder: &Path) -> HashMap<PathBuf, Vec<u8>> {
         }
     }
     files
+}
+
+#[test]
+fn a_project_states_its_unit_or_keeps_the_old_meaning() {
+    let (_folder, path) = saved_lily();
+    let loaded = anthesis_flower::project::load_project_with_warnings(&path).expect("loads");
+    assert_eq!(loaded.project.flower.unit, None);
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    // A unit is saved (as version 9) and read back as written.
+    let mut project = lily();
+    project.flower.unit = anthesis_flower::Unit::millimetres(1.8);
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(
+        text.contains("version = 9\nname = 'Asiatic lily \"test\"'\nunit = \"1.8 mm\"\n"),
+        "{text}"
+    );
+    let loaded = anthesis_flower::project::load_project_with_warnings(&path).expect("loads");
+    assert_eq!(loaded.project, project);
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    // A colour layer on one side is saved with its side.
+    let mut colouring = project.flower.templates[0].colouring_to_paint().clone();
+    colouring.layers.push(ColourLayer {
+        color: [0.5, 0.0, 0.1, 1.0],
+        mix: exact_raster(4, 4, |uv| uv.y),
+        side: anthesis_flower::Side::Inner,
+    });
+    project.flower.templates[0].colouring = Some(colouring);
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("side = \"inner\""), "{text}");
+    assert_eq!(load_project(&path).expect("loads"), project);
+    // What is not a length is refused, naming the field.
+    edit(&path, |t| {
+        replace_once(t, "unit = \"1.8 mm\"", "unit = \"1.8 furlongs\"")
+    });
+    let error = load_project(&path).expect_err("not a unit").to_string();
+    assert!(
+        error.contains("unit: `1.8 furlongs` is not a length"),
+        "{error}"
+    );
 }
 
 #[test]
@@ -1960,6 +2002,7 @@ fn a_constant_colour_map_is_a_number_and_layers_are_saved() {
         layers: vec![ColourLayer {
             color: [0.9, 0.9, 0.1, 1.0],
             mix: exact_raster(4, 4, |uv| uv.x),
+            side: anthesis_flower::Side::Both,
         }],
     });
     save_project(&project, &path).expect("save");

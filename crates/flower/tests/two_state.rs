@@ -73,6 +73,7 @@ fn project(velocity: VelocityCurve) -> Project {
             overlaps: Vec::new(),
             structure: None,
             parts: Vec::new(),
+            unit: None,
         },
         settings: SimulationSettings {
             keyframes: 50,

@@ -324,6 +324,8 @@ pub fn apple_at(edge_scale: f64) -> Result<Project, GardenError> {
             overlaps: arrangement.overlaps,
             structure: Some(structure),
             parts: crate::parts::apple_parts(APPLE_STEM),
+            // Petals about 2.5 cm long when open (about 21 units).
+            unit: anthesis_flower::Unit::millimetres(1.2),
         },
         settings,
     })

@@ -148,6 +148,8 @@ pub(crate) fn five_petal_at(edge_scale: f64) -> Result<Project, GardenError> {
                 contorted: false,
             }),
             parts: Vec::new(),
+            // Petals about 2 cm long.
+            unit: anthesis_flower::Unit::millimetres(1.0),
         },
         settings: SimulationSettings::default(),
     })

@@ -389,6 +389,8 @@ fn lily_colouring(seed: u64, count: usize) -> Colouring {
         layers: vec![ColourLayer {
             color: LILY_CRIMSON,
             mix: colour_map(spotted),
+            // The spots are inside the flower only.
+            side: anthesis_flower::Side::Inner,
         }],
     }
 }
@@ -453,6 +455,8 @@ pub(crate) fn lily_at(edge_scale: f64) -> Result<Project, GardenError> {
             overlaps: arrangement.overlaps,
             structure: None,
             parts: crate::parts::lily_parts(),
+            // Tepals about 9 cm long when open (about 50 units).
+            unit: anthesis_flower::Unit::millimetres(1.8),
         },
         settings: SimulationSettings::default(),
     })
@@ -783,6 +787,8 @@ pub fn eustoma_of(
             overlaps: arrangement.overlaps,
             structure: None,
             parts: crate::parts::eustoma_parts(),
+            // Petals about 5 cm long when open (about 50 units).
+            unit: anthesis_flower::Unit::millimetres(1.0),
         },
         settings: SimulationSettings::default(),
     })

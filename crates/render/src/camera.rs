@@ -25,6 +25,31 @@ pub struct Camera {
 const FRAMING_MARGIN: f64 = 1.08;
 
 impl Camera {
+    /// The camera the viewport's `F` frames `points_in_world` with
+    /// ([`crate::OrbitCamera::frame_points`]): from `azimuth_deg` and
+    /// `elevation_deg`, at the centre of their box, as close as keeps every
+    /// point within `fill` of the way from the image's centre to the middle
+    /// of its shorter side (0.8: the flower fills most of the picture). The
+    /// points themselves are framed, not their box, whose corners lie far
+    /// outside a round flower. `None` without points.
+    pub fn framing_points(
+        points_in_world: &[DVec3],
+        azimuth_deg: f64,
+        elevation_deg: f64,
+        fill: f64,
+    ) -> Option<Camera> {
+        if points_in_world.is_empty() {
+            return None;
+        }
+        let mut orbit = crate::OrbitCamera {
+            azimuth_deg,
+            elevation_deg,
+            ..crate::OrbitCamera::default()
+        };
+        orbit.frame_points(points_in_world, fill);
+        Some(orbit.camera())
+    }
+
     /// A camera that fits the box `[bounds_min, bounds_max]` with a 30°
     /// field of view, looking at the box centre from `azimuth_deg` around
     /// +Y (0 = from +Z, 90 = from +X) and `elevation_deg` above the XZ plane

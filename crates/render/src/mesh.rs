@@ -39,6 +39,10 @@ pub struct OrganTexture {
     pub uvs: Vec<[f32; 2]>,
     /// 8-bit sRGB-encoded RGBA, row 0 at the top (`v` near 1).
     pub image: Arc<image::RgbaImage>,
+    /// The image holds both sides: the inner side (the front, which the
+    /// normals point to) on its left half, the outer side on its right
+    /// half (`Template::colour_atlas`).
+    pub two_sided: bool,
 }
 
 impl OrganMesh {
@@ -67,7 +71,27 @@ impl OrganMesh {
     /// multiplied with its colour (so use white to show the image as it
     /// is).
     pub fn with_texture(mut self, uvs: Vec<[f32; 2]>, image: Arc<image::RgbaImage>) -> OrganMesh {
-        self.texture = Some(OrganTexture { uvs, image });
+        self.texture = Some(OrganTexture {
+            uvs,
+            image,
+            two_sided: false,
+        });
+        self
+    }
+
+    /// Paints the organ's two sides differently: `atlas` holds the inner
+    /// side's image on its left half and the outer side's on its right
+    /// (see [`OrganTexture::two_sided`]).
+    pub fn with_two_sided_texture(
+        mut self,
+        uvs: Vec<[f32; 2]>,
+        atlas: Arc<image::RgbaImage>,
+    ) -> OrganMesh {
+        self.texture = Some(OrganTexture {
+            uvs,
+            image: atlas,
+            two_sided: true,
+        });
         self
     }
 

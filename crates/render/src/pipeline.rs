@@ -483,6 +483,30 @@ impl OrganPipeline {
         self.organs.len()
     }
 
+    /// Writes each organ's colour and flags into the uniform buffer (which
+    /// holds at least `organs.len()` of them).
+    fn write_organ_uniforms(&self, queue: &wgpu::Queue, organs: &[OrganMesh]) {
+        let stride = self.organ_uniform_stride as usize;
+        let mut uniform_bytes = vec![0_u8; stride * organs.len()];
+        let flag = |on: bool| if on { 1.0 } else { 0.0 };
+        for (i, mesh) in organs.iter().enumerate() {
+            let uniform = OrganUniform {
+                color_linear: mesh.color_linear,
+                overlay_mix: [
+                    flag(mesh.overlay.is_some()),
+                    flag(mesh.texture.as_ref().is_some_and(|t| t.two_sided)),
+                    0.0,
+                    0.0,
+                ],
+            };
+            uniform_bytes[i * stride..i * stride + size_of::<OrganUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&uniform));
+        }
+        if !uniform_bytes.is_empty() {
+            queue.write_buffer(&self.organ_uniform_buffer, 0, &uniform_bytes);
+        }
+    }
+
     /// Uploads `organs`, replacing the previous ones. Buffers are reused
     /// while the new data fits, so calling this every animation frame is
     /// fine. Nothing is uploaded when an organ is malformed.
@@ -509,24 +533,7 @@ impl OrganPipeline {
             self.organ_bind_group = bind_group;
             self.organ_uniform_capacity = capacity;
         }
-        let stride = self.organ_uniform_stride as usize;
-        let mut uniform_bytes = vec![0_u8; stride * organs.len()];
-        for (i, mesh) in organs.iter().enumerate() {
-            let uniform = OrganUniform {
-                color_linear: mesh.color_linear,
-                overlay_mix: [
-                    if mesh.overlay.is_some() { 1.0 } else { 0.0 },
-                    0.0,
-                    0.0,
-                    0.0,
-                ],
-            };
-            uniform_bytes[i * stride..i * stride + size_of::<OrganUniform>()]
-                .copy_from_slice(bytemuck::bytes_of(&uniform));
-        }
-        if !uniform_bytes.is_empty() {
-            queue.write_buffer(&self.organ_uniform_buffer, 0, &uniform_bytes);
-        }
+        self.write_organ_uniforms(queue, organs);
 
         self.organs.truncate(organs.len());
         for (i, mesh) in organs.iter().enumerate() {

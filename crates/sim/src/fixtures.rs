@@ -181,6 +181,7 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
             overlaps,
             structure: None,
             parts: Vec::new(),
+            unit: None,
         },
         settings: SimulationSettings {
             keyframes,

@@ -45,6 +45,7 @@ fn flat_petal(key_dg: Option<f64>) -> Project {
             overlaps: Vec::new(),
             structure: None,
             parts: Vec::new(),
+            unit: None,
         },
         settings: SimulationSettings {
             keyframes: 10,

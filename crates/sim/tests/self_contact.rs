@@ -77,6 +77,7 @@ fn folded(rows: usize, keyframes: u32, band: (f64, f64), dg: f64) -> Project {
             overlaps: Vec::new(),
             structure: None,
             parts: Vec::new(),
+            unit: None,
         },
         settings: SimulationSettings {
             keyframes,

@@ -154,6 +154,11 @@ pub(super) struct GltfBuilder {
     /// compressed stream instead of one per accessor keeps the JSON and
     /// the per-stream overhead small (hundreds of morph targets).
     groups: Vec<Group>,
+    /// While set ([`GltfBuilder::share_accessors`]): the vertex accessors
+    /// made so far by their kind and bytes, so an identical one asked for
+    /// again is the same accessor (the outer side of a two-sided track
+    /// shares its positions, UVs and position targets with the inner side).
+    shared: Option<Vec<(Vec<u8>, usize)>>,
 }
 
 /// Vertex data waiting to become one shared buffer view.
@@ -174,7 +179,37 @@ impl GltfBuilder {
             meshopt: encoding == Encoding::Meshopt,
             fallback_len: 0,
             groups: Vec::new(),
+            shared: None,
         }
+    }
+
+    /// Starts (`true`) or ends sharing identical vertex accessors (see
+    /// [`GltfBuilder::shared`]).
+    pub(super) fn share_accessors(&mut self, on: bool) {
+        self.shared = on.then(Vec::new);
+    }
+
+    /// The accessor made earlier for `key` while sharing.
+    fn recall(&self, key: &[u8]) -> Option<usize> {
+        let shared = self.shared.as_ref()?;
+        shared.iter().find(|(k, _)| k == key).map(|(_, i)| *i)
+    }
+
+    /// Keeps `accessor` as the one for `key` while sharing.
+    fn remember(&mut self, key: Vec<u8>, accessor: usize) -> usize {
+        if let Some(shared) = &mut self.shared {
+            shared.push((key, accessor));
+        }
+        accessor
+    }
+
+    /// The sharing key of an accessor: what kind it is and its bytes.
+    fn key(&self, kind: &str, bytes: &[u8]) -> Option<Vec<u8>> {
+        self.shared.as_ref()?;
+        let mut key = kind.as_bytes().to_vec();
+        key.push(0);
+        key.extend_from_slice(bytes);
+        Some(key)
     }
 
     /// Appends `bytes` 4-byte aligned as a new buffer view.
@@ -347,11 +382,19 @@ impl GltfBuilder {
 
     pub(super) fn vec3_f32(&mut self, values: &[[f32; 3]], with_min_max: bool) -> usize {
         let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
+        let key = self.key(&format!("vec3 f32 {with_min_max}"), &bytes);
+        if let Some(shared) = key.as_deref().and_then(|k| self.recall(k)) {
+            return shared;
+        }
         let mut accessor = self.stored_vertices(&bytes, 12, false, VEC3_F32, values.len());
         if with_min_max {
             set_min_max(&mut accessor, values);
         }
-        self.accessor(accessor)
+        let index = self.accessor(accessor);
+        match key {
+            Some(key) => self.remember(key, index),
+            None => index,
+        }
     }
 
     /// A morph-target delta accessor; with [`Encoding::Sparse`] only the
@@ -364,6 +407,11 @@ impl GltfBuilder {
     ) -> usize {
         if encoding != Encoding::Sparse {
             return self.vec3_f32(deltas, with_min_max);
+        }
+        let bytes = le_bytes(deltas.iter().flatten().copied(), f32::to_le_bytes);
+        let key = self.key(&format!("sparse vec3 f32 {with_min_max}"), &bytes);
+        if let Some(shared) = key.as_deref().and_then(|k| self.recall(k)) {
+            return shared;
         }
         let mut moved: Vec<usize> = deltas
             .iter()
@@ -390,7 +438,11 @@ impl GltfBuilder {
         }
         let values = le_bytes(moved.iter().flat_map(|&i| deltas[i]), f32::to_le_bytes);
         self.add_sparse(&mut accessor, &moved, index_type, &values);
-        self.accessor(accessor)
+        let index = self.accessor(accessor);
+        match key {
+            Some(key) => self.remember(key, index),
+            None => index,
+        }
     }
 
     /// Makes `accessor` (one with no buffer view, so all zeros) sparse:
@@ -417,12 +469,20 @@ impl GltfBuilder {
         self.uses_quantization = true;
         let padded = values.iter().flat_map(|v| [v[0], v[1], v[2], 0]);
         let bytes = le_bytes(padded, i16::to_le_bytes);
+        let key = self.key(&format!("vec3 i16 {with_min_max}"), &bytes);
+        if let Some(shared) = key.as_deref().and_then(|k| self.recall(k)) {
+            return shared;
+        }
         let element = Element::normalized(SHORT, "VEC3");
         let mut accessor = self.stored_vertices(&bytes, 8, true, element, values.len());
         if with_min_max {
             set_min_max(&mut accessor, values);
         }
-        self.accessor(accessor)
+        let index = self.accessor(accessor);
+        match key {
+            Some(key) => self.remember(key, index),
+            None => index,
+        }
     }
 
     /// Normalized `i8` VEC3, padded to a 4-byte stride.
@@ -437,16 +497,32 @@ impl GltfBuilder {
 
     pub(super) fn vec2_f32(&mut self, values: &[[f32; 2]]) -> usize {
         let bytes = le_bytes(values.iter().flatten().copied(), f32::to_le_bytes);
+        let key = self.key("vec2 f32", &bytes);
+        if let Some(shared) = key.as_deref().and_then(|k| self.recall(k)) {
+            return shared;
+        }
         let element = Element::plain(FLOAT, "VEC2");
         let accessor = self.stored_vertices(&bytes, 8, false, element, values.len());
-        self.accessor(accessor)
+        let index = self.accessor(accessor);
+        match key {
+            Some(key) => self.remember(key, index),
+            None => index,
+        }
     }
 
     pub(super) fn vec2_u16_normalized(&mut self, values: &[[u16; 2]]) -> usize {
         let bytes = le_bytes(values.iter().flatten().copied(), u16::to_le_bytes);
+        let key = self.key("vec2 u16", &bytes);
+        if let Some(shared) = key.as_deref().and_then(|k| self.recall(k)) {
+            return shared;
+        }
         let element = Element::normalized(UNSIGNED_SHORT, "VEC2");
         let accessor = self.stored_vertices(&bytes, 4, false, element, values.len());
-        self.accessor(accessor)
+        let index = self.accessor(accessor);
+        match key {
+            Some(key) => self.remember(key, index),
+            None => index,
+        }
     }
 
     pub(super) fn indices(&mut self, triangles: &[[u32; 3]], vertex_count: usize) -> usize {

@@ -67,9 +67,7 @@ pub fn glb_bytes(
     let mut nodes = Vec::with_capacity(tracks.len());
     let mut meshes = Vec::with_capacity(tracks.len());
     let mut materials = Vec::with_capacity(tracks.len());
-    let mut images = Vec::new();
-    let mut textures = Vec::new();
-    let mut stored_pngs: Vec<&Vec<u8>> = Vec::new();
+    let mut textures = Textures::default();
     let mut animated_nodes = Vec::new();
     let mut top_nodes = Vec::with_capacity(tracks.len());
     // Rigid tracks: the node that moves, and its pose at each exported
@@ -78,56 +76,19 @@ pub fn glb_bytes(
 
     for (index, track) in tracks.iter().enumerate() {
         let rigid = track.rigid.as_ref().filter(|_| track.keyframes.len() > 1);
-        let frames: Vec<Vec<DVec3>> = if let Some(rigid) = rigid {
-            vec![rigid.local.clone()]
-        } else if track.keyframes.len() > 1 {
-            sample_at
-                .iter()
-                .map(|&x| sample_keyframes(&track.keyframes, x))
-                .collect()
-        } else {
-            vec![track.keyframes[0].clone()]
-        };
+        let frames = frames_in_metres(track, &sample_at);
+        let inner_material = materials.len();
+        materials.push(material(&mut gltf, &mut textures, track, Face::Inner));
 
-        let mut material = json!({
-            "name": track.name,
-            "pbrMetallicRoughness": {
-                "baseColorFactor": track.base_color.map(f32_json),
-                "metallicFactor": 0.0,
-                "roughnessFactor": 0.7,
-            },
-            "doubleSided": true,
-        });
-        if track.base_color[3] < 1.0 {
-            material["alphaMode"] = json!("BLEND");
-        }
-        if let Some(png) = &track.base_color_png {
-            // Organs of one template share its colour map: one image and
-            // texture for each distinct PNG.
-            let texture = match stored_pngs.iter().position(|stored| *stored == png) {
-                Some(texture) => texture,
-                None => {
-                    let view = gltf.view(png, None, None);
-                    images.push(json!({
-                        "name": track.name,
-                        "bufferView": view,
-                        "mimeType": "image/png",
-                    }));
-                    textures.push(json!({ "sampler": 0, "source": images.len() - 1 }));
-                    stored_pngs.push(png);
-                    textures.len() - 1
-                }
-            };
-            material["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": texture });
-        }
-        materials.push(material);
-
+        // A two-sided track's outer primitive shares every accessor whose
+        // data is the same as the inner one's (all but normals and indices).
+        gltf.share_accessors(track.outer_color_png.is_some());
         let encoded = encode_mesh(&mut gltf, track, &frames, options, &mut || tick(progress));
 
         let mut primitive = json!({
             "attributes": encoded.attributes,
             "indices": encoded.indices,
-            "material": index,
+            "material": inner_material,
             "mode": TRIANGLES,
         });
         let mut mesh = json!({ "name": track.name });
@@ -137,7 +98,20 @@ pub fn glb_bytes(
             mesh["extras"] = json!({ "targetNames": target_names });
             animated_nodes.push(nodes.len());
         }
-        mesh["primitives"] = json!([primitive]);
+        let mut primitives = vec![primitive];
+        if track.outer_color_png.is_some() {
+            let outer_material = materials.len();
+            materials.push(material(&mut gltf, &mut textures, track, Face::Outer));
+            primitives.push(outer_primitive(
+                &mut gltf,
+                track,
+                &frames,
+                options,
+                outer_material,
+            ));
+        }
+        gltf.share_accessors(false);
+        mesh["primitives"] = Value::Array(primitives);
         meshes.push(mesh);
 
         let top = nodes.len();
@@ -153,10 +127,7 @@ pub fn glb_bytes(
         if let Some(rigid) = rigid {
             // The mesh (with its dequantisation) hangs below a node that
             // carries the rigid motion.
-            let poses: Vec<Pose> = sample_at
-                .iter()
-                .map(|&x| sample_pose(&rigid.poses, x))
-                .collect();
+            let poses = poses_in_metres(&rigid.poses, &sample_at, track.unit.metres());
             let mover_index = nodes.len();
             let mut mover = json!({ "name": track.name, "children": [mover_index + 1] });
             set_pose(&mut mover, &poses[0]);
@@ -181,20 +152,209 @@ pub fn glb_bytes(
     });
 
     if !animated_nodes.is_empty() || !moving_nodes.is_empty() {
-        let sample_times = animation_times(options.timing, keyframe_count, &sample_at)?;
+        let animation = Animation {
+            sample_at: &sample_at,
+            keyframe_count,
+            target_count,
+            morphed: &animated_nodes,
+            moving: &moving_nodes,
+        };
+        root["animations"] = json!([animation.json(&mut gltf, options)?]);
+    }
+    textures.add_to(&mut root);
+    if gltf.uses_quantization {
+        root["extensionsUsed"] = json!([KHR_MESH_QUANTIZATION]);
+        root["extensionsRequired"] = json!([KHR_MESH_QUANTIZATION]);
+    }
+
+    let bytes = gltf.finish(root)?;
+    progress(1.0);
+    Ok(bytes)
+}
+
+/// The outer side of a two-sided track: the same surface wound the other
+/// way (its normals point outwards), drawn with `material` (the outer
+/// texture); its accessors with the same data as the inner side's are the
+/// inner side's while the builder shares them.
+fn outer_primitive(
+    gltf: &mut GltfBuilder,
+    track: &Track,
+    frames: &[Vec<DVec3>],
+    options: &GlbOptions,
+    material: usize,
+) -> Value {
+    let flipped = Track {
+        triangles: track.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+        ..track.clone()
+    };
+    let outer = encode_mesh(gltf, &flipped, frames, options, &mut || {});
+    let mut primitive = json!({
+        "attributes": outer.attributes,
+        "indices": outer.indices,
+        "material": material,
+        "mode": TRIANGLES,
+    });
+    if !outer.targets.is_empty() {
+        primitive["targets"] = Value::Array(outer.targets);
+    }
+    primitive
+}
+
+/// A rigid track's poses at the exported keyframe positions `sample_at`,
+/// their translations in metres.
+fn poses_in_metres(poses: &[Pose], sample_at: &[f64], metres: f64) -> Vec<Pose> {
+    sample_at
+        .iter()
+        .map(|&x| {
+            let pose = sample_pose(poses, x);
+            Pose {
+                translation: pose.translation * metres,
+                ..pose
+            }
+        })
+        .collect()
+}
+
+/// The positions of `track` the .glb stores, in metres: a rigid track's
+/// mesh in its own frame, an animated track's at each exported keyframe
+/// position `sample_at`, a still track's one keyframe.
+fn frames_in_metres(track: &Track, sample_at: &[f64]) -> Vec<Vec<DVec3>> {
+    let frames: Vec<Vec<DVec3>> = match &track.rigid {
+        Some(rigid) if track.keyframes.len() > 1 => vec![rigid.local.clone()],
+        _ if track.keyframes.len() > 1 => sample_at
+            .iter()
+            .map(|&x| sample_keyframes(&track.keyframes, x))
+            .collect(),
+        _ => vec![track.keyframes[0].clone()],
+    };
+    let metres = track.unit.metres();
+    if metres == 1.0 {
+        return frames;
+    }
+    frames
+        .into_iter()
+        .map(|frame| frame.into_iter().map(|p| p * metres).collect())
+        .collect()
+}
+
+/// The images and textures of a .glb: one for each distinct PNG.
+#[derive(Default)]
+struct Textures<'a> {
+    images: Vec<Value>,
+    textures: Vec<Value>,
+    stored: Vec<&'a Vec<u8>>,
+}
+
+impl<'a> Textures<'a> {
+    /// The texture of `png` (named after `name` when it is new).
+    fn texture(&mut self, gltf: &mut GltfBuilder, png: &'a Vec<u8>, name: &str) -> usize {
+        if let Some(texture) = self.stored.iter().position(|stored| *stored == png) {
+            return texture;
+        }
+        let view = gltf.view(png, None, None);
+        self.images.push(json!({
+            "name": name,
+            "bufferView": view,
+            "mimeType": "image/png",
+        }));
+        self.textures
+            .push(json!({ "sampler": 0, "source": self.images.len() - 1 }));
+        self.stored.push(png);
+        self.textures.len() - 1
+    }
+
+    /// Adds the images, textures and their one sampler to the glTF root.
+    fn add_to(self, root: &mut Value) {
+        if self.images.is_empty() {
+            return;
+        }
+        root["images"] = Value::Array(self.images);
+        root["textures"] = Value::Array(self.textures);
+        root["samplers"] = json!([{
+            "magFilter": LINEAR,
+            "minFilter": LINEAR_MIPMAP_LINEAR,
+            "wrapS": CLAMP_TO_EDGE,
+            "wrapT": CLAMP_TO_EDGE,
+        }]);
+    }
+}
+
+/// Which faces of a track a material is for.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Face {
+    /// The track's triangles as they are: both sides, or the inner side of
+    /// a track whose sides differ.
+    Inner,
+    /// The outer side of a track whose sides differ.
+    Outer,
+}
+
+/// The material of `track` (of its `face`): its base colour (blended when
+/// not opaque), its texture if it has one, non-metallic, double-sided
+/// unless its sides differ ([`Track::outer_color_png`]), when each side's
+/// material is single-sided.
+fn material<'a>(
+    gltf: &mut GltfBuilder,
+    textures: &mut Textures<'a>,
+    track: &'a Track,
+    face: Face,
+) -> Value {
+    let two_sided = track.outer_color_png.is_none();
+    let name = match face {
+        Face::Inner => track.name.clone(),
+        Face::Outer => format!("{} outer", track.name),
+    };
+    let mut material = json!({
+        "name": name,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": track.base_color.map(f32_json),
+            "metallicFactor": 0.0,
+            "roughnessFactor": 0.7,
+        },
+        "doubleSided": two_sided,
+    });
+    if track.base_color[3] < 1.0 {
+        material["alphaMode"] = json!("BLEND");
+    }
+    let png = match face {
+        Face::Inner => &track.base_color_png,
+        Face::Outer => &track.outer_color_png,
+    };
+    if let Some(png) = png {
+        // Organs of one template share its colour map: one image and
+        // texture for each distinct PNG.
+        let texture = textures.texture(gltf, png, &name);
+        material["pbrMetallicRoughness"]["baseColorTexture"] = json!({ "index": texture });
+    }
+    material
+}
+
+/// The one animation of a .glb: morph weights of the animated meshes'
+/// nodes and poses of the rigid tracks' nodes, at the exported keyframes.
+struct Animation<'a> {
+    sample_at: &'a [f64],
+    keyframe_count: usize,
+    target_count: usize,
+    morphed: &'a [usize],
+    moving: &'a [(usize, Vec<Pose>)],
+}
+
+impl Animation<'_> {
+    fn json(&self, gltf: &mut GltfBuilder, options: &GlbOptions) -> Result<Value, ExportError> {
+        let sample_times = animation_times(options.timing, self.keyframe_count, self.sample_at)?;
         let input = gltf.times(&sample_times);
         let mut samplers = Vec::new();
         let mut channels = Vec::new();
-        if !animated_nodes.is_empty() {
+        if !self.morphed.is_empty() {
             let output = gltf.weights(
-                sample_at.len(),
-                target_count,
+                self.sample_at.len(),
+                self.target_count,
                 options.encoding,
                 TargetDeltas::of(options.encoding),
             );
             // All animated meshes share the keyframe times and the weights,
             // so they share one sampler's accessors.
-            for &node in &animated_nodes {
+            for &node in self.morphed {
                 channels.push(json!({
                     "sampler": samplers.len(),
                     "target": { "node": node, "path": "weights" }
@@ -203,7 +363,7 @@ pub fn glb_bytes(
                     .push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
             }
         }
-        for (node, poses) in &moving_nodes {
+        for (node, poses) in self.moving {
             let translations: Vec<[f32; 3]> = poses
                 .iter()
                 .map(|p| p.translation.as_vec3().to_array())
@@ -224,27 +384,8 @@ pub fn glb_bytes(
                     .push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
             }
         }
-        root["animations"] =
-            json!([{ "name": "opening", "samplers": samplers, "channels": channels }]);
+        Ok(json!({ "name": "opening", "samplers": samplers, "channels": channels }))
     }
-    if !images.is_empty() {
-        root["images"] = Value::Array(images);
-        root["textures"] = Value::Array(textures);
-        root["samplers"] = json!([{
-            "magFilter": LINEAR,
-            "minFilter": LINEAR_MIPMAP_LINEAR,
-            "wrapS": CLAMP_TO_EDGE,
-            "wrapT": CLAMP_TO_EDGE,
-        }]);
-    }
-    if gltf.uses_quantization {
-        root["extensionsUsed"] = json!([KHR_MESH_QUANTIZATION]);
-        root["extensionsRequired"] = json!([KHR_MESH_QUANTIZATION]);
-    }
-
-    let bytes = gltf.finish(root)?;
-    progress(1.0);
-    Ok(bytes)
 }
 
 /// The pose at `x` (in keyframes) of a sequence of poses: a keyframe's own,

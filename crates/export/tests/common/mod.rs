@@ -66,6 +66,8 @@ pub fn organ_track(
             .collect(),
         base_color_png: None,
         rigid: None,
+        unit: anthesis_flower::Unit::METRE,
+        outer_color_png: None,
     }
 }
 

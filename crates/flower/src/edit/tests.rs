@@ -52,6 +52,7 @@ fn flower() -> Flower {
             contorted: false,
         }),
         parts: Vec::new(),
+        unit: None,
     }
 }
 

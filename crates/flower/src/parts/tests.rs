@@ -182,6 +182,7 @@ fn instances_go_around_the_axis_and_a_schedule_turns_them_outwards() {
         overlaps: Vec::new(),
         structure: None,
         parts: vec![stamens],
+        unit: None,
     };
     let pieces = part_pieces(&flower);
     let names: Vec<&str> = pieces.iter().map(|p| p.name.as_str()).collect();
@@ -231,6 +232,7 @@ fn the_pedicel_points_down_and_a_receptacle_part_replaces_the_automatic_one() {
         overlaps: Vec::new(),
         structure: None,
         parts: vec![receptacle, pedicel],
+        unit: None,
     };
     let pieces = part_pieces(&flower);
     assert_eq!(pieces.len(), 2);
@@ -255,6 +257,7 @@ fn each_closed_component_is_an_obstacle_of_its_own() {
         overlaps: Vec::new(),
         structure: None,
         parts: vec![part(pistil(), 1), part(stamen(), 2)],
+        unit: None,
     };
     let obstacles = obstacles(&flower);
     // Style, ovary and three lobes; filament and anther twice.
@@ -334,6 +337,7 @@ fn an_lsystems_f_segments_are_tubes_of_its_width_from_start_to_end() {
             units: 1.0,
         }),
         parts: Vec::new(),
+        unit: None,
     };
     let pieces = part_pieces(&flower);
     let names: Vec<&str> = pieces.iter().map(|p| p.name.as_str()).collect();

@@ -13,14 +13,14 @@ use glam::{DQuat, DVec2, DVec3};
 use super::check::{SizeCheck, check_names, check_project, check_unique};
 use super::error::{ProjectError, map_error};
 use super::schema::{
-    DirectionEntry, ProjectFile, ScalarEntry, SourceFile, StructureFile, StructureKind,
-    TemplateFile, TwoStateFile,
+    ColourLayerFile, DirectionEntry, ProjectFile, ScalarEntry, SourceFile, StructureFile,
+    StructureKind, TemplateFile, TwoStateFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::structure::{Arrangement, Spiral, Structure, Whorl};
 use crate::{
     BaseRegion, ColourLayer, Colouring, Flower, JointRamp, Organ, Overlap, Placement, Project,
-    Template, TwoStateAnimation,
+    Template, TwoStateAnimation, Unit,
 };
 use anthesis_twostate::{GrowthFunction, VelocityCurve};
 
@@ -313,6 +313,7 @@ impl Loader<'_> {
             .iter()
             .map(|part| part.part().map_err(|message| self.invalid(message)))
             .collect::<Result<Vec<_>, _>>()?;
+        let unit = self.unit(file.unit.as_deref())?;
         Ok(Project {
             name: file.name,
             flower: Flower {
@@ -321,9 +322,62 @@ impl Loader<'_> {
                 overlaps,
                 structure,
                 parts,
+                unit,
             },
             settings: file.simulation.settings(file.version),
         })
+    }
+
+    /// The project's `unit`, if it states one (one that does not keeps the
+    /// meaning every project had before units: one unit is one metre in
+    /// the exports; see [`crate::unit::unstated_note`]).
+    fn unit(&self, text: Option<&str>) -> Result<Option<Unit>, ProjectError> {
+        text.map(|text| Unit::parse(text).map_err(|error| self.invalid(format!("unit: {error}"))))
+            .transpose()
+    }
+
+    /// A template's colouring from its file entries: none, or a second
+    /// colour with its map and further layers, each on both sides or one.
+    fn colouring(
+        &self,
+        name: &str,
+        second_color: Option<[f32; 4]>,
+        colour_map: Option<ScalarEntry>,
+        colour_layers: Vec<ColourLayerFile>,
+    ) -> Result<Option<Colouring>, ProjectError> {
+        match (second_color, colour_map) {
+            (None, None) if colour_layers.is_empty() => Ok(None),
+            (Some(second_color), Some(entry)) => {
+                // Colour maps have sizes of their own (they are not simulated).
+                let mix = self.scalar_map(
+                    entry,
+                    &format!("template \"{name}\": colour_map"),
+                    &mut SizeCheck::default(),
+                )?;
+                let mut layers = Vec::with_capacity(colour_layers.len());
+                for (i, layer) in colour_layers.into_iter().enumerate() {
+                    layers.push(ColourLayer {
+                        color: layer.color,
+                        mix: self.scalar_map(
+                            layer.map,
+                            &format!("template \"{name}\": colour layer {}", i + 1),
+                            &mut SizeCheck::default(),
+                        )?,
+                        side: layer.side.into(),
+                    });
+                }
+                Ok(Some(Colouring {
+                    second_color,
+                    mix,
+                    layers,
+                }))
+            }
+            _ => Err(self.invalid(format!(
+                "template \"{name}\" has one of second_color and colour_map (or colour \
+                 layers without them); a colour map needs both (the colour it paints, \
+                 and where)"
+            ))),
+        }
     }
 
     fn template(&self, file: TemplateFile) -> Result<Template, ProjectError> {
@@ -369,40 +423,8 @@ impl Loader<'_> {
         size.finish()?;
         let maps = KeyedMaps::new(keys, Blend::from(&file.blend))
             .map_err(|error| self.invalid(format!("template \"{name}\": {error}")))?;
-        let colouring = match (file.second_color, file.colour_map) {
-            (None, None) if file.colour_layers.is_empty() => None,
-            (Some(second_color), Some(entry)) => {
-                // Colour maps have sizes of their own (they are not simulated).
-                let mix = self.scalar_map(
-                    entry,
-                    &format!("template \"{name}\": colour_map"),
-                    &mut SizeCheck::default(),
-                )?;
-                let mut layers = Vec::with_capacity(file.colour_layers.len());
-                for (i, layer) in file.colour_layers.into_iter().enumerate() {
-                    layers.push(ColourLayer {
-                        color: layer.color,
-                        mix: self.scalar_map(
-                            layer.map,
-                            &format!("template \"{name}\": colour layer {}", i + 1),
-                            &mut SizeCheck::default(),
-                        )?,
-                    });
-                }
-                Some(Colouring {
-                    second_color,
-                    mix,
-                    layers,
-                })
-            }
-            _ => {
-                return Err(self.invalid(format!(
-                    "template \"{name}\" has one of second_color and colour_map (or colour \
-                     layers without them); a colour map needs both (the colour it paints, \
-                     and where)"
-                )));
-            }
-        };
+        let colouring =
+            self.colouring(name, file.second_color, file.colour_map, file.colour_layers)?;
         let two_state = match file.two_state {
             None => None,
             Some(two) => Some(self.two_state(two, &mesh, name)?),

@@ -6,6 +6,11 @@
 //! format = "anthesis-project"
 //! version = 3
 //! name = "Asiatic lily"
+//! unit = "1.8 mm"              # optional (version 9): what one length is in
+//!                              # the real world (a number and µm, mm, cm or
+//!                              # m); exports write the flower at that size.
+//!                              # Absent: one unit is one metre, as before
+//!                              # (`anthesis info` says so)
 //!
 //! [simulation]                 # optional; each field defaults as shown
 //! keyframes = 100
@@ -222,7 +227,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 8;
+pub const FORMAT_VERSION: u32 = 9;
 
 /// Checks `project` by the rules every loaded or saved project obeys
 /// (names, counts, numbers, parts), as the app does before it takes an

@@ -295,6 +295,7 @@ mod tests {
                 overlaps: Vec::new(),
                 structure: None,
                 parts: Vec::new(),
+                unit: None,
             },
             settings: SimulationSettings::default(),
         }

@@ -66,6 +66,7 @@ pub(super) fn plan_save(
         format: FORMAT_NAME.to_string(),
         version: file_version(project),
         name: project.name.clone(),
+        unit: flower.unit.map(|unit| unit.to_string()),
         simulation: SimulationFile::from(&project.settings),
         templates,
         organs,
@@ -90,9 +91,18 @@ pub(super) fn plan_save(
 /// `mean_edge`, version 4 `[structure]` and organ orientations, version 5
 /// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
 /// `[templates.two_state]` and `[templates.source]`, version 8
-/// `[templates.vein]` and a sketched or PDE petal's `[templates.source]`).
+/// `[templates.vein]` and a sketched or PDE petal's `[templates.source]`,
+/// version 9 the project's `unit` and a colour layer's `side`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
+    let one_sided = |t: &Template| {
+        t.colouring
+            .as_ref()
+            .is_some_and(|c| c.layers.iter().any(|l| l.side != crate::Side::Both))
+    };
+    if flower.unit.is_some() || flower.templates.iter().any(one_sided) {
+        return FORMAT_VERSION;
+    }
     if flower.templates.iter().any(|t| {
         t.vein.is_some()
             || matches!(
@@ -100,7 +110,7 @@ fn file_version(project: &Project) -> u32 {
                 Some(crate::TemplateSource::Sketch { .. } | crate::TemplateSource::Pde { .. })
             )
     }) {
-        return FORMAT_VERSION;
+        return 8;
     }
     if flower
         .templates
@@ -133,6 +143,45 @@ fn file_version(project: &Project) -> u32 {
         (false, Resolution::MeanEdge(_)) => 3,
     }
 }
+
+/// The file entries of `template`'s colouring (second colour, its map and
+/// further layers); adds their raster maps to `files`.
+fn colouring_entries(
+    template: &Template,
+    stem: &str,
+    folder: &Path,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> Result<ColouringEntries, ProjectError> {
+    let Some(colouring) = &template.colouring else {
+        return Ok((None, None, Vec::new()));
+    };
+    let mut layers = Vec::with_capacity(colouring.layers.len());
+    for (i, layer) in colouring.layers.iter().enumerate() {
+        layers.push(ColourLayerFile {
+            color: layer.color,
+            map: colour_map_entry(
+                &layer.mix,
+                &format!("{stem}-colour-{}", i + 2),
+                folder,
+                files,
+            )?,
+            side: layer.side.into(),
+        });
+    }
+    Ok((
+        Some(colouring.second_color),
+        Some(colour_map_entry(
+            &colouring.mix,
+            &format!("{stem}-colour"),
+            folder,
+            files,
+        )?),
+        layers,
+    ))
+}
+
+/// A template's `second_color`, `colour_map` and `colour_layers` entries.
+type ColouringEntries = (Option<[f32; 4]>, Option<ScalarEntry>, Vec<ColourLayerFile>);
 
 /// The file entry of one template; adds its mesh and raster maps to `files`.
 pub(super) fn template_file(
@@ -201,33 +250,8 @@ pub(super) fn template_file(
         keys.push(key_file);
     }
     size.finish()?;
-    let (second_color, colour_map, colour_layers) = match &template.colouring {
-        None => (None, None, Vec::new()),
-        Some(colouring) => {
-            let mut layers = Vec::with_capacity(colouring.layers.len());
-            for (i, layer) in colouring.layers.iter().enumerate() {
-                layers.push(ColourLayerFile {
-                    color: layer.color,
-                    map: colour_map_entry(
-                        &layer.mix,
-                        &format!("{stem}-colour-{}", i + 2),
-                        folder,
-                        files,
-                    )?,
-                });
-            }
-            (
-                Some(colouring.second_color),
-                Some(colour_map_entry(
-                    &colouring.mix,
-                    &format!("{stem}-colour"),
-                    folder,
-                    files,
-                )?),
-                layers,
-            )
-        }
-    };
+    let (second_color, colour_map, colour_layers) =
+        colouring_entries(template, stem, folder, files)?;
 
     let two_state = template.two_state.as_ref().map(|animation| {
         // A stem never holds a dot, so no template's files clash with this.

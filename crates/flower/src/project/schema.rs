@@ -16,6 +16,10 @@ pub(super) struct ProjectFile {
     pub(super) format: String,
     pub(super) version: u32,
     pub(super) name: String,
+    /// Version 9: what one length is in the real world (`"1.8 mm"`, see
+    /// [`crate::Unit`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) unit: Option<String>,
     #[serde(default)]
     pub(super) simulation: SimulationFile,
     #[serde(default)]
@@ -264,6 +268,45 @@ fn default_g() -> f64 {
 pub(super) struct ColourLayerFile {
     pub(super) color: [f32; 4],
     pub(super) map: ScalarEntry,
+    /// Version 9: the side it is painted on (absent: both).
+    #[serde(default, skip_serializing_if = "SideFile::is_both")]
+    pub(super) side: SideFile,
+}
+
+/// [`crate::Side`] in the file.
+#[derive(Serialize, Deserialize, Clone, Copy, Default, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum SideFile {
+    #[default]
+    Both,
+    Inner,
+    Outer,
+}
+
+impl SideFile {
+    fn is_both(&self) -> bool {
+        *self == SideFile::Both
+    }
+}
+
+impl From<SideFile> for crate::Side {
+    fn from(side: SideFile) -> Self {
+        match side {
+            SideFile::Both => crate::Side::Both,
+            SideFile::Inner => crate::Side::Inner,
+            SideFile::Outer => crate::Side::Outer,
+        }
+    }
+}
+
+impl From<crate::Side> for SideFile {
+    fn from(side: crate::Side) -> Self {
+        match side {
+            crate::Side::Both => SideFile::Both,
+            crate::Side::Inner => SideFile::Inner,
+            crate::Side::Outer => SideFile::Outer,
+        }
+    }
 }
 
 fn opaque_white() -> [f32; 4] {

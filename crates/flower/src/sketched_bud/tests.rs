@@ -30,6 +30,7 @@ fn five_petals(width: f64) -> Flower {
         overlaps: Vec::new(),
         structure: None,
         parts: Vec::new(),
+        unit: None,
     }
     .arranged_by(Structure::Whorls {
         whorls: vec![whorl],

@@ -144,6 +144,7 @@ pub fn inner_driven_into_outer_by(keyframes: u32, overlap: bool, inner_drive_deg
             },
             structure: None,
             parts: Vec::new(),
+            unit: None,
         },
         settings: SimulationSettings {
             keyframes,
