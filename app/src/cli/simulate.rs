@@ -45,7 +45,7 @@ pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
         .iter()
         .chain(&anthesis_flower::unit::size_lines(flower))
     {
-        writeln!(stdout, "{line}")?;
+        out!("{line}")?;
     }
     Ok(())
 }
