@@ -14,7 +14,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 
 use super::EncodingArg;
-use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
+use super::simulate::{animation_options, check_output, write_tracks};
 
 /// `anthesis blossom BUD.obj OPEN.obj`.
 #[derive(Debug, Args)]
@@ -141,7 +141,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             base_color_png: None,
             rigid: None,
         };
-        write_tracks(out, OutputKind::of(out), &[track], &glb)?;
+        write_tracks(out, &[track], &glb)?;
         eprintln!(
             "wrote {} (keyframes 0 to {})",
             out.display(),

@@ -16,7 +16,7 @@ use glam::DVec2;
 
 use super::EncodingArg;
 use super::bud::read_pde;
-use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
+use super::simulate::{animation_options, check_output, write_tracks};
 
 /// `anthesis pde-blossom BUD.json OPEN.json`.
 #[derive(Debug, Args)]
@@ -168,7 +168,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
             base_color_png: None,
             rigid: None,
         };
-        write_tracks(out, OutputKind::of(out), &[track], &glb)?;
+        write_tracks(out, &[track], &glb)?;
         eprintln!("wrote {} (keyframes 0 to {steps})", out.display());
     }
     Ok(())

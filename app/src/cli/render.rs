@@ -8,13 +8,14 @@ use std::path::{Path, PathBuf};
 use anthesis_flower::Project;
 use anthesis_mesh::Subdivision;
 use anthesis_render::{Background, Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
+use anthesis_sim::batch::step_through;
 use anthesis_sim::memory::KeyframeCost;
 use anthesis_sim::{Selection, Simulation};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbaImage;
 
-use super::simulate::{run_keyframes, set_keyframes};
+use super::simulate::{Progress, set_keyframes};
 use super::{at_resolution, load, selection};
 use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
@@ -331,15 +332,18 @@ fn simulate_scenes(
         scenes.push((0, organs_at(&bud.positions_in_world, 0)));
     }
     let last_wanted = frames.last().copied().unwrap_or(0);
-    run_keyframes(&mut sim, last_wanted, &mut |keyframe| {
+    let last = last_wanted.min(sim.keyframe_count());
+    let mut progress = Progress::new();
+    let stepped = step_through(&mut sim, last, &|| false, &mut |sim, keyframe| {
+        progress.show(sim, keyframe.index, last);
         if frames.binary_search(&keyframe.index).is_ok() {
             scenes.push((
                 keyframe.index,
                 organs_at(&keyframe.positions_in_world, keyframe.index),
             ));
         }
-    })
-    .into_result()?;
+    });
+    progress.finish(&sim, stepped.failure)?;
     Ok(scenes)
 }
 

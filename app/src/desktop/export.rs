@@ -7,12 +7,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, sync_channel};
 use std::sync::{Arc, Mutex};
 
-use anthesis_export::{Encoding, GlbOptions, Timing, Track, UsdOptions};
-use anthesis_flower::resolution::{predicted_size, resolve};
+use anthesis_export::{Encoding, GlbOptions, Timing, Track};
+use anthesis_flower::resolution::predicted_size;
 use anthesis_flower::{Project, Resolution};
 use anthesis_render::{OffscreenRenderer, OrganMesh};
+use anthesis_sim::batch::{self, BatchError, Format};
+use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::memory::{self, KeyframeCost};
-use anthesis_sim::{Keyframe, Selection, SimError, Simulation};
+use anthesis_sim::{Keyframe, Selection, SimError};
 use anyhow::Context;
 use eframe::egui;
 
@@ -132,12 +134,6 @@ fn angle_row(ui: &mut egui::Ui, name: &str, degrees: &mut f64, limit: f64) -> eg
     response
 }
 
-/// Whether `path` asks for a rendered animation (`.gif`).
-pub fn is_gif_path(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
-}
-
 /// Renders every `step`-th keyframe of `tracks` (and the last) offscreen
 /// and writes them as a looping GIF (see [`animation::write_animation`]).
 fn write_gif(
@@ -211,9 +207,19 @@ pub fn tracks(
 /// writing the file).
 const RUN_SHARE: f32 = 0.9;
 
-/// Writes `tracks` to `target` in the format its name picks: a USD layer
-/// for .usda, .usd (text) or .usdc (binary), a rendered animation for .gif,
-/// else the animated glTF; returns the file's size.
+/// What the dialog writes to `target`: the format its extension names,
+/// else an animated glTF.
+pub fn target_format(target: &Path) -> Format {
+    match Format::from_path(target) {
+        Some(format) if format != Format::ObjFolder => format,
+        _ => Format::Glb,
+    }
+}
+
+/// Writes `tracks` to `target` in the format its name picks
+/// ([`target_format`]): a USD layer for .usda, .usd (text) or .usdc
+/// (binary), a rendered animation for .gif, else the animated glTF;
+/// returns the file's size.
 fn write_tracks(
     target: &Path,
     tracks: &[Track],
@@ -222,18 +228,15 @@ fn write_tracks(
     animation_step: u32,
     progress: &mut dyn FnMut(f32),
 ) -> Result<u64, String> {
-    let written = if anthesis_export::is_usd_path(target) {
-        let usd = UsdOptions {
-            timing: options.timing,
-            normals: options.normals,
-        };
-        anthesis_export::write_usd(target, tracks, &usd, progress).map_err(|e| e.to_string())
-    } else if is_gif_path(target) {
-        write_gif(target, tracks, animation, animation_step, progress).map_err(|e| format!("{e:#}"))
-    } else {
-        anthesis_export::write_glb(target, tracks, options, progress).map_err(|e| e.to_string())
+    let written = match target_format(target) {
+        Format::Gif => write_gif(target, tracks, animation, animation_step, progress),
+        // The export's own error names the file already.
+        format => batch::write(target, format, tracks, options, progress).map_err(|e| match e {
+            BatchError::Write { source, .. } => source.into(),
+            e => e.into(),
+        }),
     };
-    written.and_then(|()| {
+    written.map_err(|e| format!("{e:#}")).and_then(|()| {
         std::fs::metadata(target)
             .map(|m| m.len())
             .map_err(|e| format!("{}: {e}", target.display()))
@@ -251,25 +254,27 @@ fn simulate_at(
     progress: &mut dyn FnMut(f32),
     cancelled: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<Track>, String> {
-    memory::check_run(project, selection, KeyframeCost::Kept)
-        .map_err(|e| format!("does not fit: {e}"))?;
-    let resolved = resolve(project).map_err(|e| format!("cannot start: {e}"))?;
-    let mut sim =
-        Simulation::new(&resolved, selection).map_err(|e| format!("cannot start: {e}"))?;
+    let resolved =
+        batch::prepare(project, selection, KeyframeCost::Kept, None).map_err(|e| match e {
+            BatchError::Memory(e) => format!("does not fit: {e}"),
+            e => format!("cannot start: {e}"),
+        })?;
     let total = resolved.settings.keyframes.max(1);
-    let mut keyframes = vec![Arc::new(sim.bud())];
-    while !sim.finished() {
-        match sim.step(cancelled, &mut |_| {}) {
-            Ok(keyframe) => {
-                progress(keyframe.index as f32 / total as f32);
-                keyframes.push(Arc::new(keyframe));
-            }
-            Err(SimError::Cancelled) => return Err("was cancelled".to_string()),
-            Err(error) => return Err(format!("stopped: {error}")),
-        }
+    let run = batch::simulate(
+        &resolved,
+        selection,
+        OnCrossing::Stop,
+        cancelled,
+        &mut |_, keyframe| progress(keyframe.index as f32 / total as f32),
+    )
+    .map_err(|e| format!("cannot start: {e}"))?;
+    match run.stepped.failure {
+        None => {}
+        Some(SimError::Cancelled) => return Err("was cancelled".to_string()),
+        Some(error) => return Err(format!("stopped: {error}")),
     }
-    let organs = selection.organs(resolved.flower.organs.len());
-    tracks(&resolved, &organs, &keyframes, render_level).map_err(|e| format!("{e}"))
+    run.tracks(&resolved, selection, render_level)
+        .map_err(|e| format!("{e}"))
 }
 
 /// The particles a run of `organs` of `project` at `edge` makes in its
@@ -725,8 +730,7 @@ impl ExportDialog {
                 // Only the options of the chosen format: a GIF has its own,
                 // a USD layer has timing and normals.
                 let target = PathBuf::from(self.path.trim());
-                let gif = is_gif_path(&target);
-                let usd = anthesis_export::is_usd_path(&target);
+                let format = target_format(&target);
                 egui::Grid::new("export options")
                     .num_columns(2)
                     .show(ui, |ui| {
@@ -750,7 +754,7 @@ impl ExportDialog {
                             self.scope_ui(ui, project, *organ);
                         }
                         self.resimulate_ui(ui, project, selection, simulated_now);
-                        if gif {
+                        if format == Format::Gif {
                             self.gif_options_ui(ui);
                             return;
                         }
@@ -790,7 +794,7 @@ impl ExportDialog {
                             }
                         }
                         ui.end_row();
-                        if !usd {
+                        if format.has_morph_targets() {
                             let label = ui
                                 .label("Most morph targets")
                                 .on_hover_text(
@@ -808,7 +812,7 @@ impl ExportDialog {
                         ui.checkbox(&mut self.normals, "store normals")
                             .on_hover_text("Without them the file is about half as large");
                         ui.end_row();
-                        if usd {
+                        if !format.has_morph_targets() {
                             return;
                         }
                         ui.label("Encoding");
@@ -896,6 +900,7 @@ impl ExportDialog {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use anthesis_flower::resolution::resolve;
     use std::time::{Duration, Instant};
 
     /// Polls `dialog` until its export ends (failing after a minute).

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
 use anthesis_render::OrbitCamera;
+use anthesis_sim::batch::Format;
 use eframe::egui;
 
 use super::timeline::Playback;
@@ -68,12 +69,12 @@ impl DialogPurpose {
 
     /// The extensions of the files listed (and offered by the native
     /// dialog's filters).
-    pub fn extensions(self) -> &'static [&'static str] {
+    pub fn extensions(self) -> Vec<&'static str> {
         match self {
-            DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => &[PROJECT_EXTENSION],
-            DialogPurpose::ExportGlb => &["glb", "usda", "usdc", "usd", "gif"],
-            DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => &["obj"],
-            DialogPurpose::OpenShape(_) => &["obj"],
+            DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => vec![PROJECT_EXTENSION],
+            DialogPurpose::ExportGlb => Format::file_extensions(),
+            DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => vec!["obj"],
+            DialogPurpose::OpenShape(_) => vec!["obj"],
         }
     }
 }
@@ -278,22 +279,23 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
     }
     match purpose {
         DialogPurpose::OpenProject => dialog
-            .add_filter("Anthesis project", purpose.extensions())
+            .add_filter("Anthesis project", &purpose.extensions())
             .pick_file(),
         DialogPurpose::OpenShape(_) => dialog
-            .add_filter("OBJ mesh", purpose.extensions())
+            .add_filter("OBJ mesh", &purpose.extensions())
             .pick_file(),
         DialogPurpose::SaveProjectAs => dialog
-            .add_filter("Anthesis project", purpose.extensions())
+            .add_filter("Anthesis project", &purpose.extensions())
             .set_file_name(purpose.suggested_name().unwrap_or_default())
             .save_file(),
         DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => dialog
-            .add_filter("OBJ mesh", purpose.extensions())
+            .add_filter("OBJ mesh", &purpose.extensions())
             .pick_file(),
-        DialogPurpose::ExportGlb => dialog
-            .add_filter("glTF binary", &["glb"])
-            .add_filter("USD layer", &["usda", "usdc", "usd"])
-            .add_filter("GIF animation", &["gif"])
+        DialogPurpose::ExportGlb => Format::FILES
+            .into_iter()
+            .fold(dialog, |dialog, format| {
+                dialog.add_filter(format.name(), format.extensions())
+            })
             .set_file_name(purpose.suggested_name().unwrap_or_default())
             .save_file(),
     }

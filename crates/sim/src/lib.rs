@@ -10,6 +10,7 @@
 
 #![warn(missing_docs)]
 
+pub mod batch;
 pub mod collide;
 pub mod crossing;
 #[cfg(any(test, feature = "fault-hook"))]
