@@ -42,7 +42,7 @@ use glam::{DVec2, DVec3};
 
 use super::background::Background;
 use super::command::{Command, ProjectEdit};
-use super::shape_panel::quality_text;
+use super::widgets::quality_text;
 
 /// The names of a curve's control points, base to tip.
 const POINT_NAMES: [&str; 4] = ["base", "lower", "upper", "tip"];
@@ -416,7 +416,7 @@ pub fn pde_ui(
     for (c, curve_points) in points.iter().enumerate() {
         for (k, at) in curve_points.iter().enumerate() {
             let id = ui.scope_id().with(("pde point", c, k));
-            let (picked, shift) = super::shape_panel::view_point(ui, id, *at, 12.0, (scale, side));
+            let (picked, shift) = super::widgets::view_point(ui, id, *at, 12.0, (scale, side));
             if picked {
                 state.point = (c, k);
             }

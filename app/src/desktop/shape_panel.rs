@@ -18,6 +18,7 @@ use glam::DVec3;
 
 use super::background::Background;
 use super::command::{Command, ProjectEdit};
+use super::widgets::{quality_text, view_point};
 
 /// What the remesher said about one template at one edge.
 type Preview = Background<Bud, BudError>;
@@ -118,45 +119,6 @@ fn fingerprint(mesh: &Mesh) -> u64 {
     }
     mesh.triangles.hash(&mut h);
     h.finish()
-}
-
-/// One row of mesh numbers.
-pub(super) fn quality_text(q: &MeshQuality) -> String {
-    format!(
-        "{} particles, mean edge {:.3}, smallest angle {:.1}°, edge spread {:.0} %",
-        q.vertices,
-        q.mean_edge,
-        q.min_angle_deg,
-        100.0 * q.edge_spread
-    )
-}
-
-/// A control point drawn at `at` (a square of `size` pixels) in a 2D view
-/// of the template frame, front (x, y) or `side` (z, y), at `scale` pixels
-/// per unit: whether it was picked (clicked, or a drag started on it), and
-/// while it is dragged, how far it moved in the template frame.
-pub(super) fn view_point(
-    ui: &egui::Ui,
-    id: egui::Id,
-    at: egui::Pos2,
-    size: f32,
-    (scale, side): (f64, bool),
-) -> (bool, Option<DVec3>) {
-    let hit = ui.interact(
-        egui::Rect::from_center_size(at, egui::vec2(size, size)),
-        id,
-        egui::Sense::click_and_drag(),
-    );
-    let shift = hit.dragged().then(|| {
-        let d = hit.drag_delta();
-        let (across, up) = (f64::from(d.x) / scale, -f64::from(d.y) / scale);
-        if side {
-            DVec3::new(0.0, up, across)
-        } else {
-            DVec3::new(across, up, 0.0)
-        }
-    });
-    (hit.clicked() || hit.drag_started(), shift)
 }
 
 /// The Shape section for the flower's templates; pushes the edits chosen

@@ -23,7 +23,7 @@ use glam::{DVec2, DVec3};
 
 use super::background::Background;
 use super::command::{Command, ProjectEdit};
-use super::shape_panel::quality_text;
+use super::widgets::quality_text;
 
 /// The canvas's height, in points.
 const CANVAS_HEIGHT: f32 = 300.0;
