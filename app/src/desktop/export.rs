@@ -474,6 +474,192 @@ impl ExportDialog {
         ui.end_row();
     }
 
+    /// The options grid: the smooth mesh, the organs and the run, then
+    /// the options of `format` (a GIF's own; a .glb's or a USD layer's
+    /// timing and normals, a .glb's morph targets and encoding).
+    fn options_grid(
+        &mut self,
+        ui: &mut egui::Ui,
+        format: Format,
+        project: &Project,
+        selection: &Selection,
+        simulated_now: usize,
+    ) {
+        egui::Grid::new("export options")
+            .num_columns(2)
+            .show(ui, |ui| {
+                let label = ui
+                    .label("Smooth mesh")
+                    .on_hover_text(
+                        "Levels of Loop subdivision of every organ: a finer render mesh \
+                         driven by the simulated one, about four times the vertices per \
+                         level (0 = the simulated mesh as it is)",
+                    )
+                    .id;
+                ui.add(
+                    egui::DragValue::new(&mut self.render_level)
+                        .range(0..=MAX_DIALOG_RENDER_LEVEL)
+                        .prefix("subdivide ")
+                        .suffix(" ×"),
+                )
+                .labelled_by(label);
+                ui.end_row();
+                if let Selection::Only(organ) = selection {
+                    self.scope_ui(ui, project, *organ);
+                }
+                self.resimulate_ui(ui, project, selection, simulated_now);
+                if format == Format::Gif {
+                    self.gif_options_ui(ui);
+                    return;
+                }
+                ui.label("Timing");
+                ui.horizontal(|ui| {
+                    ui.radio_value(
+                        &mut self.timing_mode,
+                        TimingMode::FramesPerSecond,
+                        "keyframes per second",
+                    );
+                    ui.radio_value(&mut self.timing_mode, TimingMode::Duration, "total seconds");
+                });
+                ui.end_row();
+                match self.timing_mode {
+                    TimingMode::FramesPerSecond => {
+                        let label = ui.label("Keyframes per second").id;
+                        ui.add(
+                            egui::DragValue::new(&mut self.frames_per_second)
+                                .range(0.1..=240.0)
+                                .speed(0.5),
+                        )
+                        .labelled_by(label);
+                    }
+                    TimingMode::Duration => {
+                        let label = ui.label("Duration").id;
+                        ui.add(
+                            egui::DragValue::new(&mut self.duration_seconds)
+                                .range(0.1..=3600.0)
+                                .speed(0.1)
+                                .suffix(" s"),
+                        )
+                        .labelled_by(label);
+                    }
+                }
+                ui.end_row();
+                if format.has_morph_targets() {
+                    let label = ui
+                        .label("Most morph targets")
+                        .on_hover_text(
+                            "Per mesh; longer runs are resampled to this many keyframes \
+                             (clients slow down with very many targets)",
+                        )
+                        .id;
+                    ui.add(egui::DragValue::new(&mut self.max_morph_targets).range(2..=2000))
+                        .labelled_by(label);
+                    ui.end_row();
+                }
+                ui.label("Normals");
+                ui.checkbox(&mut self.normals, "store normals")
+                    .on_hover_text("Without them the file is about half as large");
+                ui.end_row();
+                if !format.has_morph_targets() {
+                    return;
+                }
+                ui.label("Encoding");
+                ui.horizontal(|ui| {
+                    for encoding in Encoding::ALL {
+                        ui.radio_value(&mut self.encoding, encoding, encoding.to_string());
+                    }
+                })
+                .response
+                .on_hover_text(
+                    "dense: plain floats, read everywhere; sparse: only moving vertices; \
+                     quantized: KHR_mesh_quantization, about half the size; \
+                     meshopt: quantized and compressed (EXT_meshopt_compression), \
+                     the smallest, for three.js with its meshopt decoder",
+                );
+                ui.end_row();
+            });
+    }
+
+    /// What the export will hold: the window's keyframes computed so far,
+    /// a run of its own, or the whole flower while one organ is previewed.
+    fn status_rows(
+        &self,
+        ui: &mut egui::Ui,
+        keyframes_ready: usize,
+        keyframes_total: u32,
+        project: &Project,
+        selection: &Selection,
+    ) {
+        let after_bud = keyframes_ready.saturating_sub(1);
+        let whole_of_preview = matches!(selection, Selection::Only(_)) && self.whole_flower;
+        if whole_of_preview && !self.resimulate {
+            ui.label(
+                "The export holds the whole flower: its keyframes from before the \
+                 preview if nothing changed since, else a run of its own (with progress); \
+                 the window keeps its preview",
+            );
+        } else if self.resimulate {
+            ui.label(format!(
+                "The export runs all {} keyframes again at mean edge {}; \
+                 the window keeps its run",
+                project.settings.keyframes,
+                edge_text(self.resimulate_edge)
+            ));
+        } else {
+            ui.label(format!(
+                "{after_bud} of {keyframes_total} keyframes computed{}",
+                if (after_bud as u32) < keyframes_total {
+                    " — the export holds the computed ones"
+                } else {
+                    ""
+                }
+            ));
+        }
+    }
+
+    /// The Export button and the export's state (progress with Cancel,
+    /// the file written or the error); whether Export was clicked.
+    fn export_row(&mut self, ui: &mut egui::Ui) -> bool {
+        let mut export = false;
+        ui.horizontal(|ui| {
+            let running = self.is_running();
+            if ui
+                .add_enabled(!running, egui::Button::new("Export"))
+                .clicked()
+            {
+                export = true;
+            }
+            match &self.state {
+                ExportState::Idle => {}
+                ExportState::Running { progress } => {
+                    let bar = egui::ProgressBar::new(*progress).desired_width(200.0);
+                    ui.add(match self.running_run {
+                        Some(total) if *progress < RUN_SHARE => {
+                            let done = (progress / RUN_SHARE * total as f32).floor();
+                            bar.text(format!("running: keyframe {done} of {total}"))
+                        }
+                        Some(_) => bar.text("writing the file"),
+                        None => bar.show_percentage(),
+                    });
+                    if ui.button("Cancel").clicked() {
+                        self.cancel();
+                    }
+                }
+                ExportState::Done { path, bytes } => {
+                    ui.label(format!(
+                        "Wrote {} ({:.1} MB)",
+                        path.display(),
+                        *bytes as f64 / 1.0e6
+                    ));
+                }
+                ExportState::Failed { message } => {
+                    ui.colored_label(egui::Color32::from_rgb(210, 50, 40), message);
+                }
+            }
+        });
+        export
+    }
+
     pub fn state(&self) -> &ExportState {
         &self.state
     }
@@ -731,166 +917,11 @@ impl ExportDialog {
                 // a USD layer has timing and normals.
                 let target = PathBuf::from(self.path.trim());
                 let format = target_format(&target);
-                egui::Grid::new("export options")
-                    .num_columns(2)
-                    .show(ui, |ui| {
-                        let label = ui
-                            .label("Smooth mesh")
-                            .on_hover_text(
-                                "Levels of Loop subdivision of every organ: a finer render mesh \
-                                 driven by the simulated one, about four times the vertices per \
-                                 level (0 = the simulated mesh as it is)",
-                            )
-                            .id;
-                        ui.add(
-                            egui::DragValue::new(&mut self.render_level)
-                                .range(0..=MAX_DIALOG_RENDER_LEVEL)
-                                .prefix("subdivide ")
-                                .suffix(" ×"),
-                        )
-                        .labelled_by(label);
-                        ui.end_row();
-                        if let Selection::Only(organ) = selection {
-                            self.scope_ui(ui, project, *organ);
-                        }
-                        self.resimulate_ui(ui, project, selection, simulated_now);
-                        if format == Format::Gif {
-                            self.gif_options_ui(ui);
-                            return;
-                        }
-                        ui.label("Timing");
-                        ui.horizontal(|ui| {
-                            ui.radio_value(
-                                &mut self.timing_mode,
-                                TimingMode::FramesPerSecond,
-                                "keyframes per second",
-                            );
-                            ui.radio_value(
-                                &mut self.timing_mode,
-                                TimingMode::Duration,
-                                "total seconds",
-                            );
-                        });
-                        ui.end_row();
-                        match self.timing_mode {
-                            TimingMode::FramesPerSecond => {
-                                let label = ui.label("Keyframes per second").id;
-                                ui.add(
-                                    egui::DragValue::new(&mut self.frames_per_second)
-                                        .range(0.1..=240.0)
-                                        .speed(0.5),
-                                )
-                                .labelled_by(label);
-                            }
-                            TimingMode::Duration => {
-                                let label = ui.label("Duration").id;
-                                ui.add(
-                                    egui::DragValue::new(&mut self.duration_seconds)
-                                        .range(0.1..=3600.0)
-                                        .speed(0.1)
-                                        .suffix(" s"),
-                                )
-                                .labelled_by(label);
-                            }
-                        }
-                        ui.end_row();
-                        if format.has_morph_targets() {
-                            let label = ui
-                                .label("Most morph targets")
-                                .on_hover_text(
-                                    "Per mesh; longer runs are resampled to this many keyframes \
-                                     (clients slow down with very many targets)",
-                                )
-                                .id;
-                            ui.add(
-                                egui::DragValue::new(&mut self.max_morph_targets).range(2..=2000),
-                            )
-                            .labelled_by(label);
-                            ui.end_row();
-                        }
-                        ui.label("Normals");
-                        ui.checkbox(&mut self.normals, "store normals")
-                            .on_hover_text("Without them the file is about half as large");
-                        ui.end_row();
-                        if !format.has_morph_targets() {
-                            return;
-                        }
-                        ui.label("Encoding");
-                        ui.horizontal(|ui| {
-                            for encoding in Encoding::ALL {
-                                ui.radio_value(&mut self.encoding, encoding, encoding.to_string());
-                            }
-                        })
-                        .response
-                        .on_hover_text(
-                            "dense: plain floats, read everywhere; sparse: only moving vertices; \
-                             quantized: KHR_mesh_quantization, about half the size; \
-                             meshopt: quantized and compressed (EXT_meshopt_compression), \
-                             the smallest, for three.js with its meshopt decoder",
-                        );
-                        ui.end_row();
-                    });
-                let after_bud = keyframes_ready.saturating_sub(1);
-                let whole_of_preview = matches!(selection, Selection::Only(_)) && self.whole_flower;
-                if whole_of_preview && !self.resimulate {
-                    ui.label(
-                        "The export holds the whole flower: its keyframes from before the \
-                         preview if nothing changed since, else a run of its own (with progress); \
-                         the window keeps its preview",
-                    );
-                } else if self.resimulate {
-                    ui.label(format!(
-                        "The export runs all {} keyframes again at mean edge {}; \
-                         the window keeps its run",
-                        project.settings.keyframes,
-                        edge_text(self.resimulate_edge)
-                    ));
-                } else {
-                    ui.label(format!(
-                        "{after_bud} of {keyframes_total} keyframes computed{}",
-                        if (after_bud as u32) < keyframes_total {
-                            " — the export holds the computed ones"
-                        } else {
-                            ""
-                        }
-                    ));
+                self.options_grid(ui, format, project, selection, simulated_now);
+                self.status_rows(ui, keyframes_ready, keyframes_total, project, selection);
+                if self.export_row(ui) {
+                    requests.export = true;
                 }
-                ui.horizontal(|ui| {
-                    let running = self.is_running();
-                    if ui
-                        .add_enabled(!running, egui::Button::new("Export"))
-                        .clicked()
-                    {
-                        requests.export = true;
-                    }
-                    match &self.state {
-                        ExportState::Idle => {}
-                        ExportState::Running { progress } => {
-                            let bar = egui::ProgressBar::new(*progress).desired_width(200.0);
-                            ui.add(match self.running_run {
-                                Some(total) if *progress < RUN_SHARE => {
-                                    let done = (progress / RUN_SHARE * total as f32).floor();
-                                    bar.text(format!("running: keyframe {done} of {total}"))
-                                }
-                                Some(_) => bar.text("writing the file"),
-                                None => bar.show_percentage(),
-                            });
-                            if ui.button("Cancel").clicked() {
-                                self.cancel();
-                            }
-                        }
-                        ExportState::Done { path, bytes } => {
-                            ui.label(format!(
-                                "Wrote {} ({:.1} MB)",
-                                path.display(),
-                                *bytes as f64 / 1.0e6
-                            ));
-                        }
-                        ExportState::Failed { message } => {
-                            ui.colored_label(egui::Color32::from_rgb(210, 50, 40), message);
-                        }
-                    }
-                });
             });
         self.open = open;
         requests

@@ -91,7 +91,7 @@ impl FlowerPanelState {
     }
 
     /// A scanned petal was read: it is reviewed in the panel.
-    pub(super) fn scan_read(&mut self, review: super::pde_panel::ScanReview) {
+    pub(super) fn scan_read(&mut self, review: super::scan_panel::ScanReview) {
         self.refused = None;
         self.shape.pde.scan = Some(review);
     }
@@ -764,7 +764,7 @@ pub fn flower_ui(
 
     // A scanned petal under review.
     if let Some(index) =
-        super::pde_panel::scan_ui(ui, flower, &mut state.shape.pde, &mut commands_early)
+        super::scan_panel::scan_ui(ui, flower, &mut state.shape.pde.scan, &mut commands_early)
     {
         state.shape.template = index;
         state.shape.edge = None;

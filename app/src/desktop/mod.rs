@@ -32,6 +32,7 @@ mod project_io;
 mod prompts;
 pub mod rerun;
 pub mod resolution;
+pub mod scan_panel;
 pub mod session;
 pub mod settings;
 pub mod shape_panel;
