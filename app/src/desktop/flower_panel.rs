@@ -624,6 +624,64 @@ pub fn flower_ui(
     let mut outcomes: Vec<Outcome> = Vec::new();
     let mut commands_early: Vec<Command> = Vec::new();
 
+    templates_ui(ui, flower, state, &mut outcomes, &mut commands_early);
+    ui.separator();
+
+    // A scanned petal under review.
+    if let Some(index) =
+        super::scan_panel::scan_ui(ui, flower, &mut state.shape.pde.scan, &mut commands_early)
+    {
+        state.shape.template = index;
+        state.shape.edge = None;
+        state.shape.open_now = true;
+    }
+
+    // The shape of one template.
+    shape_ui(ui, flower, &mut state.shape, &mut commands_early);
+    bud_sketch_ui(
+        ui,
+        (flower, project.settings.keyframes),
+        &mut state.bud,
+        &mut commands_early,
+    );
+    ui.separator();
+
+    arrangement_ui(ui, flower, state, now, &mut outcomes);
+    ui.separator();
+
+    organs_ui(ui, flower, state, &mut outcomes);
+    ui.separator();
+
+    overlaps_ui(ui, flower, &mut outcomes);
+    ui.separator();
+
+    let mut commands = commands_early;
+    for out in outcomes {
+        match out {
+            Outcome::Edit(label, flower) => {
+                state.refused = None;
+                commands.push(Command::Edit {
+                    label,
+                    edit: ProjectEdit::Flower(Box::new(flower)),
+                });
+            }
+            Outcome::Refused(message) => state.refused = Some(message),
+        }
+    }
+    // Parts.
+    commands.extend(parts_panel::parts_ui(ui, project));
+    commands
+}
+
+/// The Templates section: each template (renamed in place, removed),
+/// then the buttons that add one (from a shape, a mesh or a scan).
+fn templates_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    outcomes: &mut Vec<Outcome>,
+    commands_early: &mut Vec<Command>,
+) {
     // Templates.
     ui.strong("Templates")
         .on_hover_text("The organ types: a mesh, growth maps and material each.");
@@ -669,6 +727,180 @@ pub fn flower_ui(
             }
         });
     }
+    add_template_ui(ui, flower, state, outcomes, commands_early);
+}
+
+/// The Arrangement section: what places the organs (listed, whorls, a
+/// spiral or an L-system) and its settings, and why an edit was refused.
+fn arrangement_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    now: f64,
+    outcomes: &mut Vec<Outcome>,
+) {
+    // Arrangement.
+    ui.strong("Arrangement").on_hover_text(
+        "Where the organs go: listed one by one, whorls (rings, innermost first), a golden-angle \
+         spiral or an L-system whose ~X places an organ.",
+    );
+    let kind = Kind::of(flower.structure.as_ref());
+    let mut chosen = kind;
+    ui.horizontal(|ui| {
+        let label = ui.label("arrange by").id;
+        egui::ComboBox::from_id_salt("arrangement kind")
+            .selected_text(kind.name())
+            .show_ui(ui, |ui| {
+                for k in [Kind::Listed, Kind::Whorls, Kind::Spiral, Kind::LSystem] {
+                    ui.selectable_value(&mut chosen, k, k.name());
+                }
+            })
+            .response
+            .labelled_by(label);
+    });
+    if chosen != kind {
+        let whorls = whorls_like(flower);
+        let result = match chosen {
+            Kind::Listed => flower.with_structure(None),
+            Kind::Whorls => flower.arranged_by(Structure::Whorls {
+                whorls,
+                contorted: false,
+            }),
+            Kind::Spiral => match spiral_like(&whorls) {
+                Some(spiral) => flower.arranged_by(Structure::Spiral(spiral)),
+                None => Err(anthesis_flower::edit::EditError::NoOrgans),
+            },
+            Kind::LSystem => {
+                let (text, steps, surfaces) = lsystem_like(&whorls);
+                flower.arranged_by(Structure::LSystem {
+                    text,
+                    steps,
+                    surfaces,
+                    units: 1.0,
+                })
+            }
+        };
+        outcomes.push(outcome(
+            format!("arrange by {}", chosen.name().to_lowercase()),
+            result,
+        ));
+    }
+    structure_ui(ui, flower, state, now, outcomes);
+    if let Some(refused) = &state.refused {
+        ui.label(RichText::new(refused).color(ui.visuals().error_fg_color));
+    }
+}
+
+/// The settings of the flower's structure: its whorls (edited, added),
+/// its spiral or its L-system.
+fn structure_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    now: f64,
+    outcomes: &mut Vec<Outcome>,
+) {
+    match &flower.structure {
+        None => {
+            ui.label("Each organ is placed on its own (see Organs).");
+        }
+        Some(Structure::Whorls { whorls, contorted }) => {
+            let mut draft = whorls.clone();
+            let mut contorted_now = *contorted;
+            let mut label = None;
+            if ui
+                .checkbox(&mut contorted_now, "contorted")
+                .on_hover_text(
+                    "One ring whose organs each lie beneath their right-hand neighbour (Eustoma)",
+                )
+                .changed()
+            {
+                label = Some("contorted".to_string());
+            }
+            let mut remove = None;
+            for (i, whorl) in draft.iter_mut().enumerate() {
+                egui::CollapsingHeader::new(format!("whorl “{}” × {}", whorl.name, whorl.count))
+                    .id_salt(("whorl", i))
+                    .default_open(draft_len_is_small(whorls.len()))
+                    .show(ui, |ui| {
+                        if let Some(field) = whorl_rows(ui, flower, whorl, i) {
+                            label = Some(format!("{field} of whorl {}", whorl.name));
+                        }
+                        if ui
+                            .add_enabled(whorls.len() > 1, egui::Button::new("Remove whorl"))
+                            .clicked()
+                        {
+                            remove = Some(i);
+                        }
+                    });
+            }
+            if let Some(i) = remove {
+                label = Some(format!("remove whorl {}", draft[i].name));
+                draft.remove(i);
+            }
+            if ui
+                .button("Add whorl")
+                .on_hover_text("A ring outside the others, its organs between theirs")
+                .clicked()
+                && let Some(last) = draft.last()
+            {
+                let name =
+                    anthesis_flower::edit::unique_name(&format!("{} outer", last.name), |n| {
+                        draft.iter().any(|w| w.name == n)
+                    });
+                let step = 360.0 / last.count.max(1) as f64;
+                let added = Whorl {
+                    name,
+                    offset_deg: last.offset_deg + 0.5 * step,
+                    radius: last.radius * 1.15 + 0.1,
+                    ..last.clone()
+                };
+                label = Some(format!("add whorl {}", added.name));
+                draft.push(added);
+            }
+            if let Some(label) = label {
+                outcomes.push(outcome(
+                    label,
+                    flower.with_structure(Some(Structure::Whorls {
+                        whorls: draft,
+                        contorted: contorted_now,
+                    })),
+                ));
+            }
+        }
+        Some(Structure::Spiral(spiral)) => {
+            let mut draft = spiral.clone();
+            if let Some(field) = spiral_rows(ui, flower, &mut draft) {
+                outcomes.push(outcome(
+                    format!("{field} of the spiral"),
+                    flower.with_structure(Some(Structure::Spiral(draft))),
+                ));
+            }
+        }
+        Some(Structure::LSystem {
+            text,
+            steps,
+            surfaces,
+            units,
+        }) => {
+            state.units = *units;
+            let now_text = text.clone();
+            if let Some(out) = state.lsystem_ui(ui, flower, (&now_text, *steps, surfaces), now) {
+                outcomes.push(out);
+            }
+        }
+    }
+}
+
+/// The buttons that add a template: the simple petal, a new Bézier, PDE
+/// or sketched petal, an OBJ, a scanned petal, or a copy of the chosen one.
+fn add_template_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    outcomes: &mut Vec<Outcome>,
+    commands_early: &mut Vec<Command>,
+) {
     ui.horizontal_wrapped(|ui| {
         if ui
             .button("Add simple petal")
@@ -760,168 +992,15 @@ pub fn flower_ui(
             outcomes.push(Outcome::Edit(format!("add template {name}"), added));
         }
     });
-    ui.separator();
+}
 
-    // A scanned petal under review.
-    if let Some(index) =
-        super::scan_panel::scan_ui(ui, flower, &mut state.shape.pde.scan, &mut commands_early)
-    {
-        state.shape.template = index;
-        state.shape.edge = None;
-        state.shape.open_now = true;
-    }
-
-    // The shape of one template.
-    shape_ui(ui, flower, &mut state.shape, &mut commands_early);
-    bud_sketch_ui(
-        ui,
-        (flower, project.settings.keyframes),
-        &mut state.bud,
-        &mut commands_early,
-    );
-    ui.separator();
-
-    // Arrangement.
-    ui.strong("Arrangement").on_hover_text(
-        "Where the organs go: listed one by one, whorls (rings, innermost first), a golden-angle \
-         spiral or an L-system whose ~X places an organ.",
-    );
-    let kind = Kind::of(flower.structure.as_ref());
-    let mut chosen = kind;
-    ui.horizontal(|ui| {
-        let label = ui.label("arrange by").id;
-        egui::ComboBox::from_id_salt("arrangement kind")
-            .selected_text(kind.name())
-            .show_ui(ui, |ui| {
-                for k in [Kind::Listed, Kind::Whorls, Kind::Spiral, Kind::LSystem] {
-                    ui.selectable_value(&mut chosen, k, k.name());
-                }
-            })
-            .response
-            .labelled_by(label);
-    });
-    if chosen != kind {
-        let whorls = whorls_like(flower);
-        let result = match chosen {
-            Kind::Listed => flower.with_structure(None),
-            Kind::Whorls => flower.arranged_by(Structure::Whorls {
-                whorls,
-                contorted: false,
-            }),
-            Kind::Spiral => match spiral_like(&whorls) {
-                Some(spiral) => flower.arranged_by(Structure::Spiral(spiral)),
-                None => Err(anthesis_flower::edit::EditError::NoOrgans),
-            },
-            Kind::LSystem => {
-                let (text, steps, surfaces) = lsystem_like(&whorls);
-                flower.arranged_by(Structure::LSystem {
-                    text,
-                    steps,
-                    surfaces,
-                    units: 1.0,
-                })
-            }
-        };
-        outcomes.push(outcome(
-            format!("arrange by {}", chosen.name().to_lowercase()),
-            result,
-        ));
-    }
-    match &flower.structure {
-        None => {
-            ui.label("Each organ is placed on its own (see Organs).");
-        }
-        Some(Structure::Whorls { whorls, contorted }) => {
-            let mut draft = whorls.clone();
-            let mut contorted_now = *contorted;
-            let mut label = None;
-            if ui
-                .checkbox(&mut contorted_now, "contorted")
-                .on_hover_text(
-                    "One ring whose organs each lie beneath their right-hand neighbour (Eustoma)",
-                )
-                .changed()
-            {
-                label = Some("contorted".to_string());
-            }
-            let mut remove = None;
-            for (i, whorl) in draft.iter_mut().enumerate() {
-                egui::CollapsingHeader::new(format!("whorl “{}” × {}", whorl.name, whorl.count))
-                    .id_salt(("whorl", i))
-                    .default_open(draft_len_is_small(whorls.len()))
-                    .show(ui, |ui| {
-                        if let Some(field) = whorl_rows(ui, flower, whorl, i) {
-                            label = Some(format!("{field} of whorl {}", whorl.name));
-                        }
-                        if ui
-                            .add_enabled(whorls.len() > 1, egui::Button::new("Remove whorl"))
-                            .clicked()
-                        {
-                            remove = Some(i);
-                        }
-                    });
-            }
-            if let Some(i) = remove {
-                label = Some(format!("remove whorl {}", draft[i].name));
-                draft.remove(i);
-            }
-            if ui
-                .button("Add whorl")
-                .on_hover_text("A ring outside the others, its organs between theirs")
-                .clicked()
-                && let Some(last) = draft.last()
-            {
-                let name =
-                    anthesis_flower::edit::unique_name(&format!("{} outer", last.name), |n| {
-                        draft.iter().any(|w| w.name == n)
-                    });
-                let step = 360.0 / last.count.max(1) as f64;
-                let added = Whorl {
-                    name,
-                    offset_deg: last.offset_deg + 0.5 * step,
-                    radius: last.radius * 1.15 + 0.1,
-                    ..last.clone()
-                };
-                label = Some(format!("add whorl {}", added.name));
-                draft.push(added);
-            }
-            if let Some(label) = label {
-                outcomes.push(outcome(
-                    label,
-                    flower.with_structure(Some(Structure::Whorls {
-                        whorls: draft,
-                        contorted: contorted_now,
-                    })),
-                ));
-            }
-        }
-        Some(Structure::Spiral(spiral)) => {
-            let mut draft = spiral.clone();
-            if let Some(field) = spiral_rows(ui, flower, &mut draft) {
-                outcomes.push(outcome(
-                    format!("{field} of the spiral"),
-                    flower.with_structure(Some(Structure::Spiral(draft))),
-                ));
-            }
-        }
-        Some(Structure::LSystem {
-            text,
-            steps,
-            surfaces,
-            units,
-        }) => {
-            state.units = *units;
-            let now_text = text.clone();
-            if let Some(out) = state.lsystem_ui(ui, flower, (&now_text, *steps, surfaces), now) {
-                outcomes.push(out);
-            }
-        }
-    }
-    if let Some(refused) = &state.refused {
-        ui.label(RichText::new(refused).color(ui.visuals().error_fg_color));
-    }
-    ui.separator();
-
+/// The Organs section: the organs listed and made, and a new listed organ.
+fn organs_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    outcomes: &mut Vec<Outcome>,
+) {
     // Organs.
     let made = flower.made_organ_count();
     egui::CollapsingHeader::new(format!("Organs ({})", flower.organs.len()))
@@ -977,8 +1056,11 @@ pub fn flower_ui(
             ));
         }
     });
-    ui.separator();
+}
 
+/// The Overlap order section: which organ of each overlapping pair lies
+/// inside, and where the rule comes from; a click swaps a pair.
+fn overlaps_ui(ui: &mut egui::Ui, flower: &Flower, outcomes: &mut Vec<Outcome>) {
     // Overlap order.
     let origins = flower.rule_origins();
     egui::CollapsingHeader::new(format!("Overlap order ({} pairs)", flower.overlaps.len()))
@@ -1022,24 +1104,6 @@ pub fn flower_ui(
                 });
             }
         });
-    ui.separator();
-
-    let mut commands = commands_early;
-    for out in outcomes {
-        match out {
-            Outcome::Edit(label, flower) => {
-                state.refused = None;
-                commands.push(Command::Edit {
-                    label,
-                    edit: ProjectEdit::Flower(Box::new(flower)),
-                });
-            }
-            Outcome::Refused(message) => state.refused = Some(message),
-        }
-    }
-    // Parts.
-    commands.extend(parts_panel::parts_ui(ui, project));
-    commands
 }
 
 /// Where a listed organ sits: its base's azimuth and distance from the

@@ -209,152 +209,12 @@ pub fn scan_ui(
             review.outline.len()
         ));
         let mut changed = false;
-        ui.horizontal(|ui| {
-            let label = ui.label("move").id;
-            let pointed = review.corners.pointed();
-            egui::ComboBox::from_id_salt("scan corner")
-                .selected_text(CORNER_NAMES[review.moving])
-                .show_ui(ui, |ui| {
-                    for (k, name) in CORNER_NAMES.iter().enumerate() {
-                        if k == 3 && pointed {
-                            continue;
-                        }
-                        ui.selectable_value(&mut review.moving, k, *name);
-                    }
-                })
-                .response
-                .labelled_by(label);
-            let mut rounded = !pointed;
-            if ui
-                .checkbox(&mut rounded, "tip is a span")
-                .on_hover_text("Off: the tip is one point (a pointed petal)")
-                .changed()
-            {
-                let n = review.outline.len();
-                let t = review.corners.tip[0];
-                review.corners.tip = if rounded {
-                    [t, (t + (n / 20).max(1)) % n]
-                } else {
-                    [t, t]
-                };
-                if !rounded && review.moving == 3 {
-                    review.moving = 2;
-                }
-                changed = true;
-            }
-            if ui
-                .button("Found corners")
-                .on_hover_text("Back to the base and tip found automatically")
-                .clicked()
-            {
-                review.corners = review.detected;
-                changed = true;
-            }
-        });
+        corner_row(ui, review, &mut changed);
         if review.moving == 3 && review.corners.pointed() {
             review.moving = 2;
         }
 
-        // The view.
-        let (rotation, origin) = review.view.unwrap_or((glam::DMat3::IDENTITY, DVec3::ZERO));
-        let flat: Vec<DVec2> = review
-            .outline
-            .vertices
-            .iter()
-            .map(|&v| {
-                let p = rotation * (review.mesh.positions[v as usize] - origin);
-                DVec2::new(p.x, p.y)
-            })
-            .collect();
-        let (mut low, mut high) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for p in &flat {
-            low = low.min(*p);
-            high = high.max(*p);
-        }
-        let size = egui::vec2(ui.available_width().max(120.0), 220.0);
-        let (response, painter) = ui.allocate_painter(size, egui::Sense::click());
-        let rect = response.rect.shrink(14.0);
-        let extent = (high - low).max(DVec2::splat(1e-6));
-        let scale = (f64::from(rect.width()) / extent.x).min(f64::from(rect.height()) / extent.y);
-        let middle = (low + high) * 0.5;
-        let to_screen = |q: DVec2| {
-            let q = q - middle;
-            egui::pos2(
-                rect.center().x + (q.x * scale) as f32,
-                rect.center().y - (q.y * scale) as f32,
-            )
-        };
-        painter.rect_filled(response.rect, 4.0, ui.visuals().extreme_bg_color);
-        review.on_screen = flat.iter().map(|q| to_screen(*q)).collect();
-        // The fitted surface's iso-lines, faint.
-        if let Ok(fit) = &review.fit {
-            let into_view = |p: DVec3| {
-                // The fit is in its own template frame; the view is the
-                // last fit's, which is this one.
-                to_screen(DVec2::new(p.x, p.y))
-            };
-            let lines = 6;
-            for i in 0..=lines {
-                let points: Vec<egui::Pos2> = (0..=20)
-                    .map(|j| {
-                        into_view(
-                            fit.sweep
-                                .point(DVec2::new(i as f64 / lines as f64, j as f64 / 20.0)),
-                        )
-                    })
-                    .collect();
-                painter.add(egui::Shape::line(
-                    points,
-                    egui::Stroke::new(1.0, ui.visuals().weak_text_color()),
-                ));
-            }
-        }
-        // The outline, its spans coloured: base, margins, tip.
-        let n = review.outline.len();
-        let [b0, b1] = review.corners.base;
-        let [t0, t1] = review.corners.tip;
-        let steps = |k: usize| (k + n - b0) % n;
-        let base_colour = Color32::from_rgb(240, 170, 60);
-        let tip_colour = Color32::from_rgb(220, 90, 200);
-        let margin_colour = Color32::from_rgb(120, 170, 255);
-        for k in 0..n {
-            let s = steps(k);
-            let colour = if s < steps(b1) {
-                base_colour
-            } else if s >= steps(t0) && s < steps(t1) {
-                tip_colour
-            } else {
-                margin_colour
-            };
-            painter.line_segment(
-                [review.on_screen[k], review.on_screen[(k + 1) % n]],
-                egui::Stroke::new(2.0, colour),
-            );
-        }
-        for (k, corner) in [b0, b1, t0, t1].iter().enumerate() {
-            let colour = if k < 2 { base_colour } else { tip_colour };
-            let radius = if k == review.moving { 6.0 } else { 4.0 };
-            painter.circle_filled(review.on_screen[*corner], radius, colour);
-        }
-        if response.clicked()
-            && let Some(at) = response.interact_pointer_pos()
-        {
-            let nearest = (0..n).min_by(|&a, &b| {
-                review.on_screen[a]
-                    .distance_sq(at)
-                    .total_cmp(&review.on_screen[b].distance_sq(at))
-            });
-            if let Some(k) = nearest {
-                match review.moving {
-                    0 => review.corners.base[0] = k,
-                    1 => review.corners.base[1] = k,
-                    2 if review.corners.pointed() => review.corners.tip = [k, k],
-                    2 => review.corners.tip[0] = k,
-                    _ => review.corners.tip[1] = k,
-                }
-                changed = true;
-            }
-        }
+        outline_view(ui, review, &mut changed);
         ui.horizontal(|ui| {
             if ui
                 .checkbox(&mut review.flip, "inner side convex")
@@ -420,63 +280,237 @@ pub fn scan_ui(
                 );
             }
         }
-        let mut refused = None;
-        ui.horizontal(|ui| {
-            match (&review.fit, review.built.as_ref().map(|(_, b)| b)) {
-                _ if fitting => {}
-                (Ok(fit), Some(Ok(bud))) => {
-                    ui.label(format!("meshed: {}", quality_text(&bud.quality)));
-                    if ui
-                        .button("Make template")
-                        .on_hover_text(
-                            "A new template of the fitted surface (a PDE petal, to edit again) \
-                             with uniform maps and one organ (one undo step)",
-                        )
-                        .clicked()
-                    {
-                        let mut template = anthesis_garden::five_petal::simple_template_of_mesh(
-                            &review.name,
-                            bud.mesh.clone(),
-                        );
-                        template.source = Some(TemplateSource::Pde {
-                            sweep: fit.sweep,
-                            edge: review.edge,
-                        });
-                        match flower.with_template_and_organ(template) {
-                            Ok(added) => {
-                                let index = added.templates.len() - 1;
-                                commands.push(Command::Edit {
-                                    label: format!(
-                                        "import scanned petal {}",
-                                        added.templates[index].name
-                                    ),
-                                    edit: ProjectEdit::Flower(Box::new(added)),
-                                });
-                                made = Some(index);
-                                close = true;
-                            }
-                            Err(e) => refused = Some(e.to_string()),
-                        }
-                    }
-                }
-                (Ok(_), Some(Err(e))) => {
-                    ui.label(
-                        RichText::new(format!("cannot mesh: {e}"))
-                            .color(ui.visuals().error_fg_color),
-                    );
-                }
-                _ => {}
-            }
-            if ui.button("Cancel scan").clicked() {
-                close = true;
-            }
-        });
-        if let Some(e) = refused {
-            review.built = Some((review.edge.to_bits(), Err(e)));
-        }
+        make_row(
+            ui,
+            flower,
+            review,
+            fitting,
+            commands,
+            (&mut made, &mut close),
+        );
     });
     if close {
         *scan = None;
     }
     made
+}
+
+/// The row that chooses the corner a click moves, whether the tip is a
+/// span, and goes back to the corners found; sets `changed` when the
+/// corners changed.
+fn corner_row(ui: &mut egui::Ui, review: &mut ScanReview, changed: &mut bool) {
+    ui.horizontal(|ui| {
+        let label = ui.label("move").id;
+        let pointed = review.corners.pointed();
+        egui::ComboBox::from_id_salt("scan corner")
+            .selected_text(CORNER_NAMES[review.moving])
+            .show_ui(ui, |ui| {
+                for (k, name) in CORNER_NAMES.iter().enumerate() {
+                    if k == 3 && pointed {
+                        continue;
+                    }
+                    ui.selectable_value(&mut review.moving, k, *name);
+                }
+            })
+            .response
+            .labelled_by(label);
+        let mut rounded = !pointed;
+        if ui
+            .checkbox(&mut rounded, "tip is a span")
+            .on_hover_text("Off: the tip is one point (a pointed petal)")
+            .changed()
+        {
+            let n = review.outline.len();
+            let t = review.corners.tip[0];
+            review.corners.tip = if rounded {
+                [t, (t + (n / 20).max(1)) % n]
+            } else {
+                [t, t]
+            };
+            if !rounded && review.moving == 3 {
+                review.moving = 2;
+            }
+            *changed = true;
+        }
+        if ui
+            .button("Found corners")
+            .on_hover_text("Back to the base and tip found automatically")
+            .clicked()
+        {
+            review.corners = review.detected;
+            *changed = true;
+        }
+    });
+}
+
+/// The scan seen from its fitted frame: the fitted surface's iso-lines,
+/// the outline coloured by span with its corners; a click on the outline
+/// moves the chosen corner there (and sets `changed`).
+fn outline_view(ui: &mut egui::Ui, review: &mut ScanReview, changed: &mut bool) {
+    // The view.
+    let (rotation, origin) = review.view.unwrap_or((glam::DMat3::IDENTITY, DVec3::ZERO));
+    let flat: Vec<DVec2> = review
+        .outline
+        .vertices
+        .iter()
+        .map(|&v| {
+            let p = rotation * (review.mesh.positions[v as usize] - origin);
+            DVec2::new(p.x, p.y)
+        })
+        .collect();
+    let (mut low, mut high) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in &flat {
+        low = low.min(*p);
+        high = high.max(*p);
+    }
+    let size = egui::vec2(ui.available_width().max(120.0), 220.0);
+    let (response, painter) = ui.allocate_painter(size, egui::Sense::click());
+    let rect = response.rect.shrink(14.0);
+    let extent = (high - low).max(DVec2::splat(1e-6));
+    let scale = (f64::from(rect.width()) / extent.x).min(f64::from(rect.height()) / extent.y);
+    let middle = (low + high) * 0.5;
+    let to_screen = |q: DVec2| {
+        let q = q - middle;
+        egui::pos2(
+            rect.center().x + (q.x * scale) as f32,
+            rect.center().y - (q.y * scale) as f32,
+        )
+    };
+    painter.rect_filled(response.rect, 4.0, ui.visuals().extreme_bg_color);
+    review.on_screen = flat.iter().map(|q| to_screen(*q)).collect();
+    // The fitted surface's iso-lines, faint.
+    if let Ok(fit) = &review.fit {
+        let into_view = |p: DVec3| {
+            // The fit is in its own template frame; the view is the
+            // last fit's, which is this one.
+            to_screen(DVec2::new(p.x, p.y))
+        };
+        let lines = 6;
+        for i in 0..=lines {
+            let points: Vec<egui::Pos2> = (0..=20)
+                .map(|j| {
+                    into_view(
+                        fit.sweep
+                            .point(DVec2::new(i as f64 / lines as f64, j as f64 / 20.0)),
+                    )
+                })
+                .collect();
+            painter.add(egui::Shape::line(
+                points,
+                egui::Stroke::new(1.0, ui.visuals().weak_text_color()),
+            ));
+        }
+    }
+    // The outline, its spans coloured: base, margins, tip.
+    let n = review.outline.len();
+    let [b0, b1] = review.corners.base;
+    let [t0, t1] = review.corners.tip;
+    let steps = |k: usize| (k + n - b0) % n;
+    let base_colour = Color32::from_rgb(240, 170, 60);
+    let tip_colour = Color32::from_rgb(220, 90, 200);
+    let margin_colour = Color32::from_rgb(120, 170, 255);
+    for k in 0..n {
+        let s = steps(k);
+        let colour = if s < steps(b1) {
+            base_colour
+        } else if s >= steps(t0) && s < steps(t1) {
+            tip_colour
+        } else {
+            margin_colour
+        };
+        painter.line_segment(
+            [review.on_screen[k], review.on_screen[(k + 1) % n]],
+            egui::Stroke::new(2.0, colour),
+        );
+    }
+    for (k, corner) in [b0, b1, t0, t1].iter().enumerate() {
+        let colour = if k < 2 { base_colour } else { tip_colour };
+        let radius = if k == review.moving { 6.0 } else { 4.0 };
+        painter.circle_filled(review.on_screen[*corner], radius, colour);
+    }
+    if response.clicked()
+        && let Some(at) = response.interact_pointer_pos()
+    {
+        let nearest = (0..n).min_by(|&a, &b| {
+            review.on_screen[a]
+                .distance_sq(at)
+                .total_cmp(&review.on_screen[b].distance_sq(at))
+        });
+        if let Some(k) = nearest {
+            match review.moving {
+                0 => review.corners.base[0] = k,
+                1 => review.corners.base[1] = k,
+                2 if review.corners.pointed() => review.corners.tip = [k, k],
+                2 => review.corners.tip[0] = k,
+                _ => review.corners.tip[1] = k,
+            }
+            *changed = true;
+        }
+    }
+}
+
+/// The fit's mesh numbers with "Make template" (which sets `made` to the
+/// new template and `close`), or why it cannot be meshed, and "Cancel
+/// scan" (which sets `close`).
+fn make_row(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    review: &mut ScanReview,
+    fitting: bool,
+    commands: &mut Vec<Command>,
+    (made, close): (&mut Option<usize>, &mut bool),
+) {
+    let mut refused = None;
+    ui.horizontal(|ui| {
+        match (&review.fit, review.built.as_ref().map(|(_, b)| b)) {
+            _ if fitting => {}
+            (Ok(fit), Some(Ok(bud))) => {
+                ui.label(format!("meshed: {}", quality_text(&bud.quality)));
+                if ui
+                    .button("Make template")
+                    .on_hover_text(
+                        "A new template of the fitted surface (a PDE petal, to edit again) \
+                             with uniform maps and one organ (one undo step)",
+                    )
+                    .clicked()
+                {
+                    let mut template = anthesis_garden::five_petal::simple_template_of_mesh(
+                        &review.name,
+                        bud.mesh.clone(),
+                    );
+                    template.source = Some(TemplateSource::Pde {
+                        sweep: fit.sweep,
+                        edge: review.edge,
+                    });
+                    match flower.with_template_and_organ(template) {
+                        Ok(added) => {
+                            let index = added.templates.len() - 1;
+                            commands.push(Command::Edit {
+                                label: format!(
+                                    "import scanned petal {}",
+                                    added.templates[index].name
+                                ),
+                                edit: ProjectEdit::Flower(Box::new(added)),
+                            });
+                            *made = Some(index);
+                            *close = true;
+                        }
+                        Err(e) => refused = Some(e.to_string()),
+                    }
+                }
+            }
+            (Ok(_), Some(Err(e))) => {
+                ui.label(
+                    RichText::new(format!("cannot mesh: {e}")).color(ui.visuals().error_fg_color),
+                );
+            }
+            _ => {}
+        }
+        if ui.button("Cancel scan").clicked() {
+            *close = true;
+        }
+    });
+    if let Some(e) = refused {
+        review.built = Some((review.edge.to_bits(), Err(e)));
+    }
 }
