@@ -143,8 +143,95 @@ pub fn pde_ui(
             .on_hover_text("From the side: z across, y from base to tip");
     });
     state.asymmetric = !symmetric;
-    let side = state.side_view;
+    sweep = sweep_view(ui, state, sweep, symmetric);
 
+    // The chosen point's numbers.
+    ui.horizontal(|ui| {
+        let label = ui.label("point").id;
+        let (c, k) = state.point;
+        egui::ComboBox::from_id_salt("pde point")
+            .selected_text(format!(
+                "{} {}",
+                curve_name(SweepCurve::ALL[c]),
+                POINT_NAMES[k]
+            ))
+            .show_ui(ui, |ui| {
+                for (c, curve) in SweepCurve::ALL.iter().enumerate() {
+                    for (k, point) in POINT_NAMES.iter().enumerate() {
+                        ui.selectable_value(
+                            &mut state.point,
+                            (c, k),
+                            format!("{} {point}", curve_name(*curve)),
+                        );
+                    }
+                }
+            })
+            .response
+            .labelled_by(label);
+    });
+    let (c, k) = state.point;
+    let curve = SweepCurve::ALL[c];
+    let mut p = sweep.curve(curve).control[k];
+    let mut typed = false;
+    ui.horizontal(|ui| {
+        for (axis, value) in [("x", &mut p.x), ("y", &mut p.y), ("z", &mut p.z)] {
+            let label = ui.label(axis).id;
+            typed |= ui
+                .add(DragValue::new(value).speed(0.05).max_decimals(3))
+                .labelled_by(label)
+                .changed();
+        }
+    })
+    .response
+    .on_hover_text(if curve.is_margin() {
+        "The margin's control point, in the template frame"
+    } else {
+        "The across-tangent dS/du at that control point (a vector; the handle shows a third of it, \
+         into the surface)"
+    });
+    if typed {
+        sweep = sweep.with_point(curve, k, p, symmetric);
+    }
+    let mut lambda = sweep.stretch_to_bend();
+    ui.horizontal(|ui| {
+        let label = ui
+            .label("k_s/k_b")
+            .on_hover_text(
+                "Stretch over bend stiffness of the generator (seed eq. 5): 0 gives the cubic \
+                 of eq. 12, larger values pull it taut between the margins",
+            )
+            .id;
+        if ui
+            .add(
+                egui::Slider::new(&mut lambda, 0.0..=anthesis_bud::MAX_STRETCH_TO_BEND)
+                    .logarithmic(true)
+                    .smallest_positive(0.01),
+            )
+            .labelled_by(label)
+            .changed()
+        {
+            sweep = sweep.with_stretch_to_bend(lambda);
+        }
+    });
+    if sweep != before {
+        state.error = None;
+    }
+    state.drafts.insert(name.clone(), (saved, sweep));
+
+    mesh_and_apply(ui, (flower, index), (sweep, edge), state, commands);
+}
+
+/// The 2D view of the sweep: its margins with their control polygons and
+/// points, the tangent handles and the surface's iso-lines; returns the
+/// sweep with the point dragged moved (and its mirror image when
+/// `symmetric`).
+fn sweep_view(
+    ui: &mut egui::Ui,
+    state: &mut PdeState,
+    sweep: PdeSweep,
+    symmetric: bool,
+) -> PdeSweep {
+    let side = state.side_view;
     // The view: margins, their control polygons and points, tangent
     // handles and the surface's iso-lines.
     let across = |p: DVec3| if side { p.z } else { p.x };
@@ -167,30 +254,8 @@ pub fn pde_ui(
         std::array::from_fn(|k| handle(2, k)),
         std::array::from_fn(|k| handle(3, k)),
     ];
-    let lines = 8;
-    let samples = 24;
-    let iso: Vec<Vec<DVec3>> = (0..=lines)
-        .map(|i| {
-            (0..=samples)
-                .map(|j| {
-                    sweep.point(DVec2::new(
-                        i as f64 / lines as f64,
-                        j as f64 / samples as f64,
-                    ))
-                })
-                .collect()
-        })
-        .chain((0..=lines).map(|j| {
-            (0..=samples)
-                .map(|i| {
-                    sweep.point(DVec2::new(
-                        i as f64 / samples as f64,
-                        j as f64 / lines as f64,
-                    ))
-                })
-                .collect()
-        }))
-        .collect();
+    let iso = iso_lines(&sweep);
+    let samples = CURVE_SAMPLES;
     let (mut low, mut high) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     for p in handled.iter().flatten().chain(iso.iter().flatten()) {
         low = low.min(flat(*p));
@@ -270,91 +335,73 @@ pub fn pde_ui(
         }
     }
     state.on_screen = Some(points);
-    if let Some((c, k, shift)) = moved {
-        let curve = SweepCurve::ALL[c];
-        // A handle's head moves the tangent three times as far (the other
-        // way at margin 2, whose handle is C1 − T1/3).
-        let value = match curve {
-            SweepCurve::Margin0 | SweepCurve::Margin1 => sweep.curve(curve).control[k] + shift,
-            SweepCurve::Tangent0 => sweep.curve(curve).control[k] + 3.0 * shift,
-            SweepCurve::Tangent1 => sweep.curve(curve).control[k] - 3.0 * shift,
-        };
-        sweep = sweep.with_point(curve, k, value, symmetric);
+    match moved {
+        Some(dragged) => with_dragged(sweep, dragged, symmetric),
+        None => sweep,
     }
+}
 
-    // The chosen point's numbers.
-    ui.horizontal(|ui| {
-        let label = ui.label("point").id;
-        let (c, k) = state.point;
-        egui::ComboBox::from_id_salt("pde point")
-            .selected_text(format!(
-                "{} {}",
-                curve_name(SweepCurve::ALL[c]),
-                POINT_NAMES[k]
-            ))
-            .show_ui(ui, |ui| {
-                for (c, curve) in SweepCurve::ALL.iter().enumerate() {
-                    for (k, point) in POINT_NAMES.iter().enumerate() {
-                        ui.selectable_value(
-                            &mut state.point,
-                            (c, k),
-                            format!("{} {point}", curve_name(*curve)),
-                        );
-                    }
-                }
-            })
-            .response
-            .labelled_by(label);
-    });
-    let (c, k) = state.point;
+/// Points along each curve and iso-line the view draws.
+const CURVE_SAMPLES: usize = 24;
+
+/// Lines of constant `u` and of constant `v` across `sweep`, 8 spans
+/// each, [`CURVE_SAMPLES`] spans along.
+fn iso_lines(sweep: &PdeSweep) -> Vec<Vec<DVec3>> {
+    let lines = 8;
+    let samples = CURVE_SAMPLES;
+    (0..=lines)
+        .map(|i| {
+            (0..=samples)
+                .map(|j| {
+                    sweep.point(DVec2::new(
+                        i as f64 / lines as f64,
+                        j as f64 / samples as f64,
+                    ))
+                })
+                .collect()
+        })
+        .chain((0..=lines).map(|j| {
+            (0..=samples)
+                .map(|i| {
+                    sweep.point(DVec2::new(
+                        i as f64 / samples as f64,
+                        j as f64 / lines as f64,
+                    ))
+                })
+                .collect()
+        }))
+        .collect()
+}
+
+/// `sweep` with control point `k` of curve `c` (by index in
+/// [`SweepCurve::ALL`]) dragged by `shift` in the template frame, and its
+/// mirror image too when `symmetric`.
+fn with_dragged(
+    sweep: PdeSweep,
+    (c, k, shift): (usize, usize, DVec3),
+    symmetric: bool,
+) -> PdeSweep {
     let curve = SweepCurve::ALL[c];
-    let mut p = sweep.curve(curve).control[k];
-    let mut typed = false;
-    ui.horizontal(|ui| {
-        for (axis, value) in [("x", &mut p.x), ("y", &mut p.y), ("z", &mut p.z)] {
-            let label = ui.label(axis).id;
-            typed |= ui
-                .add(DragValue::new(value).speed(0.05).max_decimals(3))
-                .labelled_by(label)
-                .changed();
-        }
-    })
-    .response
-    .on_hover_text(if curve.is_margin() {
-        "The margin's control point, in the template frame"
-    } else {
-        "The across-tangent dS/du at that control point (a vector; the handle shows a third of it, \
-         into the surface)"
-    });
-    if typed {
-        sweep = sweep.with_point(curve, k, p, symmetric);
-    }
-    let mut lambda = sweep.stretch_to_bend();
-    ui.horizontal(|ui| {
-        let label = ui
-            .label("k_s/k_b")
-            .on_hover_text(
-                "Stretch over bend stiffness of the generator (seed eq. 5): 0 gives the cubic \
-                 of eq. 12, larger values pull it taut between the margins",
-            )
-            .id;
-        if ui
-            .add(
-                egui::Slider::new(&mut lambda, 0.0..=anthesis_bud::MAX_STRETCH_TO_BEND)
-                    .logarithmic(true)
-                    .smallest_positive(0.01),
-            )
-            .labelled_by(label)
-            .changed()
-        {
-            sweep = sweep.with_stretch_to_bend(lambda);
-        }
-    });
-    if sweep != before {
-        state.error = None;
-    }
-    state.drafts.insert(name.clone(), (saved, sweep));
+    // A handle's head moves the tangent three times as far (the other
+    // way at margin 2, whose handle is C1 − T1/3).
+    let value = match curve {
+        SweepCurve::Margin0 | SweepCurve::Margin1 => sweep.curve(curve).control[k] + shift,
+        SweepCurve::Tangent0 => sweep.curve(curve).control[k] + 3.0 * shift,
+        SweepCurve::Tangent1 => sweep.curve(curve).control[k] - 3.0 * shift,
+    };
+    sweep.with_point(curve, k, value, symmetric)
+}
 
+/// The mesh the sweep would become at `edge` (built when either changes)
+/// with "Apply surface", or why it cannot be meshed or used.
+fn mesh_and_apply(
+    ui: &mut egui::Ui,
+    (flower, index): (&Flower, usize),
+    (sweep, edge): (PdeSweep, f64),
+    state: &mut PdeState,
+    commands: &mut Vec<Command>,
+) {
+    let name = &flower.templates[index].name;
     // The mesh it would become, built when the draft or edge changes.
     let key = (sweep, edge_bits(edge));
     if state.built.as_ref().is_none_or(|(k, _)| *k != key) {
