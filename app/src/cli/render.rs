@@ -190,6 +190,18 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         bail!("--out DIR or --animation OUT.gif|FOLDER says where the pictures go");
     };
 
+    write_stills(args, &mut renderer, &scenes, out, (width, height))
+}
+
+/// Renders each scene as `out/frame-NNN.png` with one camera framing them
+/// all, writes `camera.json` and, with `--tile`, the pictures side by side.
+fn write_stills(
+    args: &RenderArgs,
+    renderer: &mut OffscreenRenderer,
+    scenes: &[(u32, Vec<OrganMesh>)],
+    out: &Path,
+    (width, height): (u32, u32),
+) -> Result<()> {
     // One camera for all pictures, so the flower does not jump between them.
     let bounds = scenes
         .iter()
@@ -200,7 +212,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     };
     let camera = Camera::framing(lo, hi, args.azimuth, args.elevation);
     let mut pictures = Vec::with_capacity(scenes.len());
-    for (index, organs) in &scenes {
+    for (index, organs) in scenes {
         let picture = renderer
             .render(organs, &camera, width, height)
             .with_context(|| format!("cannot render keyframe {index}"))?;
