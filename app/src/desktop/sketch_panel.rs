@@ -531,28 +531,7 @@ fn canvas(
     painter.line_segment([origin, origin - egui::vec2(0.0, 16.0)], axis);
     // The petal: its control net and its outline.
     if let Some(petal) = petal {
-        let net = petal.control_in_sketch();
-        let line = Stroke::new(1.0, Color32::from_rgb(150, 150, 170));
-        for (j, row) in net.iter().enumerate() {
-            for (i, p) in row.iter().enumerate() {
-                let at = view.to_screen(*p);
-                if let Some(q) = row.get(i + 1) {
-                    painter.line_segment([at, view.to_screen(*q)], line);
-                }
-                if let Some(q) = net.get(j + 1).map(|r| r[i]) {
-                    painter.line_segment([at, view.to_screen(q)], line);
-                }
-                painter.circle_filled(at, 2.5, Color32::from_rgb(200, 200, 220));
-            }
-        }
-        let outline: Vec<Pos2> = boundary(&petal.surface)
-            .into_iter()
-            .map(|p| view.to_screen(petal.frame.to_sketch(p.truncate())))
-            .collect();
-        painter.add(egui::Shape::closed_line(
-            outline,
-            Stroke::new(1.5, Color32::from_rgb(235, 150, 175)),
-        ));
+        draw_petal(&painter, view, petal);
     }
     // The strokes as drawn.
     let colours = [
@@ -603,6 +582,32 @@ fn canvas(
         state.drawing = None;
     }
     state.view = Some(view);
+}
+
+/// The sketched petal over the canvas: its control net and its outline.
+fn draw_petal(painter: &egui::Painter, view: View, petal: &SketchedPetal) {
+    let net = petal.control_in_sketch();
+    let line = Stroke::new(1.0, Color32::from_rgb(150, 150, 170));
+    for (j, row) in net.iter().enumerate() {
+        for (i, p) in row.iter().enumerate() {
+            let at = view.to_screen(*p);
+            if let Some(q) = row.get(i + 1) {
+                painter.line_segment([at, view.to_screen(*q)], line);
+            }
+            if let Some(q) = net.get(j + 1).map(|r| r[i]) {
+                painter.line_segment([at, view.to_screen(q)], line);
+            }
+            painter.circle_filled(at, 2.5, Color32::from_rgb(200, 200, 220));
+        }
+    }
+    let outline: Vec<Pos2> = boundary(&petal.surface)
+        .into_iter()
+        .map(|p| view.to_screen(petal.frame.to_sketch(p.truncate())))
+        .collect();
+    painter.add(egui::Shape::closed_line(
+        outline,
+        Stroke::new(1.5, Color32::from_rgb(235, 150, 175)),
+    ));
 }
 
 /// The surface's outline: base, right margin, tip, left margin.
