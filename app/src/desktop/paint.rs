@@ -301,98 +301,9 @@ impl PaintState {
                 .labelled_by(label);
                 ui.end_row();
 
-                let label = ui.label("Key dg").id;
-                ui.horizontal(|ui| {
-                    let key = &current.maps.keys()[self.key];
-                    let mut own = key.dg.is_some();
-                    let mut dg = key.dg.unwrap_or(current.dg);
-                    let toggled = ui
-                        .checkbox(&mut own, "own")
-                        .on_hover_text(
-                            "This key's own growth scale in place of the template's dg, \
-                             blended between keys like the maps; negative: the organ \
-                             shrinks (wilting after it opened)",
-                        )
-                        .changed();
-                    let dragged = ui
-                        .add_enabled(
-                            own,
-                            egui::DragValue::new(&mut dg)
-                                .speed(0.0001)
-                                .range(-0.5..=0.5)
-                                .max_decimals(4),
-                        )
-                        .labelled_by(label)
-                        .changed();
-                    if toggled || dragged {
-                        let mut value = current.clone();
-                        if let Some(k) = value.maps.keys_mut().get_mut(self.key) {
-                            k.dg = own.then_some(dg);
-                        }
-                        chosen.push(Command::Edit {
-                            label: format!("dg of key {} of {}", key.step, current.name),
-                            edit: ProjectEdit::Template {
-                                template,
-                                value: Box::new(value),
-                                keyframes: project.settings.keyframes,
-                            },
-                        });
-                    }
-                });
-                ui.end_row();
+                self.key_dg_row(ui, (project, template, current), &mut chosen);
 
-                let label = ui.label("New key").id;
-                ui.horizontal(|ui| {
-                    ui.add(egui::DragValue::new(&mut self.new_key_step).range(0..=100_000))
-                        .labelled_by(label)
-                        .on_hover_text("Step of the key to add");
-                    let exists = current
-                        .maps
-                        .keys()
-                        .iter()
-                        .any(|k| k.step == self.new_key_step);
-                    if ui
-                        .add_enabled(!exists, egui::Button::new("Add key"))
-                        .on_hover_text(
-                            "Add a key at this step, starting from the selected key's maps",
-                        )
-                        .clicked()
-                    {
-                        // The new key starts from the selected key's maps;
-                        // applying it selects it for painting.
-                        let maps = current.maps.keys()[self.key].maps.clone();
-                        let step = self.new_key_step;
-                        chosen.push(Command::Edit {
-                            label: format!("add key {step} to {}", current.name),
-                            edit: ProjectEdit::AddKey {
-                                template,
-                                key: Box::new(MapKey {
-                                    dg: None,
-                                    step,
-                                    maps,
-                                }),
-                            },
-                        });
-                    }
-                    if ui
-                        .add_enabled(
-                            current.maps.keys().len() > 1,
-                            egui::Button::new("Remove key"),
-                        )
-                        .on_hover_text("Remove the selected key (the last key cannot go)")
-                        .clicked()
-                    {
-                        chosen.push(Command::Edit {
-                            label: format!("remove key from {}", current.name),
-                            edit: ProjectEdit::RemoveKey {
-                                template,
-                                key: self.key,
-                            },
-                        });
-                        self.key = self.key.saturating_sub(1);
-                    }
-                });
-                ui.end_row();
+                self.new_key_row(ui, (template, current), &mut chosen);
 
                 let label = ui.label("Blend").id;
                 let mut blend = current.maps.blend;
@@ -427,6 +338,115 @@ impl PaintState {
             .id_salt("brush settings")
             .show(ui, |ui| self.brush_ui(ui));
         chosen
+    }
+
+    /// The "Key dg" row of the paint grid: the chosen time key's own growth
+    /// scale, or the template's.
+    fn key_dg_row(
+        &mut self,
+        ui: &mut egui::Ui,
+        (project, template, current): (&Project, usize, &Template),
+        chosen: &mut Vec<Command>,
+    ) {
+        let label = ui.label("Key dg").id;
+        ui.horizontal(|ui| {
+            let key = &current.maps.keys()[self.key];
+            let mut own = key.dg.is_some();
+            let mut dg = key.dg.unwrap_or(current.dg);
+            let toggled = ui
+                .checkbox(&mut own, "own")
+                .on_hover_text(
+                    "This key's own growth scale in place of the template's dg, \
+                             blended between keys like the maps; negative: the organ \
+                             shrinks (wilting after it opened)",
+                )
+                .changed();
+            let dragged = ui
+                .add_enabled(
+                    own,
+                    egui::DragValue::new(&mut dg)
+                        .speed(0.0001)
+                        .range(-0.5..=0.5)
+                        .max_decimals(4),
+                )
+                .labelled_by(label)
+                .changed();
+            if toggled || dragged {
+                let mut value = current.clone();
+                if let Some(k) = value.maps.keys_mut().get_mut(self.key) {
+                    k.dg = own.then_some(dg);
+                }
+                chosen.push(Command::Edit {
+                    label: format!("dg of key {} of {}", key.step, current.name),
+                    edit: ProjectEdit::Template {
+                        template,
+                        value: Box::new(value),
+                        keyframes: project.settings.keyframes,
+                    },
+                });
+            }
+        });
+        ui.end_row();
+    }
+
+    /// The "New key" row of the paint grid: a time key added at a step (a
+    /// copy of the chosen key's maps), or the chosen key removed.
+    fn new_key_row(
+        &mut self,
+        ui: &mut egui::Ui,
+        (template, current): (usize, &Template),
+        chosen: &mut Vec<Command>,
+    ) {
+        let label = ui.label("New key").id;
+        ui.horizontal(|ui| {
+            ui.add(egui::DragValue::new(&mut self.new_key_step).range(0..=100_000))
+                .labelled_by(label)
+                .on_hover_text("Step of the key to add");
+            let exists = current
+                .maps
+                .keys()
+                .iter()
+                .any(|k| k.step == self.new_key_step);
+            if ui
+                .add_enabled(!exists, egui::Button::new("Add key"))
+                .on_hover_text("Add a key at this step, starting from the selected key's maps")
+                .clicked()
+            {
+                // The new key starts from the selected key's maps;
+                // applying it selects it for painting.
+                let maps = current.maps.keys()[self.key].maps.clone();
+                let step = self.new_key_step;
+                chosen.push(Command::Edit {
+                    label: format!("add key {step} to {}", current.name),
+                    edit: ProjectEdit::AddKey {
+                        template,
+                        key: Box::new(MapKey {
+                            dg: None,
+                            step,
+                            maps,
+                        }),
+                    },
+                });
+            }
+            if ui
+                .add_enabled(
+                    current.maps.keys().len() > 1,
+                    egui::Button::new("Remove key"),
+                )
+                .on_hover_text("Remove the selected key (the last key cannot go)")
+                .clicked()
+            {
+                chosen.push(Command::Edit {
+                    label: format!("remove key from {}", current.name),
+                    edit: ProjectEdit::RemoveKey {
+                        template,
+                        key: self.key,
+                    },
+                });
+                self.key = self.key.saturating_sub(1);
+            }
+        });
+        ui.end_row();
     }
 
     /// Brush mode, radius, strength, hardness, value, mirror, 3D painting.
@@ -590,6 +610,41 @@ impl PaintState {
             None => {}
         }
 
+        self.draw_map(ui, rect, current, &to_screen);
+        let painter = ui.painter_at(rect);
+        self.hover_uv = response.hover_pos().map(to_uv);
+        if let Some(pointer) = response.hover_pos() {
+            // The brush outline: a circle of the brush radius in canvas
+            // pixels (and its mirror image with mirroring).
+            let r = self.brush.radius_in_uv as f32 * size;
+            painter.circle_stroke(
+                pointer,
+                r + 1.0,
+                Stroke::new(1.0, Color32::from_black_alpha(160)),
+            );
+            painter.circle_stroke(pointer, r, Stroke::new(1.0, Color32::WHITE));
+            if self.brush.mirror {
+                let uv = to_uv(pointer);
+                painter.circle_stroke(
+                    to_screen(DVec2::new(1.0 - uv.x, uv.y)),
+                    r,
+                    Stroke::new(1.0, Color32::from_white_alpha(120)),
+                );
+            }
+        }
+        dabs
+    }
+
+    /// The canvas's picture: the shown map (as this frame found it) over
+    /// the UV square, the mesh's triangles, the midrib, and on the direction
+    /// map its arrows.
+    fn draw_map(
+        &mut self,
+        ui: &egui::Ui,
+        rect: Rect,
+        current: &Template,
+        to_screen: &dyn Fn(DVec2) -> Pos2,
+    ) {
         // The document as it is before this frame's dab (the app draws
         // again once the dab is applied).
         let shown = current;
@@ -658,27 +713,6 @@ impl PaintState {
                 }
             }
         }
-        self.hover_uv = response.hover_pos().map(to_uv);
-        if let Some(pointer) = response.hover_pos() {
-            // The brush outline: a circle of the brush radius in canvas
-            // pixels (and its mirror image with mirroring).
-            let r = self.brush.radius_in_uv as f32 * size;
-            painter.circle_stroke(
-                pointer,
-                r + 1.0,
-                Stroke::new(1.0, Color32::from_black_alpha(160)),
-            );
-            painter.circle_stroke(pointer, r, Stroke::new(1.0, Color32::WHITE));
-            if self.brush.mirror {
-                let uv = to_uv(pointer);
-                painter.circle_stroke(
-                    to_screen(DVec2::new(1.0 - uv.x, uv.y)),
-                    r,
-                    Stroke::new(1.0, Color32::from_white_alpha(120)),
-                );
-            }
-        }
-        dabs
     }
 
     /// The pending click as one dab, if there is one.
