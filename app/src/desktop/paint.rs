@@ -337,9 +337,11 @@ impl PaintState {
         chosen.extend(self.canvas(ui, project, template, current));
         self.legend_ui(ui, current);
         ui.separator();
-        egui::ScrollArea::vertical()
+        let brush = egui::ScrollArea::vertical()
             .id_salt("brush settings")
-            .show(ui, |ui| self.brush_ui(ui));
+            .show(ui, |ui| self.brush_ui(ui))
+            .inner;
+        chosen.extend(brush);
         chosen
     }
 
@@ -452,11 +454,13 @@ impl PaintState {
         ui.end_row();
     }
 
-    /// Brush mode, radius, strength, hardness, value, mirror, 3D painting.
-    fn brush_ui(&mut self, ui: &mut egui::Ui) {
+    /// Brush mode, radius, strength, hardness, value, mirror, 3D painting;
+    /// a change of the brush as a command ([`Command::SetBrush`]).
+    fn brush_ui(&mut self, ui: &mut egui::Ui) -> Option<Command> {
+        let mut brush = self.brush;
         ui.horizontal_wrapped(|ui| {
             for mode in BrushMode::ALL {
-                ui.selectable_value(&mut self.brush.mode, mode, mode.label())
+                ui.selectable_value(&mut brush.mode, mode, mode.label())
                     .on_hover_text(match mode {
                         BrushMode::Set => "Move values towards the brush value",
                         BrushMode::Add => "Add the brush value",
@@ -476,11 +480,8 @@ impl PaintState {
             };
             let label = ui.label("radius").id;
             ui.add(
-                egui::Slider::new(
-                    &mut self.brush.radius_in_uv,
-                    MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV,
-                )
-                .logarithmic(true),
+                egui::Slider::new(&mut brush.radius_in_uv, MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV)
+                    .logarithmic(true),
             )
             .labelled_by(label)
             .on_hover_text("Brush radius in UV units (the layout is 1 wide)");
@@ -488,19 +489,19 @@ impl PaintState {
             slider(
                 ui,
                 "strength",
-                &mut self.brush.strength,
+                &mut brush.strength,
                 "How much one dab changes a value",
             );
             slider(
                 ui,
                 "hardness",
-                &mut self.brush.hardness,
+                &mut brush.hardness,
                 "Fraction of the radius at full strength",
             );
             slider(
                 ui,
                 "value",
-                &mut self.brush.value,
+                &mut brush.value,
                 "What set moves towards, and what add and subtract add or take away",
             );
         });
@@ -509,12 +510,13 @@ impl PaintState {
                 "Click the canvas (or the organ, when painting on the 3D organ) to pick the \
                  value under the pointer as a set brush (Alt+click always picks)",
             );
-        ui.checkbox(&mut self.brush.mirror, "Mirror about the midrib (u = 0.5)");
+        ui.checkbox(&mut brush.mirror, "Mirror about the midrib (u = 0.5)");
         ui.checkbox(&mut self.on_3d, "Paint on the 3D organ (drag on it)")
             .on_hover_text(
                 "Dragging on the selected organ in the viewport paints; Alt+click picks the \
                  value there; Shift+drag orbits",
             );
+        (brush != self.brush).then_some(Command::SetBrush(brush))
     }
 }
 
