@@ -5,10 +5,13 @@
 mod blossom;
 mod bud;
 mod fit;
+#[cfg(test)]
+mod fuzz;
 mod import_scan;
-mod pde_blossom;
+pub mod pde_blossom;
 mod render;
 mod simulate;
+pub(crate) mod stream;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -20,6 +23,7 @@ use anthesis_sim::Selection;
 use anthesis_sim::memory::KeyframeCost;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand, ValueEnum};
+use stream::say;
 
 pub use bud::{BudArgs, Example, InnerSideArg};
 pub use render::RenderArgs;
@@ -64,9 +68,9 @@ pub enum Command {
         /// Simulate only this organ (single-organ preview, no collisions).
         #[arg(long)]
         organ: Option<String>,
-        /// Number of keyframes (default: the project's).
+        /// Number of keyframes, 1 to 10,000 (default: the project's).
         #[arg(long)]
-        keyframes: Option<u32>,
+        keyframes: Option<i64>,
         /// Simulate every template remeshed at this mean edge length, in
         /// project units (the painted maps apply unchanged), or `as-built`
         /// for the meshes as they are (default: the project's
@@ -125,7 +129,7 @@ pub enum Command {
     Blossom(blossom::BlossomArgs),
     /// Animate a swept organ between two PDE sweep surfaces (its bud and
     /// its open state) by the PDE-driven in-betweening of
-    /// pde-surfaces-lily.txt §V: each generator's deformation from the
+    /// Chaudhry et al. §V: each generator's deformation from the
     /// dynamic equation (13), its force corrected (eq. 21) until the open
     /// state is met.
     PdeBlossom(pde_blossom::PdeBlossomArgs),
@@ -141,7 +145,8 @@ pub enum Command {
         #[arg(long = "from", value_name = "NAME")]
         from: String,
         /// The folder to write (created if missing; refused if it already
-        /// holds a project, so nothing is overwritten).
+        /// holds a project or any file the project would write, so nothing
+        /// is overwritten).
         dir: PathBuf,
     },
 }
@@ -171,32 +176,65 @@ impl From<EncodingArg> for Encoding {
 }
 
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    stream::guard();
+    let cli = match parse() {
         Ok(cli) => cli,
         Err(e) => {
             // Help and version are not errors.
             let code = if e.use_stderr() {
                 ExitCode::from(2)
+            } else if stream::stdout_closed() {
+                // The help had nowhere to go.
+                say!("error: cannot write to standard output: it is closed");
+                ExitCode::FAILURE
             } else {
                 ExitCode::SUCCESS
             };
-            let _ = e.print();
-            return code;
+            return match e.print() {
+                Ok(()) => code,
+                Err(_) if e.use_stderr() => code,
+                Err(error) => {
+                    say!("error: cannot write to standard output: {error}");
+                    ExitCode::FAILURE
+                }
+            };
         }
     };
     if !cli.no_cache {
         install_remesh_cache();
     }
+    let command = cli.command.is_some();
     match run(cli) {
+        // A command that could not say what it did on standard error
+        // (`2>/dev/full`) has still written its files; it ends non-zero.
+        Ok(()) if command && stream::stderr_failure().is_some() => ExitCode::FAILURE,
         Ok(()) => ExitCode::SUCCESS,
         // A reader that stopped reading (`anthesis info … | head -1`) is not
         // an error worth a message.
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", one_line(&error_message(&e)));
+            say!("error: {}", one_line(&error_message(&e)));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The command line, with every option's value allowed to be a negative
+/// number (`--keyframes -5`, `--edge -1`: read as values and refused with
+/// their range, not taken for unknown options).
+fn parse() -> Result<Cli, clap::Error> {
+    use clap::{CommandFactory, FromArgMatches};
+    let negative_values = |arg: clap::Arg| {
+        if arg.get_action().takes_values() {
+            arg.allow_negative_numbers(true)
+        } else {
+            arg
+        }
+    };
+    let command = Cli::command()
+        .mut_args(negative_values)
+        .mut_subcommands(|sub| sub.mut_args(negative_values));
+    Cli::from_arg_matches(&command.try_get_matches()?)
 }
 
 /// Keeps remeshed templates in the user's cache for this process (the
@@ -211,7 +249,7 @@ fn install_remesh_cache() {
 /// (the command goes on without it).
 pub(crate) fn warn_about_the_cache() {
     if let Some(warning) = anthesis_flower::remesh_cache::installed().take_warning() {
-        eprintln!("warning: {warning}");
+        say!("warning: {warning}");
     }
 }
 
@@ -260,6 +298,7 @@ pub fn run(cli: Cli) -> Result<()> {
         None => match cli.project.as_deref() {
             None => crate::desktop::run(None, Vec::new()),
             Some(path) => {
+                refuse_unknown_subcommand(path)?;
                 let (project, file, warnings) = open(path)?;
                 crate::desktop::run(Some((project, file)), warnings)
             }
@@ -280,11 +319,19 @@ pub fn run(cli: Cli) -> Result<()> {
             subdivide,
             allow_crossings,
         }) => {
+            let keyframes = keyframes
+                .map(|n| check_count("--keyframes", n, 1, anthesis_flower::MAX_KEYFRAMES as usize))
+                .transpose()?
+                .map(|n| n as u32);
             let timing = match (fps, duration) {
                 (_, Some(d)) if d > 0.0 && d.is_finite() => Timing::Duration(d),
-                (_, Some(d)) => bail!("--duration must be a positive number of seconds, got {d}"),
+                (_, Some(d)) => {
+                    bail!("--duration must be a number of seconds above 0 (and finite), got {d}")
+                }
                 (Some(f), None) if f > 0.0 && f.is_finite() => Timing::FramesPerSecond(f),
-                (Some(f), None) => bail!("--fps must be positive, got {f}"),
+                (Some(f), None) => bail!(
+                    "--fps must be a number of keyframes per second above 0 (and finite), got {f}"
+                ),
                 (None, None) => Timing::FramesPerSecond(anthesis_export::DEFAULT_FRAMES_PER_SECOND),
             };
             let glb = GlbOptions {
@@ -317,6 +364,34 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Refuses a first word that is neither a subcommand nor a project
+/// (`anthesis grow` said "grow: it does not exist"): a plain word with no
+/// file or folder of that name is taken for a mistyped subcommand. A path
+/// that exists still opens as a project.
+fn refuse_unknown_subcommand(path: &Path) -> Result<()> {
+    use clap::CommandFactory;
+    let Some(word) = path.to_str() else {
+        return Ok(());
+    };
+    let plain = !word.is_empty()
+        && word
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    if !plain || path.exists() {
+        return Ok(());
+    }
+    let names: Vec<String> = Cli::command()
+        .get_subcommands()
+        .map(|sub| sub.get_name().to_owned())
+        .filter(|name| name != "help")
+        .collect();
+    bail!(
+        "`{word}` is not a subcommand (they are: {}) and no project file or folder of that name \
+         exists",
+        names.join(", ")
+    );
+}
+
 /// Loads a project file, or a flower built into the binary when the path
 /// is `builtin:NAME` (`builtin:lily`, `builtin:eustoma-maite-lady`, …).
 fn load(path: &Path) -> Result<Project> {
@@ -342,7 +417,7 @@ fn load_with_warnings(path: &Path) -> Result<(Project, Vec<String>)> {
     // The project error names the file itself.
     let loaded = load_project_with_warnings(path).context("cannot open project")?;
     for warning in &loaded.warnings {
-        eprintln!("warning: {warning}");
+        say!("warning: {warning}");
     }
     check_units(&loaded.project)?;
     Ok((loaded.project, loaded.warnings))
@@ -384,18 +459,85 @@ fn refuse_project_folder(dir: &Path) -> Result<()> {
 
 /// `anthesis new --from NAME DIR`: the built-in flower NAME saved as
 /// `DIR/NAME.anthesis.toml` with its meshes and maps.
+///
+/// Decided: `new` writes only files it creates. The project is written into
+/// a staging folder inside DIR first; if any of its files (the project,
+/// `meshes/…`, `maps/…`) is already in DIR, nothing is written and the
+/// error names that file (a user's own `meshes/petal.obj` was replaced with
+/// exit 0). Each file is then linked into place, which fails rather than
+/// replace a file made meanwhile.
 fn new_project(from: &str, dir: &Path) -> Result<()> {
     let project = load(Path::new(&format!("builtin:{from}")))?;
     if dir.is_dir() {
         refuse_project_folder(dir)?;
+    } else {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
     }
-    let path = dir.join(format!(
-        "{from}{}",
-        anthesis_flower::project::PROJECT_EXTENSION
-    ));
-    anthesis_flower::project::save_project(&project, &path)?;
-    eprintln!("wrote {}", path.display());
+    let name = format!("{from}{}", anthesis_flower::project::PROJECT_EXTENSION);
+    let staging = tempfile::Builder::new()
+        .prefix(".anthesis-new-")
+        .tempdir_in(dir)
+        .with_context(|| format!("cannot write in the folder {}", dir.display()))?;
+    anthesis_flower::project::save_project(&project, &staging.path().join(&name))?;
+    let files = files_under(staging.path())?;
+    if let Some(existing) = files
+        .iter()
+        .map(|relative| dir.join(relative))
+        .find(|path| path.symlink_metadata().is_ok())
+    {
+        bail!(
+            "{} already exists; `new` writes only files it creates: choose an empty or new \
+             folder, or move that file away",
+            existing.display()
+        );
+    }
+    for relative in &files {
+        let target = dir.join(relative);
+        if let Some(parent) = target.parent() {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create the folder {}", parent.display()))?;
+        }
+        std::fs::hard_link(staging.path().join(relative), &target)
+            .or_else(|_| move_if_absent(&staging.path().join(relative), &target))
+            .with_context(|| format!("cannot write {}", target.display()))?;
+    }
+    say!("wrote {}", dir.join(&name).display());
     Ok(())
+}
+
+/// Moves `from` to `to` unless `to` exists (where hard links are not
+/// supported).
+fn move_if_absent(from: &Path, to: &Path) -> std::io::Result<()> {
+    if to.symlink_metadata().is_ok() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            "the file already exists",
+        ));
+    }
+    std::fs::rename(from, to)
+}
+
+/// The files under `root`, as paths relative to it.
+fn files_under(root: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    let mut folders = vec![PathBuf::new()];
+    while let Some(relative) = folders.pop() {
+        let folder = root.join(&relative);
+        for entry in std::fs::read_dir(&folder)
+            .with_context(|| format!("cannot read the folder {}", folder.display()))?
+        {
+            let entry = entry.with_context(|| format!("cannot read {}", folder.display()))?;
+            let path = relative.join(entry.file_name());
+            if entry.file_type().is_ok_and(|t| t.is_dir()) {
+                folders.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    Ok(files)
 }
 
 /// `--edge`: a positive length, or `as-built`.
@@ -422,15 +564,94 @@ fn at_resolution(
     edge: Option<Resolution>,
     memory: Option<(&Selection, KeyframeCost)>,
 ) -> Result<Project> {
+    let from_command_line = edge.is_some();
     if let Some(edge) = edge {
         project.settings.resolution = edge;
     }
+    check_particle_limit(&project, from_command_line)?;
     if let Some((selection, cost)) = memory {
         anthesis_sim::memory::check_run(&project, selection, cost)?;
     }
     let resolved = anthesis_flower::resolution::resolve(&project);
     warn_about_the_cache();
     Ok(resolved?)
+}
+
+/// Refuses a mean edge that would remesh a template into more particles
+/// than [`anthesis_flower::resolution::MAX_PARTICLES_PER_TEMPLATE`], with
+/// the finest edge the limit allows, before anything is remeshed (`--edge
+/// 1e-9` was refused by the memory check with "16384 PiB" of capped
+/// figures, or overflowed in the remesher).
+fn check_particle_limit(project: &Project, from_command_line: bool) -> Result<()> {
+    use anthesis_flower::resolution::{
+        MAX_PARTICLES_PER_TEMPLATE, edge_for_particles, predicted_size,
+    };
+    let Some(edge) = project.settings.resolution.mean_edge() else {
+        return Ok(());
+    };
+    for template in &project.flower.templates {
+        let (particles, _) = predicted_size(&template.mesh, edge);
+        if particles > MAX_PARTICLES_PER_TEMPLATE {
+            let what = if from_command_line {
+                format!("--edge {edge}")
+            } else {
+                format!("the project's mean_edge {edge}")
+            };
+            let finest = edge_for_particles(&template.mesh, MAX_PARTICLES_PER_TEMPLATE)
+                .map(|finest| format!("; give a mean edge of at least {}", round_up(finest)))
+                .unwrap_or_default();
+            bail!(
+                "{what} would remesh template \"{}\" into about {} particles, more than the \
+                 limit of {} per template{finest}",
+                template.name,
+                crate::desktop::params::grouped(particles as u64),
+                crate::desktop::params::grouped(MAX_PARTICLES_PER_TEMPLATE as u64),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `value` rounded up to three significant digits (an edge the limit
+/// allows, said in a message).
+fn round_up(value: f64) -> f64 {
+    if !(value > 0.0 && value.is_finite()) {
+        return value;
+    }
+    let scale = 10f64.powi(2 - value.log10().floor() as i32);
+    (value * scale).ceil() / scale
+}
+
+/// Refuses a count given on the command line outside `min..=max`, naming
+/// the option and the range.
+/// (Counts are read as any whole number, so `--keyframes -5` is refused
+/// with its range, not taken for an unknown option.)
+pub(crate) fn check_count(option: &str, value: i64, min: usize, max: usize) -> Result<usize> {
+    match usize::try_from(value) {
+        Ok(count) if (min..=max).contains(&count) => Ok(count),
+        _ => bail!(
+            "{option} must be a whole number from {min} to {}, got {value}",
+            crate::desktop::params::grouped(max as u64)
+        ),
+    }
+}
+
+/// Refuses an animation of `vertices` per keyframe over `keyframes` (and
+/// the first shape) that holds more positions than an export may
+/// ([`anthesis_export::MAX_RENDER_POSITIONS`]), before any is computed.
+pub(crate) fn check_positions(vertices: usize, keyframes: u32) -> Result<()> {
+    let positions = (vertices as u64).saturating_mul(u64::from(keyframes) + 1);
+    if positions > anthesis_export::MAX_RENDER_POSITIONS {
+        bail!(
+            "{} vertices x {} shapes is {} positions, more than the limit of {}: use fewer \
+             keyframes or a coarser mesh",
+            vertices,
+            u64::from(keyframes) + 1,
+            crate::desktop::params::grouped(positions),
+            crate::desktop::params::grouped(anthesis_export::MAX_RENDER_POSITIONS),
+        );
+    }
+    Ok(())
 }
 
 /// Refuses a project with a mesh in another unit than the project (see

@@ -1,5 +1,5 @@
 //! The bad-input catalogue: every bad file and argument named in issue 17
-//! and in DESIGN.md §6, given to the `anthesis` binary the way a user would,
+//! and in the project's design brief, given to the `anthesis` binary the way a user would,
 //! each with the message it must get. Every case must end within
 //! [`MAX_SECONDS`] (a FIFO or `/dev/zero` once hung or filled the memory),
 //! with exit code 1 (an error, not a panic's 101 or a kill) and a last
@@ -127,6 +127,9 @@ struct Case {
     expect: &'static str,
     /// Environment of the run.
     env: &'static [(&'static str, &'static str)],
+    /// The exit code: 1 for an error, 2 for a command line clap refuses
+    /// (its usage line follows the error).
+    code: i32,
 }
 
 macro_rules! case {
@@ -139,9 +142,74 @@ macro_rules! case {
             prepare: $prepare,
             expect: $expect,
             env: $env,
+            code: 1,
         }
     };
 }
+
+/// A case of a command line clap refuses (exit code 2).
+macro_rules! usage_case {
+    ($name:expr, $prepare:expr, $expect:expr) => {
+        Case {
+            name: $name,
+            prepare: $prepare,
+            expect: $expect,
+            env: &[],
+            code: 2,
+        }
+    };
+}
+
+/// The built-in five-petal flower written to `dir/fp` (a project with a
+/// `[structure]` of one whorl), its structure replaced by `structure`;
+/// returns `info` on it.
+fn five_petal_with_structure(dir: &Path, structure: &str) -> Vec<String> {
+    let folder = dir.join("fp");
+    let status = common::command()
+        .args(["new", "--from", "five-petal"])
+        .arg(&folder)
+        .stderr(Stdio::null())
+        .status()
+        .expect("the binary runs");
+    assert!(status.success(), "new --from five-petal");
+    let file = folder.join("five-petal.anthesis.toml");
+    let text = std::fs::read_to_string(&file).expect("read");
+    let cut = text.find("[structure]").expect("a structure");
+    std::fs::write(&file, format!("{}{structure}\n", &text[..cut])).expect("write");
+    vec!["info".into(), file.display().to_string()]
+}
+
+/// `[structure]` of an L-system placing surface `p` as the template
+/// `petal`, derived `steps` times (`text` with `\n` escapes for TOML).
+fn lsystem(text: &str, steps: u32) -> String {
+    format!(
+        "[structure]\nkind = \"lsystem\"\n[structure.lsystem]\nsteps = {steps}\n\
+         text = \"{text}\"\nsurfaces = {{ p = \"petal\" }}"
+    )
+}
+
+/// `bud.json` (the lily petal's PDE sweep) and `open.json` (`edit` applied
+/// to its JSON) in `dir`; returns `pde-blossom bud.json open.json` and
+/// `more`.
+fn pde_pair(dir: &Path, edit: fn(&mut serde_json::Value), more: &[&str]) -> Vec<String> {
+    let bud = in_dir(dir, "bud.json");
+    let status = common::command()
+        .args(["bud", "--example", "lily-petal", "--save-surface", &bud])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .expect("the binary runs");
+    assert!(status.success(), "bud --save-surface");
+    let mut open: serde_json::Value = serde_json::from_str(&read(dir, "bud.json")).expect("json");
+    edit(&mut open);
+    write(dir, "open.json", open.to_string());
+    let mut args = vec!["pde-blossom".to_string(), bud, in_dir(dir, "open.json")];
+    args.extend(more.iter().map(|s| s.to_string()));
+    args
+}
+
+/// The open state as the bud (a valid pair).
+fn same(_: &mut serde_json::Value) {}
 
 fn catalogue() -> Vec<Case> {
     vec![
@@ -501,12 +569,12 @@ fn catalogue() -> Vec<Case> {
         case!(
             "a billion keyframes asked for",
             |d| simulate(d, &["--keyframes", "1000000000"]),
-            "--keyframes 1000000000 is more than the limit of 10000"
+            "--keyframes must be a whole number from 1 to 10,000, got 1000000000"
         ),
         case!(
             "zero keyframes asked for",
             |d| simulate(d, &["--keyframes", "0"]),
-            "--keyframes must be at least 1"
+            "--keyframes must be a whole number from 1 to 10,000, got 0"
         ),
         case!(
             "an organ that does not exist",
@@ -571,10 +639,10 @@ fn catalogue() -> Vec<Case> {
         ),
         // -------------------------------------------------------- resolution
         case!(
-            "a mean edge that would make millions of particles",
-            |d| simulate(d, &["--edge", "0.0001"]),
+            "a mean edge finer than the memory allows",
+            |d| simulate(d, &["--edge", "0.04"]),
             "of memory is available; simulate fewer organs (one organ alone) or keyframes, or use a coarser mesh",
-            &[("ANTHESIS_MEMORY_LIMIT_MIB", "4096")]
+            &[("ANTHESIS_MEMORY_LIMIT_MIB", "16")]
         ),
         case!(
             "a mean edge too long for a template",
@@ -595,6 +663,199 @@ fn catalogue() -> Vec<Case> {
             "simulation: mean_edge must be a positive length, found -1"
         ),
         // ------------------------------------------------------------ solver
+        // ------------------------------------- counts and sizes (issue 38)
+        case!(
+            "an L-system placing more organs than the limit",
+            |d| five_petal_with_structure(d, &lsystem("axiom: ~p f(10)\\n~p -> ~p f(10) ~p", 14)),
+            "the structure makes 16384 organs; at most 10000 are allowed"
+        ),
+        case!(
+            "an L-system piling thousands of organs on one spot",
+            |d| five_petal_with_structure(d, &lsystem("axiom: ~p\\n~p -> ~p ~p", 13)),
+            "the structure's organs meet in more than 1000000 pairs (overlap rules)"
+        ),
+        case!(
+            "a whorl of a billion organs",
+            |d| five_petal_with_structure(
+                d,
+                "[structure]\nkind = \"whorls\"\n[[structure.whorls]]\nname = \"petal\"\n\
+                 template = \"petal\"\ncount = 1000000000\nradius = 4.0\nhalf_span_deg = 25.0"
+            ),
+            "the structure makes 1000000000 organs; at most 10000 are allowed"
+        ),
+        case!(
+            "an L-system angle of 0/0",
+            |d| five_petal_with_structure(d, &lsystem("axiom: +(0/0) ~p", 0)),
+            "L-system line 1, column 10: `0/0` is NaN, not a finite number"
+        ),
+        case!(
+            "a mean edge that would make a trillion particles",
+            |d| simulate(d, &["--edge", "1e-9"]),
+            "--edge 0.000000001 would remesh template \"petal\" into about"
+        ),
+        case!(
+            "info at a mean edge past the particle limit",
+            |d| {
+                let mut args = info(d);
+                args.extend(["--edge".to_string(), "1e-9".to_string()]);
+                args
+            },
+            "more than the limit of 200,000 per template; give a mean edge of at least"
+        ),
+        case!(
+            "a negative keyframe count",
+            |d| simulate(d, &["--keyframes", "-5"]),
+            "--keyframes must be a whole number from 1 to 10,000, got -5"
+        ),
+        usage_case!(
+            "a negative mean edge",
+            |d| simulate(d, &["--edge", "-1"]),
+            "`-1` is not a mean edge length: give a positive number in project units, or as-built"
+        ),
+        case!(
+            "a frame rate of 0",
+            |d| simulate(d, &["--fps", "0"]),
+            "--fps must be a number of keyframes per second above 0 (and finite), got 0"
+        ),
+        case!(
+            "a negative frame rate",
+            |d| simulate(d, &["--fps", "-1"]),
+            "--fps must be a number of keyframes per second above 0 (and finite), got -1"
+        ),
+        case!(
+            "a frame rate that is not a number",
+            |d| simulate(d, &["--fps", "NaN"]),
+            "--fps must be a number of keyframes per second above 0 (and finite), got NaN"
+        ),
+        case!(
+            "a GIF frame rate of 0",
+            |d| {
+                let gif = in_dir(d, "a.gif");
+                let mut args = vec!["render".to_string(), project(d)];
+                args.extend(["--animation".into(), gif, "--fps".into(), "0".into()]);
+                args
+            },
+            "--fps must be from 0.0016 to 50 frames per second for a GIF"
+        ),
+        case!(
+            "an unknown subcommand",
+            |_| vec!["grow".to_string()],
+            "`grow` is not a subcommand (they are: info, simulate, render, bud, import-scan, blossom, pde-blossom, fit, new)"
+        ),
+        case!(
+            "blossom with a billion keyframes",
+            |d| vec![
+                "blossom".into(),
+                in_dir(d, PETAL),
+                in_dir(d, PETAL),
+                "--keyframes".into(),
+                "1000000000".into()
+            ],
+            "--keyframes must be a whole number from 1 to 10,000, got 1000000000"
+        ),
+        case!(
+            "pde-blossom with a billion keyframes",
+            |d| pde_pair(d, same, &["--keyframes", "1000000000"]),
+            "--keyframes must be a whole number from 1 to 10,000, got 1000000000"
+        ),
+        case!(
+            "pde-blossom with a negative keyframe count",
+            |d| pde_pair(d, same, &["--keyframes", "-5"]),
+            "--keyframes must be a whole number from 1 to 10,000, got -5"
+        ),
+        case!(
+            "pde-blossom with no nodes",
+            |d| pde_pair(d, same, &["--nodes", "0"]),
+            "--nodes must be a whole number from 4 to 1,024, got 0"
+        ),
+        case!(
+            "pde-blossom with a hundred million nodes",
+            |d| pde_pair(d, same, &["--nodes", "100000000"]),
+            "--nodes must be a whole number from 4 to 1,024, got 100000000"
+        ),
+        case!(
+            "pde-blossom with a hundred million rows",
+            |d| pde_pair(d, same, &["--rows", "100000000"]),
+            "--rows must be a whole number from 1 to 1,024, got 100000000"
+        ),
+        case!(
+            "pde-blossom with rows x nodes x keyframes past the limit",
+            |d| pde_pair(d, same, &["--rows", "1000", "--nodes", "1000"]),
+            "is 100,200,100 node-steps, more than the limit of 10,000,000"
+        ),
+        // ------------------------------ silent wrong results (issue 38)
+        case!(
+            "new --from into a folder holding the user's own petal",
+            |d| {
+                let folder = d.join("mine");
+                std::fs::create_dir_all(folder.join("meshes")).expect("mkdir");
+                std::fs::write(folder.join("meshes/petal.obj"), "my own petal\n").expect("write");
+                vec![
+                    "new".into(),
+                    "--from".into(),
+                    "lily".into(),
+                    folder.display().to_string(),
+                ]
+            },
+            "meshes/petal.obj already exists; `new` writes only files it creates"
+        ),
+        case!(
+            "pde-blossom with the open state's margins swapped",
+            |d| pde_pair(
+                d,
+                |open| {
+                    let swap = |open: &mut serde_json::Value, a: &str, b: &str| {
+                        let first = open[a].take();
+                        open[a] = open[b].take();
+                        open[b] = first;
+                    };
+                    swap(open, "margin0", "margin1");
+                    swap(open, "tangent0", "tangent1");
+                },
+                &[]
+            ),
+            "the open state's margins are the other way round from the bud's"
+        ),
+        case!(
+            "two [[overlaps]] entries that contradict each other",
+            |d| {
+                let mut args = five_petal_with_structure(
+                    d,
+                    "[structure]\nkind = \"whorls\"\n[[structure.whorls]]\nname = \"petal\"\n\
+                     template = \"petal\"\ncount = 5\nradius = 4.0\nhalf_span_deg = 25.0",
+                );
+                let file = std::path::PathBuf::from(args.pop().expect("the project"));
+                let text = std::fs::read_to_string(&file).expect("read");
+                let text = text.replacen(
+                    "overlaps = []",
+                    "overlaps = [{ inner = \"petal-1\", outer = \"petal-2\" }, \
+                     { inner = \"petal-2\", outer = \"petal-1\" }]",
+                    1,
+                );
+                std::fs::write(&file, text).expect("write");
+                args.push(file.display().to_string());
+                args
+            },
+            "[[overlaps]] 1 puts \"petal-1\" inside \"petal-2\", but [[overlaps]] 2 puts \"petal-2\" inside \"petal-1\"; keep one of them"
+        ),
+        case!(
+            "pde-blossom reading /dev/zero as a surface",
+            |d| {
+                let mut args = pde_pair(d, same, &[]);
+                args[1] = "/dev/zero".into();
+                args
+            },
+            "cannot read PDE sweep surface /dev/zero: it is a character device"
+        ),
+        case!(
+            "pde-blossom with a control point at 1e308 (found by fuzzing)",
+            |d| pde_pair(
+                d,
+                |open| open["margin0"][1][1] = serde_json::json!(-1e308),
+                &[]
+            ),
+            "coordinates must be finite and within ±1e6"
+        ),
         case!(
             "a solver that does not converge",
             |d| {
@@ -646,7 +907,13 @@ fn every_bad_input_gets_its_message_and_exit_code_1() {
         let args = (case.prepare)(dir.path());
         let expected = case.expect;
         let (code, stderr, took) = run_bounded(&args, case.env);
-        let last = stderr.trim_end().lines().last().unwrap_or("").to_string();
+        // The last error line (clap's usage lines follow its error).
+        let last = stderr
+            .lines()
+            .rev()
+            .find(|line| line.starts_with("error: "))
+            .unwrap_or("")
+            .to_string();
         if discover {
             eprintln!(
                 "{:<45} {code:?} {:.2}s {last}",
@@ -654,7 +921,7 @@ fn every_bad_input_gets_its_message_and_exit_code_1() {
                 took.as_secs_f64()
             );
         }
-        let problem = if code != Some(1) {
+        let problem = if code != Some(case.code) {
             Some(format!("exit code {code:?}"))
         } else if !last.starts_with("error: ") {
             Some("no `error:` line".to_string())
@@ -732,8 +999,116 @@ fn the_readme_lists_the_limits_the_code_enforces() {
             "| Template and organ names | {} characters |",
             anthesis_flower::project::MAX_NAME_CHARS
         ),
+        format!(
+            "| Particles per remeshed template (`--edge`, `mean_edge`) | {} |",
+            grouped(anthesis_flower::resolution::MAX_PARTICLES_PER_TEMPLATE as u64)
+        ),
+        format!(
+            "| Organs a structure makes (whorls, spiral, L-system `~X`) | {} |",
+            grouped(anthesis_flower::structure::MAX_STRUCTURE_ORGANS as u64)
+        ),
+        format!(
+            "| Overlap rules a structure makes | {} |",
+            grouped(anthesis_flower::structure::MAX_OVERLAP_RULES as u64)
+        ),
+        format!(
+            "| L-system derived word | {} modules, {} derivation steps |",
+            grouped(anthesis_flower::structure::lsystem::MAX_MODULES as u64),
+            anthesis_flower::structure::lsystem::MAX_STEPS
+        ),
+        format!(
+            "| L-system parameter expression | {} terms |",
+            anthesis_flower::structure::lsystem::MAX_EXPRESSION_TERMS
+        ),
+        format!(
+            "| `blossom` and `pde-blossom` keyframes | 1 to {} |",
+            grouped(u64::from(anthesis_flower::MAX_KEYFRAMES))
+        ),
+        format!(
+            "| `pde-blossom --nodes` | 4 to {} |",
+            grouped(anthesis_app::cli::pde_blossom::MAX_NODES as u64)
+        ),
+        format!(
+            "| `pde-blossom --rows` | 1 to {} |",
+            grouped(anthesis_app::cli::pde_blossom::MAX_ROWS as u64)
+        ),
+        format!(
+            "| `pde-blossom` (rows + 1) × (nodes + 1) × keyframes | {} |",
+            grouped(anthesis_app::cli::pde_blossom::MAX_NODE_STEPS as u64)
+        ),
     ];
     for row in rows {
         assert!(readme.contains(&row), "README lacks the row `{row}`");
     }
+}
+
+/// The binary run on the valid project with its standard streams as given.
+fn run_with_streams(dir: &Path, args: &[String], stdout: Stdio, stderr: Stdio) -> (i32, String) {
+    let output = common::command()
+        .args(args)
+        .current_dir(dir)
+        .env("RUST_BACKTRACE", "0")
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(stderr)
+        .output()
+        .expect("the binary runs");
+    (output.status.code().unwrap_or(-1), text(&output.stderr))
+}
+
+fn dev_full() -> Stdio {
+    Stdio::from(std::fs::File::create("/dev/full").expect("/dev/full"))
+}
+
+#[test]
+fn a_full_standard_error_loses_no_result_and_panics_nowhere() {
+    // Issue 38: any command with `2>/dev/full` panicked (exit 101); a
+    // successful `simulate --out x.glb` panicked at its last line and
+    // wrote no .glb.
+    let dir = tempfile::tempdir().expect("tempdir");
+    valid_project(dir.path());
+    let glb = in_dir(dir.path(), "x.glb");
+    let args = simulate(dir.path(), &["--keyframes", "1", "--out", &glb]);
+    let (code, _) = run_with_streams(dir.path(), &args, Stdio::null(), dev_full());
+    assert_eq!(code, 1, "a message that could not be said is an error");
+    let bytes = std::fs::read(&glb).expect("the .glb is written");
+    assert!(bytes.starts_with(b"glTF"), "a .glb");
+    // A failing command as well: exit 1, not a panic's 101.
+    let (code, _) = run_with_streams(
+        dir.path(),
+        &["info".into(), in_dir(dir.path(), "missing.anthesis.toml")],
+        Stdio::null(),
+        dev_full(),
+    );
+    assert_eq!(code, 1);
+}
+
+#[test]
+fn a_full_or_closed_standard_output_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    valid_project(dir.path());
+    let (code, stderr) =
+        run_with_streams(dir.path(), &info(dir.path()), dev_full(), Stdio::piped());
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("error: cannot write to standard output: No space left on device"),
+        "{stderr}"
+    );
+    // `info >&-` exited 0 having written nothing.
+    let output = Command::new("sh")
+        .args([
+            "-c",
+            "exec \"$0\" \"$@\" >&-",
+            env!("CARGO_BIN_EXE_anthesis"),
+        ])
+        .args(info(dir.path()))
+        .env("ANTHESIS_CACHE_DIR", "")
+        .output()
+        .expect("sh runs");
+    let stderr = text(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("error: cannot write to standard output: it is closed"),
+        "{stderr}"
+    );
 }

@@ -420,7 +420,7 @@ fn bad_input_gives_one_line_and_a_non_zero_exit() {
     let early: Vec<(Vec<&str>, String)> = vec![
         (
             vec![p, "--keyframes", "1000000000"],
-            "--keyframes 1000000000 is more than the limit of 10000".into(),
+            "--keyframes must be a whole number from 1 to 10,000, got 1000000000".into(),
         ),
         (
             vec![

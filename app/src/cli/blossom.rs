@@ -2,11 +2,11 @@
 //! open state) by the two-state blossom of `anthesis-twostate`, written as
 //! the same animation files `anthesis simulate` writes.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anthesis_export::Track;
+use anthesis_flower::MAX_KEYFRAMES;
 use anthesis_mesh::Mesh;
 use anthesis_mesh::obj::{MAX_OBJ_BYTES, object_text, parse_obj};
 use anthesis_twostate::{GrowthFunction, TwoState};
@@ -15,6 +15,7 @@ use clap::Args;
 
 use super::EncodingArg;
 use super::simulate::{animation_options, check_output, write_tracks};
+use super::stream::{out, say};
 
 /// `anthesis blossom BUD.obj OPEN.obj`.
 #[derive(Debug, Args)]
@@ -30,9 +31,9 @@ pub struct BlossomArgs {
     /// object).
     #[arg(long)]
     pub object: Option<String>,
-    /// Keyframes after the bud (the open state is the last).
+    /// Keyframes after the bud (the open state is the last), 1 to 10,000.
     #[arg(long, default_value_t = 100)]
-    pub keyframes: u32,
+    pub keyframes: i64,
     /// The growth rate g of G(t; g, T) (eq. 4): 6 reaches the open state's
     /// ratios at the last keyframe, more overshoots them, less stops short.
     #[arg(long, default_value_t = 6.0)]
@@ -57,12 +58,11 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     if !(args.g.is_finite() && args.g > 0.0) {
         bail!("--g must be a positive number, got {}", args.g);
     }
-    if args.keyframes == 0 {
-        bail!("--keyframes must be at least 1");
-    }
+    let keyframes =
+        super::check_count("--keyframes", args.keyframes, 1, MAX_KEYFRAMES as usize)? as u32;
     let glb = animation_options(args.fps, args.encoding)?;
     if let Some(out) = &args.out {
-        check_output(out, &glb, args.keyframes)?;
+        check_output(out, &glb, keyframes)?;
     }
     let read = |path: &Path, what: &str| -> Result<Mesh> {
         let text = anthesis_files::read_regular_text(path, MAX_OBJ_BYTES, "an OBJ mesh")
@@ -73,6 +73,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     };
     let bud = read(&args.bud, "bud")?;
     let open = read(&args.open, "open state")?;
+    super::check_positions(bud.vertex_count(), keyframes)?;
     let base: Vec<u32> = (0..bud.uvs.len() as u32)
         .filter(|&i| bud.uvs[i as usize].y <= args.base_v)
         .collect();
@@ -86,9 +87,9 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
     })?;
     two.growth = GrowthFunction {
         g: args.g,
-        duration: f64::from(args.keyframes),
+        duration: f64::from(keyframes),
     };
-    let keyframes: Vec<_> = (0..=args.keyframes)
+    let shapes: Vec<_> = (0..=keyframes)
         .map(|k| two.shape_at(f64::from(k)))
         .collect();
     let seconds = started.elapsed().as_secs_f64();
@@ -104,14 +105,13 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
         .iter()
         .map(|c| c.direction.to_axis_angle().1.to_degrees())
         .fold(0.0, f64::max);
-    let last = &keyframes[keyframes.len() - 1];
+    let last = &shapes[shapes.len() - 1];
     let miss = last
         .iter()
         .zip(&open.positions)
         .map(|(p, q)| p.distance(*q))
         .fold(0.0, f64::max);
-    writeln!(
-        std::io::stdout().lock(),
+    out!(
         "{} cells, {} base particles; adaxial variation median {:.3} (min {:.3}, max {:.3}), \
          abaxial median {:.3} (min {:.3}, max {:.3}); largest turn {turn_deg:.1} degrees; \
          last keyframe within {miss:.2e} of the open state; {} keyframes in {seconds:.2} s",
@@ -123,7 +123,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
         median(&mut abaxial),
         abaxial[0],
         abaxial[abaxial.len() - 1],
-        keyframes.len(),
+        shapes.len(),
     )?;
 
     if let Some(out) = &args.out {
@@ -137,16 +137,54 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             triangles: bud.triangles.clone(),
             uvs: bud.uvs.clone(),
             base_color: [0.95, 0.6, 0.3, 1.0],
-            keyframes,
+            keyframes: shapes,
             base_color_png: None,
             rigid: None,
         };
         write_tracks(out, &[track], &glb)?;
-        eprintln!(
-            "wrote {} (keyframes 0 to {})",
-            out.display(),
-            args.keyframes
-        );
+        say!("wrote {} (keyframes 0 to {})", out.display(), keyframes);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The open state's OBJ reader and the two-state blossom on random
+    /// edits of a valid open state: a clean error or finite keyframes,
+    /// never a panic.
+    #[test]
+    fn fuzz_blossom_open_state_reader_and_animation() {
+        let bud = anthesis_mesh::generate::test_petal(4.0, 1.5, 4, 6);
+        let mut open = bud.clone();
+        for p in &mut open.positions {
+            *p = glam::DVec3::new(p.x * 1.3, p.y * 1.2, p.z + 0.1 * p.y * p.y);
+        }
+        let valid = anthesis_mesh::obj_string(&open);
+        let base: Vec<u32> = (0..bud.uvs.len() as u32)
+            .filter(|&i| bud.uvs[i as usize].y <= 0.06)
+            .collect();
+        let mut accepted = 0;
+        super::super::fuzz::run("blossom", |rng| {
+            let text = super::super::fuzz::mutate(&valid, rng);
+            let Ok(open) = parse_obj(&text) else {
+                return;
+            };
+            match TwoState::from_meshes(&bud, &open, &base) {
+                Ok(two) => {
+                    for k in 0..=4 {
+                        let shape = two.shape_at(f64::from(k) * 25.0);
+                        assert!(
+                            shape.iter().all(|p| p.is_finite()),
+                            "keyframe {k} not finite from:\n{text}"
+                        );
+                    }
+                    accepted += 1;
+                }
+                Err(error) => assert!(error.to_string().chars().count() < 800),
+            }
+        });
+        assert!(accepted > 0, "some edits keep a valid open state");
+    }
 }

@@ -2,9 +2,9 @@
 //! petal, a bicubic Bézier patch or a PDE sweep surface), remeshed by
 //! `anthesis-bud` and written as OBJ, with its quality on one line.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use super::stream::{out, say};
 use anthesis_bud::formats::{BezierFile, PdeFile};
 use anthesis_bud::{
     BezierPatch, Bud, InnerSide, MeshQuality, PdeSweep, RemeshOptions, Surface, build_organ,
@@ -166,9 +166,9 @@ pub fn bud(args: &BudArgs) -> Result<()> {
     if let Some(out) = &args.out {
         anthesis_files::write_atomic(out, anthesis_mesh::obj_string(&mesh).as_bytes())?;
     }
-    writeln!(std::io::stdout().lock(), "{}", quality_line(&quality))?;
+    out!("{}", quality_line(&quality))?;
     if let Some(out) = &args.out {
-        eprintln!("wrote {}", out.display());
+        say!("wrote {}", out.display());
     }
     Ok(())
 }
@@ -195,8 +195,14 @@ pub(super) fn pde_json(sweep: &PdeSweep) -> Result<String> {
 }
 
 /// Reads a surface file and parses it with `parse`; errors name the file.
+/// The largest surface file read (`--bezier`, `--pde`, `pde-blossom`): a
+/// surface is a few dozen numbers.
+pub const MAX_SURFACE_BYTES: u64 = 1 << 20;
+
 fn read_surface<T>(path: &Path, what: &str, parse: fn(&str) -> Result<T>) -> Result<T> {
-    let text = std::fs::read_to_string(path)
+    // A regular file of at most 1 MiB (a FIFO hung, /dev/zero filled the
+    // memory).
+    let text = anthesis_files::read_regular_text(path, MAX_SURFACE_BYTES, "a JSON surface")
         .with_context(|| format!("cannot read {what} {}", path.display()))?;
     parse(&text).with_context(|| {
         format!(

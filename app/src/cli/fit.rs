@@ -2,7 +2,7 @@
 //! (`anthesis-fit`), written as a project that `anthesis simulate` runs
 //! like any other, with a JSON report of how close the fit came.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use anthesis_fit::{Fit, FitProgress, FitSettings, Grid, Registered, Target};
@@ -10,6 +10,7 @@ use anthesis_mesh::obj::MAX_OBJ_BYTES;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 
+use super::stream::{out, say, say_part};
 use super::{at_resolution, load, selection};
 
 /// `anthesis fit PROJECT --organ NAME --target OPEN.obj --out FITTED_DIR`.
@@ -151,7 +152,7 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
         target = target.flipped();
     }
     for warning in &target.warnings {
-        eprintln!("target {}: {warning}", args.target.display());
+        say!("target {}: {warning}", args.target.display());
     }
 
     let registered = if args.register || args.register_scale {
@@ -160,7 +161,7 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
                 false
             })
             .with_context(|| format!("cannot register the target on organ `{}`", args.organ))?;
-        eprintln!("{}", registered.describe());
+        say!("{}", registered.describe());
         Some(registered)
     } else {
         None
@@ -190,7 +191,7 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
     )
     .with_context(|| format!("cannot fit organ `{}`", args.organ))?;
     if terminal {
-        eprintln!();
+        say!();
     }
 
     // The project as it was, with the template's maps replaced: at its own
@@ -221,12 +222,12 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
     );
     move_into_place(staging, &args.out)?;
     let project_path = args.out.join(&project_file);
-    eprintln!("wrote {}", project_path.display());
+    say!("wrote {}", project_path.display());
 
     if let Some(path) = &args.report {
         write_report(path, args, registered, (&result, &target))?;
     }
-    writeln!(std::io::stdout().lock(), "{}", result.verdict())?;
+    out!("{}", result.verdict())?;
     Ok(())
 }
 
@@ -260,10 +261,9 @@ fn show_progress(p: &FitProgress, terminal: bool) {
         p.seconds
     );
     if terminal {
-        eprint!("\r{line}   ");
-        let _ = std::io::stderr().flush();
+        say_part!("\r{line}   ");
     } else {
-        eprintln!("{line}");
+        say!("{line}");
     }
 }
 

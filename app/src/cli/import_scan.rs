@@ -3,9 +3,9 @@
 //! and meshed as a template in the organ template frame, with the fit
 //! error printed on one line.
 
-use std::io::Write;
 use std::path::PathBuf;
 
+use super::stream::{out, say};
 use anthesis_bud::{RemeshOptions, ScanFitOptions, ScanOutline, build_organ, fit_scan};
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -49,7 +49,7 @@ pub fn import_scan(args: &ImportScanArgs) -> Result<()> {
     let file = anthesis_mesh::load_obj_shape(&args.scan)
         .with_context(|| format!("cannot read the scan {}", args.scan.display()))?;
     for warning in &file.warnings {
-        eprintln!("{}: {warning}", args.scan.display());
+        say!("{}: {warning}", args.scan.display());
     }
     let mesh = file.mesh;
     let outline = ScanOutline::of(&mesh)
@@ -97,8 +97,7 @@ pub fn import_scan(args: &ImportScanArgs) -> Result<()> {
         anthesis_files::write_atomic(path, serde_json::to_string_pretty(&report)?.as_bytes())
             .with_context(|| format!("cannot write the report {}", path.display()))?;
     }
-    writeln!(
-        std::io::stdout().lock(),
+    out!(
         "length={:.4} rms={:.5} max={:.5} back_rms={:.5} back_max={:.5} stretch_to_bend={} vertices={} min_angle_deg={:.1}",
         fit.length,
         rms,
@@ -109,6 +108,6 @@ pub fn import_scan(args: &ImportScanArgs) -> Result<()> {
         bud.quality.vertices,
         bud.quality.min_angle_deg
     )?;
-    eprintln!("wrote {}", args.out.display());
+    say!("wrote {}", args.out.display());
     Ok(())
 }

@@ -16,6 +16,7 @@ use clap::Args;
 use image::RgbaImage;
 
 use super::simulate::{Progress, set_keyframes};
+use super::stream::{say, say_part};
 use super::{at_resolution, load, selection};
 use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
 
@@ -49,7 +50,7 @@ pub struct RenderArgs {
         requires = "animation"
     )]
     pub turn: f64,
-    /// With --animation to a GIF: frames per second (at most 50).
+    /// With --animation to a GIF: frames per second, from 0.0016 to 50.
     #[arg(long, value_name = "F", default_value_t = crate::animation::DEFAULT_GIF_FRAMES_PER_SECOND, requires = "animation")]
     pub fps: f64,
     /// Simulate and show only this organ (no collisions).
@@ -78,7 +79,7 @@ pub struct RenderArgs {
     pub elevation: f64,
     /// Number of keyframes of the run (default: the project's).
     #[arg(long, value_name = "N")]
-    pub keyframes: Option<u32>,
+    pub keyframes: Option<i64>,
     /// Simulate every template remeshed at this mean edge length (see
     /// `simulate --edge`).
     #[arg(long, value_name = "LENGTH|as-built", value_parser = super::parse_edge)]
@@ -99,7 +100,12 @@ pub struct RenderArgs {
 
 pub fn render(args: &RenderArgs) -> Result<()> {
     let mut project = load(&args.project)?;
-    set_keyframes(&mut project, args.keyframes)?;
+    let keyframes = args
+        .keyframes
+        .map(|n| super::check_count("--keyframes", n, 1, anthesis_flower::MAX_KEYFRAMES as usize))
+        .transpose()?
+        .map(|n| n as u32);
+    set_keyframes(&mut project, keyframes)?;
     let selection = selection(&project, args.organ.as_deref())?;
     let project = at_resolution(project, args.edge, Some((&selection, KeyframeCost::Kept)))?;
     let last_keyframe = project.settings.keyframes;
@@ -122,6 +128,20 @@ pub fn render(args: &RenderArgs) -> Result<()> {
                 bail!("--step must be at least 1");
             }
             let target = AnimationTarget::of(path);
+            // A GIF frame lasts 1/100 s to 655.35 s (whole hundredths).
+            let slowest = 100.0 / f64::from(u16::MAX);
+            let fastest = crate::animation::MAX_GIF_FRAMES_PER_SECOND;
+            if matches!(target, AnimationTarget::Gif(_))
+                && !(args.fps >= slowest && args.fps <= fastest)
+            {
+                bail!(
+                    "--fps must be from {:.4} to {fastest} frames per second for a GIF (a frame \
+                     lasts a whole number of hundredths of a second up to 655.35 s; browsers show \
+                     faster GIFs at 10), got {}",
+                    (slowest * 1e4).ceil() / 1e4,
+                    args.fps
+                );
+            }
             let options = AnimationOptions {
                 width,
                 height,
@@ -174,13 +194,13 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         let show_progress = std::io::stderr().is_terminal();
         animation::write_animation(&mut renderer, &organs, options, target, &mut |done| {
             if show_progress {
-                eprint!("\rrendered frame {done}/{count}   ");
+                say_part!("\rrendered frame {done}/{count}   ");
             }
         })?;
         if show_progress {
-            eprintln!();
+            say!();
         }
-        eprintln!(
+        say!(
             "wrote {count} frame(s) of {width}x{height} to {}",
             target.path().display()
         );
@@ -226,7 +246,7 @@ fn write_stills(
         write_png(&out.join("tiled.png"), &side_by_side(&pictures))?;
         written += 1;
     }
-    eprintln!(
+    say!(
         "wrote {written} picture(s) of {width}x{height} and camera.json to {}",
         out.display()
     );

@@ -1,7 +1,7 @@
 //! `anthesis info` and `anthesis simulate`, and the keyframe loop with
 //! progress that `anthesis render` shares.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
@@ -13,24 +13,33 @@ use anthesis_sim::memory::KeyframeCost;
 use anthesis_sim::{KeyframeStats, SimError, Simulation};
 use anyhow::{Context, Result, bail};
 
-use super::{EncodingArg, at_resolution, load, selection, warn_about_the_cache};
+use super::stream::{out, say, say_part};
+use super::{
+    EncodingArg, at_resolution, check_particle_limit, load, selection, warn_about_the_cache,
+};
 
 pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
     let project = at_resolution(load(path)?, edge, None)?;
     let flower = &project.flower;
-    let mut stdout = std::io::stdout().lock();
+    // Each template's mesh checked once, not once per organ (10,000 organs).
+    let edges = flower
+        .templates
+        .iter()
+        .map(|template| {
+            anthesis_mesh::validate(&template.mesh)
+                .map(|topology| topology.edges.len())
+                .with_context(|| format!("template `{}` has a bad mesh", template.name))
+        })
+        .collect::<Result<Vec<_>>>()?;
     for (i, organ) in flower.organs.iter().enumerate() {
         let template = flower.template_of(i);
-        let topology = anthesis_mesh::validate(&template.mesh)
-            .with_context(|| format!("template `{}` has a bad mesh", template.name))?;
-        writeln!(
-            stdout,
+        out!(
             "{} {} {} {} {}",
             organ.name,
             template.name,
             template.mesh.vertex_count(),
             template.mesh.triangle_count(),
-            topology.edges.len()
+            edges[organ.template]
         )?;
     }
     Ok(())
@@ -83,6 +92,7 @@ pub(super) fn simulate(
         check_output(out, glb, project.settings.keyframes)?;
     }
     let cost = out.map_or(KeyframeCost::Kept, |out| output_format(out).keyframe_cost());
+    check_particle_limit(&project, edge.is_some())?;
     let prepared = batch::prepare(&project, &selection, cost, out.map(|_| render_level));
     warn_about_the_cache();
     let project = prepared?;
@@ -127,7 +137,7 @@ pub(super) fn simulate(
     {
         let tracks = run.tracks(&project, &selection, render_level)?;
         write_tracks(out, &tracks, glb)?;
-        eprintln!("wrote {} (keyframes 0 to {done})", out.display());
+        say!("wrote {} (keyframes 0 to {done})", out.display());
         written = Some(out);
     }
     match (run_result, written) {
@@ -186,17 +196,16 @@ impl Progress {
     pub(super) fn show(&mut self, sim: &Simulation, done: u32, last: u32) {
         for crossing in &sim.crossings()[self.warned.min(sim.crossings().len())..] {
             if self.show {
-                eprintln!();
+                say!();
             }
-            eprintln!("warning: {crossing}");
+            say!("warning: {crossing}");
         }
         self.warned = sim.crossings().len();
         self.done = done;
         if self.show {
             let elapsed = self.started.elapsed().as_secs_f64();
             let left = elapsed / f64::from(done) * f64::from(last - done);
-            eprint!("\rkeyframe {done}/{last}  {elapsed:.1} s, about {left:.1} s left   ");
-            let _ = std::io::stderr().flush();
+            say_part!("\rkeyframe {done}/{last}  {elapsed:.1} s, about {left:.1} s left   ");
         }
     }
 
@@ -205,11 +214,11 @@ impl Progress {
     pub(super) fn finish(self, sim: &Simulation, failure: Option<SimError>) -> Result<f64> {
         let seconds = self.started.elapsed().as_secs_f64();
         if self.show && self.done > 0 {
-            eprintln!();
+            say!();
         }
         match failure {
             None => {
-                eprintln!(
+                say!(
                     "simulated {} keyframes of {} organ(s) in {seconds:.2} s ({} Hessian factorisations)",
                     self.done,
                     sim.organs().len(),
@@ -289,7 +298,7 @@ pub(super) fn check_creatable_folder(out: &Path) -> Result<()> {
 pub(super) fn animation_options(fps: Option<f64>, encoding: EncodingArg) -> Result<GlbOptions> {
     let fps = fps.unwrap_or(anthesis_export::DEFAULT_FRAMES_PER_SECOND);
     if !(fps.is_finite() && fps > 0.0) {
-        bail!("--fps must be positive, got {fps}");
+        bail!("--fps must be a number of keyframes per second above 0 (and finite), got {fps}");
     }
     Ok(GlbOptions {
         timing: anthesis_export::Timing::FramesPerSecond(fps),

@@ -166,7 +166,18 @@ impl AnthesisApp {
     /// recovery left in the folder by a launch that did not end cleanly is
     /// offered at the next frame.
     pub fn enable_autosave(&mut self, folder: RecoveryFolder, interval: Duration) {
-        self.recovery_offer = folder.find();
+        // A damaged recovery is said, kept aside (never replaced by the
+        // next autosave) and, when its project is there, offered.
+        let mut readable = None;
+        for aside in folder.set_aside_damaged() {
+            self.log.error(format!(
+                "the recovered work is damaged ({}); it is kept at {}",
+                aside.problem,
+                aside.folder.display()
+            ));
+            readable = readable.or(aside.recovery);
+        }
+        self.recovery_offer = folder.find().or(readable);
         match Autosave::start(folder, interval) {
             Ok(autosave) => self.autosave = Some(autosave),
             Err(e) => self
@@ -226,7 +237,32 @@ impl AnthesisApp {
                     age_in_words(recovery.saved_at_unix_seconds, unix_seconds_now())
                 ));
             }
-            Err(e) => self.log.error(format!("cannot recover the work: {e}")),
+            Err(e) => {
+                self.log.error(format!("cannot recover the work: {e}"));
+                // Kept from the next autosave, which would replace it.
+                let in_use = recovery
+                    .project_file
+                    .parent()
+                    .filter(|folder| {
+                        folder.parent() == self.autosave.as_ref().map(|a| a.folder().dir())
+                    })
+                    .filter(|folder| {
+                        !folder
+                            .file_name()
+                            .is_some_and(|name| name.to_string_lossy().starts_with("damaged-"))
+                    });
+                if let (Some(folder), Some(autosave)) = (in_use, self.autosave.as_ref()) {
+                    match autosave.folder().set_aside(folder, e.to_string()) {
+                        Ok(aside) => self.log.info(format!(
+                            "the recovery is kept at {}",
+                            aside.folder.display()
+                        )),
+                        Err(error) => self
+                            .log
+                            .error(format!("cannot keep the recovery aside: {error}")),
+                    }
+                }
+            }
         }
     }
 

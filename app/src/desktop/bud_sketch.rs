@@ -1,5 +1,5 @@
 //! The Flower panel's "Sketched bud" section (issue 14 item 7,
-//! `sketch-based-floral-blossom.txt` §3.2): the user draws one curved
+//! the floral blossom paper §3.2): the user draws one curved
 //! stroke in a side view of the flower (the axis up the middle, the
 //! receptacle's height as the ground line), the initial primary vein of a
 //! petal; the bud is the chosen template bent along it and instanced on a

@@ -85,7 +85,8 @@ impl Log {
             Level::Warning => "warning",
             Level::Error => "error",
         };
-        eprintln!("anthesis {tag}: {message}");
+        // Never a panic when standard error is full or closed.
+        crate::cli::stream::write_err(format_args!("anthesis {tag}: {message}\n"));
         self.entries.push(Entry { level, message });
         if self.entries.len() > LOG_LIMIT {
             self.entries.remove(0);

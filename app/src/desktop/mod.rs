@@ -13,6 +13,7 @@
 pub mod autosave;
 mod background;
 pub mod bud_sketch;
+pub mod checked_field;
 pub mod command;
 pub mod document;
 pub mod export;
@@ -499,10 +500,20 @@ impl AnthesisApp {
         for note in drained.notes {
             self.log.info(note);
         }
+        for warning in drained.warnings {
+            self.log.warn(warning);
+        }
         for failure in drained.failures {
+            // A value the user chose at the end of its range is named.
+            let suspects = checked_field::values_at_limits(self.doc.project());
+            let suspects = if suspects.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", suspects.join("; "))
+            };
             self.log.error_about(
                 Topic::Simulation,
-                format!("the simulation stopped: {failure}"),
+                format!("the simulation stopped: {failure}{suspects}"),
             );
         }
         if let Some(end) = self.export.poll() {
@@ -552,6 +563,9 @@ impl eframe::App for AnthesisApp {
             self.apply(Command::DropFile(path));
         }
         self.drain_worker();
+        for notice in checked_field::take_notices(&ctx) {
+            self.log.warn(notice);
+        }
         self.handle_close_request(&ctx);
         for command in self.shortcut_commands(&ctx) {
             self.apply(command);

@@ -198,9 +198,14 @@ impl AnthesisApp {
             self.paint.on_3d,
             self.paint.brush.radius_in_uv,
         );
+        let mut row = 0;
         if let Some((badge, color)) = timeline::viewport_badge(&self.session, key.time_in_keyframes)
         {
-            viewport::badge(ui, viewport_rect, badge, color);
+            viewport::badge(ui, viewport_rect, row, badge, color);
+            row += 1;
+        }
+        if let Some(warning) = timeline::crossing_badge(&self.session, key.time_in_keyframes) {
+            viewport::badge(ui, viewport_rect, row, &warning, timeline::CROSSING_COLOR);
         }
         let template = self.selected_template();
         // Alt, or the eyedropper, picks the value under the pointer on the

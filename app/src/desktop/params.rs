@@ -22,15 +22,9 @@ fn number(
     speed: f64,
     range: std::ops::RangeInclusive<f64>,
 ) -> bool {
-    let label = ui.label(label).on_hover_text(tooltip);
-    let changed = ui
-        .add(
-            DragValue::new(value)
-                .speed(speed)
-                .range(range)
-                .max_decimals(5),
-        )
-        .labelled_by(label.id)
+    let label_response = ui.label(label).on_hover_text(tooltip);
+    let changed = super::checked_field::checked_number(ui, label, value, speed, range)
+        .labelled_by(label_response.id)
         .on_hover_text(tooltip)
         .changed();
     ui.end_row();

@@ -11,7 +11,7 @@
 //! from margin 1 to margin 2); dragging the arrow's head turns and
 //! stretches the tangent. The 2D view looks from the front (x, y) or the side (z, y);
 //! the chosen point's numbers can be typed. Symmetric editing about the
-//! midrib is on by default. The surface (eq. 12 of `pde-surfaces-lily.txt`,
+//! midrib is on by default. The surface (eq. 12 of Chaudhry et al.,
 //! closed form, so cheap) is drawn live as iso-lines, and the mesh it would
 //! become at the Shape section's edge is built on every change, so its
 //! particle count and quality are shown before **Apply surface**, which

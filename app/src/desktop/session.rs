@@ -9,11 +9,13 @@
 //! project whose meshes its positions belong to, so a proxy is drawn on the
 //! proxy's meshes.
 
+use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use anthesis_export::KeyframeBlend;
 use anthesis_flower::Project;
+use anthesis_sim::crossing::Crossings;
 use anthesis_sim::worker::{Event, RunId, Worker};
 use anthesis_sim::{Keyframe, KeyframeStats, Selection};
 use glam::DVec3;
@@ -124,6 +126,9 @@ pub struct SimSession {
     first_computed: u32,
     /// Whether the current run's proxy is still being computed.
     proxy_running: bool,
+    /// What crosses in the current run's converged keyframes, by keyframe
+    /// (the run warns and goes on; see `Event::Crossed`).
+    crossed: BTreeMap<u32, Arc<Crossings>>,
     /// The serial number of the next frame.
     next_serial: u64,
 }
@@ -160,6 +165,7 @@ impl SimSession {
             iteration: None,
             first_computed: 1,
             proxy_running: false,
+            crossed: BTreeMap::new(),
             next_serial: 0,
         }
     }
@@ -344,6 +350,10 @@ impl SimSession {
                 self.first_computed = first_computed;
                 self.status = RunStatus::Running;
                 self.proxy_running = proxy;
+                self.crossed.clear();
+            }
+            Event::Crossed { crossings, .. } => {
+                self.crossed.insert(crossings.keyframe, crossings);
             }
             Event::Keyframe { keyframe, .. } => {
                 if keyframe.index as usize == self.keyframes.len() {
@@ -380,6 +390,9 @@ impl SimSession {
                 // Every keyframe of the run is converged now; earlier runs'
                 // keyframes past its end (the count was lowered) go too.
                 self.frames.truncate(self.keyframes.len());
+                if let Some(note) = self.crossing_note() {
+                    drained.warnings.push(note);
+                }
                 self.status = RunStatus::Finished {
                     seconds,
                     first_computed: self.first_computed,
@@ -504,6 +517,43 @@ impl SimSession {
         self.frame_state((time_in_keyframes.max(0.0).ceil() as usize).min(end))
     }
 
+    /// What crosses in the converged keyframe the view at
+    /// `time_in_keyframes` shows (the one at or after it, as
+    /// [`SimSession::state_at`] picks it), if anything.
+    pub fn crossing_at(&self, time_in_keyframes: f64) -> Option<&Crossings> {
+        if self.state_at(time_in_keyframes) != Some(FrameState::Converged) {
+            return None;
+        }
+        let end = self.shown_end()?;
+        let index = (time_in_keyframes.max(0.0).ceil() as u32).min(end);
+        self.crossed.get(&index).map(Arc::as_ref)
+    }
+
+    /// The current run's converged keyframes in which organs cross.
+    pub fn crossed_keyframes(&self) -> impl Iterator<Item = u32> + '_ {
+        self.crossed.keys().copied()
+    }
+
+    /// One line for the log when a run's organs cross: the first crossing
+    /// and how many keyframes have one.
+    fn crossing_note(&self) -> Option<String> {
+        let first = self.crossed.values().next()?;
+        let count = self.crossed.len();
+        let more = if count > 1 {
+            format!(
+                " (and {} later keyframe{})",
+                count - 1,
+                if count == 2 { "" } else { "s" }
+            )
+        } else {
+            String::new()
+        };
+        Some(format!(
+            "organs pass through each other: {first}{more}; the timeline marks them red. \
+             Painting less growth where they meet keeps them apart"
+        ))
+    }
+
     /// Which frames the view at `time_in_keyframes` shows (the two it
     /// blends, as [`SimSession::shown_at`] picks them), as serial numbers
     /// that change whenever another frame takes their place: the scene
@@ -614,6 +664,8 @@ pub struct Drained {
     /// Things worth a line in the log that stop nothing (a proxy that
     /// failed).
     pub notes: Vec<String>,
+    /// Things the user should look at that stop nothing (organs crossing).
+    pub warnings: Vec<String>,
 }
 
 #[cfg(test)]
@@ -888,6 +940,55 @@ mod tests {
             },
             &mut Vec::new()
         ));
+    }
+
+    #[test]
+    fn crossings_mark_their_converged_keyframes_and_are_told_once_when_the_run_ends() {
+        use anthesis_sim::crossing::Crossed;
+        let project = Arc::new(anthesis_sim::fixtures::whorl(2, 4, 6, 3));
+        let mut session = SimSession::recorded();
+        let run = session.start(Arc::clone(&project), Selection::All);
+        started(&mut session, run, 3, false);
+        feed(&mut session, &project, run, &[0.0, 1.0, 2.0, 3.0]);
+        let organ = |index: usize, name: &str| Crossed::Organ {
+            index,
+            name: name.to_string(),
+            uv: glam::DVec2::new(0.5, 0.9),
+        };
+        for keyframe in [2, 3] {
+            let crossings = Arc::new(Crossings {
+                keyframe,
+                pairs: 4,
+                between: vec![(organ(0, "petal-1"), organ(1, "petal-2"), 4)],
+                organs: vec![0, 1],
+            });
+            assert!(session.accept(Event::Crossed { run, crossings }, &mut Vec::new()));
+        }
+        assert_eq!(session.crossed_keyframes().collect::<Vec<_>>(), [2, 3]);
+        assert!(session.crossing_at(1.0).is_none());
+        assert_eq!(session.crossing_at(1.5).map(|c| c.keyframe), Some(2));
+        assert_eq!(
+            crate::desktop::timeline::crossing_badge(&session, 3.0).as_deref(),
+            Some("CROSSING: petal-1 / petal-2")
+        );
+        let mut drained = Drained::default();
+        let finished = Event::Finished {
+            run,
+            keyframes: 3,
+            seconds: 0.1,
+        };
+        assert!(session.accept_into(finished, &mut drained));
+        assert_eq!(drained.warnings.len(), 1, "{:?}", drained.warnings);
+        let warning = &drained.warnings[0];
+        assert!(
+            warning.contains("keyframe 2: `petal-1` at uv (0.50, 0.90) passes through `petal-2`")
+                && warning.contains("(and 1 later keyframe)"),
+            "{warning}"
+        );
+        // The next run starts clean (the worker sends the kept ones again).
+        let next = session.start(Arc::clone(&project), Selection::All);
+        started(&mut session, next, 3, false);
+        assert_eq!(session.crossed_keyframes().count(), 0);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! The Shape section's sketched petal editor
-//! (`sketch-based-floral-blossom.txt` §3.1, `anthesis_bud::PetalSketch`):
+//! (the floral blossom paper §3.1, `anthesis_bud::PetalSketch`):
 //! a canvas in the base plane where the two outline strokes, the vein and
 //! cross-sections are drawn with the mouse, the B-spline surface's control
 //! net and outline drawn live over them, a side view of the bent rows, the

@@ -262,6 +262,20 @@ pub fn viewport_badge(session: &SimSession, time: f64) -> Option<(&'static str, 
     }
 }
 
+/// The viewport's warning at `time`, under its state badge: which organs
+/// cross in the converged keyframe shown, if any.
+pub fn crossing_badge(session: &SimSession, time: f64) -> Option<String> {
+    let crossings = session.crossing_at(time)?;
+    let (a, b, _) = crossings.between.first()?;
+    Some(if a.name() == b.name() {
+        format!("CROSSING: {} through itself", a.name())
+    } else {
+        format!("CROSSING: {} / {}", a.name(), b.name())
+    })
+}
+
+/// Colour of keyframes where organs cross.
+pub const CROSSING_COLOR: Color32 = Color32::from_rgb(200, 50, 50);
 /// Colour of the current run's computed keyframes.
 const COMPUTED_COLOR: Color32 = Color32::from_rgb(90, 140, 90);
 /// Colour of the current run's proxy keyframes (the converged ones are
@@ -408,7 +422,8 @@ fn scrubber(
     let response = response.on_hover_text(format!(
         "Timeline: green cells are computed keyframes, blue ones the coarse proxy (shown \
          until the full-resolution run reaches them), brown ones the previous result \
-         (stale, shown until the new run reaches them), empty ones pending. Triangles mark \
+         (stale, shown until the new run reaches them), empty ones pending; a red bar marks \
+         a keyframe where organs pass through each other (the log says which). Triangles mark \
          the time keys of {} (filled: the key being painted). Click or drag to scrub.",
         keys.template
     ));
@@ -445,6 +460,17 @@ fn scrubber(
         );
         painter.rect_filled(cells, 0.0, color_of(state));
         k = last + 1;
+    }
+    // Keyframes where organs cross: a red bar along the cell's bottom.
+    for k in session.crossed_keyframes().filter(|&k| k >= 1 && k <= end) {
+        let bar = Rect::from_min_max(
+            Pos2::new(x_of(f64::from(k - 1)), rect.bottom() - 6.0),
+            Pos2::new(
+                x_of(f64::from(k)).max(x_of(f64::from(k - 1)) + 2.0),
+                rect.bottom(),
+            ),
+        );
+        painter.rect_filled(bar, 0.0, CROSSING_COLOR);
     }
     // Keyframe ticks: every keyframe when they are far enough apart,
     // otherwise every 10th.

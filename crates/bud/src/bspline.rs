@@ -1,5 +1,5 @@
 //! B-spline curves and tensor-product B-spline surfaces (the sketched
-//! petal of `sketch-based-floral-blossom.txt` §3.1 is one).
+//! petal of the floral blossom paper §3.1 is one).
 //!
 //! A curve of degree `p` with `n` control points has `n + p + 1`
 //! non-decreasing knots. The knot vectors made here are *clamped*: the

@@ -1,4 +1,4 @@
-//! PDE-driven in-betweening of a swept organ (`pde-surfaces-lily.txt` §V):
+//! PDE-driven in-betweening of a swept organ (Chaudhry et al. §V):
 //! the deformation `d(u, t)` of the sweep's generator between two states is
 //! the solution of the dynamic equation (13)
 //!

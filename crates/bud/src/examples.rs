@@ -10,7 +10,7 @@ use glam::DVec3;
 use crate::surface::{BezierCurve, BezierPatch, PdeSweep};
 
 /// A lily (Lilium) petal of a closed bud, about 40 long and 12 wide, as a PDE
-/// sweep (`pde-surfaces-lily.txt` §IV, the cubic generator). Narrow base
+/// sweep (Chaudhry et al. §IV, the cubic generator). Narrow base
 /// (2 wide), widest a little below the middle, pointed tip bent in towards
 /// the flower axis, cupped across. Meshed at edge 1.3 it has on the order of
 /// the paper's 388 vertices.
@@ -26,7 +26,7 @@ pub fn lily_petal_surface() -> PdeSweep {
 }
 
 /// An Eustoma (lisianthus) petal of a closed bud, about 38 long, as a
-/// bicubic Bézier patch (`lsystem-bezier-flower.txt` §4): narrow claw at the
+/// bicubic Bézier patch (Qin and Chen 2006 §4): narrow claw at the
 /// base, obovate blade widest near two thirds of its length, a broad rounded
 /// top (the patch's `v = 1` edge), cupped across and bent in at the top.
 /// Meshed at edge 2.0 it has on the order of the paper's 261 vertices.

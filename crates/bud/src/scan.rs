@@ -1,4 +1,4 @@
-//! Scanned petals (issue 14 item 6; `pde-surfaces-lily.txt` §III.C–§IV:
+//! Scanned petals (issue 14 item 6; Chaudhry et al. §III.C–§IV:
 //! reconstructed polygon models turned into curve-defined PDE surfaces).
 //!
 //! A petal mesh of any triangulation and without UVs (a photogrammetry or
@@ -475,13 +475,43 @@ struct Parameters {
 }
 
 /// The harmonic map of the scan onto the parameter domain (see the module
-/// notes).
+/// notes): the outline placed on the domain's sides
+/// ([`outline_on_domain`]), the inner vertices where the cotangent
+/// weights ([`cotangent_weights`]) balance them ([`harmonic_interior`]),
+/// then read as square parameters ([`square_parameters`]).
 fn parameterise(
     mesh: &Mesh,
     outline: &ScanOutline,
     corners: &ScanCorners,
 ) -> Result<Parameters, ScanError> {
-    let n = mesh.positions.len();
+    let pointed = corners.pointed();
+    let Boundary {
+        mut domain,
+        fixed,
+        held_u,
+        held_v,
+    } = outline_on_domain(mesh.positions.len(), outline, corners);
+    let neighbours = cotangent_weights(mesh);
+    harmonic_interior(&neighbours, &fixed, &mut domain)?;
+    let uv = square_parameters(&domain, pointed);
+    Ok(Parameters { uv, held_u, held_v })
+}
+
+/// The outline's vertices on the parameter domain, and which parameters
+/// they hold.
+struct Boundary {
+    /// Each vertex's point in the domain (the outline's placed, the rest
+    /// zero).
+    domain: Vec<DVec2>,
+    /// Whether the vertex is on the outline (fixed in the harmonic map).
+    fixed: Vec<bool>,
+    held_u: Vec<Option<f64>>,
+    held_v: Vec<Option<f64>>,
+}
+
+/// The outline of `n` vertices placed on the domain: base (0,0)-(1,0);
+/// top (1,1)-(0,1), or the apex (0.5, 1); each span by arc length.
+fn outline_on_domain(n: usize, outline: &ScanOutline, corners: &ScanCorners) -> Boundary {
     let loop_len = outline.len();
     let pointed = corners.pointed();
     // The domain: base (0,0)-(1,0); top (1,1)-(0,1), or the apex (0.5, 1).
@@ -544,9 +574,18 @@ fn parameterise(
         held_u[tip] = Some(0.5);
         held_v[tip] = Some(1.0);
     }
+    Boundary {
+        domain,
+        fixed,
+        held_u,
+        held_v,
+    }
+}
 
-    // Cotangent weights, clamped positive (a positive-weight harmonic map
-    // onto a convex domain cannot fold).
+/// Cotangent weights per vertex, clamped positive (a positive-weight
+/// harmonic map onto a convex domain cannot fold).
+fn cotangent_weights(mesh: &Mesh) -> Vec<Vec<(usize, f64)>> {
+    let n = mesh.positions.len();
     let mut neighbours: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
     let mut add = |i: usize, j: usize, w: f64| {
         if let Some(entry) = neighbours[i].iter_mut().find(|(k, _)| *k == j) {
@@ -578,6 +617,18 @@ fn parameterise(
             entry.1 = entry.1.max(1e-3 * mean.max(1e-12));
         }
     }
+    neighbours
+}
+
+/// The free (not `fixed`) vertices of `domain` placed where the weights
+/// `neighbours` balance them: Jacobi-preconditioned conjugate gradients,
+/// both coordinates at once, from the mean of the outline.
+fn harmonic_interior(
+    neighbours: &[Vec<(usize, f64)>],
+    fixed: &[bool],
+    domain: &mut [DVec2],
+) -> Result<(), ScanError> {
+    let n = domain.len();
     // Conjugate gradients on the free vertices, both coordinates at once.
     let free: Vec<usize> = (0..n).filter(|&v| !fixed[v]).collect();
     let mut index = vec![usize::MAX; n];
@@ -610,63 +661,67 @@ fn parameterise(
         })
         .collect();
     let m = free.len();
-    if m > 0 {
-        // Start from the mean of the outline.
-        let start = (0..n)
-            .filter(|&v| fixed[v])
-            .map(|v| domain[v])
-            .sum::<DVec2>()
-            / (n - m).max(1) as f64;
-        let mut x = vec![start; m];
-        let mut ax = vec![DVec2::ZERO; m];
-        apply(&x, &mut ax);
-        let mut r: Vec<DVec2> = (0..m).map(|k| rhs[k] - ax[k]).collect();
-        let mut z: Vec<DVec2> = (0..m).map(|k| r[k] / diagonal[k]).collect();
-        let mut p = z.clone();
-        let dot =
-            |a: &[DVec2], b: &[DVec2]| -> DVec2 { a.iter().zip(b).map(|(a, b)| *a * *b).sum() };
-        let mut rz = dot(&r, &z);
-        let norm0 = dot(&rhs, &rhs).max_element().sqrt().max(1e-300);
-        let mut ap = vec![DVec2::ZERO; m];
-        for _ in 0..(4 * m + 100) {
-            apply(&p, &mut ap);
-            let pap = dot(&p, &ap);
-            let alpha = DVec2::new(
-                if pap.x > 0.0 { rz.x / pap.x } else { 0.0 },
-                if pap.y > 0.0 { rz.y / pap.y } else { 0.0 },
-            );
-            for k in 0..m {
-                x[k] += alpha * p[k];
-                r[k] -= alpha * ap[k];
-            }
-            if dot(&r, &r).max_element().sqrt() <= 1e-12 * norm0 {
-                break;
-            }
-            for k in 0..m {
-                z[k] = r[k] / diagonal[k];
-            }
-            let rz_new = dot(&r, &z);
-            let beta = DVec2::new(
-                if rz.x > 0.0 { rz_new.x / rz.x } else { 0.0 },
-                if rz.y > 0.0 { rz_new.y / rz.y } else { 0.0 },
-            );
-            rz = rz_new;
-            for k in 0..m {
-                p[k] = z[k] + beta * p[k];
-            }
+    if m == 0 {
+        return Ok(());
+    }
+    // Start from the mean of the outline.
+    let start = (0..n)
+        .filter(|&v| fixed[v])
+        .map(|v| domain[v])
+        .sum::<DVec2>()
+        / (n - m).max(1) as f64;
+    let mut x = vec![start; m];
+    let mut ax = vec![DVec2::ZERO; m];
+    apply(&x, &mut ax);
+    let mut r: Vec<DVec2> = (0..m).map(|k| rhs[k] - ax[k]).collect();
+    let mut z: Vec<DVec2> = (0..m).map(|k| r[k] / diagonal[k]).collect();
+    let mut p = z.clone();
+    let dot = |a: &[DVec2], b: &[DVec2]| -> DVec2 { a.iter().zip(b).map(|(a, b)| *a * *b).sum() };
+    let mut rz = dot(&r, &z);
+    let norm0 = dot(&rhs, &rhs).max_element().sqrt().max(1e-300);
+    let mut ap = vec![DVec2::ZERO; m];
+    for _ in 0..(4 * m + 100) {
+        apply(&p, &mut ap);
+        let pap = dot(&p, &ap);
+        let alpha = DVec2::new(
+            if pap.x > 0.0 { rz.x / pap.x } else { 0.0 },
+            if pap.y > 0.0 { rz.y / pap.y } else { 0.0 },
+        );
+        for k in 0..m {
+            x[k] += alpha * p[k];
+            r[k] -= alpha * ap[k];
         }
-        if x.iter().any(|p| !p.is_finite()) {
-            return Err(ScanError::Fit(
-                "the harmonic map of the scan onto the unit square is not finite".into(),
-            ));
+        if dot(&r, &r).max_element().sqrt() <= 1e-12 * norm0 {
+            break;
         }
-        for (k, &v) in free.iter().enumerate() {
-            domain[v] = x[k];
+        for k in 0..m {
+            z[k] = r[k] / diagonal[k];
+        }
+        let rz_new = dot(&r, &z);
+        let beta = DVec2::new(
+            if rz.x > 0.0 { rz_new.x / rz.x } else { 0.0 },
+            if rz.y > 0.0 { rz_new.y / rz.y } else { 0.0 },
+        );
+        rz = rz_new;
+        for k in 0..m {
+            p[k] = z[k] + beta * p[k];
         }
     }
-    // The domain point as square parameters (a triangle's rows widen to
-    // the square's).
-    let uv = domain
+    if x.iter().any(|p| !p.is_finite()) {
+        return Err(ScanError::Fit(
+            "the harmonic map of the scan onto the unit square is not finite".into(),
+        ));
+    }
+    for (k, &v) in free.iter().enumerate() {
+        domain[v] = x[k];
+    }
+    Ok(())
+}
+
+/// The domain points as square parameters (a triangle's rows widen to
+/// the square's).
+fn square_parameters(domain: &[DVec2], pointed: bool) -> Vec<DVec2> {
+    domain
         .iter()
         .map(|d| {
             let width = if pointed { 1.0 - d.y } else { 1.0 };
@@ -677,8 +732,7 @@ fn parameterise(
             };
             DVec2::new(u.clamp(0.0, 1.0), d.y.clamp(0.0, 1.0))
         })
-        .collect();
-    Ok(Parameters { uv, held_u, held_v })
+        .collect()
 }
 
 /// The fitted unknowns: which of the 16 control values (curve `k` of
@@ -893,7 +947,36 @@ pub fn fit_scan(
     outline.check(&corners)?;
     let start = parameterise(mesh, &outline, &corners)?;
     let weight = vertex_areas(mesh);
-    let slots = unknown_slots(corners.pointed());
+    let (sweep, uv) = least_squares(mesh, &start, &weight, corners.pointed(), options)?;
+    let scan_to_surface = scan_to_surface(mesh, &sweep, &uv, &weight);
+    let surface_to_scan = surface_to_scan(&sweep, mesh);
+    let (rotation, base) = template_frame(&sweep, options.flip_inner_side)?;
+    let placed = in_template_frame(&sweep, rotation, base);
+    let length = middle_length(&placed);
+    Ok(ScanFit {
+        sweep: placed,
+        length,
+        scan_to_surface,
+        surface_to_scan,
+        rotation,
+        origin: base,
+        corners,
+    })
+}
+
+/// The sweep fitted to the scan's vertices weighted by area from the
+/// harmonic parameters `start`: for each stretch-to-bend ratio tried two
+/// rounds of solving and projecting the points to their closest
+/// parameters, then the best goes on for the rounds left. Returns the
+/// sweep and each vertex's parameters.
+fn least_squares(
+    mesh: &Mesh,
+    start: &Parameters,
+    weight: &[f64],
+    pointed: bool,
+    options: &ScanFitOptions,
+) -> Result<(PdeSweep, Vec<DVec2>), ScanError> {
+    let slots = unknown_slots(pointed);
     let tried: Vec<f64> = match options.stretch_to_bend {
         Some(lambda) => vec![lambda],
         None => vec![0.0, 2.0, 10.0],
@@ -903,7 +986,7 @@ pub fn fit_scan(
         mesh.positions
             .iter()
             .zip(uv)
-            .zip(&weight)
+            .zip(weight)
             .map(|((p, q), w)| w * sweep.point(*q).distance_squared(*p))
             .sum::<f64>()
             / total
@@ -922,7 +1005,7 @@ pub fn fit_scan(
                 break;
             }
             last = now;
-            sweep = solve(&mesh.positions, &uv, &weight, &slots, lambda)?;
+            sweep = solve(&mesh.positions, &uv, weight, &slots, lambda)?;
         }
         Ok::<_, ScanError>((sweep, uv))
     };
@@ -930,7 +1013,7 @@ pub fn fit_scan(
     let screening = options.rounds.min(2);
     let mut best: Option<(f64, f64, PdeSweep, Vec<DVec2>)> = None;
     for lambda in tried {
-        let first = solve(&mesh.positions, &start.uv, &weight, &slots, lambda)?;
+        let first = solve(&mesh.positions, &start.uv, weight, &slots, lambda)?;
         let (sweep, uv) = improve(first, start.uv.clone(), screening, lambda)?;
         let c = cost(&sweep, &uv);
         if c.is_finite() && best.as_ref().is_none_or(|(b, ..)| c < *b) {
@@ -940,21 +1023,30 @@ pub fn fit_scan(
     let Some((_, lambda, sweep, uv)) = best else {
         return Err(ScanError::Fit("no finite fit".into()));
     };
-    let (sweep, uv) = improve(sweep, uv, options.rounds - screening, lambda)?;
-    // Distances at the scan's vertices, each at its own closest
-    // parameters (outline points not held to their side: the true
-    // distance).
+    improve(sweep, uv, options.rounds - screening, lambda)
+}
+
+/// The scan's distances to the fitted sweep, RMS (weighted by `weight`)
+/// and largest, each vertex at its own closest parameters from `uv`
+/// (outline points not held to their side: the true distance).
+fn scan_to_surface(mesh: &Mesh, sweep: &PdeSweep, uv: &[DVec2], weight: &[f64]) -> [f64; 2] {
+    let total: f64 = weight.iter().sum::<f64>().max(1e-300);
     let (mut sum, mut max) = (0.0, 0.0f64);
-    for ((p, q), w) in mesh.positions.iter().zip(&uv).zip(&weight) {
-        let free = project(&sweep, *p, *q, None, None);
+    for ((p, q), w) in mesh.positions.iter().zip(uv).zip(weight) {
+        let free = project(sweep, *p, *q, None, None);
         let d = sweep.point(free).distance(*p);
         sum += w * d * d;
         max = max.max(d);
     }
     let rms = (sum / total).sqrt();
-    let surface_to_scan = surface_to_scan(&sweep, mesh);
+    [rms, max]
+}
 
-    // The template frame.
+/// The template frame of a fitted sweep: the rotation into it and its
+/// origin (the base's middle). Y runs from base to tip, Z away from the
+/// inner side, which is the concave side (the outline lies on the concave
+/// side of a cupped petal) unless `flip_inner_side`.
+fn template_frame(sweep: &PdeSweep, flip_inner_side: bool) -> Result<(DMat3, DVec3), ScanError> {
     let base = sweep.point(DVec2::new(0.5, 0.0));
     let tip = sweep.point(DVec2::new(0.5, 1.0));
     let y = (tip - base).normalize_or_zero();
@@ -991,14 +1083,16 @@ pub fn fit_scan(
     } else {
         n
     };
-    let inner = if options.flip_inner_side {
-        -concave
-    } else {
-        concave
-    };
+    let inner = if flip_inner_side { -concave } else { concave };
     let z = -inner;
     let x = y.cross(z);
     let rotation = DMat3::from_cols(x, y, z).transpose();
+    Ok((rotation, base))
+}
+
+/// The sweep put in the template frame (`rotation` about `base`), u along
+/// −X like the shipped petals.
+fn in_template_frame(sweep: &PdeSweep, rotation: DMat3, base: DVec3) -> PdeSweep {
     let place = |c: &BezierCurve| BezierCurve::new(c.control.map(|p| rotation * (p - base)));
     let turn = |c: &BezierCurve| BezierCurve::new(c.control.map(|t| rotation * t));
     let mut placed = PdeSweep::new(
@@ -1015,16 +1109,7 @@ pub fn fit_scan(
     if across.x > 0.0 {
         placed = reversed_across(&placed);
     }
-    let length = middle_length(&placed);
-    Ok(ScanFit {
-        sweep: placed,
-        length,
-        scan_to_surface: [rms, max],
-        surface_to_scan,
-        rotation,
-        origin: base,
-        corners,
-    })
+    placed
 }
 
 /// The same surface with `u` running the other way: `S'(u, v) = S(1 − u, v)`.

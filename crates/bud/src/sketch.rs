@@ -1,4 +1,4 @@
-//! The sketched petal (`sketch-based-floral-blossom.txt` §3.1): three
+//! The sketched petal (the floral blossom paper §3.1): three
 //! strokes on the base plane (the two margins and the primary vein) give a
 //! flat bicubic B-spline surface whose control points are spread evenly
 //! across and along the petal; a cross-section stroke drawn over a row of
@@ -340,11 +340,6 @@ impl PetalSketch {
             StrokeRole::Vein => &self.vein,
             StrokeRole::CrossSection(n) => self.sections.get(n).map_or(&[], Vec::as_slice),
         }
-    }
-
-    /// Whether the two outline strokes and the vein are all drawn.
-    pub fn has_outline(&self) -> bool {
-        !(self.left.is_empty() || self.right.is_empty() || self.vein.is_empty())
     }
 
     /// The sketch with `points` drawn with `tool` (see [`SketchTool`]):

@@ -1,6 +1,6 @@
 //! Parametric organ surfaces: bicubic Bézier patches
-//! (`lsystem-bezier-flower.txt` §4) and PDE sweep surfaces
-//! (`pde-surfaces-lily.txt` §IV).
+//! (Qin and Chen 2006 §4) and PDE sweep surfaces
+//! (Chaudhry et al. §IV).
 //!
 //! Every surface maps the unit square of parameters to the organ template
 //! frame. Parameter `u` runs across the organ (the midrib is at `u = 0.5` when
@@ -103,7 +103,7 @@ impl Surface for BezierPatch {
 /// beyond it the 2x2 boundary system loses accuracy to cancellation.
 pub const MAX_STRETCH_TO_BEND: f64 = 100.0;
 
-/// A PDE sweep surface (`pde-surfaces-lily.txt` §IV): a generator curve,
+/// A PDE sweep surface (Chaudhry et al. §IV): a generator curve,
 /// the solution of the fourth-order ODE (seed eq. 5)
 /// `k_b d'''' - k_s d'' = 0` in `u`, swept along two boundary curves
 /// (the seed's "trajectories") that it meets with prescribed tangents:

@@ -1,5 +1,5 @@
 //! A petal's primary vein drawn as one stroke in a side view, and a
-//! template bent so its midrib follows it (`sketch-based-floral-blossom.txt`
+//! template bent so its midrib follows it (the floral blossom paper
 //! §3.2: "the user first draws a curved stroke indicating the outline of a
 //! flower bud ... the initial form of the primary vein of one petal";
 //! copies of the curve around the axis then carry the bud's petals).

@@ -1,6 +1,6 @@
 //! Positions between keyframes: the one interpolation rule of Anthesis
-//! (DESIGN.md §2: the animation is the linear interpolation of its
-//! keyframes), used by the exporters when they resample and by the
+//! (a rule of the project's design: the animation is the linear
+//! interpolation of its keyframes), used by the exporters when they resample and by the
 //! desktop's timeline when it shows a time between two keyframes.
 
 use glam::DVec3;

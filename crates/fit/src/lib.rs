@@ -665,6 +665,42 @@ struct Problem<'a> {
     cancel: &'a (dyn Fn() -> bool + Sync),
 }
 
+impl<'a> Problem<'a> {
+    /// The problem of fitting organ `organ` of `project` to `target` with
+    /// `settings`: the basis's layout, the map size, the coarse run.
+    fn new(
+        project: &'a Project,
+        organ: usize,
+        target: &'a Target,
+        settings: &FitSettings,
+        length: f64,
+        deadline: Instant,
+        cancel: &'a (dyn Fn() -> bool + Sync),
+    ) -> Problem<'a> {
+        let template = project.flower.template_of(organ);
+        let layout = Layout {
+            growth: settings.growth_nodes,
+            direction: settings.direction_nodes,
+            key_steps: basis::key_steps(settings.keys, project.settings.keyframes),
+        };
+        let size = template.maps.raster_size().unwrap_or((64, 64));
+        let coarse = coarse_run(project, organ, &layout, settings.coarse);
+        Problem {
+            project,
+            coarse,
+            organ,
+            layout,
+            size,
+            triangles: &template.mesh.triangles,
+            target,
+            target_weights: target.surface.vertex_weights(),
+            length,
+            deadline,
+            cancel,
+        }
+    }
+}
+
 impl Problem<'_> {
     fn maps(&self, p: &[f64]) -> Result<KeyedMaps, MapError> {
         let template = self.project.flower.template_of(self.organ);
@@ -772,6 +808,12 @@ fn target_at_particles(
 /// target already in the project's frame, or [`register_target`]'s).
 /// `progress` hears of every iteration; `cancel` is polled inside the
 /// simulations.
+///
+/// The phases (private functions of this file): the inputs checked
+/// (`check_inputs`), the start chosen (`start`), then Levenberg–Marquardt
+/// iterations (`Iterate`: a Jacobian, fresh or updated, `jacobian`; two
+/// damped steps tried, `step`; the better kept, `accept`, or the damping
+/// raised, `reject`) until a [`Stop`].
 pub fn fit(
     project: &Project,
     organ: usize,
@@ -783,6 +825,104 @@ pub fn fit(
 ) -> Result<Fit, FitError> {
     let started = Instant::now();
     let deadline = started + Duration::from_secs_f64(settings.max_seconds.clamp(0.0, 1e9));
+    let topology = check_inputs(project, organ, target)?;
+    let template = project.flower.template_of(organ);
+    let bud_positions = bud_positions(project, organ)?;
+    let base_particles = template.base_region.particles(&template.mesh);
+    let length = organ_length(project, organ, target, placement)?;
+
+    let problem = Problem::new(project, organ, target, settings, length, deadline, cancel);
+    let report = |iteration: u32, apart: &Apart, simulations: usize| {
+        let (rms, max) = problem.fractions(apart);
+        FitProgress {
+            iteration,
+            rms,
+            max,
+            simulations,
+            seconds: started.elapsed().as_secs_f64(),
+        }
+    };
+
+    let (p, s, simulations) = start(
+        &problem,
+        placement,
+        &topology,
+        &bud_positions,
+        settings.max_seconds,
+    )?;
+    let apart = problem.measure(&s, placement, None);
+    let guess_rms = problem.fractions(&apart).0;
+    let mut state = Iterate {
+        p,
+        s,
+        apart,
+        placement,
+        jacobian: None,
+        fresh: false,
+        jacobian_seconds: None,
+        mu: 0.0,
+        iterations: 0,
+        simulations,
+    };
+    progress(report(0, &state.apart, state.simulations));
+
+    let stop = loop {
+        if let Some(stop) = state.done(&problem, settings) {
+            break stop;
+        }
+        let j = match state.jacobian(&problem, settings.step) {
+            Ok(j) => j,
+            Err(Exit::Stop(stop)) => break stop,
+            Err(Exit::Failed(e)) => return Err(e),
+        };
+        let converged = match state.step(&problem, settings, j, &base_particles) {
+            Ok(converged) => converged,
+            Err(Exit::Stop(stop)) => break stop,
+            Err(Exit::Failed(e)) => return Err(e),
+        };
+        progress(report(state.iterations, &state.apart, state.simulations));
+        if converged {
+            break Stop::Converged;
+        }
+    };
+
+    let Iterate {
+        p,
+        s,
+        apart,
+        placement,
+        iterations,
+        simulations,
+        ..
+    } = state;
+    let (rms, max) = problem.fractions(&apart);
+    let maps = problem.maps(&p)?;
+    Ok(Fit {
+        maps,
+        parameters: p,
+        length,
+        guess_rms,
+        rms,
+        max,
+        iterations,
+        simulations,
+        seconds: started.elapsed().as_secs_f64(),
+        stop,
+        max_iterations: settings.max_iterations,
+        max_seconds: settings.max_seconds,
+        placement,
+        shape: s,
+    })
+}
+
+/// The fit's inputs checked: the organ exists, the target has triangles
+/// and finite positions, the organ's template mesh is valid (its topology
+/// returned, for the first guess).
+fn check_inputs(
+    project: &Project,
+    organ: usize,
+    target: &Target,
+) -> Result<anthesis_mesh::Topology, FitError> {
     let flower = &project.flower;
     if flower.organs.get(organ).is_none() {
         return Err(FitError::NoSuchOrgan(format!("#{organ}")));
@@ -798,48 +938,44 @@ pub fn fit(
         template: template.name.clone(),
         error,
     })?;
-    let bud_positions = bud_positions(project, organ)?;
-    let base_particles = template.base_region.particles(&template.mesh);
-    let length = organ_length(project, organ, target, placement)?;
+    Ok(topology)
+}
 
-    let layout = Layout {
-        growth: settings.growth_nodes,
-        direction: settings.direction_nodes,
-        key_steps: basis::key_steps(settings.keys, project.settings.keyframes),
-    };
-    let size = template.maps.raster_size().unwrap_or((64, 64));
-    let coarse = coarse_run(project, organ, &layout, settings.coarse);
-    let problem = Problem {
-        project,
-        coarse,
-        organ,
-        layout,
-        size,
-        triangles: &template.mesh.triangles,
-        target,
-        target_weights: target.surface.vertex_weights(),
-        length,
-        deadline,
-        cancel,
-    };
-    let mut simulations = 0usize;
-    let report = |iteration: u32, apart: &Apart, simulations: usize| {
-        let (rms, max) = problem.fractions(apart);
-        FitProgress {
-            iteration,
-            rms,
-            max,
-            simulations,
-            seconds: started.elapsed().as_secs_f64(),
-        }
-    };
-    let first_error = |halt: Halt| match halt {
+/// What a stopped simulation before the iterations means for the fit:
+/// each is an error (only the first guess must simulate within the time).
+fn halt_error(halt: Halt, max_seconds: f64) -> FitError {
+    match halt {
         Halt::Cancelled => FitError::Cancelled,
         Halt::OutOfTime => FitError::OutOfTime {
-            seconds: settings.max_seconds,
+            seconds: max_seconds,
         },
         Halt::Failed(e) => e,
-    };
+    }
+}
+
+/// The start of the iterations: the closed-form first guess (no growth
+/// when the target cannot be read at the particles) and the project's own
+/// maps in the basis, simulated at once; the nearer wins, no growth if
+/// neither simulates. Returns the parameters, their final shape and the
+/// simulations run.
+fn start(
+    problem: &Problem<'_>,
+    placement: Similarity,
+    topology: &anthesis_mesh::Topology,
+    bud_positions: &[DVec3],
+    max_seconds: f64,
+) -> Result<(Vec<f64>, Vec<DVec3>, usize), FitError> {
+    let Problem {
+        project,
+        organ,
+        target,
+        deadline,
+        cancel,
+        ..
+    } = *problem;
+    let template = project.flower.template_of(organ);
+    let mut simulations = 0usize;
+    let first_error = |halt: Halt| halt_error(halt, max_seconds);
 
     // The first guess, or no growth when its simulation fails.
     let mut guess_sims = 0;
@@ -851,8 +987,8 @@ pub fn fit(
     simulations += guess_sims;
     let organ_guess = guess::Organ {
         mesh: &template.mesh,
-        topology: &topology,
-        bud: &bud_positions,
+        topology,
+        bud: bud_positions,
         dg: template.dg,
         thickness: template.thickness,
         steps: project.settings.keyframes,
@@ -878,7 +1014,7 @@ pub fn fit(
             starts.push((cost, q, shape));
         }
     }
-    let (mut p, mut s) = match starts.into_iter().min_by(|a, b| a.0.total_cmp(&b.0)) {
+    let (p, s) = match starts.into_iter().min_by(|a, b| a.0.total_cmp(&b.0)) {
         Some((_, q, shape)) => (q, shape),
         None => {
             let none = vec![0.0; problem.layout.len()];
@@ -890,113 +1026,110 @@ pub fn fit(
             (none, shape)
         }
     };
-    let mut placement = placement;
-    let mut apart = problem.measure(&s, placement, None);
-    let guess_rms = problem.fractions(&apart).0;
-    progress(report(0, &apart, simulations));
+    Ok((p, s, simulations))
+}
 
-    let n = p.len();
-    let positions = 3 * s.len();
-    let mut jacobian: Option<Vec<f64>> = None; // of the positions, column-major, positions x n
-    let mut fresh = false;
-    let mut jacobian_seconds: Option<f64> = None;
-    let mut mu = 0.0;
-    let mut iterations = 0;
-    let stop = loop {
-        if problem.fractions(&apart).0 <= settings.goal_rms {
-            break Stop::Goal;
+/// Why the iterations end early: a [`Stop`] (the best so far returned), or
+/// an error (cancelled, maps that cannot be built).
+enum Exit {
+    Stop(Stop),
+    Failed(FitError),
+}
+
+impl From<Halt> for Exit {
+    /// A simulation stopped inside the iterations: out of time stops the
+    /// fit with its best so far.
+    fn from(halt: Halt) -> Self {
+        match halt {
+            Halt::OutOfTime => Exit::Stop(Stop::Seconds),
+            Halt::Cancelled => Exit::Failed(FitError::Cancelled),
+            Halt::Failed(e) => Exit::Failed(e),
         }
-        if iterations >= settings.max_iterations {
-            break Stop::Iterations;
+    }
+}
+
+/// The state of the Levenberg–Marquardt iterations.
+struct Iterate {
+    /// The parameters accepted last.
+    p: Vec<f64>,
+    /// Their final shape on the full run.
+    s: Vec<DVec3>,
+    /// How far `s` is from the target.
+    apart: Apart,
+    /// Where the target is placed (refined as the fit goes).
+    placement: Similarity,
+    /// The Jacobian of the positions kept for the next step, column-major,
+    /// positions x parameters.
+    jacobian: Option<Vec<f64>>,
+    /// Whether the Jacobian in use was taken afresh (not updated).
+    fresh: bool,
+    /// How long the last fresh Jacobian took.
+    jacobian_seconds: Option<f64>,
+    /// The damping.
+    mu: f64,
+    iterations: u32,
+    simulations: usize,
+}
+
+impl Iterate {
+    /// The stop before an iteration: the goal reached, no iterations or
+    /// time left.
+    fn done(&self, problem: &Problem<'_>, settings: &FitSettings) -> Option<Stop> {
+        if problem.fractions(&self.apart).0 <= settings.goal_rms {
+            return Some(Stop::Goal);
+        }
+        if self.iterations >= settings.max_iterations {
+            return Some(Stop::Iterations);
         }
         if problem.seconds_left() <= 0.0 {
-            break Stop::Seconds;
+            return Some(Stop::Seconds);
         }
-        let j = match jacobian.take() {
-            Some(j) => j,
-            None => {
-                // A fresh Jacobian is the dearest part; after the first,
-                // only when it can end within the time allowed.
-                if jacobian_seconds.is_some_and(|t| t > problem.seconds_left()) {
-                    break Stop::Seconds;
-                }
-                let before = Instant::now();
-                let (j, runs) = match finite_differences(&problem, &p, &s, settings.step) {
-                    Ok(done) => done,
-                    Err(Halt::OutOfTime) => break Stop::Seconds,
-                    Err(Halt::Cancelled) => return Err(FitError::Cancelled),
-                    Err(Halt::Failed(e)) => return Err(e),
-                };
-                jacobian_seconds = Some(before.elapsed().as_secs_f64());
-                simulations += runs;
-                fresh = true;
-                j
-            }
-        };
-        // The residual rows at the shape now, and their Jacobian through
-        // the positions'.
-        let mut rows = Vec::new();
-        problem.measure(&s, placement, Some(&mut rows));
-        let r: Vec<f64> = rows.iter().map(|row| row.value(&s)).collect();
-        let m = rows.len();
-        let mut jr = vec![0.0; m * n]; // column-major, m x n
-        for (col, column) in j.chunks_exact(positions).enumerate() {
-            let out = &mut jr[col * m..(col + 1) * m];
-            for (value, row) in out.iter_mut().zip(&rows) {
-                *value = (0..3)
-                    .map(|k| {
-                        let i = 3 * row.particles[k] as usize;
-                        row.weights[k]
-                            * DVec3::new(column[i], column[i + 1], column[i + 2]).dot(row.direction)
-                    })
-                    .sum();
-            }
+        None
+    }
+
+    /// The Jacobian of this iteration: the one kept, or a fresh one by
+    /// finite differences (the dearest part; after the first, only when
+    /// it can end within the time allowed).
+    fn jacobian(&mut self, problem: &Problem<'_>, step: f64) -> Result<Vec<f64>, Exit> {
+        if let Some(j) = self.jacobian.take() {
+            return Ok(j);
         }
-        // Normal equations.
-        let mut jtj = vec![0.0; n * n];
-        let mut jtr = vec![0.0; n];
-        for a in 0..n {
-            let ca = &jr[a * m..(a + 1) * m];
-            jtr[a] = ca.iter().zip(&r).map(|(x, y)| x * y).sum();
-            for b in a..n {
-                let cb = &jr[b * m..(b + 1) * m];
-                let dot: f64 = ca.iter().zip(cb).map(|(x, y)| x * y).sum();
-                jtj[a * n + b] = dot;
-                jtj[b * n + a] = dot;
-            }
+        if self
+            .jacobian_seconds
+            .is_some_and(|t| t > problem.seconds_left())
+        {
+            return Err(Exit::Stop(Stop::Seconds));
         }
-        let max_diag = (0..n).map(|i| jtj[i * n + i]).fold(0.0, f64::max);
-        if mu == 0.0 {
-            mu = 1e-3;
+        let before = Instant::now();
+        let (j, runs) = finite_differences(problem, &self.p, &self.s, step)?;
+        self.jacobian_seconds = Some(before.elapsed().as_secs_f64());
+        self.simulations += runs;
+        self.fresh = true;
+        Ok(j)
+    }
+
+    /// One iteration with the positions' Jacobian `j`: two damped steps
+    /// simulated at once, the better kept if it lowers the distance.
+    /// Returns whether the fit converged.
+    fn step(
+        &mut self,
+        problem: &Problem<'_>,
+        settings: &FitSettings,
+        j: Vec<f64>,
+        base_particles: &[u32],
+    ) -> Result<bool, Exit> {
+        let (jtj, jtr) = normal_equations(problem, &self.s, self.placement, &j, self.p.len());
+        if self.mu == 0.0 {
+            self.mu = 1e-3;
         }
-        let floor = 1e-9 * max_diag.max(1e-300);
-        let step_for = |damping: f64| -> Option<Vec<f64>> {
-            let mut a = jtj.clone();
-            for i in 0..n {
-                a[i * n + i] += damping * jtj[i * n + i].max(floor);
-            }
-            let delta = dense::solve(n, a, jtr.iter().map(|g| -g).collect())?;
-            let mut q: Vec<f64> = p.iter().zip(&delta).map(|(a, b)| a + b).collect();
-            guess::clamp(&problem.layout, &mut q);
-            Some(q)
-        };
-        let dampings = [mu, 10.0 * mu];
-        let candidates: Vec<(f64, Vec<f64>)> = dampings
-            .iter()
-            .filter_map(|&d| step_for(d).map(|q| (d, q)))
-            .collect();
-        let tried: Result<Vec<Tried>, Halt> = candidates
+        let candidates = damped_steps(&problem.layout, &self.p, &jtj, &jtr, self.mu);
+        let tried: Vec<Tried> = candidates
             .into_par_iter()
             .map(|(d, q)| problem.shape(&q, false).map(|shape| (d, q, shape)))
-            .collect();
-        let tried = match tried {
-            Ok(tried) => tried,
-            Err(Halt::OutOfTime) => break Stop::Seconds,
-            Err(Halt::Cancelled) => return Err(FitError::Cancelled),
-            Err(Halt::Failed(e)) => return Err(e),
-        };
-        simulations += tried.len();
-        let now = apart.cost();
+            .collect::<Result<_, Halt>>()?;
+        self.simulations += tried.len();
+        let now = self.apart.cost();
+        let placement = self.placement;
         let best = tried
             .into_iter()
             .filter_map(|(d, q, shape)| {
@@ -1006,110 +1139,210 @@ pub fn fit(
                 })
             })
             .min_by(|a, b| a.0.cost().total_cmp(&b.0.cost()));
-        iterations += 1;
-        let mut converged = false;
-        match best {
+        self.iterations += 1;
+        Ok(match best {
             Some((a, d, q, shape)) if a.cost() < now => {
-                // Broyden's update of the positions' Jacobian with the
-                // step taken.
-                let dp: Vec<f64> = q.iter().zip(&p).map(|(a, b)| a - b).collect();
-                let dp2: f64 = dp.iter().map(|x| x * x).sum();
-                let mut j = j;
-                if dp2 > 0.0 {
-                    let mut predicted = vec![0.0; positions];
-                    for (col, step) in dp.iter().enumerate() {
-                        if *step != 0.0 {
-                            for (pr, jv) in predicted
-                                .iter_mut()
-                                .zip(&j[col * positions..(col + 1) * positions])
-                            {
-                                *pr += jv * step;
-                            }
-                        }
-                    }
-                    let moved: Vec<f64> = shape
-                        .iter()
-                        .zip(&s)
-                        .flat_map(|(a, b)| (*a - *b).to_array())
-                        .collect();
-                    let miss: Vec<f64> = (0..positions).map(|i| moved[i] - predicted[i]).collect();
-                    for (col, step) in dp.iter().enumerate() {
-                        if *step != 0.0 {
-                            let f = step / dp2;
-                            for (jv, m) in j[col * positions..(col + 1) * positions]
-                                .iter_mut()
-                                .zip(&miss)
-                            {
-                                *jv += m * f;
-                            }
-                        }
-                    }
-                }
-                let gain = 1.0 - a.cost() / now;
-                mu = if d == mu { mu / 3.0 } else { d };
-                p = q;
-                s = shape;
-                apart = a;
-                if settings.refine_placement {
-                    let refined = register::refine(
-                        &target.surface,
-                        &s,
-                        problem.triangles,
-                        &base_particles,
-                        placement,
-                        3,
-                    );
-                    let moved = problem.measure(&s, refined, None);
-                    if moved.cost() < apart.cost() {
-                        placement = refined;
-                        apart = moved;
-                    }
-                }
-                // A poor gain on an updated Jacobian: take a fresh one.
-                jacobian = if gain < 0.05 && !fresh { None } else { Some(j) };
-                fresh = false;
-                if gain < 1e-4 && jacobian.is_some() {
-                    converged = true;
-                }
+                let accepted = Accepted {
+                    apart: a,
+                    damping: d,
+                    p: q,
+                    shape,
+                };
+                self.accept(problem, settings, j, accepted, now, base_particles)
             }
-            _ => {
-                mu *= 100.0;
-                if fresh {
-                    // A fresh Jacobian and still no descent: try harder
-                    // damping once more before giving up.
-                    if mu > 1e8 {
-                        converged = true;
-                    }
-                    jacobian = Some(j);
-                } else {
-                    jacobian = None;
-                }
-            }
-        }
-        progress(report(iterations, &apart, simulations));
-        if converged {
-            break Stop::Converged;
-        }
-    };
+            _ => self.reject(j),
+        })
+    }
 
-    let (rms, max) = problem.fractions(&apart);
-    let maps = problem.maps(&p)?;
-    Ok(Fit {
-        maps,
-        parameters: p,
-        length,
-        guess_rms,
-        rms,
-        max,
-        iterations,
-        simulations,
-        seconds: started.elapsed().as_secs_f64(),
-        stop,
-        max_iterations: settings.max_iterations,
-        max_seconds: settings.max_seconds,
-        placement,
-        shape: s,
-    })
+    /// A step that lowered the distance (from `now`) taken: the Jacobian
+    /// updated by Broyden, the damping lowered, the placement refined when
+    /// asked. Returns whether the fit converged (almost no gain on a
+    /// Jacobian kept).
+    fn accept(
+        &mut self,
+        problem: &Problem<'_>,
+        settings: &FitSettings,
+        mut j: Vec<f64>,
+        step: Accepted,
+        now: f64,
+        base_particles: &[u32],
+    ) -> bool {
+        let Accepted {
+            apart: a,
+            damping: d,
+            p: q,
+            shape,
+        } = step;
+        broyden_update(&mut j, &q, &self.p, &shape, &self.s);
+        let gain = 1.0 - a.cost() / now;
+        self.mu = if d == self.mu { self.mu / 3.0 } else { d };
+        self.p = q;
+        self.s = shape;
+        self.apart = a;
+        if settings.refine_placement {
+            let refined = register::refine(
+                &problem.target.surface,
+                &self.s,
+                problem.triangles,
+                base_particles,
+                self.placement,
+                3,
+            );
+            let moved = problem.measure(&self.s, refined, None);
+            if moved.cost() < self.apart.cost() {
+                self.placement = refined;
+                self.apart = moved;
+            }
+        }
+        // A poor gain on an updated Jacobian: take a fresh one.
+        self.jacobian = if gain < 0.05 && !self.fresh {
+            None
+        } else {
+            Some(j)
+        };
+        self.fresh = false;
+        gain < 1e-4 && self.jacobian.is_some()
+    }
+
+    /// No step lowered the distance: the damping raised a hundredfold and
+    /// the Jacobian `j` kept if fresh (dropped if updated). Returns whether
+    /// the fit converged (a fresh Jacobian and damping past 1e8).
+    fn reject(&mut self, j: Vec<f64>) -> bool {
+        self.mu *= 100.0;
+        if self.fresh {
+            // A fresh Jacobian and still no descent: try harder
+            // damping once more before giving up.
+            self.jacobian = Some(j);
+            self.mu > 1e8
+        } else {
+            self.jacobian = None;
+            false
+        }
+    }
+}
+
+/// A step that lowered the distance: how far its shape is, its damping,
+/// parameters and shape.
+struct Accepted {
+    apart: Apart,
+    damping: f64,
+    p: Vec<f64>,
+    shape: Vec<DVec3>,
+}
+
+/// The Gauss–Newton normal equations at shape `s`: the residual rows made
+/// there (against the target at `placement`), their Jacobian through the
+/// positions' `j` (column-major, positions x `n`), and JᵀJ (row-major
+/// `n` x `n`) with Jᵀr.
+fn normal_equations(
+    problem: &Problem<'_>,
+    s: &[DVec3],
+    placement: Similarity,
+    j: &[f64],
+    n: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let positions = 3 * s.len();
+    // The residual rows at the shape now, and their Jacobian through
+    // the positions'.
+    let mut rows = Vec::new();
+    problem.measure(s, placement, Some(&mut rows));
+    let r: Vec<f64> = rows.iter().map(|row| row.value(s)).collect();
+    let m = rows.len();
+    let mut jr = vec![0.0; m * n]; // column-major, m x n
+    for (col, column) in j.chunks_exact(positions).enumerate() {
+        let out = &mut jr[col * m..(col + 1) * m];
+        for (value, row) in out.iter_mut().zip(&rows) {
+            *value = (0..3)
+                .map(|k| {
+                    let i = 3 * row.particles[k] as usize;
+                    row.weights[k]
+                        * DVec3::new(column[i], column[i + 1], column[i + 2]).dot(row.direction)
+                })
+                .sum();
+        }
+    }
+    // Normal equations.
+    let mut jtj = vec![0.0; n * n];
+    let mut jtr = vec![0.0; n];
+    for a in 0..n {
+        let ca = &jr[a * m..(a + 1) * m];
+        jtr[a] = ca.iter().zip(&r).map(|(x, y)| x * y).sum();
+        for b in a..n {
+            let cb = &jr[b * m..(b + 1) * m];
+            let dot: f64 = ca.iter().zip(cb).map(|(x, y)| x * y).sum();
+            jtj[a * n + b] = dot;
+            jtj[b * n + a] = dot;
+        }
+    }
+    (jtj, jtr)
+}
+
+/// The steps from `p` at damping `mu` and ten times it (Marquardt's
+/// scaling by the diagonal, floored), clamped to the bounds; a damping
+/// whose system cannot be solved gives none.
+fn damped_steps(
+    layout: &Layout,
+    p: &[f64],
+    jtj: &[f64],
+    jtr: &[f64],
+    mu: f64,
+) -> Vec<(f64, Vec<f64>)> {
+    let n = p.len();
+    let max_diag = (0..n).map(|i| jtj[i * n + i]).fold(0.0, f64::max);
+    let floor = 1e-9 * max_diag.max(1e-300);
+    let step_for = |damping: f64| -> Option<Vec<f64>> {
+        let mut a = jtj.to_vec();
+        for i in 0..n {
+            a[i * n + i] += damping * jtj[i * n + i].max(floor);
+        }
+        let delta = dense::solve(n, a, jtr.iter().map(|g| -g).collect())?;
+        let mut q: Vec<f64> = p.iter().zip(&delta).map(|(a, b)| a + b).collect();
+        guess::clamp(layout, &mut q);
+        Some(q)
+    };
+    let dampings = [mu, 10.0 * mu];
+    dampings
+        .iter()
+        .filter_map(|&d| step_for(d).map(|q| (d, q)))
+        .collect()
+}
+
+/// Broyden's rank-one update of the positions' Jacobian `j` (column-major)
+/// with the step from `p` to `q`, which moved shape `s` to `shape`.
+fn broyden_update(j: &mut [f64], q: &[f64], p: &[f64], shape: &[DVec3], s: &[DVec3]) {
+    let positions = 3 * s.len();
+    let dp: Vec<f64> = q.iter().zip(p).map(|(a, b)| a - b).collect();
+    let dp2: f64 = dp.iter().map(|x| x * x).sum();
+    if dp2 > 0.0 {
+        let mut predicted = vec![0.0; positions];
+        for (col, step) in dp.iter().enumerate() {
+            if *step != 0.0 {
+                for (pr, jv) in predicted
+                    .iter_mut()
+                    .zip(&j[col * positions..(col + 1) * positions])
+                {
+                    *pr += jv * step;
+                }
+            }
+        }
+        let moved: Vec<f64> = shape
+            .iter()
+            .zip(s)
+            .flat_map(|(a, b)| (*a - *b).to_array())
+            .collect();
+        let miss: Vec<f64> = (0..positions).map(|i| moved[i] - predicted[i]).collect();
+        for (col, step) in dp.iter().enumerate() {
+            if *step != 0.0 {
+                let f = step / dp2;
+                for (jv, m) in j[col * positions..(col + 1) * positions]
+                    .iter_mut()
+                    .zip(&miss)
+                {
+                    *jv += m * f;
+                }
+            }
+        }
+    }
 }
 
 /// The Jacobian of the final positions at `p` (whose full run's shape is

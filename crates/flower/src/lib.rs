@@ -106,7 +106,7 @@ pub enum TemplateSource {
         /// The mean edge it was meshed at.
         edge: f64,
     },
-    /// A sketched petal (`sketch-based-floral-blossom.txt` §3.1): its
+    /// A sketched petal (the floral blossom paper §3.1): its
     /// outline, vein and cross-section strokes as drawn, meshed at mean
     /// edge `edge` (`kind = "sketch"`, project version 8).
     Sketch {
@@ -115,7 +115,7 @@ pub enum TemplateSource {
         /// The mean edge it was meshed at.
         edge: f64,
     },
-    /// A PDE sweep surface (`pde-surfaces-lily.txt` §IV, eq. 12): margins,
+    /// A PDE sweep surface (Chaudhry et al. §IV, eq. 12): margins,
     /// across-tangents and `k_s/k_b`, meshed at mean edge `edge` (the app's
     /// PDE petal editor, or a fitted scan; project version 8).
     Pde {
@@ -140,7 +140,7 @@ impl TemplateSource {
     }
 }
 
-/// A two-state animation (`sketch-based-floral-blossom.txt` §4): the
+/// A two-state animation (the floral blossom paper §4): the
 /// template's organs go from the bud (the template mesh) to `open` along
 /// the growth function G(t; g, T) and the velocity curve, instead of
 /// growing. Organs of such a template are kinematic in a run: placed like

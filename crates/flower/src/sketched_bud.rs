@@ -1,4 +1,4 @@
-//! The sketched bud (`sketch-based-floral-blossom.txt` §3.2, issue 14 item
+//! The sketched bud (the floral blossom paper §3.2, issue 14 item
 //! 7): one curved stroke in a side view is the initial primary vein of a
 //! petal, and the bud is that petal instanced around the axis, at the
 //! golden angle or where the flower's arrangement puts its organs, each

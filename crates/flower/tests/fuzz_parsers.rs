@@ -1,5 +1,6 @@
-//! Fuzzing the three readers of files from strangers: the OBJ reader, the
-//! PNG map reader and the project loader. Inputs are real files of the
+//! Fuzzing the readers of files from strangers: the OBJ reader, the
+//! PNG map reader, the project loader and the L-system parser (with its
+//! derivation, turtle and overlap rules). Inputs are real files of the
 //! shipped flowers with random edits (lines deleted, doubled, swapped or
 //! cut, tokens replaced by troublesome values, bytes changed; PNG chunks
 //! edited with their checksums fixed so the edit reaches the decoder) and
@@ -743,4 +744,161 @@ fn regression_a_tiny_number_is_shown_short() {
         .expect_err("no particle lies in so thin a base region")
         .to_string();
     assert!(message.contains("u from 0 to 1e-320) holds"), "{message}");
+}
+
+// --------------------------------------------------------------- L-system
+
+/// Real L-systems to edit: the apple's (as the project ships it) and
+/// small ones using parameters, brackets and every turtle symbol.
+fn lsystem_seeds() -> Vec<String> {
+    let apple = String::from_utf8(asset("apple/apple.anthesis.toml")).expect("utf-8");
+    let start = apple.find("text = \"\"\"\n").expect("the apple's L-system") + 11;
+    let end = start + apple[start..].find("\"\"\"").expect("its end");
+    vec![
+        apple[start..end].to_owned(),
+        "angle = 30\nstep = 2\naxiom: A(1)\nA(x) -> F(x) [+(x*10) ~p] [-(x * 10) ~s] A(x / 2 + 0.5)"
+            .to_owned(),
+        "ω: X\nX -> F [& ~p] [^ ~s] / (137.5) X\nF -> F F".to_owned(),
+        "width = 3\naxiom: !(2) ;(0.2, 0.5, 0.1) F(3) [\\(45) ~p] #(1) ~s".to_owned(),
+    ]
+}
+
+/// Pieces that break L-system parsers: operators, brackets, nesting,
+/// numbers that are not finite, huge counts of steps and modules.
+const LSYSTEM_TROUBLE: &[&str] = &[
+    "(",
+    ")",
+    "((((((((((",
+    "))))",
+    "->",
+    "→",
+    "~",
+    "~p",
+    "~s",
+    "~q",
+    "~(",
+    "A(x)",
+    "A(x,y)",
+    "A(",
+    "0/0",
+    "1/0",
+    "-1/0",
+    "1e308*10",
+    "x/0",
+    "x*x*x*x",
+    "axiom:",
+    "ω:",
+    "A -> A A",
+    "A -> A A A A A A A A",
+    "X -> X X",
+    "[",
+    "]",
+    "]]]",
+    "[[[",
+    "+(0/0)",
+    "/(1e309)",
+    "F(-1e30)",
+    ";(2, -1, 0.5)",
+    ";(0/0, 0, 0)",
+    "!(0/0)",
+    "#(-5)",
+    "angle = nan",
+    "step = inf",
+    "lenA = 1e308",
+    "=",
+    ":",
+    ",",
+    "--",
+    "- -",
+    "*",
+    "/",
+    "\\",
+];
+
+fn lsystem_edit() -> impl Strategy<Value = TextEdit> {
+    prop_oneof![
+        3 => text_edit(),
+        4 => (any::<Index>(), any::<Index>(), proptest::sample::select(LSYSTEM_TROUBLE))
+            .prop_map(|(line, token, with)| TextEdit::ReplaceToken { line, token, with }),
+        2 => (any::<Index>(), proptest::collection::vec(proptest::sample::select(LSYSTEM_TROUBLE), 1..4))
+            .prop_map(|(at, words)| TextEdit::InsertLine { at, text: words.join(" ") }),
+    ]
+}
+
+fn check_lsystem(text: &str, steps: u32) -> Result<Outcome, TestCaseError> {
+    use anthesis_flower::structure::Structure;
+    let templates = lsystem_templates();
+    let structure = Structure::LSystem {
+        text: text.to_owned(),
+        steps,
+        surfaces: [('p', 0), ('s', 1), ('c', 0)].into_iter().collect(),
+        units: 0.08,
+    };
+    match structure.arrange(templates) {
+        Ok(arrangement) => {
+            let n = arrangement.organs.len();
+            prop_assert!(n <= anthesis_flower::structure::MAX_STRUCTURE_ORGANS);
+            prop_assert!(
+                arrangement.overlaps.len() <= anthesis_flower::structure::MAX_OVERLAP_RULES
+            );
+            for organ in &arrangement.organs {
+                prop_assert!(organ.placement.position.is_finite(), "{organ:?}");
+                prop_assert!(organ.placement.orientation.is_finite(), "{organ:?}");
+            }
+            for overlap in &arrangement.overlaps {
+                prop_assert!(
+                    overlap.inner < n && overlap.outer < n && overlap.inner != overlap.outer
+                );
+            }
+            for segment in structure.segments() {
+                prop_assert!(segment.start.is_finite() && segment.end.is_finite());
+            }
+            Ok(Outcome::Accepted)
+        }
+        Err(error) => refused(&error.to_string()),
+    }
+}
+
+/// Two templates for the surfaces `p` and `s` (the lily's, with a small
+/// mesh), made once.
+fn lsystem_templates() -> &'static [anthesis_flower::Template] {
+    static TEMPLATES: std::sync::OnceLock<Vec<anthesis_flower::Template>> =
+        std::sync::OnceLock::new();
+    TEMPLATES.get_or_init(|| {
+        let lily = flower("lily");
+        let files = |relative: &str| {
+            lily.files
+                .get(relative)
+                .cloned()
+                .ok_or_else(|| std::io::Error::from(std::io::ErrorKind::NotFound))
+        };
+        parse_project(&lily.text, &files)
+            .expect("the lily loads")
+            .flower
+            .templates
+    })
+}
+
+#[test]
+fn lsystem_parser_edited_real_systems() {
+    let seeds = lsystem_seeds();
+    // The seeds themselves make organs.
+    for seed in &seeds {
+        assert_eq!(
+            check_lsystem(seed, 3).ok(),
+            Some(Outcome::Accepted),
+            "{seed}"
+        );
+    }
+    let strategy = (
+        any::<Index>(),
+        proptest::collection::vec(lsystem_edit(), 1..5),
+        0u32..12,
+    );
+    fuzz("lsystem-edited", strategy, |(seed, edits, steps)| {
+        check_lsystem(
+            &apply_text_edits(&seeds[seed.index(seeds.len())], &edits),
+            steps,
+        )
+    });
 }

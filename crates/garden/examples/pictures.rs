@@ -182,8 +182,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .iter()
                 .enumerate()
                 .map(|(i, p)| {
-                    let (color, texture) = &looks[i];
-                    let mesh = OrganMesh::from_positions(p, &meshes[i].triangles, *color);
+                    let (colour, texture) = &looks[i];
+                    let mesh = OrganMesh::from_positions(p, &meshes[i].triangles, *colour);
                     match texture {
                         Some((uvs, image)) => mesh.with_texture(uvs.clone(), image.clone()),
                         None => mesh,

@@ -72,7 +72,10 @@ fn collect(worker: &Worker, run: u64) -> Result<Sent, String> {
         match event {
             Event::Started { first_computed, .. } => first = Some(first_computed),
             Event::Keyframe { keyframe, .. } => keyframes.push(keyframe.bits()),
-            Event::Progress { .. } | Event::Proxy { .. } | Event::ProxyEnded { .. } => {}
+            Event::Progress { .. }
+            | Event::Proxy { .. }
+            | Event::ProxyEnded { .. }
+            | Event::Crossed { .. } => {}
             Event::Finished { .. } => {
                 return Ok((first.ok_or("no Started event")?, keyframes, None));
             }

@@ -1,4 +1,4 @@
-//! The apple flower of `lsystem-bezier-flower.txt` §3–§4 (issue 13 item 3):
+//! The apple flower of Qin and Chen 2006 §3–§4 (issue 13 item 3):
 //! the seed's own L-system (3) places a stem, and six segments of calyx,
 //! petal and stamen on its end; the calyx and the petal are its Bézier
 //! surfaces (§4: the calyx two bicubic patches joined with C⁰ continuity,
@@ -245,7 +245,7 @@ fn apple_template(
     name: &str,
     mesh: anthesis_mesh::Mesh,
     maps: KeyedMaps,
-    color: [f32; 4],
+    colour: [f32; 4],
 ) -> Template {
     Template {
         name: name.to_string(),
@@ -257,7 +257,7 @@ fn apple_template(
         stretch_stiffness: APPLE_STIFFNESS,
         bend_stiffness: APPLE_STIFFNESS,
         joint_schedule: Vec::new(),
-        color,
+        color: colour,
         colouring: None,
         two_state: None,
         source: None,

@@ -1,5 +1,5 @@
 //! The lily, bloom and decay (issue 15 item 3, after the decay sequence of
-//! `pde-surfaces-lily.txt` §VI.B): the built-in lily's 100 keyframes of
+//! Chaudhry et al. §VI.B): the built-in lily's 100 keyframes of
 //! opening, then 60 of wilting, by the growth simulation alone. From step
 //! 100 each tepal's maps blend, over 15 steps, into a decay key whose own
 //! growth scale is negative ([`DECAY_DG`], `MapKey::dg`): the tepals

@@ -290,7 +290,7 @@ struct TemplateSpec {
     stiffness: f64,
     base_v: f64,
     joint: JointRamp,
-    color: [f32; 4],
+    colour: [f32; 4],
 }
 
 fn template(
@@ -314,7 +314,7 @@ fn template(
         stretch_stiffness: spec.stiffness,
         bend_stiffness: spec.stiffness,
         joint_schedule: vec![spec.joint],
-        color: spec.color,
+        color: spec.colour,
         colouring: None,
         two_state: None,
         source: None,
@@ -329,7 +329,7 @@ pub const LILY_JOINT: JointRamp = JointRamp {
     angle_deg: 23.0,
 };
 
-fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, color: [f32; 4]) -> TemplateSpec {
+fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, colour: [f32; 4]) -> TemplateSpec {
     TemplateSpec {
         organ,
         bud,
@@ -339,17 +339,13 @@ fn lily_spec(organ: &'static str, bud: RingOrgan, edge: f64, color: [f32; 4]) ->
         stiffness: LILY_STIFFNESS,
         base_v: LILY_BASE_V,
         joint: LILY_JOINT,
-        color,
+        colour,
     }
 }
 
-/// The lily petal template: [`lily_petal_bud`] meshed at [`EDGE_SCALE`]
-/// times Table 1's edge 1.3 (about 2.6 times the paper's 388 particles),
-/// [`lily_maps`], Table 1's material.
-pub fn lily_petal_template() -> Result<Template, GardenError> {
-    lily_petal_template_at(EDGE_SCALE)
-}
-
+/// The lily petal template: [`lily_petal_bud`] meshed at `edge_scale`
+/// times Table 1's edge 1.3 ([`EDGE_SCALE`] for the shipped lily: about
+/// 2.6 times the paper's 388 particles), [`lily_maps`], Table 1's material.
 fn lily_petal_template_at(edge_scale: f64) -> Result<Template, GardenError> {
     let spec = lily_spec(
         "lily petal",
@@ -397,13 +393,9 @@ fn lily_colouring(seed: u64, count: usize) -> Colouring {
     }
 }
 
-/// The lily sepal template: [`lily_sepal_bud`] meshed at [`EDGE_SCALE`]
-/// times Table 1's edge 1.4 (about 2.6 times the paper's 323 particles), the
-/// petal's maps.
-pub fn lily_sepal_template() -> Result<Template, GardenError> {
-    lily_sepal_template_at(EDGE_SCALE)
-}
-
+/// The lily sepal template: [`lily_sepal_bud`] meshed at `edge_scale`
+/// times Table 1's edge 1.4 ([`EDGE_SCALE`] for the shipped lily: about
+/// 2.6 times the paper's 323 particles), the petal's maps.
 fn lily_sepal_template_at(edge_scale: f64) -> Result<Template, GardenError> {
     let spec = lily_spec(
         "lily sepal",
@@ -507,7 +499,7 @@ impl Cultivar {
         }
     }
 
-    fn color(self) -> [f32; 4] {
+    fn colour(self) -> [f32; 4] {
         match self {
             Cultivar::MellowYellow => [0.97, 0.9, 0.5, 1.0],
             // White with a purple picotee rim.
@@ -628,7 +620,7 @@ pub struct EustomaGrowth {
     pub top_stiffness: f64,
 }
 
-/// The growth of `cultivar` (see [`eustoma_maps`]).
+/// The growth of `cultivar` (see [`eustoma_maps_of`]).
 pub fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
     match cultivar {
         // Bell: growth is larger late, when the inner upper region expands
@@ -684,17 +676,13 @@ pub fn eustoma_growth(cultivar: Cultivar) -> EustomaGrowth {
     }
 }
 
-/// The growth maps of one cultivar (paper §6.2, Fig. 16): regions by `v`
+/// The growth maps painted from `growth`, one cultivar's
+/// ([`eustoma_growth`]; paper §6.2, Fig. 16): regions by `v`
 /// (lower, middle, upper) with each cultivar's observations, early maps up
 /// to step 40 and late maps from step 60, blended in between (Fig. 16's
 /// caption); the same stretch and bend maps for all three (the bottom
 /// harder than the top); direction along the venation, Maite Lady's
 /// fanning out more than the others'.
-pub fn eustoma_maps(cultivar: Cultivar) -> Result<KeyedMaps, MapError> {
-    eustoma_maps_of(&eustoma_growth(cultivar))
-}
-
-/// The growth maps painted from `growth` (see [`eustoma_maps`]).
 pub fn eustoma_maps_of(growth: &EustomaGrowth) -> Result<KeyedMaps, MapError> {
     let grows = |uv: DVec2| above_base(uv.y, EUSTOMA_BASE_V, 0.05);
     let by_region = |values: [f64; 3], v: f64| {
@@ -726,23 +714,11 @@ pub fn eustoma_maps_of(growth: &EustomaGrowth) -> Result<KeyedMaps, MapError> {
     keyed(keys)
 }
 
-/// The Eustoma petal template of `cultivar`: [`eustoma_petal_bud`] meshed
-/// at [`EDGE_SCALE`] times Table 1's edge 2.0 (about 2.6 times the paper's
-/// 261 particles), the cultivar's maps,
-/// Table 1's material.
-pub fn eustoma_petal_template(cultivar: Cultivar) -> Result<Template, GardenError> {
-    eustoma_petal_template_at(cultivar, EDGE_SCALE)
-}
-
-fn eustoma_petal_template_at(cultivar: Cultivar, edge_scale: f64) -> Result<Template, GardenError> {
-    eustoma_petal_template_of(
-        cultivar,
-        &eustoma_growth(cultivar),
-        &eustoma_petal_bud(),
-        edge_scale,
-    )
-}
-
+/// The Eustoma petal template of `cultivar` with `growth`: `bud` meshed
+/// at `edge_scale` times Table 1's edge 2.0 ([`EDGE_SCALE`] for the
+/// shipped Eustoma, with [`eustoma_petal_bud`]: about 2.6 times the
+/// paper's 261 particles), the maps painted from `growth`, Table 1's
+/// material.
 fn eustoma_petal_template_of(
     cultivar: Cultivar,
     growth: &EustomaGrowth,
@@ -758,7 +734,7 @@ fn eustoma_petal_template_of(
         stiffness: EUSTOMA_STIFFNESS,
         base_v: EUSTOMA_BASE_V,
         joint: EUSTOMA_JOINT,
-        color: cultivar.color(),
+        colour: cultivar.colour(),
     };
     let mut petal = template("petal", &spec, eustoma_maps_of(growth))?;
     petal.colouring = Some(cultivar.colouring());

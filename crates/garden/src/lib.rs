@@ -9,7 +9,7 @@
 //! - [`paint`]: growth maps painted as functions of UV;
 //! - [`flowers`]: the four projects of the paper ([`flowers::lily`],
 //!   [`flowers::eustoma`]);
-//! - [`apple`]: the apple flower of `lsystem-bezier-flower.txt` §3–§4, placed
+//! - [`apple`]: the apple flower of Qin and Chen 2006 §3–§4, placed
 //!   by the seed's own L-system;
 //! - [`decay`]: the lily, bloom and decay (negative growth in late keys);
 //! - [`five_petal`]: the empty starting point, one whorl of five simple

@@ -9,7 +9,7 @@ use anthesis_flower::JointRamp;
 use anthesis_flower::parts::{Part, PartShape, Tube};
 
 /// A part with the settings every built-in one shares.
-fn part(name: &str, shape: PartShape, count: u32, color: [f32; 4], head: [f32; 4]) -> Part {
+fn part(name: &str, shape: PartShape, count: u32, colour: [f32; 4], head: [f32; 4]) -> Part {
     Part {
         name: name.to_string(),
         shape,
@@ -19,19 +19,19 @@ fn part(name: &str, shape: PartShape, count: u32, color: [f32; 4], head: [f32; 4
         offset_deg: 0.0,
         angle_deg: 0.0,
         schedule: Vec::new(),
-        color,
+        color: colour,
         head_color: head,
     }
 }
 
 /// The receptacle under the organs and the stem below it.
-fn stem(radius: f64, depth: f64, stem_radius: f64, length: f64, color: [f32; 4]) -> [Part; 2] {
+fn stem(radius: f64, depth: f64, stem_radius: f64, length: f64, colour: [f32; 4]) -> [Part; 2] {
     let receptacle = part(
         "receptacle",
         PartShape::Receptacle { radius, depth },
         1,
-        color,
-        color,
+        colour,
+        colour,
     );
     let mut pedicel = part(
         "pedicel",
@@ -43,8 +43,8 @@ fn stem(radius: f64, depth: f64, stem_radius: f64, length: f64, color: [f32; 4])
             },
         },
         1,
-        color,
-        color,
+        colour,
+        colour,
     );
     // It starts inside the receptacle's lower half.
     pedicel.height = -0.8 * depth;

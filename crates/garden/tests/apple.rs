@@ -1,4 +1,4 @@
-//! The apple flower of `lsystem-bezier-flower.txt` §3–§4 (issue 13 item 3):
+//! The apple flower of Qin and Chen 2006 §3–§4 (issue 13 item 3):
 //! placed by the seed's own L-system, it opens in 100 keyframes, and at
 //! every keyframe, checked geometrically rather than by trusting the
 //! solver's contacts, no organ passes through another (or itself): no two

@@ -1,6 +1,6 @@
 //! The lily, bloom and decay (issue 15 item 3): its first 100 keyframes are
 //! the lily's opening, and in the 60 after them the tepals shrink, hang
-//! lower and curl their tips further down and in (`pde-surfaces-lily.txt`
+//! lower and curl their tips further down and in (Chaudhry et al.
 //! §VI.B), measured with `anthesis_garden::shape`.
 
 use anthesis_flower::Project;

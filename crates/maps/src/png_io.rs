@@ -99,8 +99,8 @@ pub(crate) fn decode(bytes: &[u8]) -> Result<DecodedPng, MapError> {
     if width > MAX_MAP_SIDE || height > MAX_MAP_SIDE {
         return Err(MapError::TooManyPixels { width, height });
     }
-    let color = decoder.color_type();
-    let (channels, depth) = match color {
+    let colour_type = decoder.color_type();
+    let (channels, depth) = match colour_type {
         ColorType::L8 => (1, BitDepth::Eight),
         ColorType::La8 => (2, BitDepth::Eight),
         ColorType::Rgb8 => (3, BitDepth::Eight),
@@ -148,7 +148,7 @@ pub(crate) fn encode(
     depth: BitDepth,
     codes: &[u16],
 ) -> Result<Vec<u8>, MapError> {
-    let color = match (channels, depth) {
+    let colour_type = match (channels, depth) {
         (1, BitDepth::Eight) => ExtendedColorType::L8,
         (1, BitDepth::Sixteen) => ExtendedColorType::L16,
         (3, BitDepth::Eight) => ExtendedColorType::Rgb8,
@@ -167,7 +167,7 @@ pub(crate) fn encode(
     };
     let mut png = Vec::new();
     PngEncoder::new(&mut png)
-        .write_image(&raw, width, height, color)
+        .write_image(&raw, width, height, colour_type)
         .map_err(|error| MapError::Encode {
             message: error.to_string(),
         })?;

@@ -107,6 +107,40 @@ impl CrossingSearch {
         cell: f64,
         tested: &dyn Fn(usize, usize) -> bool,
     ) -> Vec<Crossing> {
+        // Which bodies may cross, looked up per pair.
+        let count = bodies.len();
+        self.tested.clear();
+        self.tested.extend(
+            (0..count * count)
+                .map(|k| tested((k / count).min(k % count), (k / count).max(k % count))),
+        );
+        self.gather(bodies);
+        self.prune(count);
+        let entries = self.cover(cell);
+        let buckets = self.fill(entries);
+        // The buckets in chunks on rayon's threads (sorted after, so the
+        // answer does not depend on them).
+        let this = &*self;
+        let chunk = buckets.div_ceil(64).max(1024);
+        let mut found: Vec<Crossing> = (0..buckets)
+            .step_by(chunk)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .flat_map_iter(|first| {
+                let mut out = Vec::new();
+                for k in first..(first + chunk).min(buckets) {
+                    this.pairs_in(k, bodies.len(), &mut out);
+                }
+                out
+            })
+            .collect();
+        found.sort_unstable_by_key(|c| (c.a, c.b));
+        found
+    }
+
+    /// Every triangle of `bodies` in order: its bounding box (NaN for a
+    /// triangle with a non-finite corner), body, corners and vertices.
+    fn gather(&mut self, bodies: &[Body<'_>]) {
         self.boxes.clear();
         self.owner.clear();
         self.first.clear();
@@ -131,17 +165,52 @@ impl CrossingSearch {
                 self.vertices.push(*t);
             }
         }
+    }
+
+    /// The broad phase by bodies: a triangle of a body not tested against
+    /// itself (a part) can only cross a triangle of a body whose bounding
+    /// box its own box overlaps, so one that overlaps none of the boxes of
+    /// the bodies it is tested with is left out of the grid (as a broken
+    /// triangle is). The parts' many small triangles (anthers, filaments,
+    /// the stem) mostly lie away from the organs, and every one of them
+    /// cost its grid cells and a test against each triangle sharing one.
+    fn prune(&mut self, count: usize) {
+        let mut extent = vec![(DVec3::INFINITY, DVec3::NEG_INFINITY); count];
+        for (&(lo, hi), &b) in self.boxes.iter().zip(&self.owner) {
+            if lo.is_finite() && hi.is_finite() {
+                let e = &mut extent[b as usize];
+                *e = (e.0.min(lo), e.1.max(hi));
+            }
+        }
+        for (bx, &b) in self.boxes.iter_mut().zip(&self.owner) {
+            let b = b as usize;
+            if self.tested[b * count + b] {
+                continue;
+            }
+            let (lo, hi) = *bx;
+            let reaches = (0..count).any(|c| {
+                c != b
+                    && self.tested[b * count + c]
+                    && !(lo.cmpgt(extent[c].1).any() || extent[c].0.cmpgt(hi).any())
+            });
+            if !reaches {
+                *bx = (DVec3::NAN, DVec3::NAN);
+            }
+        }
+    }
+
+    /// Each triangle's range of cells of size `cell` or larger: the cell
+    /// grows until the boxes cover few enough of them (a box too large for
+    /// `i32` cells counts as too many). Returns how many cells they cover.
+    fn cover(&mut self, cell: f64) -> usize {
         let n = self.boxes.len();
         let mut cell = if cell.is_finite() && cell > 0.0 {
             cell
         } else {
             1.0
         };
-        // Each triangle's range of cells; the cell grows until the boxes
-        // cover few enough of them (a box too large for `i32` cells counts
-        // as too many).
         let limit = f64::from(i32::MAX / 2);
-        let entries = loop {
+        loop {
             self.ranges.clear();
             let mut total = 0usize;
             let mut fits = true;
@@ -166,31 +235,24 @@ impl CrossingSearch {
                 self.ranges.push((a, b));
             }
             if fits {
-                break total;
+                return total;
             }
             cell *= 2.0;
-        };
-        // The hash table: a power of two of buckets, at least the entries.
+        }
+    }
+
+    /// The hash table of the `entries` cells the ranges cover: a power of
+    /// two of buckets, at least the entries, filled by a counting sort.
+    /// Returns the buckets.
+    fn fill(&mut self, entries: usize) -> usize {
         let buckets = entries.max(1).next_power_of_two();
         let mask = buckets as u64 - 1;
-        let bucket = |c: IVec3| {
-            let h = (c.x as u32 as u64).wrapping_mul(73_856_093)
-                ^ (c.y as u32 as u64).wrapping_mul(19_349_663)
-                ^ (c.z as u32 as u64).wrapping_mul(83_492_791);
-            // Mix the high bits down, so that the mask sees them.
-            ((h ^ (h >> 17)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32 & mask) as usize
-        };
-        let cells = |(a, b): (IVec3, IVec3)| {
-            (a.x..=b.x).flat_map(move |x| {
-                (a.y..=b.y).flat_map(move |y| (a.z..=b.z).map(move |z| IVec3::new(x, y, z)))
-            })
-        };
         // Counting sort of the entries by bucket.
         self.starts.clear();
         self.starts.resize(buckets + 1, 0);
         for &range in &self.ranges {
             for c in cells(range) {
-                self.starts[bucket(c) + 1] += 1;
+                self.starts[bucket(c, mask) + 1] += 1;
             }
         }
         for i in 0..buckets {
@@ -202,37 +264,12 @@ impl CrossingSearch {
         self.next.extend_from_slice(&self.starts[..buckets]);
         for (t, &range) in self.ranges.iter().enumerate() {
             for c in cells(range) {
-                let slot = &mut self.next[bucket(c)];
+                let slot = &mut self.next[bucket(c, mask)];
                 self.entries[*slot as usize] = (t as u32, c);
                 *slot += 1;
             }
         }
-
-        // Which bodies may cross, looked up per pair.
-        let count = bodies.len();
-        self.tested.clear();
-        self.tested.extend(
-            (0..count * count)
-                .map(|k| tested((k / count).min(k % count), (k / count).max(k % count))),
-        );
-        // The buckets in chunks on rayon's threads (sorted after, so the
-        // answer does not depend on them).
-        let this = &*self;
-        let chunk = buckets.div_ceil(64).max(1024);
-        let mut found: Vec<Crossing> = (0..buckets)
-            .step_by(chunk)
-            .collect::<Vec<_>>()
-            .into_par_iter()
-            .flat_map_iter(|first| {
-                let mut out = Vec::new();
-                for k in first..(first + chunk).min(buckets) {
-                    this.pairs_in(k, bodies.len(), &mut out);
-                }
-                out
-            })
-            .collect();
-        found.sort_unstable_by_key(|c| (c.a, c.b));
-        found
+        buckets
     }
 
     /// The crossings among the entries of bucket `k` (of a search over
@@ -283,6 +320,22 @@ impl CrossingSearch {
             }
         }
     }
+}
+
+/// The bucket of cell `c` in a table of `mask + 1` buckets.
+fn bucket(c: IVec3, mask: u64) -> usize {
+    let h = (c.x as u32 as u64).wrapping_mul(73_856_093)
+        ^ (c.y as u32 as u64).wrapping_mul(19_349_663)
+        ^ (c.z as u32 as u64).wrapping_mul(83_492_791);
+    // Mix the high bits down, so that the mask sees them.
+    ((h ^ (h >> 17)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 32 & mask) as usize
+}
+
+/// The cells of the range `(a, b)` (inclusive), x slowest.
+fn cells((a, b): (IVec3, IVec3)) -> impl Iterator<Item = IVec3> {
+    (a.x..=b.x).flat_map(move |x| {
+        (a.y..=b.y).flat_map(move |y| (a.z..=b.z).map(move |z| IVec3::new(x, y, z)))
+    })
 }
 
 /// Whether triangles `a` and `b` cross (an edge of either passes through
@@ -446,9 +499,15 @@ mod tests {
             *p = DVec3::new(p.x + 0.37, p.z + 0.41, p.y - 1.03);
         }
         let roll = rolled(1.6, 0.0, 0.1);
-        let bodies = [body(&sheet), body(&tilted), body(&roll)];
+        // A body not tested against itself (as a part) partly beside the
+        // others, which the broad phase leaves partly out.
+        let mut beside = roll.clone();
+        for p in &mut beside.positions {
+            p.x += 1.7;
+        }
+        let bodies = [body(&sheet), body(&tilted), body(&roll), body(&beside)];
         for cell in [0.1, 0.5, 3.0] {
-            let tested = |i: usize, j: usize| i != 1 || j != 1;
+            let tested = |i: usize, j: usize| (i != 1 || j != 1) && (i != 3 || j != 3);
             let mut grid = CrossingSearch::find(&mut CrossingSearch::new(), &bodies, cell, &tested);
             let mut all = brute_force(&bodies, &tested);
             assert!(all.len() > 10, "{}", all.len());

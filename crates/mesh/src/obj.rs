@@ -433,87 +433,87 @@ impl Parsed {
 
 /// With `uvs` false the texture coordinates are read past: every vertex
 /// gets UV zero, and faces need none.
+///
+/// The phases: the statements read line by line ([`Statements::read`]),
+/// checked for a surface ([`Statements::check`]), one texture coordinate
+/// found per position ([`Statements::texcoord_per_position`]), then the
+/// used positions kept in file order ([`Statements::into_parsed`]).
 fn parse(text: &str, uvs: bool) -> Result<Parsed, MeshError> {
-    // Notepad and some exporters start UTF-8 files with a byte-order mark.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut positions: Vec<DVec3> = Vec::new();
-    let mut position_lines: Vec<usize> = Vec::new();
-    let mut texcoords: Vec<DVec2> = Vec::new();
-    let mut texcoord_lines: Vec<usize> = Vec::new();
-    let mut triangles: Vec<[Corner; 3]> = Vec::new();
-    let mut face_of_triangle: Vec<(usize, usize)> = Vec::new();
-    let mut face_count = 0;
-    let mut first_face_without_uv: Option<usize> = None;
-    let mut warnings: Vec<ObjWarning> = Vec::new();
+    let statements = Statements::read(text, uvs)?;
+    statements.check(uvs)?;
+    let (texcoord_of_position, used_position) = statements.texcoord_per_position()?;
+    Ok(statements.into_parsed(&texcoord_of_position, &used_position))
+}
 
-    // Classic Mac OS ended lines with a lone CR; such a file has no LF,
-    // and read by LF it was one comment line, "empty".
-    let lines: Box<dyn Iterator<Item = &str>> = if text.contains('\n') {
-        Box::new(text.lines())
-    } else {
-        Box::new(text.split('\r'))
-    };
-    for (line_index, raw_line) in lines.enumerate() {
-        let line = line_index + 1;
+/// An OBJ file's statements as read, with the lines they are on.
+#[derive(Default)]
+struct Statements {
+    positions: Vec<DVec3>,
+    position_lines: Vec<usize>,
+    texcoords: Vec<DVec2>,
+    texcoord_lines: Vec<usize>,
+    /// The faces, triangulated.
+    triangles: Vec<[Corner; 3]>,
+    /// Each triangle's face number (from 1) and line.
+    face_of_triangle: Vec<(usize, usize)>,
+    face_count: usize,
+    first_face_without_uv: Option<usize>,
+    warnings: Vec<ObjWarning>,
+}
+
+impl Statements {
+    /// Reads every line of `text` (LF, CRLF or classic Mac CR line ends, a
+    /// byte-order mark skipped); an error names the line.
+    fn read(text: &str, uvs: bool) -> Result<Statements, MeshError> {
+        // Notepad and some exporters start UTF-8 files with a byte-order mark.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let mut read = Statements::default();
+        // Classic Mac OS ended lines with a lone CR; such a file has no LF,
+        // and read by LF it was one comment line, "empty".
+        let lines: Box<dyn Iterator<Item = &str>> = if text.contains('\n') {
+            Box::new(text.lines())
+        } else {
+            Box::new(text.split('\r'))
+        };
+        for (line_index, raw_line) in lines.enumerate() {
+            read.line(line_index + 1, raw_line, uvs)?;
+        }
+        Ok(read)
+    }
+
+    /// One line, numbered `line` from 1.
+    fn line(&mut self, line: usize, raw_line: &str, uvs: bool) -> Result<(), MeshError> {
         let content = raw_line.split('#').next().unwrap_or("");
         let mut words = content.split_whitespace();
         let Some(keyword) = words.next() else {
-            continue;
+            return Ok(());
         };
         let syntax = |message: String| MeshError::ObjSyntax { line, message };
         let too_many =
             |what: &'static str, limit: usize| MeshError::TooManyElements { line, what, limit };
         match keyword {
             "v" => {
-                if positions.len() == MAX_VERTICES {
+                if self.positions.len() == MAX_VERTICES {
                     return Err(too_many("vertices", MAX_VERTICES));
                 }
                 let [x, y, z] = parse_numbers::<3>(&mut words, "v", "x y z").map_err(syntax)?;
-                positions.push(DVec3::new(x, y, z));
-                position_lines.push(line);
+                self.positions.push(DVec3::new(x, y, z));
+                self.position_lines.push(line);
             }
             "vt" => {
-                if texcoords.len() == MAX_TEXCOORDS {
+                if self.texcoords.len() == MAX_TEXCOORDS {
                     return Err(too_many("texture coordinates", MAX_TEXCOORDS));
                 }
                 let [u, v] = parse_numbers::<2>(&mut words, "vt", "u v").map_err(syntax)?;
-                texcoords.push(DVec2::new(u, v));
-                texcoord_lines.push(line);
+                self.texcoords.push(DVec2::new(u, v));
+                self.texcoord_lines.push(line);
             }
-            "f" => {
-                let mut corners = Vec::new();
-                for word in words {
-                    let mut corner =
-                        parse_corner(word, positions.len(), texcoords.len()).map_err(syntax)?;
-                    if !uvs {
-                        corner.texcoord = None;
-                    }
-                    if corner.texcoord.is_none() && first_face_without_uv.is_none() {
-                        first_face_without_uv = Some(line);
-                    }
-                    corners.push(corner);
-                }
-                if corners.len() < 3 {
-                    return Err(syntax(format!(
-                        "a face needs at least 3 corners, found {}",
-                        corners.len()
-                    )));
-                }
-                if triangles.len() + corners.len() - 2 > MAX_TRIANGLES {
-                    return Err(too_many("triangles", MAX_TRIANGLES));
-                }
-                face_count += 1;
-                let points = polygon_points(&corners, &positions, &texcoords);
-                for [a, b, c] in triangulate(corners.len(), &points) {
-                    triangles.push([corners[a], corners[b], corners[c]]);
-                    face_of_triangle.push((face_count, line));
-                }
-            }
+            "f" => self.face(line, words, uvs)?,
             // Blender writes loose edges as `l`; points are as loose. Neither
             // is part of a surface.
-            "l" | "p" => match warnings.iter_mut().find(|w| w.keyword == keyword) {
+            "l" | "p" => match self.warnings.iter_mut().find(|w| w.keyword == keyword) {
                 Some(warning) => warning.count += 1,
-                None => warnings.push(ObjWarning {
+                None => self.warnings.push(ObjWarning {
                     keyword: if keyword == "l" { "l" } else { "p" },
                     count: 1,
                     first_line: line,
@@ -527,84 +527,151 @@ fn parse(text: &str, uvs: bool) -> Result<Parsed, MeshError> {
                 )));
             }
         }
+        Ok(())
     }
 
-    if positions.is_empty() && triangles.is_empty() {
-        return Err(MeshError::EmptyObj);
-    }
-    if triangles.is_empty() {
-        return Err(MeshError::NoFaces);
-    }
-    if uvs && texcoords.is_empty() {
-        return Err(MeshError::MissingUvs);
-    }
-    if let Some(line) = first_face_without_uv.filter(|_| uvs) {
-        return Err(MeshError::MissingUvOnFace { line });
-    }
-
-    // One texture coordinate per position; a second, different one is a seam.
-    let mut texcoord_of_position: Vec<Option<usize>> = vec![None; positions.len()];
-    let mut used_position = vec![false; positions.len()];
-    for (triangle, corners) in triangles.iter().enumerate() {
-        for corner in corners {
-            used_position[corner.position] = true;
+    /// An `f` statement on `line`: its corners, triangulated.
+    fn face<'a>(
+        &mut self,
+        line: usize,
+        words: impl Iterator<Item = &'a str>,
+        uvs: bool,
+    ) -> Result<(), MeshError> {
+        let syntax = |message: String| MeshError::ObjSyntax { line, message };
+        let mut corners = Vec::new();
+        for word in words {
+            let mut corner =
+                parse_corner(word, self.positions.len(), self.texcoords.len()).map_err(syntax)?;
+            if !uvs {
+                corner.texcoord = None;
+            }
+            if corner.texcoord.is_none() && self.first_face_without_uv.is_none() {
+                self.first_face_without_uv = Some(line);
+            }
+            corners.push(corner);
         }
-        for corner in corners {
-            let Some(texcoord) = corner.texcoord else {
-                continue;
-            };
-            match texcoord_of_position[corner.position] {
-                None => texcoord_of_position[corner.position] = Some(texcoord),
-                Some(previous) if texcoords[previous] != texcoords[texcoord] => {
-                    return Err(MeshError::InObj {
-                        line: Some(face_of_triangle[triangle].1),
-                        error: Box::new(MeshError::UvSeam {
-                            vertex: corner.position + 1,
-                        }),
-                    });
+        if corners.len() < 3 {
+            return Err(syntax(format!(
+                "a face needs at least 3 corners, found {}",
+                corners.len()
+            )));
+        }
+        if self.triangles.len() + corners.len() - 2 > MAX_TRIANGLES {
+            return Err(MeshError::TooManyElements {
+                line,
+                what: "triangles",
+                limit: MAX_TRIANGLES,
+            });
+        }
+        self.face_count += 1;
+        let points = polygon_points(&corners, &self.positions, &self.texcoords);
+        for [a, b, c] in triangulate(corners.len(), &points) {
+            self.triangles.push([corners[a], corners[b], corners[c]]);
+            self.face_of_triangle.push((self.face_count, line));
+        }
+        Ok(())
+    }
+
+    /// A file with no surface (or, when `uvs`, without texture
+    /// coordinates on every face) is refused.
+    fn check(&self, uvs: bool) -> Result<(), MeshError> {
+        if self.positions.is_empty() && self.triangles.is_empty() {
+            return Err(MeshError::EmptyObj);
+        }
+        if self.triangles.is_empty() {
+            return Err(MeshError::NoFaces);
+        }
+        if uvs && self.texcoords.is_empty() {
+            return Err(MeshError::MissingUvs);
+        }
+        if let Some(line) = self.first_face_without_uv.filter(|_| uvs) {
+            return Err(MeshError::MissingUvOnFace { line });
+        }
+        Ok(())
+    }
+
+    /// One texture coordinate per position; a second, different one is a
+    /// seam. Returns each position's texture coordinate and whether a face
+    /// uses it.
+    fn texcoord_per_position(&self) -> Result<(Vec<Option<usize>>, Vec<bool>), MeshError> {
+        let mut texcoord_of_position: Vec<Option<usize>> = vec![None; self.positions.len()];
+        let mut used_position = vec![false; self.positions.len()];
+        for (triangle, corners) in self.triangles.iter().enumerate() {
+            for corner in corners {
+                used_position[corner.position] = true;
+            }
+            for corner in corners {
+                let Some(texcoord) = corner.texcoord else {
+                    continue;
+                };
+                match texcoord_of_position[corner.position] {
+                    None => texcoord_of_position[corner.position] = Some(texcoord),
+                    Some(previous) if self.texcoords[previous] != self.texcoords[texcoord] => {
+                        return Err(MeshError::InObj {
+                            line: Some(self.face_of_triangle[triangle].1),
+                            error: Box::new(MeshError::UvSeam {
+                                vertex: corner.position + 1,
+                            }),
+                        });
+                    }
+                    Some(_) => {}
                 }
-                Some(_) => {}
             }
         }
+        Ok((texcoord_of_position, used_position))
     }
 
-    // Keep the used positions in file order.
-    let mut parsed = Parsed {
-        mesh: Mesh::default(),
-        warnings,
-        vertex_number: Vec::new(),
-        vertex_line: Vec::new(),
-        texcoord_line: Vec::new(),
-        face_number: face_of_triangle.iter().map(|&(face, _)| face).collect(),
-        face_line: face_of_triangle.iter().map(|&(_, line)| line).collect(),
-    };
-    let mesh = &mut parsed.mesh;
-    let mut new_index: Vec<u32> = vec![u32::MAX; positions.len()];
-    for (position_index, texcoord) in texcoord_of_position.iter().enumerate() {
-        if !used_position[position_index] {
-            continue;
-        }
-        new_index[position_index] = mesh.positions.len() as u32;
-        mesh.positions.push(positions[position_index]);
-        parsed.vertex_number.push(position_index + 1);
-        parsed.vertex_line.push(position_lines[position_index]);
-        match *texcoord {
-            Some(texcoord) => {
-                mesh.uvs.push(texcoords[texcoord]);
-                parsed.texcoord_line.push(texcoord_lines[texcoord]);
+    /// The mesh of the used positions in file order, with the numbers and
+    /// lines its errors are reported at.
+    fn into_parsed(self, texcoord_of_position: &[Option<usize>], used_position: &[bool]) -> Parsed {
+        let Statements {
+            positions,
+            position_lines,
+            texcoords,
+            texcoord_lines,
+            triangles,
+            face_of_triangle,
+            warnings,
+            ..
+        } = self;
+        // Keep the used positions in file order.
+        let mut parsed = Parsed {
+            mesh: Mesh::default(),
+            warnings,
+            vertex_number: Vec::new(),
+            vertex_line: Vec::new(),
+            texcoord_line: Vec::new(),
+            face_number: face_of_triangle.iter().map(|&(face, _)| face).collect(),
+            face_line: face_of_triangle.iter().map(|&(_, line)| line).collect(),
+        };
+        let mesh = &mut parsed.mesh;
+        let mut new_index: Vec<u32> = vec![u32::MAX; positions.len()];
+        for (position_index, texcoord) in texcoord_of_position.iter().enumerate() {
+            if !used_position[position_index] {
+                continue;
             }
-            // Only when UVs are not read (otherwise every corner has one).
-            None => {
-                mesh.uvs.push(DVec2::ZERO);
-                parsed.texcoord_line.push(position_lines[position_index]);
+            new_index[position_index] = mesh.positions.len() as u32;
+            mesh.positions.push(positions[position_index]);
+            parsed.vertex_number.push(position_index + 1);
+            parsed.vertex_line.push(position_lines[position_index]);
+            match *texcoord {
+                Some(texcoord) => {
+                    mesh.uvs.push(texcoords[texcoord]);
+                    parsed.texcoord_line.push(texcoord_lines[texcoord]);
+                }
+                // Only when UVs are not read (otherwise every corner has one).
+                None => {
+                    mesh.uvs.push(DVec2::ZERO);
+                    parsed.texcoord_line.push(position_lines[position_index]);
+                }
             }
         }
+        mesh.triangles = triangles
+            .iter()
+            .map(|corners| corners.map(|c| new_index[c.position]))
+            .collect();
+        parsed
     }
-    mesh.triangles = triangles
-        .iter()
-        .map(|corners| corners.map(|c| new_index[c.position]))
-        .collect();
-    Ok(parsed)
 }
 
 /// Polygons with more corners than this are always fanned: ear clipping

@@ -33,6 +33,12 @@ pub struct Contact {
     /// How far past `point` along `normal` the particle must stay, in
     /// lengths of the positions (the project's collision offset).
     pub offset: f64,
+    /// The share of the contact stiffness this contact carries: 1 for a
+    /// particle held off a neighbour; a two-sided contact's reaction spreads
+    /// the stiffness over the neighbour triangle's corners by the contact
+    /// point's barycentric weights, so its forces sum to the contact's,
+    /// opposite.
+    pub weight: f64,
 }
 
 impl Contact {
@@ -214,7 +220,7 @@ impl Elastic {
         for c in contacts {
             let v = c.violation(x[c.particle as usize]);
             if v > 0.0 {
-                e += 0.5 * self.contact_stiffness * v * v;
+                e += 0.5 * (self.contact_stiffness * c.weight) * v * v;
             }
         }
         for &(p, target) in &self.anchors {
@@ -295,8 +301,9 @@ impl Elastic {
         for c in contacts {
             let v = c.violation(x[c.particle as usize]);
             if v > 0.0 {
-                e += 0.5 * self.contact_stiffness * v * v;
-                g[c.particle as usize] -= c.normal * (self.contact_stiffness * v);
+                let k = self.contact_stiffness * c.weight;
+                e += 0.5 * k * v * v;
+                g[c.particle as usize] -= c.normal * (k * v);
             }
         }
         for &(p, target) in &self.anchors {
@@ -423,7 +430,7 @@ impl Elastic {
     ) {
         for c in contacts {
             if c.violation(x[c.particle as usize]) > 0.0 {
-                let block = outer(c.normal, c.normal) * self.contact_stiffness;
+                let block = outer(c.normal, c.normal) * (self.contact_stiffness * c.weight);
                 pattern.add_block(values, c.particle, c.particle, &block);
             }
         }

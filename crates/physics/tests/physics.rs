@@ -95,19 +95,22 @@ fn flatten(v: &[DVec3]) -> Vec<f64> {
 fn gradient_matches_finite_differences_on_random_meshes() {
     for seed in 1..=4 {
         let (_, mesh, elastic) = random_case(seed);
-        // Two contacts, one violated and one satisfied.
+        // Two contacts, one violated and one satisfied; the violated one
+        // carries a share of the stiffness (a two-sided contact's reaction).
         let contacts = [
             Contact {
                 particle: 3,
                 point: mesh.positions[3] + DVec3::Z * 0.05,
                 normal: DVec3::Z,
                 offset: 0.01,
+                weight: 0.3,
             },
             Contact {
                 particle: 7,
                 point: mesh.positions[7] - DVec3::Z * 0.5,
                 normal: DVec3::Z,
                 offset: 0.01,
+                weight: 1.0,
             },
         ];
         let x = &mesh.positions;
@@ -157,6 +160,7 @@ fn the_elastic_part_and_the_penalties_make_energy_gradient_and_hessian_bit_for_b
             point: mesh.positions[3] + DVec3::Z * 0.05,
             normal: DVec3::Z,
             offset: 0.01,
+            weight: 1.0,
         }];
         let x: Vec<DVec3> = mesh
             .positions
@@ -225,6 +229,7 @@ fn hessian_matches_finite_differences_where_it_is_exact() {
             point: mesh.positions[5] + DVec3::Y * 0.05,
             normal: DVec3::Y,
             offset: 0.0,
+            weight: 0.6,
         }];
         let x = &mesh.positions;
         let pattern = BlockPattern::new(x.len(), elastic.coupled_pairs());

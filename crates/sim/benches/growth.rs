@@ -1,5 +1,5 @@
-//! How long 100 keyframes take (DESIGN.md §6: a single lily-sized petal and
-//! a whole flower; the paper took 11.5 minutes for its lily). Each
+//! How long 100 keyframes take (the project's speed target: a single
+//! lily-sized petal and a whole flower; the paper took 11.5 minutes for its lily). Each
 //! iteration runs a whole project from the bud to the last keyframe.
 //!
 //! `cargo bench -p anthesis-sim --bench growth`

@@ -366,6 +366,7 @@ fn contact_at(
         point: nearest.point + normal * flat.max(bulge).max(0.0),
         normal,
         offset,
+        weight: 1.0,
     };
     Some(match violated {
         Violated::MoveAll => contact,
@@ -591,6 +592,82 @@ pub fn move_half(mut contact: Contact, x: DVec3) -> Contact {
     contact
 }
 
+/// Where on the other organ a violated contact presses (issue 35, two-sided
+/// contact): the contact's index in its list, the corners of the
+/// neighbour's triangle under the particle and the point's barycentric
+/// weights there. The neighbour feels the reaction there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Held {
+    /// The contact's index in the list it was found in.
+    pub contact: u32,
+    /// The other organ's particles at the triangle's corners.
+    pub corners: [u32; 3],
+    /// The contact point's barycentric weights on that triangle.
+    pub weights: [f64; 3],
+}
+
+/// Where each contact of `contacts` (of particles at `positions`, against
+/// `other`, whose nearest-particle lookup is `tracker`) that is violated
+/// presses on `other`: the same triangle the contact search found (it
+/// looks the same way).
+pub fn held_where(
+    contacts: &[Contact],
+    positions: &[DVec3],
+    other: &Surface,
+    tracker: &Tracker,
+) -> Vec<Held> {
+    contacts
+        .iter()
+        .enumerate()
+        .filter_map(|(n, c)| {
+            let x = positions[c.particle as usize];
+            if c.violation(x) <= 0.0 {
+                return None;
+            }
+            let q = tracker.nearest(x, other.positions)?;
+            let nearest = nearest_on_surface(x, other, q)?;
+            Some(Held {
+                contact: n as u32,
+                corners: nearest.triangle,
+                weights: nearest.weights,
+            })
+        })
+        .collect()
+}
+
+/// The reaction of `contact` (found all the way, [`Violated::MoveAll`],
+/// for a particle at `x`) on the other organ, where `held` says it presses:
+/// one contact per corner of the triangle, of the contact's stiffness times
+/// the corner's weight, holding the corner (at `corners_at`, the other
+/// organ's positions) off the particle along the opposite normal. Each is
+/// violated by half the contact's violation, as the contact moved half way
+/// is ([`move_half`]): the two organs meet in the middle, and the forces
+/// on the corners sum to the force on the particle, opposite.
+pub fn reactions(
+    contact: &Contact,
+    held: &Held,
+    x: DVec3,
+    corners_at: &[DVec3],
+    out: &mut Vec<Contact>,
+) {
+    let half = 0.5 * contact.violation(x);
+    if half <= 0.0 {
+        return;
+    }
+    for (&corner, &weight) in held.corners.iter().zip(&held.weights) {
+        if weight <= 0.0 {
+            continue;
+        }
+        out.push(Contact {
+            particle: corner,
+            point: corners_at[corner as usize] + contact.normal * (contact.offset - half),
+            normal: -contact.normal,
+            offset: contact.offset,
+            weight: contact.weight * weight,
+        });
+    }
+}
+
 /// The point of an organ's surface nearest a particle.
 struct Nearest {
     /// On the Phong surface.
@@ -605,6 +682,8 @@ struct Nearest {
     on_rim: bool,
     /// The triangle's particles.
     triangle: [u32; 3],
+    /// The point's barycentric weights on the flat triangle.
+    weights: [f64; 3],
 }
 
 /// The point of `surface` nearest `x` among the triangles near particle
@@ -652,6 +731,7 @@ fn nearest_on_surface(x: DVec3, surface: &Surface, q: u32) -> Option<Nearest> {
         normal,
         on_rim: on_rim(tri, weights, surface.rim),
         triangle: tri,
+        weights,
     })
 }
 
@@ -978,12 +1058,14 @@ mod tests {
                 point: DVec3::ZERO,
                 normal: DVec3::Z,
                 offset: 0.01,
+                weight: 1.0,
             },
             Contact {
                 particle: 1,
                 point: DVec3::new(1.0, 0.0, 0.0),
                 normal: DVec3::Z,
                 offset: 0.01,
+                weight: 1.0,
             },
         ];
         let mut moved = vec![false; positions.len()];
@@ -1002,6 +1084,7 @@ mod tests {
             point: DVec3::ZERO,
             normal: DVec3::Z,
             offset: 0.01,
+            weight: 1.0,
         };
         let mut positions = vec![
             DVec3::new(0.0, 0.0, -0.3),
@@ -1031,17 +1114,74 @@ mod tests {
                 point: DVec3::ZERO,
                 normal: DVec3::Z,
                 offset: 0.01,
+                weight: 1.0,
             },
             Contact {
                 particle: 0,
                 point: DVec3::new(0.0, 0.0, 0.5),
                 normal: DVec3::Z,
                 offset: 0.01,
+                weight: 1.0,
             },
         ];
         let mut moved = vec![false; positions.len()];
         assert_eq!(push_back(&mut positions, &contacts, &mut moved), 1);
         assert_eq!(moved.iter().filter(|&&m| m).count(), 1);
         assert!((positions[0].z - 0.51).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_contact_and_its_reaction_are_equal_and_opposite_and_meet_half_way() {
+        // A particle 0.2 below a tilted triangle's surface, held above it.
+        let corners = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.3),
+            DVec3::new(0.0, 2.0, -0.2),
+        ];
+        let normal = (corners[1] - corners[0])
+            .cross(corners[2] - corners[0])
+            .normalize();
+        let weights = [0.2, 0.5, 0.3];
+        let point: DVec3 = (0..3).map(|k| corners[k] * weights[k]).sum();
+        let x = point - normal * 0.2;
+        let contact = Contact {
+            particle: 7,
+            point,
+            normal,
+            offset: 0.01,
+            weight: 1.0,
+        };
+        let held = Held {
+            contact: 0,
+            corners: [0, 1, 2],
+            weights,
+        };
+        let mut out = Vec::new();
+        reactions(&contact, &held, x, &corners, &mut out);
+        assert_eq!(out.len(), 3);
+        // The penalty force of each (stiffness k times its share times its
+        // violation, along its normal) where the contact was found: the
+        // particle's contact moved half way, against the corners'.
+        let k = 1000.0;
+        let half = move_half(contact, x);
+        let on_particle = half.normal * (k * half.weight * half.violation(x));
+        let on_corners: DVec3 = out
+            .iter()
+            .map(|r| r.normal * (k * r.weight * r.violation(corners[r.particle as usize])))
+            .sum();
+        assert!(on_particle.length() > 100.0);
+        assert!(
+            (on_particle + on_corners).length() < 1e-12 * on_particle.length(),
+            "{on_particle} against {on_corners}"
+        );
+        // Each corner gives way half the depth, as the particle does.
+        for r in &out {
+            let v = r.violation(corners[r.particle as usize]);
+            assert!((v - 0.5 * (0.2 + 0.01)).abs() < 1e-12, "{v}");
+        }
+        // Nothing where the contact holds.
+        let mut none = Vec::new();
+        reactions(&contact, &held, point + normal * 0.5, &corners, &mut none);
+        assert!(none.is_empty());
     }
 }

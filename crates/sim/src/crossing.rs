@@ -28,6 +28,10 @@ pub enum OnCrossing {
     /// Keep the keyframe and go on; what was found is kept as a warning
     /// ([`Simulation::crossings`](crate::Simulation::crossings)).
     Warn,
+    /// Do not look. For a preview whose converged run looks: the window's
+    /// proxy (a coarse mesh can cross where the converged one does not, and
+    /// the search is a quarter of a 180-particle proxy's time).
+    Skip,
 }
 
 /// One side of a crossing: where on an organ, or which part.
@@ -50,7 +54,8 @@ pub enum Crossed {
 }
 
 impl Crossed {
-    fn name(&self) -> &str {
+    /// The organ's or part's name.
+    pub fn name(&self) -> &str {
         match self {
             Crossed::Organ { name, .. } | Crossed::Part { name } => name,
         }

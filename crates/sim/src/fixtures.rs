@@ -1,5 +1,7 @@
 //! Small generated flowers for tests and benchmarks (not the default lily,
-//! which is built from the bud builder).
+//! which is built from the bud builder). Compiled only for this crate's
+//! tests and with the `fixtures` feature, which the crates whose tests,
+//! examples and benches use them turn on from their dev-dependencies.
 
 use anthesis_flower::{
     BaseRegion, Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings, Template,

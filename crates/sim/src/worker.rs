@@ -29,6 +29,7 @@ use std::time::Instant;
 
 use anthesis_flower::Project;
 
+use crate::crossing::{Crossings, OnCrossing};
 #[cfg(any(test, feature = "fault-hook"))]
 use crate::fault::Fault;
 use crate::{IterationProgress, Keyframe, Selection, SimError, Simulation, panic_message};
@@ -72,6 +73,17 @@ pub enum Event {
         run: RunId,
         /// The proxy keyframe.
         keyframe: Arc<Keyframe>,
+    },
+    /// Organs cross in a converged keyframe (see [`crate::crossing`]). The
+    /// worker's converged runs warn and go on, so a window keeps the whole
+    /// opening and says where it is wrong; the event follows the keyframe's
+    /// own, and is sent again for reused keyframes after `Started`. Proxy
+    /// runs do not look (their converged run does).
+    Crossed {
+        /// The run.
+        run: RunId,
+        /// What crosses, where.
+        crossings: Arc<Crossings>,
     },
     /// The proxy pass is over: every proxy keyframe was sent, or the proxy
     /// stopped (`error`: a coarse mesh may fail where the converged one does
@@ -121,6 +133,7 @@ impl Event {
             Event::Started { run, .. }
             | Event::Keyframe { run, .. }
             | Event::Proxy { run, .. }
+            | Event::Crossed { run, .. }
             | Event::ProxyEnded { run, .. }
             | Event::Progress { run, .. }
             | Event::Finished { run, .. }
@@ -205,6 +218,13 @@ pub const PROGRESS_WAKE_EVERY: std::time::Duration = std::time::Duration::from_m
 /// owner views (see [`Worker::set_viewed_keyframe`]).
 pub const OTHER_KEYFRAME_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(250);
 
+/// How long after a run with a proxy starts only the viewed keyframe and
+/// the run's start and end wake the owner: the proxy's latency budget for
+/// an early-key stroke (issue 34). Each other wake is a redraw, about a
+/// tenth of a second of a core on a software renderer, taken from the
+/// proxy; a proxy that takes longer gets the usual pacing after it.
+pub const PROXY_QUIET_FOR: std::time::Duration = std::time::Duration::from_millis(600);
+
 /// What an event is, as far as waking the owner goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Wakes {
@@ -212,6 +232,8 @@ enum Wakes {
     Progress,
     /// A keyframe (converged or proxy) of this index.
     Keyframe(u32),
+    /// A run with a proxy pass started.
+    ProxyRunStarted,
     /// A run started, its proxy ended, or it ended.
     Lifecycle,
 }
@@ -223,6 +245,8 @@ impl Wakes {
             Event::Keyframe { keyframe, .. } | Event::Proxy { keyframe, .. } => {
                 Wakes::Keyframe(keyframe.index)
             }
+            Event::Crossed { crossings, .. } => Wakes::Keyframe(crossings.keyframe),
+            Event::Started { proxy: true, .. } => Wakes::ProxyRunStarted,
             _ => Wakes::Lifecycle,
         }
     }
@@ -232,23 +256,39 @@ impl Wakes {
 /// keyframe the owner views, wake it at once; other keyframes when
 /// [`OTHER_KEYFRAME_WAKE_EVERY`] has passed since the last wake (at once
 /// when the owner views none in particular); progress when
-/// [`PROGRESS_WAKE_EVERY`] has. A window redraws on each wake, and on a
-/// software renderer that takes a core from the solver.
+/// [`PROGRESS_WAKE_EVERY`] has. For [`PROXY_QUIET_FOR`] after a run with a
+/// proxy starts, or until its proxy ends, neither other keyframes nor
+/// progress wake it. A window redraws on each wake, and on a software
+/// renderer that takes a core from the solver.
 #[derive(Debug, Default)]
 struct WakeGate {
     last_wake: Option<Instant>,
+    /// When the quiet of a run with a proxy began, while it lasts.
+    quiet_since: Option<Instant>,
 }
 
 impl WakeGate {
     fn wakes(&mut self, event: Wakes, viewed: Option<u32>, now: Instant) -> bool {
+        let quiet = self
+            .quiet_since
+            .is_some_and(|at| now.saturating_duration_since(at) < PROXY_QUIET_FOR);
         let since = |every| {
-            self.last_wake
-                .is_none_or(|at| now.saturating_duration_since(at) >= every)
+            !quiet
+                && self
+                    .last_wake
+                    .is_none_or(|at| now.saturating_duration_since(at) >= every)
         };
         let wakes = match event {
-            Wakes::Lifecycle => true,
+            Wakes::ProxyRunStarted => {
+                self.quiet_since = Some(now);
+                true
+            }
+            Wakes::Lifecycle => {
+                self.quiet_since = None;
+                true
+            }
             Wakes::Keyframe(index) => match viewed {
-                None => true,
+                None => !quiet,
                 Some(viewed) => index == viewed || since(OTHER_KEYFRAME_WAKE_EVERY),
             },
             Wakes::Progress => since(PROGRESS_WAKE_EVERY),
@@ -512,6 +552,12 @@ fn simulation_for(
     }
     let mut sim = Simulation::new(project, &lane.selection)?;
     sim.keep_checkpoints();
+    sim.on_crossing(if lane.proxy {
+        // The converged run that follows checks for crossings.
+        OnCrossing::Skip
+    } else {
+        OnCrossing::Warn
+    });
     Ok((sim, Vec::new()))
 }
 
@@ -541,8 +587,15 @@ fn step_to_end(
         match result {
             Ok(made) => {
                 let made = Arc::new(made);
+                let index = made.index;
                 keyframes.push(Arc::clone(&made));
                 emit(keyframe(made));
+                if let Some(crossings) = sim.crossings().last().filter(|c| c.keyframe == index) {
+                    emit(Event::Crossed {
+                        run,
+                        crossings: Arc::new(crossings.clone()),
+                    });
+                }
             }
             Err(SimError::Cancelled) => return Steps::Cancelled,
             Err(SimError::Panicked {
@@ -652,11 +705,18 @@ fn run_job(request: &RunRequest, kept: &mut Kept, current: &AtomicU64, emit: &dy
     if keyframes.is_empty() {
         keyframes.push(Arc::new(sim.bud()));
     }
-    // The keyframes the edit left as they were, at once.
+    // The keyframes the edit left as they were, at once, and what crosses
+    // in them.
     for keyframe in &keyframes {
         emit(Event::Keyframe {
             run,
             keyframe: Arc::clone(keyframe),
+        });
+    }
+    for crossings in sim.crossings() {
+        emit(Event::Crossed {
+            run,
+            crossings: Arc::new(crossings.clone()),
         });
     }
     if let Some(proxy) = proxy {
@@ -789,6 +849,27 @@ mod tests {
         assert!(gate.wakes(Wakes::Keyframe(54), Some(54), at(301)));
         assert!(!gate.wakes(Wakes::Keyframe(55), Some(54), at(500)));
         assert!(gate.wakes(Wakes::Keyframe(56), Some(54), at(551)));
+    }
+
+    #[test]
+    fn a_run_with_a_proxy_is_quiet_but_for_the_viewed_keyframe_until_its_proxy_ends() {
+        let mut gate = WakeGate::default();
+        let t0 = Instant::now();
+        let at = |ms| t0 + Duration::from_millis(ms);
+        let quiet = PROXY_QUIET_FOR.as_millis() as u64;
+        assert!(gate.wakes(Wakes::ProxyRunStarted, Some(100), at(0)));
+        assert!(!gate.wakes(Wakes::Progress, Some(100), at(150)));
+        assert!(!gate.wakes(Wakes::Keyframe(40), Some(100), at(300)));
+        assert!(!gate.wakes(Wakes::Keyframe(41), None, at(301)));
+        assert!(gate.wakes(Wakes::Keyframe(100), Some(100), at(400)));
+        assert!(!gate.wakes(Wakes::Progress, Some(100), at(quiet - 1)));
+        // A slow proxy gets the usual pacing once the quiet is over.
+        assert!(gate.wakes(Wakes::Progress, Some(100), at(quiet + 1)));
+        // The proxy's end ends the quiet at once.
+        assert!(gate.wakes(Wakes::ProxyRunStarted, Some(100), at(2000)));
+        assert!(!gate.wakes(Wakes::Keyframe(3), Some(100), at(2300)));
+        assert!(gate.wakes(Wakes::Lifecycle, Some(100), at(2310)));
+        assert!(gate.wakes(Wakes::Keyframe(4), Some(100), at(2560)));
     }
 
     #[test]

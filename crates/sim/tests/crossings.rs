@@ -113,7 +113,7 @@ fn organs_driven_through_each_other_stop_the_run_at_the_first_crossing_keyframe(
     // with as many crossing pairs as testing every pair of triangles finds.
     let mut warned = Simulation::new(&project, &Selection::All).expect("valid");
     warned.on_crossing(OnCrossing::Warn);
-    let (all, _) = run(&mut warned);
+    let (all, warned_error) = run(&mut warned);
     assert!(all.len() > found.keyframe as usize);
     let first = &warned.crossings()[0];
     assert_eq!(first, found.as_ref());
@@ -125,6 +125,21 @@ fn organs_driven_through_each_other_stop_the_run_at_the_first_crossing_keyframe(
         .filter(|&k| crossings_between_organs(&warned, &all[k as usize]) > 0)
         .collect();
     assert_eq!(reported, expected);
+    // A proxy's run does not look (its converged run does): the same
+    // keyframes and the same end, nothing found, no stop at a crossing.
+    let mut skipped = Simulation::new(&project, &Selection::All).expect("valid");
+    skipped.on_crossing(OnCrossing::Skip);
+    let (unchecked, error) = run(&mut skipped);
+    assert_eq!(error, warned_error);
+    assert!(skipped.crossings().is_empty());
+    assert_eq!(unchecked.len(), all.len());
+    for (u, w) in unchecked.iter().zip(&all) {
+        assert_eq!(
+            u.positions_in_world, w.positions_in_world,
+            "keyframe {}",
+            u.index
+        );
+    }
 }
 
 #[test]

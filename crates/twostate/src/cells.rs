@@ -1,4 +1,4 @@
-//! The growth variations of `sketch-based-floral-blossom.txt` §4.2, per
+//! The growth variations of the floral blossom paper §4.2, per
 //! triangle ("cell") of an organ taken in two states: each cell's growth
 //! property ellipse (major axis along the mesh's `v`, the organ's length;
 //! minor axis across it), the primary growth direction (the rotation from

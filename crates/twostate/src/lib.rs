@@ -1,5 +1,5 @@
 #![warn(missing_docs)]
-//! Two-state blossom (`sketch-based-floral-blossom.txt` §4): an organ
+//! Two-state blossom (the floral blossom paper §4): an organ
 //! animated from its bud shape to its open shape without a growth
 //! simulation.
 //!

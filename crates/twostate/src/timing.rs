@@ -1,4 +1,4 @@
-//! The growth function G(t; g, T) of `sketch-based-floral-blossom.txt`
+//! The growth function G(t; g, T) of the floral blossom paper
 //! eq. (4), and the velocity curve that times the turn of the cells'
 //! growth directions.
 

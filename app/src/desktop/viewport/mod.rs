@@ -83,14 +83,14 @@ pub struct ViewportResponse {
 }
 
 /// A badge in the top-left corner of the viewport `rect` saying what the
-/// view shows when it is not the converged result ("PROXY", "STALE"):
-/// white text on `color`.
-pub fn badge(ui: &egui::Ui, rect: egui::Rect, text: &str, color: egui::Color32) {
+/// view shows when it is not the converged result ("PROXY", "STALE") or is
+/// wrong ("CROSSING: …"): white text on `color`, `row` badges down.
+pub fn badge(ui: &egui::Ui, rect: egui::Rect, row: usize, text: &str, color: egui::Color32) {
     let font = egui::FontId::proportional(13.0);
     let galley = ui
         .painter()
         .layout_no_wrap(text.to_string(), font, egui::Color32::WHITE);
-    let at = rect.left_top() + Vec2::new(10.0, 10.0);
+    let at = rect.left_top() + Vec2::new(10.0, 10.0 + 26.0 * row as f32);
     let frame = egui::Rect::from_min_size(at, galley.size() + Vec2::new(12.0, 6.0));
     let painter = ui.painter_at(rect);
     painter.rect_filled(frame, 4.0, color);

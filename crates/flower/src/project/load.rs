@@ -277,17 +277,37 @@ impl Loader<'_> {
         };
         // Listed rules come after the derived ones and override a derived
         // rule for the same pair of organs.
+        // Two listed rules for one pair the opposite way round are refused
+        // naming both (the later silently won).
         let mut overlaps = derived.overlaps;
-        for overlap in &file.overlaps {
+        let mut listed_at: std::collections::HashMap<(usize, usize), usize> = Default::default();
+        for (k, overlap) in file.overlaps.iter().enumerate() {
             let listed = Overlap {
                 inner: organ_index(&overlap.inner)?,
                 outer: organ_index(&overlap.outer)?,
             };
-            overlaps.retain(|o| !(o.inner == listed.outer && o.outer == listed.inner));
-            if !overlaps.contains(&listed) {
-                overlaps.push(listed);
+            if let Some(&earlier) = listed_at.get(&(listed.outer, listed.inner)) {
+                return Err(self.invalid(format!(
+                    "[[overlaps]] {} puts \"{}\" inside \"{}\", but [[overlaps]] {} puts \"{}\" inside \"{}\"; keep one of them",
+                    earlier + 1, overlap.outer, overlap.inner, k + 1, overlap.inner, overlap.outer
+                )));
             }
+            listed_at.entry((listed.inner, listed.outer)).or_insert(k);
         }
+        let mut listed_rules: Vec<(usize, Overlap)> = listed_at
+            .iter()
+            .map(|(&(inner, outer), &k)| (k, Overlap { inner, outer }))
+            .collect();
+        listed_rules.sort_by_key(|(k, _)| *k);
+        overlaps.retain(|o| !listed_at.contains_key(&(o.outer, o.inner)));
+        let made: std::collections::HashSet<(usize, usize)> =
+            overlaps.iter().map(|o| (o.inner, o.outer)).collect();
+        overlaps.extend(
+            listed_rules
+                .into_iter()
+                .map(|(_, o)| o)
+                .filter(|o| !made.contains(&(o.inner, o.outer))),
+        );
         let parts = file
             .parts
             .iter()

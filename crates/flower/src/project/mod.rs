@@ -67,7 +67,7 @@
 //! # left = [[-0.5, 0.0], ...]   right = [...]   vein = [...]
 //! # sections = [[[-4.0, 9.0], ...], ...]   # optional cross-sections
 //! # edge = 1.2
-//! # or (version 8) a PDE sweep (eq. 12 of pde-surfaces-lily.txt):
+//! # or (version 8) a PDE sweep (eq. 12 of Chaudhry et al.):
 //! # kind = "pde"
 //! # margin0 = [[1.2, 0, -0.3], ...]  # 4 Bézier control points, base to tip
 //! # margin1 = [...]; tangent0 = [...]; tangent1 = [...]  # dS/du there

@@ -23,6 +23,22 @@ const PREVIOUS: &str = "previous";
 const WRITING_PREFIX: &str = "writing-";
 const PROJECT_FILE: &str = "recovered.anthesis.toml";
 const ABOUT_FILE: &str = "recovery.toml";
+const DAMAGED_PREFIX: &str = "damaged-";
+
+/// A recovery that could not be read whole, moved out of the way of the
+/// next autosave (renamed `damaged-*` in the recovery folder, which
+/// [`RecoveryFolder::write`] and [`RecoveryFolder::discard`] never touch).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SetAside {
+    /// Where it is kept now.
+    pub folder: PathBuf,
+    /// What was wrong with it, for the user.
+    pub problem: String,
+    /// Its project, when the project file is there to be opened (the
+    /// original and the time from its note when readable, else none and
+    /// the file's modification time).
+    pub recovery: Option<Recovery>,
+}
 
 /// What `recovery.toml` records.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
@@ -125,7 +141,66 @@ impl RecoveryFolder {
     pub fn find(&self) -> Option<Recovery> {
         [LATEST, PREVIOUS]
             .iter()
-            .find_map(|name| read_recovery(&self.dir.join(name)))
+            .find_map(|name| read_recovery(&self.dir.join(name)).ok())
+    }
+
+    /// Moves every recovery whose note (`recovery.toml`) or project file
+    /// is missing or damaged out of the way, so that no autosave replaces
+    /// it, and says what was wrong with each. Call before [`Self::find`]
+    /// and before the first write of a launch.
+    pub fn set_aside_damaged(&self) -> Vec<SetAside> {
+        let mut set_aside = Vec::new();
+        for name in [LATEST, PREVIOUS] {
+            let folder = self.dir.join(name);
+            if !folder.is_dir() {
+                continue;
+            }
+            if let Err(problem) = read_recovery(&folder) {
+                match self.set_aside(&folder, problem) {
+                    Ok(aside) => set_aside.push(aside),
+                    Err(error) => set_aside.push(SetAside {
+                        folder: folder.clone(),
+                        problem: format!("it could not be moved aside either: {error}"),
+                        recovery: None,
+                    }),
+                }
+            }
+        }
+        set_aside
+    }
+
+    /// Moves the recovery in `folder` aside as damaged (`problem`): a
+    /// recovery whose project does not load is kept, never replaced.
+    pub fn set_aside(&self, folder: &Path, problem: String) -> std::io::Result<SetAside> {
+        let stamp = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs());
+        let mut target = self.dir.join(format!("{DAMAGED_PREFIX}{stamp}"));
+        let mut n = 1;
+        while target.exists() {
+            n += 1;
+            target = self.dir.join(format!("{DAMAGED_PREFIX}{stamp}-{n}"));
+        }
+        fs::rename(folder, &target)?;
+        let project_file = target.join(PROJECT_FILE);
+        let recovery = project_file.is_file().then(|| {
+            let about = read_about(&target).ok();
+            let modified = fs::metadata(&project_file)
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+                .map_or(0, |d| d.as_secs());
+            Recovery {
+                project_file: project_file.clone(),
+                original: about.as_ref().and_then(|a| a.original.clone()),
+                saved_at_unix_seconds: about.map_or(modified, |a| a.saved_at_unix_seconds),
+            }
+        });
+        Ok(SetAside {
+            folder: target,
+            problem,
+            recovery,
+        })
     }
 
     /// Removes every recovery (after a save, a clean exit, or when the user
@@ -147,19 +222,31 @@ impl RecoveryFolder {
     }
 }
 
-fn read_recovery(folder: &Path) -> Option<Recovery> {
+/// The recovery in `folder`, or what is wrong with it.
+fn read_recovery(folder: &Path) -> Result<Recovery, String> {
     let project_file = folder.join(PROJECT_FILE);
     if !project_file.is_file() {
-        return None;
+        return Err(format!("{} is missing", project_file.display()));
     }
-    let text =
-        anthesis_files::read_regular_text(&folder.join(ABOUT_FILE), 64 << 10, "a recovery note")
-            .ok()?;
-    let about: About = toml::from_str(&text).ok()?;
-    Some(Recovery {
+    let about = read_about(folder)?;
+    Ok(Recovery {
         project_file,
         original: about.original,
         saved_at_unix_seconds: about.saved_at_unix_seconds,
+    })
+}
+
+/// `folder`'s `recovery.toml`, or what is wrong with it.
+fn read_about(folder: &Path) -> Result<About, String> {
+    let path = folder.join(ABOUT_FILE);
+    let text = anthesis_files::read_regular_text(&path, 64 << 10, "a recovery note")
+        .map_err(|e| format!("{} cannot be read: {e}", path.display()))?;
+    toml::from_str(&text).map_err(|e| {
+        format!(
+            "{} is damaged: {}",
+            path.display(),
+            e.message().lines().next().unwrap_or("not a recovery note")
+        )
     })
 }
 
@@ -291,5 +378,40 @@ mod tests {
         )
         .expect("write");
         assert_eq!(folder.find(), None);
+    }
+
+    #[test]
+    fn a_damaged_note_is_set_aside_kept_from_the_next_autosave_and_still_opens() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let folder = RecoveryFolder::new(dir.path().join("recovery"));
+        let work = project("work");
+        let original = dir.path().join("mine/flower.anthesis.toml");
+        folder
+            .write(&work, Some(&original), 1_700_000_000)
+            .expect("write");
+        let note = folder.dir().join(LATEST).join(ABOUT_FILE);
+        fs::write(&note, "saved_at_unix_seconds = \"yesterday").expect("damage");
+        let aside = folder.set_aside_damaged();
+        assert_eq!(aside.len(), 1, "{aside:?}");
+        assert!(
+            aside[0].problem.contains("recovery.toml is damaged"),
+            "{}",
+            aside[0].problem
+        );
+        assert!(aside[0].folder.starts_with(folder.dir()));
+        let recovery = aside[0].recovery.clone().expect("its project is there");
+        assert_eq!(recovery.original, None, "the note is unreadable");
+        assert_eq!(folder.find(), None, "not offered as a whole recovery");
+        // The next autosave and a discard leave it where it is.
+        folder
+            .write(&project("later"), None, 1_700_000_100)
+            .expect("write");
+        folder.discard().expect("discard");
+        assert_eq!(recovery.load().expect("what is readable opens"), work);
+        // A folder without its project is set aside too.
+        fs::create_dir_all(folder.dir().join(LATEST)).expect("mkdir");
+        let aside = folder.set_aside_damaged();
+        assert!(aside[0].problem.contains("is missing"), "{aside:?}");
+        assert_eq!(aside[0].recovery, None);
     }
 }

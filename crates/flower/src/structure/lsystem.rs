@@ -1,4 +1,4 @@
-//! Bracketed parametric L-systems as `lsystem-bezier-flower.txt` §2–§3
+//! Bracketed parametric L-systems as Qin and Chen 2006 §2–§3
 //! writes them: an axiom, productions rewritten in parallel for a number
 //! of derivation steps, and named constants.
 //!
@@ -32,6 +32,10 @@ pub const MAX_MODULES: usize = 1_000_000;
 
 /// The most derivation steps asked for (real flowers need a handful).
 pub const MAX_STEPS: u32 = 100;
+
+/// The most terms (numbers, names, signs and parentheses) one parameter
+/// expression may hold: deeper nesting would exhaust the stack.
+pub const MAX_EXPRESSION_TERMS: usize = 256;
 
 /// A syntax error, or a word that grows too long.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -75,6 +79,44 @@ pub enum LSystemError {
         /// 1-based line of the production.
         line: usize,
     },
+    /// A number or a parameter that is not finite (`0/0`, `1/0`, `NaN`):
+    /// the turtle would place organs nowhere. `column` counts from 1.
+    #[error("L-system line {line}, column {column}: `{text}` is {value}, not a finite number")]
+    NotFinite {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column, in characters.
+        column: usize,
+        /// The expression or number as written.
+        text: String,
+        /// What it evaluates to (NaN, inf or -inf).
+        value: f64,
+    },
+    /// A production gives a module a parameter that is not finite at a
+    /// derivation step (`A(x) -> A(x / 0)`).
+    #[error(
+        "L-system line {line}: the production gives module {symbol} the parameter {value} at derivation step {step}, not a finite number"
+    )]
+    NotFiniteAt {
+        /// 1-based line of the production.
+        line: usize,
+        /// The module given it.
+        symbol: String,
+        /// The value (NaN, inf or -inf).
+        value: f64,
+        /// 1-based derivation step.
+        step: u32,
+    },
+    /// An expression with more terms than [`MAX_EXPRESSION_TERMS`].
+    #[error(
+        "L-system line {line}, column {column}: an expression may hold at most {MAX_EXPRESSION_TERMS} terms"
+    )]
+    TooComplex {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column where the expression starts.
+        column: usize,
+    },
     /// More derivation steps than [`MAX_STEPS`] were asked for.
     #[error("the L-system asks for {0} derivation steps; at most {MAX_STEPS} are allowed")]
     TooManySteps(u32),
@@ -106,6 +148,17 @@ enum Expr {
 }
 
 impl Expr {
+    /// Whether the expression reads a formal parameter (else it is a
+    /// constant, known when parsed).
+    fn has_param(&self) -> bool {
+        match self {
+            Expr::Number(_) => false,
+            Expr::Param(_) => true,
+            Expr::Neg(e) => e.has_param(),
+            Expr::Binary(_, a, b) => a.has_param() || b.has_param(),
+        }
+    }
+
     fn eval(&self, args: &[f64]) -> f64 {
         match self {
             Expr::Number(v) => *v,
@@ -163,10 +216,26 @@ impl LSystem {
                 continue;
             }
             if let Some((name, value)) = constant(trimmed) {
-                let value = value.trim().parse::<f64>().map_err(|_| {
-                    let column = column_of(line, value.trim());
-                    syntax(number, column, "a number", first_char(value.trim()))
-                })?;
+                let column = column_of(line, value.trim());
+                let value = value
+                    .trim()
+                    .parse::<f64>()
+                    .map_err(|_| syntax(number, column, "a number", first_char(value.trim())))?;
+                if !value.is_finite() {
+                    return Err(LSystemError::NotFinite {
+                        line: number,
+                        column,
+                        text: line
+                            .trim()
+                            .rsplit('=')
+                            .next()
+                            .unwrap_or("")
+                            .trim()
+                            .escape_debug()
+                            .to_string(),
+                        value,
+                    });
+                }
                 constants.insert(name, value);
             } else if let Some(rest) = strip_label(trimmed, &["axiom", "ω"]) {
                 if axiom.is_some() {
@@ -224,10 +293,22 @@ impl LSystem {
                                 line: p.line,
                             });
                         }
-                        next.extend(p.successor.iter().map(|t| Module {
-                            symbol: t.symbol.clone(),
-                            params: t.params.iter().map(|e| e.eval(&module.params)).collect(),
-                        }));
+                        for t in &p.successor {
+                            let params: Vec<f64> =
+                                t.params.iter().map(|e| e.eval(&module.params)).collect();
+                            if let Some(&value) = params.iter().find(|v| !v.is_finite()) {
+                                return Err(LSystemError::NotFiniteAt {
+                                    line: p.line,
+                                    symbol: t.symbol.clone(),
+                                    value,
+                                    step,
+                                });
+                            }
+                            next.push(Module {
+                                symbol: t.symbol.clone(),
+                                params,
+                            });
+                        }
                     }
                     None => next.push(module.clone()),
                 }
@@ -288,9 +369,10 @@ fn column_of(line: &str, part: &str) -> usize {
 }
 
 fn first_char(s: &str) -> String {
-    s.chars()
-        .next()
-        .map_or_else(|| "the end of the line".to_owned(), |c| format!("`{c}`"))
+    s.chars().next().map_or_else(
+        || "the end of the line".to_owned(),
+        |c| format!("`{}`", c.escape_debug()),
+    )
 }
 
 fn syntax(line: usize, column: usize, expected: &str, found: String) -> LSystemError {
@@ -375,6 +457,11 @@ struct Parser {
     chars: Vec<char>,
     pos: usize,
     end: usize,
+    /// Terms of the expression being read, against
+    /// [`MAX_EXPRESSION_TERMS`].
+    terms: usize,
+    /// Where that expression starts (0-based).
+    expression_start: usize,
 }
 
 impl Parser {
@@ -386,6 +473,8 @@ impl Parser {
             chars,
             pos: start,
             end,
+            terms: 0,
+            expression_start: start,
         }
     }
 
@@ -404,7 +493,10 @@ impl Parser {
             self.line,
             self.pos + 1,
             expected,
-            found.map_or_else(|| "the end of the line".to_owned(), |c| format!("`{c}`")),
+            found.map_or_else(
+                || "the end of the line".to_owned(),
+                |c| format!("`{}`", c.escape_debug()),
+            ),
         )
     }
 
@@ -463,7 +555,28 @@ impl Parser {
             if self.peek() == Some('(') {
                 self.pos += 1;
                 loop {
-                    params.push(self.expression(constants, formals)?);
+                    self.skip_spaces();
+                    let start = self.pos;
+                    self.terms = 0;
+                    self.expression_start = start;
+                    let expression = self.expression(constants, formals)?;
+                    if !expression.has_param() {
+                        let value = expression.eval(&[]);
+                        if !value.is_finite() {
+                            return Err(LSystemError::NotFinite {
+                                line: self.line,
+                                column: start + 1,
+                                text: self.chars[start..self.pos]
+                                    .iter()
+                                    .collect::<String>()
+                                    .trim()
+                                    .escape_debug()
+                                    .to_string(),
+                                value,
+                            });
+                        }
+                    }
+                    params.push(expression);
                     self.skip_spaces();
                     match self.peek() {
                         Some(',') => self.pos += 1,
@@ -525,6 +638,13 @@ impl Parser {
         constants: &BTreeMap<String, f64>,
         formals: &[String],
     ) -> Result<Expr, LSystemError> {
+        self.terms += 1;
+        if self.terms > MAX_EXPRESSION_TERMS {
+            return Err(LSystemError::TooComplex {
+                line: self.line,
+                column: self.expression_start + 1,
+            });
+        }
         self.skip_spaces();
         match self.peek() {
             Some('-') => {

@@ -1,6 +1,6 @@
 //! Where a flower's organs go, as data: whorls, contorted whorls and
 //! golden-angle spirals on the receptacle ([`whorl`]), and the bracketed
-//! parametric L-systems and turtle of `lsystem-bezier-flower.txt` §2–§3
+//! parametric L-systems and turtle of Qin and Chen 2006 §2–§3
 //! ([`lsystem`], [`turtle`]). A project's `[structure]` is one of them
 //! ([`Structure`]); its organs and overlap rules are made when the project
 //! loads ([`Structure::arrange`]).
@@ -17,7 +17,24 @@ use thiserror::Error;
 use crate::{Organ, Overlap, Placement, Template};
 use lsystem::{LSystem, LSystemError};
 use turtle::{Defaults, interpret};
-pub use whorl::{Arrangement, GOLDEN_ANGLE_DEG, Spiral, Whorl};
+pub use whorl::{Arrangement, GOLDEN_ANGLE_DEG, MAX_OVERLAP_RULES, Spiral, Whorl};
+
+/// The most organs a structure may make (whorls, a spiral or an L-system),
+/// checked before any is made: a real flower has tens, a dense
+/// inflorescence hundreds; an L-system's `~X` can otherwise place up to
+/// [`lsystem::MAX_MODULES`].
+pub const MAX_STRUCTURE_ORGANS: usize = 10_000;
+
+/// How far an organ may reach from its base, in multiples of its bud's
+/// reach, when an L-system's overlap rules are made: organs whose reaches
+/// never meet get no rule (they grow, so the bud's reach alone is too
+/// short).
+const REACH_GROWTH: f64 = 3.0;
+
+/// The most pairs of L-system organs within reach of each other that are
+/// looked at for overlap rules (organs piled on one spot would otherwise
+/// make the work grow with the square of their number).
+const MAX_NEAR_PAIRS: usize = 10 * MAX_OVERLAP_RULES;
 
 /// Where a project's organs come from, besides those it lists one by one.
 #[derive(Debug, Clone, PartialEq)]
@@ -80,6 +97,24 @@ pub enum StructureError {
         "the contorted whorl `{0}` needs neighbours whose spans meet and organs two apart whose spans do not"
     )]
     Contorted(String),
+    /// The structure makes more organs than [`MAX_STRUCTURE_ORGANS`].
+    #[error(
+        "the structure makes {count} organs; at most {MAX_STRUCTURE_ORGANS} are allowed (use fewer organs, fewer derivation steps or a smaller count)"
+    )]
+    TooManyOrgans {
+        /// How many it would make (at least; counting stopped there).
+        count: usize,
+    },
+    /// The structure's organs would need more overlap rules than
+    /// [`MAX_OVERLAP_RULES`], or (an L-system) more organs lie within reach
+    /// of one another than can be looked at.
+    #[error(
+        "the structure's organs meet in more than {limit} pairs (overlap rules); spread them out, narrow their spans or use fewer organs"
+    )]
+    TooManyOverlaps {
+        /// The limit that was passed.
+        limit: usize,
+    },
     /// A whorl or spiral names a template index that does not exist.
     #[error("the structure uses template {index}, but there are {count} templates")]
     NoTemplate {
@@ -105,23 +140,36 @@ impl Structure {
                 })
             }
         };
+        let check_count = |count: usize| {
+            if count > MAX_STRUCTURE_ORGANS {
+                Err(StructureError::TooManyOrgans { count })
+            } else {
+                Ok(())
+            }
+        };
+        let too_many_rules = |_| StructureError::TooManyOverlaps {
+            limit: MAX_OVERLAP_RULES,
+        };
         match self {
             Structure::Whorls { whorls, contorted } => {
                 for w in whorls {
                     check(w.template)?;
                 }
+                check_count(whorls.iter().fold(0, |n, w| n.saturating_add(w.count)))?;
                 match (contorted, whorls.as_slice()) {
                     (true, [ring]) => whorl::contorted_whorl(ring)
                         .ok_or_else(|| StructureError::Contorted(ring.name.clone())),
                     (true, _) => Err(StructureError::Contorted(
                         "(a contorted structure has exactly one whorl)".to_owned(),
                     )),
-                    (false, _) => Ok(whorl::nested_whorls(whorls)),
+                    (false, _) => whorl::nested_whorls_within(whorls, MAX_OVERLAP_RULES)
+                        .map_err(too_many_rules),
                 }
             }
             Structure::Spiral(spiral) => {
                 check(spiral.template)?;
-                Ok(whorl::spiral(spiral))
+                check_count(spiral.count)?;
+                whorl::spiral_within(spiral, MAX_OVERLAP_RULES).map_err(too_many_rules)
             }
             Structure::LSystem {
                 text,
@@ -188,7 +236,12 @@ fn lsystem_arrangement(
     templates: &[Template],
 ) -> Result<Arrangement, StructureError> {
     let system = LSystem::parse(text)?;
-    let drawing = interpret(&system.derive(steps)?, &Defaults::of(&system));
+    let word = system.derive(steps)?;
+    let count = word.iter().filter(|m| m.symbol.starts_with('~')).count();
+    if count > MAX_STRUCTURE_ORGANS {
+        return Err(StructureError::TooManyOrgans { count });
+    }
+    let drawing = interpret(&word, &Defaults::of(&system));
     let mut organs = Vec::new();
     let mut faces: Vec<DVec3> = Vec::new();
     let mut counts = vec![0usize; templates.len()];
@@ -222,19 +275,113 @@ fn lsystem_arrangement(
             },
         });
     }
+    // Only organs within reach of each other can meet: a grid of cells as
+    // wide as the longest reach finds them without looking at every pair.
+    let reach_of_template: Vec<f64> = templates
+        .iter()
+        .map(|t| {
+            let bud = t
+                .mesh
+                .positions
+                .iter()
+                .map(|p| p.length())
+                .fold(0.0, f64::max);
+            REACH_GROWTH * bud
+        })
+        .collect();
+    let reach = |i: usize| reach_of_template[organs[i].template];
+    let cell = (0..organs.len()).map(reach).fold(0.0, f64::max) * 2.0;
+    let grid = Grid::new(
+        organs.iter().map(|o| o.placement.position),
+        if cell > 0.0 && cell.is_finite() {
+            cell
+        } else {
+            1.0
+        },
+    );
     let mut overlaps = Vec::new();
+    let mut looked_at = 0usize;
+    let mut outers = Vec::new();
     for (i, inner) in organs.iter().enumerate() {
-        for (j, outer) in organs.iter().enumerate() {
+        outers.clear();
+        for j in grid.near(inner.placement.position) {
+            looked_at += 1;
+            if looked_at > MAX_NEAR_PAIRS {
+                return Err(StructureError::TooManyOverlaps {
+                    limit: MAX_NEAR_PAIRS,
+                });
+            }
+            let outer = &organs[j];
             let (li, lj) = (
                 layer_of_template[inner.template],
                 layer_of_template[outer.template],
             );
-            if li > lj && faces[i].dot(faces[j]) > 0.0 {
-                overlaps.push(Overlap { inner: i, outer: j });
+            let near =
+                inner.placement.position.distance(outer.placement.position) <= reach(i) + reach(j);
+            if li > lj && near && faces[i].dot(faces[j]) > 0.0 {
+                outers.push(j);
             }
+        }
+        // The order of the rules as every pair was once looked at: by
+        // inner organ, then outer.
+        outers.sort_unstable();
+        overlaps.extend(outers.iter().map(|&j| Overlap { inner: i, outer: j }));
+        if overlaps.len() > MAX_OVERLAP_RULES {
+            return Err(StructureError::TooManyOverlaps {
+                limit: MAX_OVERLAP_RULES,
+            });
         }
     }
     Ok(Arrangement { organs, overlaps })
+}
+
+/// Points binned in cubic cells of one size, to find those near a point
+/// by looking in its cell and the 26 around it.
+struct Grid {
+    cell: f64,
+    cells: std::collections::HashMap<[i64; 3], Vec<usize>>,
+}
+
+impl Grid {
+    fn new(points: impl Iterator<Item = DVec3>, cell: f64) -> Grid {
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> =
+            std::collections::HashMap::new();
+        for (i, p) in points.enumerate() {
+            cells.entry(Grid::key(p, cell)).or_default().push(i);
+        }
+        Grid { cell, cells }
+    }
+
+    fn key(p: DVec3, cell: f64) -> [i64; 3] {
+        // `as` saturates: points beyond ±9e18 cells share the outermost.
+        let k = (p / cell).floor();
+        [k.x as i64, k.y as i64, k.z as i64]
+    }
+
+    /// The points in `p`'s cell and its neighbours (each once).
+    fn near(&self, p: DVec3) -> impl Iterator<Item = usize> + '_ {
+        let [x, y, z] = Grid::key(p, self.cell);
+        let mut keys = Vec::with_capacity(27);
+        for dx in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dz in -1..=1i64 {
+                    let key = [
+                        x.saturating_add(dx),
+                        y.saturating_add(dy),
+                        z.saturating_add(dz),
+                    ];
+                    // Saturated keys repeat at the edges of the range.
+                    if !keys.contains(&key) {
+                        keys.push(key);
+                    }
+                }
+            }
+        }
+        keys.into_iter()
+            .filter_map(|key| self.cells.get(&key))
+            .flatten()
+            .copied()
+    }
 }
 
 #[cfg(test)]

@@ -260,3 +260,232 @@ fn syntax_errors_name_the_line_the_column_and_what_was_expected() {
         LSystemError::TooLong { step: 20 }
     ));
 }
+
+// ------------------------------------------------- bounds (issue 38)
+
+use super::whorl::{Spiral, Whorl, nested_whorls, spiral};
+use super::{MAX_STRUCTURE_ORGANS, Structure, StructureError};
+use crate::Overlap;
+
+/// The rules of nested whorls as every pair was once looked at.
+fn nested_pairs_by_brute_force(whorls: &[Whorl]) -> Vec<Overlap> {
+    let mut first = 0;
+    let firsts: Vec<usize> = whorls
+        .iter()
+        .map(|w| {
+            let f = first;
+            first += w.count;
+            f
+        })
+        .collect();
+    let mut out = Vec::new();
+    for (i, inner) in whorls.iter().enumerate() {
+        for (j, outer) in whorls.iter().enumerate().skip(i + 1) {
+            for a in 0..inner.count {
+                for b in 0..outer.count {
+                    let d = super::whorl::angular_distance_deg(
+                        inner.azimuth_deg(a),
+                        outer.azimuth_deg(b),
+                    );
+                    if d < inner.half_span_deg + outer.half_span_deg {
+                        out.push(Overlap {
+                            inner: firsts[i] + a,
+                            outer: firsts[j] + b,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn ring(name: &str, count: usize, offset_deg: f64, half_span_deg: f64) -> Whorl {
+    Whorl {
+        name: name.to_owned(),
+        template: 0,
+        count,
+        offset_deg,
+        radius: 1.0,
+        height: 0.0,
+        joint_angle_deg: 0.0,
+        half_span_deg,
+    }
+}
+
+#[test]
+fn windowed_whorl_rules_are_the_rules_of_every_pair_in_the_same_order() {
+    // Counts, offsets and spans from narrow to wider than the circle.
+    for (n_in, n_out, offset, span_in, span_out) in [
+        (3, 3, 60.0, 40.0, 45.0),
+        (5, 5, 36.0, 30.0, 30.0),
+        (7, 13, 11.3, 5.0, 9.0),
+        (40, 17, -250.0, 2.0, 12.0),
+        (6, 6, 0.0, 30.0, 30.0),
+        (9, 4, 725.0, 100.0, 90.0),
+        (1, 8, 0.0, 0.0, 22.5),
+    ] {
+        let whorls = [
+            ring("in", n_in, 0.0, span_in),
+            ring("mid", n_out, offset, span_out),
+            ring("out", n_in + n_out, offset / 3.0, span_in),
+        ];
+        assert_eq!(
+            nested_whorls(&whorls).overlaps,
+            nested_pairs_by_brute_force(&whorls),
+            "{n_in} {n_out} {offset} {span_in} {span_out}"
+        );
+    }
+}
+
+#[test]
+fn windowed_spiral_rules_are_the_rules_of_every_pair_in_the_same_order() {
+    for (count, divergence, half_span) in [
+        (30, super::GOLDEN_ANGLE_DEG, 40.0),
+        (200, super::GOLDEN_ANGLE_DEG, 7.5),
+        (50, 90.0, 45.0),
+        (50, 360.0, 1.0),
+        (25, -100.0, 95.0),
+    ] {
+        let s = Spiral {
+            name: "s".to_owned(),
+            template: 0,
+            count,
+            divergence_deg: divergence,
+            first_radius: 1.0,
+            first_height: 0.0,
+            radius_step: 0.0,
+            height_step: 0.0,
+            joint_angle_deg: 0.0,
+            half_span_deg: half_span,
+        };
+        let azimuth = |k: usize| divergence * k as f64;
+        let mut expected = Vec::new();
+        for later in 0..count {
+            for earlier in 0..later {
+                if super::whorl::angular_distance_deg(azimuth(earlier), azimuth(later))
+                    < 2.0 * half_span
+                {
+                    expected.push(Overlap {
+                        inner: later,
+                        outer: earlier,
+                    });
+                }
+            }
+        }
+        assert_eq!(spiral(&s).overlaps, expected, "{count} {divergence}");
+    }
+}
+
+fn test_templates() -> Vec<crate::Template> {
+    vec![
+        crate::test_template("a", anthesis_mesh::generate::test_petal(1.0, 0.5, 2, 3)),
+        crate::test_template("b", anthesis_mesh::generate::test_petal(1.0, 0.5, 2, 3)),
+    ]
+}
+
+fn lsystem(text: &str, steps: u32) -> Structure {
+    Structure::LSystem {
+        text: text.to_owned(),
+        steps,
+        surfaces: [('A', 0), ('B', 1)].into_iter().collect(),
+        units: 1.0,
+    }
+}
+
+#[test]
+fn too_many_organs_are_refused_before_any_is_made() {
+    // 2^14 = 16,384 organs from a few bytes.
+    let doubling = lsystem("axiom: ~A f(10)\n~A -> ~A f(10) ~A", 14);
+    assert_eq!(
+        doubling.arrange(&test_templates()),
+        Err(StructureError::TooManyOrgans { count: 16_384 })
+    );
+    let ring = Structure::Whorls {
+        whorls: vec![ring("r", MAX_STRUCTURE_ORGANS + 1, 0.0, 1.0)],
+        contorted: false,
+    };
+    assert!(matches!(
+        ring.arrange(&test_templates()),
+        Err(StructureError::TooManyOrgans { .. })
+    ));
+}
+
+#[test]
+fn lsystem_rules_pair_only_organs_within_reach() {
+    // Two rows of A and B organs facing the same way, 100 apart along x:
+    // each B lies inside the A beside it only (all pairs faced alike).
+    let text = "axiom: ~A ~B -(90) f(100) +(90) ~A ~B -(90) f(100) +(90) ~A ~B";
+    let arrangement = lsystem(text, 0).arrange(&test_templates()).unwrap();
+    let pairs: Vec<(usize, usize)> = arrangement
+        .overlaps
+        .iter()
+        .map(|o| (o.inner, o.outer))
+        .collect();
+    assert_eq!(pairs, [(1, 0), (3, 2), (5, 4)]);
+    // All at one spot: every B inside every A, in order.
+    let text = "axiom: ~A ~A ~B ~B";
+    let arrangement = lsystem(text, 0).arrange(&test_templates()).unwrap();
+    let pairs: Vec<(usize, usize)> = arrangement
+        .overlaps
+        .iter()
+        .map(|o| (o.inner, o.outer))
+        .collect();
+    assert_eq!(pairs, [(2, 0), (2, 1), (3, 0), (3, 1)]);
+}
+
+#[test]
+fn organs_piled_on_one_spot_are_refused_not_paired_forever() {
+    // 2 x 4096 organs at the origin: 16.7 million pairs within reach.
+    let piled = lsystem("axiom: ~A ~B\n~A -> ~A ~A\n~B -> ~B ~B", 12);
+    assert!(matches!(
+        piled.arrange(&test_templates()),
+        Err(StructureError::TooManyOverlaps { .. })
+    ));
+}
+
+#[test]
+fn a_parameter_that_is_not_finite_is_refused_with_line_and_column() {
+    let error = LSystem::parse("axiom: F\n\nA -> +(0/0) F").unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "L-system line 3, column 8: `0/0` is NaN, not a finite number"
+    );
+    let error = LSystem::parse("axiom: +(1/0)F").unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "L-system line 1, column 10: `1/0` is inf, not a finite number"
+    );
+    let error = LSystem::parse("angle = NaN\naxiom: F").unwrap_err();
+    assert!(matches!(
+        error,
+        LSystemError::NotFinite {
+            line: 1,
+            column: 9,
+            ..
+        }
+    ));
+    // Known only when derived: named with its production and step.
+    let system = LSystem::parse("axiom: A(1)\nA(x) -> A(x / 0)").unwrap();
+    assert_eq!(
+        system.derive(2).unwrap_err().to_string(),
+        "L-system line 2: the production gives module A the parameter inf at derivation step 1, not a finite number"
+    );
+}
+
+#[test]
+fn a_deeply_nested_expression_is_refused_not_a_stack_overflow() {
+    let deep = format!("axiom: F({}1{})", "(".repeat(100_000), ")".repeat(100_000));
+    assert!(matches!(
+        LSystem::parse(&deep),
+        Err(LSystemError::TooComplex {
+            line: 1,
+            column: 10
+        })
+    ));
+    let long = format!("axiom: F({})", vec!["1"; 100_000].join("+"));
+    assert!(matches!(
+        LSystem::parse(&long),
+        Err(LSystemError::TooComplex { .. })
+    ));
+}

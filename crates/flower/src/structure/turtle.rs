@@ -1,4 +1,4 @@
-//! The turtle interpretation of `lsystem-bezier-flower.txt` §2: a derived
+//! The turtle interpretation of Qin and Chen 2006 §2: a derived
 //! word read from left to right moves a turtle (position P, heading H,
 //! left L, up U with H × L = U), draws `F` segments as tubes of the current
 //! width and places the surfaces `~X` at its position and frame.

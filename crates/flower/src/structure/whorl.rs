@@ -11,7 +11,7 @@ use crate::{Organ, Overlap, Placement};
 use glam::DVec3;
 
 /// The golden divergence angle of spiral phyllotaxis, 360° (1 − 1/φ)
-/// (`sketch-based-floral-blossom.txt` §3.2).
+/// (the floral blossom paper §3.2).
 pub const GOLDEN_ANGLE_DEG: f64 = 137.507_764_050_037_85;
 
 /// A ring of identical organs around the axis.
@@ -91,10 +91,26 @@ pub struct Arrangement {
     pub overlaps: Vec<Overlap>,
 }
 
+/// The most overlap rules a structure may make (a flower's organs meet
+/// their few neighbours; a ring of organs each spanning the whole circle
+/// would otherwise make a rule for every pair).
+pub const MAX_OVERLAP_RULES: usize = 100_000;
+
 /// Nested whorls, innermost first: every organ lies inside each organ of
 /// an outer whorl whose span it meets (the lily's petals inside its sepals).
 /// Organs of one whorl get no rule between them (they sit side by side).
 pub fn nested_whorls(whorls: &[Whorl]) -> Arrangement {
+    // No count of rules passes usize::MAX.
+    match nested_whorls_within(whorls, usize::MAX) {
+        Ok(arrangement) | Err(arrangement) => arrangement,
+    }
+}
+
+/// [`nested_whorls`], stopping with what it made so far (`Err`) as soon as
+/// there are more than `limit` overlap rules. Only the organs of an outer
+/// whorl within an organ's span are looked at, so the work grows with the
+/// organs and the rules, not with every pair.
+pub fn nested_whorls_within(whorls: &[Whorl], limit: usize) -> Result<Arrangement, Arrangement> {
     let mut organs = Vec::new();
     let mut first_index = Vec::new();
     for whorl in whorls {
@@ -102,24 +118,52 @@ pub fn nested_whorls(whorls: &[Whorl]) -> Arrangement {
         organs.extend(whorl.organs());
     }
     let mut overlaps = Vec::new();
+    let mut outers = Vec::new();
     for (i, inner) in whorls.iter().enumerate() {
         for (j, outer) in whorls.iter().enumerate().skip(i + 1) {
+            let reach = inner.half_span_deg + outer.half_span_deg;
             for a in 0..inner.count {
-                for b in 0..outer.count {
-                    let distance = angular_distance_deg(inner.azimuth_deg(a), outer.azimuth_deg(b));
-                    if distance < inner.half_span_deg + outer.half_span_deg {
-                        overlaps.push(Overlap {
-                            inner: first_index[i] + a,
-                            outer: first_index[j] + b,
-                        });
+                let azimuth = inner.azimuth_deg(a);
+                outers.clear();
+                for b in ring_window(outer, azimuth, reach) {
+                    let distance = angular_distance_deg(azimuth, outer.azimuth_deg(b));
+                    if distance < reach {
+                        outers.push(b);
                     }
+                }
+                outers.sort_unstable();
+                outers.dedup();
+                overlaps.extend(outers.iter().map(|&b| Overlap {
+                    inner: first_index[i] + a,
+                    outer: first_index[j] + b,
+                }));
+                if overlaps.len() > limit {
+                    return Err(Arrangement { organs, overlaps });
                 }
             }
         }
     }
-    Arrangement { organs, overlaps }
+    Ok(Arrangement { organs, overlaps })
 }
 
+/// The organs of `ring` whose azimuths may lie within `reach` degrees of
+/// `azimuth` (a few more at the window's ends; all when the window is as
+/// wide as the ring).
+fn ring_window(ring: &Whorl, azimuth: f64, reach: f64) -> Box<dyn Iterator<Item = usize>> {
+    let n = ring.count;
+    let step = 360.0 / n.max(1) as f64;
+    let wide = !(reach.is_finite() && azimuth.is_finite() && ring.offset_deg.is_finite())
+        || 2.0 * reach / step + 3.0 >= n as f64;
+    if wide {
+        return Box::new(0..n);
+    }
+    let centre = (azimuth - ring.offset_deg) / step;
+    let half = reach / step;
+    let first = (centre - half).floor() as i64 - 1;
+    let last = (centre + half).ceil() as i64 + 1;
+    let n = n as i64;
+    Box::new((first..=last).map(move |k| k.rem_euclid(n) as usize))
+}
 /// One contorted whorl (Eustoma's corolla, paper Fig. 12(b)): each organ's
 /// right side (towards increasing azimuth) lies beneath its right-hand
 /// neighbour. Requires the spans of neighbours to meet and those of organs
@@ -142,7 +186,7 @@ pub fn contorted_whorl(whorl: &Whorl) -> Option<Arrangement> {
     })
 }
 
-/// A phyllotactic spiral (`sketch-based-floral-blossom.txt` §3.2).
+/// A phyllotactic spiral (the floral blossom paper §3.2).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spiral {
     /// Organ names are `<name>-1`, `<name>-2`, … from the first (outermost)
@@ -172,8 +216,83 @@ pub struct Spiral {
 /// organ of each pair whose spans meet lies outside the later one, as in a
 /// rose bud.
 pub fn spiral(spiral: &Spiral) -> Arrangement {
+    let organs = spiral_organs(spiral);
+    match spiral_overlaps(spiral, usize::MAX) {
+        Ok(overlaps) | Err(overlaps) => Arrangement { organs, overlaps },
+    }
+}
+
+/// [`spiral`], or `Err` as soon as it makes more than `limit` overlap
+/// rules.
+pub fn spiral_within(spiral: &Spiral, limit: usize) -> Result<Arrangement, Arrangement> {
+    let organs = spiral_organs(spiral);
+    match spiral_overlaps(spiral, limit) {
+        Ok(overlaps) => Ok(Arrangement { organs, overlaps }),
+        Err(overlaps) => Err(Arrangement { organs, overlaps }),
+    }
+}
+
+/// The overlap rules of a spiral, later organ inside earlier, ordered by
+/// the later organ then the earlier; `Err` with those made so far past
+/// `limit`. The organs sorted by azimuth give, by binary search, those
+/// within an organ's span, so the work grows with n log n and the rules.
+fn spiral_overlaps(spiral: &Spiral, limit: usize) -> Result<Vec<Overlap>, Vec<Overlap>> {
     let azimuth = |k: usize| spiral.divergence_deg * k as f64;
-    let organs = (0..spiral.count)
+    let reach = 2.0 * spiral.half_span_deg;
+    let mut by_azimuth: Vec<(f64, usize)> = (0..spiral.count)
+        .map(|k| (azimuth(k).rem_euclid(360.0), k))
+        .collect();
+    by_azimuth.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let all = !(reach.is_finite() && reach < 180.0 && spiral.divergence_deg.is_finite());
+    let mut overlaps = Vec::new();
+    let mut earlier = Vec::new();
+    for later in 0..spiral.count {
+        earlier.clear();
+        let mut consider = |k: usize| {
+            if k < later && angular_distance_deg(azimuth(k), azimuth(later)) < reach {
+                earlier.push(k);
+            }
+        };
+        if all {
+            (0..later).for_each(&mut consider);
+        } else {
+            // The window [a - reach, a + reach] around 360, a little wider
+            // for rounding; the exact test above decides.
+            let a = azimuth(later).rem_euclid(360.0);
+            let slack = 1e-9 * (1.0 + a.abs());
+            let mut window = |lo: f64, hi: f64| {
+                let start = by_azimuth.partition_point(|e| e.0 < lo);
+                let end = by_azimuth.partition_point(|e| e.0 <= hi);
+                for &(_, k) in &by_azimuth[start..end.max(start)] {
+                    consider(k);
+                }
+            };
+            let (lo, hi) = (a - reach - slack, a + reach + slack);
+            window(lo.max(0.0), hi.min(360.0));
+            if lo < 0.0 {
+                window(lo + 360.0, 360.0);
+            }
+            if hi > 360.0 {
+                window(0.0, hi - 360.0);
+            }
+        }
+        earlier.sort_unstable();
+        earlier.dedup();
+        overlaps.extend(earlier.iter().map(|&k| Overlap {
+            inner: later,
+            outer: k,
+        }));
+        if overlaps.len() > limit {
+            return Err(overlaps);
+        }
+    }
+    Ok(overlaps)
+}
+
+/// The organs of a spiral, placed.
+fn spiral_organs(spiral: &Spiral) -> Vec<Organ> {
+    let azimuth = |k: usize| spiral.divergence_deg * k as f64;
+    (0..spiral.count)
         .map(|k| Organ {
             name: format!("{}-{}", spiral.name, k + 1),
             template: spiral.template,
@@ -184,19 +303,7 @@ pub fn spiral(spiral: &Spiral) -> Arrangement {
                 spiral.joint_angle_deg,
             ),
         })
-        .collect();
-    let mut overlaps = Vec::new();
-    for later in 0..spiral.count {
-        for earlier in 0..later {
-            if angular_distance_deg(azimuth(earlier), azimuth(later)) < 2.0 * spiral.half_span_deg {
-                overlaps.push(Overlap {
-                    inner: later,
-                    outer: earlier,
-                });
-            }
-        }
-    }
-    Arrangement { organs, overlaps }
+        .collect()
 }
 
 #[cfg(test)]

@@ -5,10 +5,10 @@ use image::{ExtendedColorType, ImageEncoder};
 use crate::{BitDepth, DirectionMap, MapError, ScalarMap};
 
 /// A PNG written straight with the `image` crate, as a paint program would.
-fn png_with(width: u32, height: u32, color: ExtendedColorType, raw: &[u8]) -> Vec<u8> {
+fn png_with(width: u32, height: u32, colour: ExtendedColorType, raw: &[u8]) -> Vec<u8> {
     let mut png = Vec::new();
     PngEncoder::new(&mut png)
-        .write_image(raw, width, height, color)
+        .write_image(raw, width, height, colour)
         .expect("encodable test image");
     png
 }

@@ -1,0 +1,258 @@
+//! Number fields that say what became of a typed value. egui's `DragValue`
+//! clamps a typed value into its range and drops text that is not a number
+//! without a word ("abc" in dg reverted, a thickness of −1 became 0.001,
+//! fps 0 became 0.1). A checked field notes both: the field is outlined
+//! and its tooltip says why for a few seconds, and a line with the accepted
+//! range goes to the log ([`take_notices`], drained by the app each frame).
+//! A run that fails while a template holds a value at the edge of its
+//! field's range names it ([`values_at_limits`]).
+
+use std::cell::RefCell;
+use std::ops::RangeInclusive;
+
+use eframe::egui::{self, DragValue};
+
+/// How long a refused or clamped field stays marked, in seconds.
+const MARK_SECONDS: f64 = 6.0;
+
+/// What became of text typed into a field with `range`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Typed {
+    /// A number in the range: taken as typed.
+    Taken(f64),
+    /// A number outside the range: the field holds the nearest end.
+    Clamped {
+        /// What was typed.
+        typed: f64,
+        /// What the field holds.
+        to: f64,
+    },
+    /// Not a number: the field keeps its value.
+    Refused(String),
+}
+
+/// Reads `text` typed into a field accepting `range` (what `DragValue`
+/// would make of it, said instead of done silently).
+pub fn read_typed(text: &str, range: &RangeInclusive<f64>) -> Typed {
+    match text.trim().parse::<f64>() {
+        Ok(value) if value.is_nan() => Typed::Refused(text.to_owned()),
+        Ok(value) if range.contains(&value) => Typed::Taken(value),
+        Ok(value) => Typed::Clamped {
+            typed: value,
+            to: value.clamp(*range.start(), *range.end()),
+        },
+        Err(_) => Typed::Refused(text.to_owned()),
+    }
+}
+
+/// The log line for `typed` into the field `label`, or none when it was
+/// taken as typed.
+pub fn notice(label: &str, typed: &Typed, range: &RangeInclusive<f64>) -> Option<String> {
+    let accepted = format!("{label} accepts {} to {}", range.start(), range.end());
+    match typed {
+        Typed::Taken(_) => None,
+        Typed::Clamped { typed, to } => Some(format!(
+            "{label} {typed} is out of range ({accepted}); set to {to}"
+        )),
+        Typed::Refused(text) => Some(format!(
+            "`{}` is not a number; {label} kept its value ({accepted})",
+            text.chars().take(40).collect::<String>()
+        )),
+    }
+}
+
+/// A number field like `DragValue::new(value).speed(speed).range(range)`
+/// that marks and logs a typed value it refuses or clamps. Returns the
+/// response.
+pub fn checked_number(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut f64,
+    speed: f64,
+    range: RangeInclusive<f64>,
+) -> egui::Response {
+    let typed: RefCell<Option<Typed>> = RefCell::new(None);
+    let parse_range = range.clone();
+    let mut response = ui.add(
+        DragValue::new(value)
+            .speed(speed)
+            .range(range.clone())
+            .max_decimals(5)
+            .custom_parser(|text| {
+                let read = read_typed(text, &parse_range);
+                let value = match read {
+                    Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
+                    Typed::Refused(_) => None,
+                };
+                *typed.borrow_mut() = Some(read);
+                value
+            }),
+    );
+    let id = response.id.with("checked field notice");
+    let now = ui.input(|i| i.time);
+    if let Some(message) = typed
+        .into_inner()
+        .and_then(|typed| notice(label, &typed, &range))
+    {
+        // egui may read the typed text more than once as the edit ends:
+        // the same notice within a second is one.
+        let before: Option<(String, f64)> = ui.data(|d| d.get_temp(id));
+        let repeated = before.is_some_and(|(said, at)| said == message && now - at < 1.0);
+        ui.data_mut(|d| d.insert_temp(id, (message.clone(), now)));
+        if !repeated {
+            push_notice(ui.ctx(), message);
+        }
+    }
+    let marked: Option<(String, f64)> = ui.data(|d| d.get_temp(id));
+    if let Some((message, since)) = marked {
+        if now - since < MARK_SECONDS {
+            ui.painter().rect_stroke(
+                response.rect.expand(1.0),
+                2.0,
+                egui::Stroke::new(1.5, ui.visuals().error_fg_color),
+                egui::StrokeKind::Outside,
+            );
+            response = response.on_hover_text(message);
+            ui.ctx()
+                .request_repaint_after(std::time::Duration::from_secs_f64(MARK_SECONDS));
+        } else {
+            ui.data_mut(|d| d.remove::<(String, f64)>(id));
+        }
+    }
+    response
+}
+
+fn notices_id() -> egui::Id {
+    egui::Id::unique("checked field notices")
+}
+
+fn push_notice(ctx: &egui::Context, message: String) {
+    ctx.data_mut(|d| {
+        d.get_temp_mut_or_default::<Vec<String>>(notices_id())
+            .push(message)
+    });
+}
+
+/// The notices of refused and clamped values since the last call, for the
+/// log.
+pub fn take_notices(ctx: &egui::Context) -> Vec<String> {
+    ctx.data_mut(|d| std::mem::take(d.get_temp_mut_or_default::<Vec<String>>(notices_id())))
+}
+
+/// The ranges of the template fields a run depends on, as the parameters
+/// panel gives them: (label, value, range).
+pub fn template_fields(
+    template: &anthesis_flower::Template,
+) -> [(&'static str, f64, RangeInclusive<f64>); 4] {
+    [
+        ("dg", template.dg, DG_RANGE),
+        ("thickness", template.thickness, THICKNESS_RANGE),
+        ("Ks", template.stretch_stiffness, STIFFNESS_RANGE),
+        ("Kb", template.bend_stiffness, STIFFNESS_RANGE),
+    ]
+}
+
+/// The range of the dg field.
+pub const DG_RANGE: RangeInclusive<f64> = -0.5..=0.5;
+/// The range of the thickness field.
+pub const THICKNESS_RANGE: RangeInclusive<f64> = 0.001..=100.0;
+/// The range of the stiffness fields.
+pub const STIFFNESS_RANGE: RangeInclusive<f64> = 0.001..=1.0e6;
+
+/// The values of `project`'s templates that sit at an end of their field's
+/// range (where a typed value was clamped to), each said for a failure
+/// message: "thickness 0.001 of petal is the lowest the field accepts
+/// (0.001 to 100)".
+pub fn values_at_limits(project: &anthesis_flower::Project) -> Vec<String> {
+    let mut said = Vec::new();
+    for template in &project.flower.templates {
+        for (label, value, range) in template_fields(template) {
+            let end = if value <= *range.start() {
+                "lowest"
+            } else if value >= *range.end() {
+                "highest"
+            } else {
+                continue;
+            };
+            said.push(format!(
+                "{label} {value} of {} is the {end} the field accepts ({} to {})",
+                template.name,
+                range.start(),
+                range.end()
+            ));
+        }
+    }
+    said
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn typed_values_are_taken_clamped_or_refused_and_said() {
+        let range = THICKNESS_RANGE;
+        assert_eq!(read_typed(" 0.2 ", &range), Typed::Taken(0.2));
+        assert_eq!(
+            read_typed("-1", &range),
+            Typed::Clamped {
+                typed: -1.0,
+                to: 0.001
+            }
+        );
+        assert_eq!(read_typed("abc", &range), Typed::Refused("abc".into()));
+        assert_eq!(read_typed("NaN", &range), Typed::Refused("NaN".into()));
+        assert_eq!(notice("thickness", &Typed::Taken(0.2), &range), None);
+        assert_eq!(
+            notice("thickness", &read_typed("-1", &range), &range).as_deref(),
+            Some("thickness -1 is out of range (thickness accepts 0.001 to 100); set to 0.001")
+        );
+        assert_eq!(
+            notice("dg", &read_typed("abc", &DG_RANGE), &DG_RANGE).as_deref(),
+            Some("`abc` is not a number; dg kept its value (dg accepts -0.5 to 0.5)")
+        );
+    }
+
+    #[test]
+    fn a_value_at_the_end_of_its_range_is_named() {
+        let mut project = anthesis_garden::five_petal::five_petal().expect("the five-petal start");
+        assert_eq!(values_at_limits(&project), Vec::<String>::new());
+        project.flower.templates[0].thickness = *THICKNESS_RANGE.start();
+        assert_eq!(
+            values_at_limits(&project),
+            ["thickness 0.001 of petal is the lowest the field accepts (0.001 to 100)"]
+        );
+    }
+
+    #[test]
+    fn a_refused_and_a_clamped_field_are_logged_once() {
+        use egui_kittest::Harness;
+        use egui_kittest::kittest::Queryable;
+        let mut harness = Harness::new_ui_state(
+            |ui, state: &mut (f64, Vec<String>)| {
+                let label = ui.label("thickness");
+                checked_number(ui, "thickness", &mut state.0, 0.005, THICKNESS_RANGE)
+                    .labelled_by(label.id);
+                state.1.extend(take_notices(ui.ctx()));
+            },
+            (0.2, Vec::new()),
+        );
+        for text in ["abc", "-1"] {
+            harness.get_by_label("thickness").focus();
+            harness.run();
+            harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+            harness.get_by_label("thickness").type_text(text);
+            harness.key_press(egui::Key::Enter);
+            harness.run();
+        }
+        let (value, notices) = harness.state().clone();
+        assert_eq!(
+            notices,
+            [
+                "`abc` is not a number; thickness kept its value (thickness accepts 0.001 to 100)",
+                "thickness -1 is out of range (thickness accepts 0.001 to 100); set to 0.001",
+            ]
+        );
+        assert_eq!(value, 0.001);
+    }
+}

@@ -1,0 +1,521 @@
+//! Phase 2 (and again after each settling): the contact search. Where the
+//! organs are, which particles lie near a neighbour, a part or their own
+//! surface beyond its neighbourhood, each with the side it must stay on:
+//! overlap sides, free pairs (organs without an overlap rule), parts and
+//! self-contacts (see `collide`).
+
+use anthesis_physics::Contact;
+use anthesis_physics::solver::same_position_bits;
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::Simulation;
+use crate::collide::{
+    Held, Surface, Tracker, Violated, contacts_against, contacts_of, held_where,
+    kept_side_contacts, move_half, reactions, self_contacts,
+};
+use crate::organ::OrganSim;
+
+/// How deep, in mean edges of the pressed organ, a contact may be violated
+/// and still push the other organ back (two-sided contact).
+const REACTION_DEPTH: f64 = 0.5;
+
+impl Simulation {
+    /// Every overlap side's contacts and every organ's against the parts,
+    /// from the current positions (`geometry`: what is known of the organs
+    /// there, completed here), each to be put all the way
+    /// ([`Violated::MoveAll`]; [`Simulation::contacts`] gives each organ's
+    /// list, moved half way where both organs give way).
+    pub(crate) fn search(&self, geometry: &mut [Option<Geometry>]) -> Found {
+        let mut parts = vec![Vec::new(); self.organs.len()];
+        self.obstacle_contacts(&mut parts, &vec![true; self.organs.len()]);
+        self.drop_base_contacts(&mut parts);
+        geometry
+            .par_iter_mut()
+            .zip(&self.organs)
+            .for_each(|(known, organ)| {
+                known.get_or_insert_with(|| Geometry::of(organ));
+            });
+        let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
+        let selves = self.self_contacts(&geometry);
+        let free = self
+            .free
+            .par_iter()
+            .map(|&(moving, other)| self.free_contacts_of(moving, other, geometry[other]))
+            .collect();
+        let mut sides = vec![Vec::new(); 2 * self.overlaps.len()];
+        if !self.overlaps.is_empty() {
+            // A kinematic organ (two-state) gets no contacts.
+            let keys: Vec<(usize, usize, usize, f64)> = self
+                .sides()
+                .filter(|&(_, moving, _, _)| !self.organs[moving].is_kinematic())
+                .collect();
+            // Each side's contacts on its own thread.
+            let found: Vec<Vec<Contact>> = keys
+                .par_iter()
+                .map(|&(_, moving, other, side)| {
+                    self.contacts_between(moving, other, side, geometry[other])
+                })
+                .collect();
+            for (&(key, ..), list) in keys.iter().zip(found) {
+                sides[key] = list;
+            }
+        }
+        let side_held = self
+            .sides()
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|&(key, moving, other, _)| self.held(moving, other, &sides[key], geometry[other]))
+            .collect();
+        let free_held = self
+            .free
+            .par_iter()
+            .zip(&free)
+            .map(
+                |(&(moving, other), list): (&(usize, usize), &Vec<Contact>)| {
+                    self.held(moving, other, list, geometry[other])
+                },
+            )
+            .collect();
+        Found {
+            parts,
+            sides,
+            selves,
+            free,
+            side_held,
+            free_held,
+        }
+    }
+
+    /// Where the violated contacts of `list` (organ `moving`'s against
+    /// organ `other`, whose geometry is `known`) press on `other`, for
+    /// their reactions (none on a kinematic organ, which does not give
+    /// way).
+    fn held(&self, moving: usize, other: usize, list: &[Contact], known: &Geometry) -> Vec<Held> {
+        let o = &self.organs[other];
+        if !self.two_sided || o.is_kinematic() || list.is_empty() {
+            return Vec::new();
+        }
+        held_where(
+            list,
+            &self.organs[moving].positions,
+            &o.surface(&known.normals),
+            &known.tracker,
+        )
+    }
+
+    /// Organ `moving`'s contacts against organ `other` (a free pair;
+    /// `known`: the other's geometry where it is), each keeping the side it
+    /// was on when the last keyframe ended, to be put all the way.
+    pub(crate) fn free_contacts_of(
+        &self,
+        moving: usize,
+        other: usize,
+        known: &Geometry,
+    ) -> Vec<Contact> {
+        let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let mut list = Vec::new();
+        let (Some(previous_moving), Some(previous_other)) = (
+            m.previous(),
+            o.previous()
+                .or_else(|| o.is_kinematic().then_some(o.positions.as_slice())),
+        ) else {
+            return list;
+        };
+        let previous_normals = anthesis_mesh::vertex_normals(previous_other, &o.mesh.triangles);
+        let then = Surface {
+            positions: previous_other,
+            ..o.surface(&previous_normals)
+        };
+        kept_side_contacts(
+            &m.surface(&[]),
+            &o.surface(&known.normals),
+            &known.tracker,
+            previous_moving,
+            &then,
+            &m.is_base,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut list,
+        );
+        list
+    }
+
+    /// How many of each organ's contacts of `found` are against the parts
+    /// and its neighbours: [`Simulation::contacts`] appends the
+    /// self-contacts after them.
+    pub(crate) fn neighbour_contacts(&self, found: &Found) -> Vec<usize> {
+        let mut counts: Vec<usize> = found.parts.iter().map(Vec::len).collect();
+        for (key, moving, _, _) in self.sides() {
+            counts[moving] += found.sides[key].len();
+        }
+        for (&(moving, _), list) in self.free.iter().zip(&found.free) {
+            counts[moving] += list.len();
+        }
+        counts
+    }
+
+    /// Whether any organ can touch itself (a growing organ: a kinematic
+    /// one gets no contacts).
+    pub(crate) fn self_contact(&self) -> bool {
+        self.organs.iter().any(|o| !o.is_kinematic())
+    }
+
+    /// Each organ's self-contacts where it is (`geometry`: each organ's),
+    /// each to be put all the way, base particles left out (see
+    /// `collide::self_contacts`).
+    pub(crate) fn self_contacts(&self, geometry: &[&Geometry]) -> Vec<Vec<Contact>> {
+        (0..self.organs.len())
+            .into_par_iter()
+            .map(|i| self.self_contacts_of(i, geometry[i]))
+            .collect()
+    }
+
+    /// Organ `i`'s self-contacts where it is (`known`: its geometry).
+    pub(crate) fn self_contacts_of(&self, i: usize, known: &Geometry) -> Vec<Contact> {
+        let organ = &self.organs[i];
+        let mut list = Vec::new();
+        let Some(previous) = organ.previous().filter(|_| !organ.is_kinematic()) else {
+            return list;
+        };
+        let locality = organ.locality();
+        let cells = known.tracker.cell_bounds(locality.uv);
+        let previous_normals = anthesis_mesh::vertex_normals(previous, &organ.mesh.triangles);
+        let then = Surface {
+            positions: previous,
+            ..organ.surface(&previous_normals)
+        };
+        self_contacts(
+            &organ.surface(&known.normals),
+            &known.tracker,
+            &cells,
+            &locality,
+            &then,
+            &organ.is_base,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut list,
+        );
+        list
+    }
+
+    /// Each organ's contacts of `found`: against the parts, then each side
+    /// in order, then (with `selves`) against itself. With
+    /// [`Violated::MoveHalf`] a violated contact against an organ that
+    /// gives way moves half way (a kinematic organ, two-state, never gives
+    /// way, so the organ against it moves all the way, as against a part);
+    /// so does a self-contact (the other side of the fold is held off this
+    /// one too). The statistics count contacts without `selves` (particles
+    /// touching a neighbour).
+    pub(crate) fn contacts(
+        &self,
+        found: &Found,
+        violated: Violated,
+        selves: bool,
+    ) -> Vec<Vec<Contact>> {
+        let mut contacts = found.parts.clone();
+        for (key, moving, other, _) in self.sides() {
+            let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
+            let positions = &self.organs[moving].positions;
+            contacts[moving].extend(found.sides[key].iter().map(|&c| {
+                if half {
+                    move_half(c, positions[c.particle as usize])
+                } else {
+                    c
+                }
+            }));
+        }
+        for (&(moving, other), list) in self.free.iter().zip(&found.free) {
+            let half = violated == Violated::MoveHalf && !self.organs[other].is_kinematic();
+            let positions = &self.organs[moving].positions;
+            contacts[moving].extend(list.iter().map(|&c| {
+                if half {
+                    move_half(c, positions[c.particle as usize])
+                } else {
+                    c
+                }
+            }));
+        }
+        if selves {
+            for ((list, own), organ) in contacts.iter_mut().zip(&found.selves).zip(&self.organs) {
+                list.extend(own.iter().map(|&c| match violated {
+                    Violated::MoveHalf => move_half(c, organ.positions[c.particle as usize]),
+                    Violated::MoveAll => c,
+                }));
+            }
+            if violated == Violated::MoveHalf && self.two_sided {
+                self.add_reactions(found, &mut contacts);
+            }
+        }
+        contacts
+    }
+
+    /// Two-sided contact (issue 35): each violated contact of a side or a
+    /// free pair against an organ that gives way pushes that organ back,
+    /// at the triangle it presses on (see `collide::reactions`), so a
+    /// petal pressing a neighbour moves it. Appended to the pressed
+    /// organ's list after its own contacts; its base particles, which
+    /// attachment places, are left out.
+    fn add_reactions(&self, found: &Found, contacts: &mut [Vec<Contact>]) {
+        let lists = self
+            .sides()
+            .map(|(key, moving, other, _)| {
+                (moving, other, &found.sides[key], &found.side_held[key])
+            })
+            .chain(
+                self.free
+                    .iter()
+                    .zip(found.free.iter().zip(&found.free_held))
+                    .map(|(&(moving, other), (list, held))| (moving, other, list, held)),
+            );
+        for (moving, other, list, held) in lists {
+            let (m, o) = (&self.organs[moving], &self.organs[other]);
+            let mut pushed = Vec::new();
+            // A triangle with a base corner is placed by attachment and
+            // gets no reaction (driven through a neighbour's base region,
+            // the pressing organ was stretched 24 % against it:
+            // `collisions.rs`, the organ turned past horizontal).
+            for h in held
+                .iter()
+                .filter(|h| h.corners.iter().all(|&k| !o.is_base[k as usize]))
+            {
+                let c = &list[h.contact as usize];
+                // Only a contact pressed in less than REACTION_DEPTH pushes
+                // back: a particle grown or driven deep into a neighbour in
+                // one keyframe is put on its side by the presser alone, as
+                // before (its reaction moved the neighbour's triangles by
+                // half that depth at once, and Newton found no descent
+                // from there: `crossings.rs`, the jammed petals).
+                if c.violation(m.positions[c.particle as usize]) > REACTION_DEPTH * o.mean_edge {
+                    continue;
+                }
+                reactions(
+                    c,
+                    h,
+                    m.positions[c.particle as usize],
+                    &o.positions,
+                    &mut pushed,
+                );
+            }
+            contacts[other].extend(
+                pushed
+                    .into_iter()
+                    .filter(|c| !o.is_base[c.particle as usize]),
+            );
+        }
+    }
+
+    /// Base particles sit on the receptacle, where organs meet by design;
+    /// attachment, not collision, decides where they go.
+    pub(crate) fn drop_base_contacts(&self, contacts: &mut [Vec<Contact>]) {
+        for (organ, list) in self.organs.iter().zip(contacts) {
+            list.retain(|c| !organ.is_base[c.particle as usize]);
+        }
+    }
+
+    /// Contacts keeping the particles of every organ `wanted` outside the
+    /// parts, each to be put all the way out (a part does not move aside).
+    pub(crate) fn obstacle_contacts(&self, contacts: &mut [Vec<Contact>], wanted: &[bool]) {
+        let offset = self.settings.collision_offset;
+        let obstacles = &self.obstacles;
+        if obstacles.is_empty() {
+            return;
+        }
+        self.organs
+            .par_iter()
+            .zip(contacts)
+            .zip(wanted)
+            .for_each(|((organ, list), &wanted)| {
+                if organ.is_kinematic() || !wanted {
+                    return;
+                }
+                for obstacle in obstacles {
+                    let near = organ
+                        .positions
+                        .iter()
+                        .copied()
+                        .enumerate()
+                        .filter(|&(_, p)| obstacle.reaches(p));
+                    contacts_of(
+                        near,
+                        &organ.surface(&[]),
+                        &obstacle.surface(),
+                        obstacle.tracker(),
+                        1.0,
+                        offset,
+                        Violated::MoveAll,
+                        list,
+                    );
+                }
+            });
+    }
+
+    /// Contacts of organ `moving` against organ `other` (`known`: its
+    /// normals and tracker where it is) from the current positions, each
+    /// moving particle to be put all the way on its side (`side` as in
+    /// [`contacts_against`]).
+    pub(crate) fn contacts_between(
+        &self,
+        moving: usize,
+        other: usize,
+        side: f64,
+        known: &Geometry,
+    ) -> Vec<Contact> {
+        let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let other_surface = o.surface(&known.normals);
+        let moving_surface = m.surface(&[]);
+        let mut contacts = Vec::new();
+        contacts_against(
+            &moving_surface,
+            &other_surface,
+            &known.tracker,
+            side,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut contacts,
+        );
+        contacts.retain(|c| !m.is_base[c.particle as usize]);
+        contacts
+    }
+
+    /// Which particles of organ `moving` are no longer where `before`
+    /// has them (bit for bit).
+    pub(crate) fn changed_since(&self, moving: usize, before: &[DVec3]) -> Vec<usize> {
+        let now = &self.organs[moving].positions;
+        (0..now.len())
+            .filter(|&p| !same_position_bits(now[p], before[p]))
+            .collect()
+    }
+
+    /// `list`, the contacts of organ `moving` against organ `other` found
+    /// where `other` is now, brought to where `moving`'s particles are now:
+    /// the particles `changed` (ascending) and those sharing an edge with
+    /// one are searched again, the others' contacts kept. The same as
+    /// [`Simulation::contacts_between`] (each particle's contact depends
+    /// only on where it, the particles it shares an edge with and the other
+    /// organ are), in the same order (by particle, at most one each).
+    pub(crate) fn update_contacts(
+        &self,
+        moving: usize,
+        other: usize,
+        side: f64,
+        known: &Geometry,
+        list: Vec<Contact>,
+        changed: &[usize],
+    ) -> Vec<Contact> {
+        let (m, o) = (&self.organs[moving], &self.organs[other]);
+        let own = m.surface(&[]);
+        let mut is_changed = vec![false; m.positions.len()];
+        for &p in changed {
+            for &t in own.rings.around(p as u32) {
+                for k in own.triangles[t as usize] {
+                    is_changed[k as usize] = true;
+                }
+            }
+        }
+        let mut fresh = Vec::new();
+        contacts_of(
+            (0..m.positions.len())
+                .filter(|&p| is_changed[p])
+                .map(|p| (p, m.positions[p])),
+            &own,
+            &o.surface(&known.normals),
+            &known.tracker,
+            side,
+            self.settings.collision_offset,
+            Violated::MoveAll,
+            &mut fresh,
+        );
+        fresh.retain(|c| !m.is_base[c.particle as usize]);
+        let mut merged = Vec::with_capacity(list.len() + fresh.len());
+        let mut fresh = fresh.into_iter().peekable();
+        for c in list {
+            while let Some(f) = fresh.next_if(|f| f.particle < c.particle) {
+                merged.push(f);
+            }
+            if !is_changed[c.particle as usize] {
+                merged.push(c);
+            }
+        }
+        merged.extend(fresh);
+        merged
+    }
+
+    /// Every overlap side in order: its key in [`Found::sides`], the organ
+    /// whose particles it holds, the other organ, and which side of the
+    /// other they stay on (+1 its inner side). Inner particles stay on the
+    /// outer organ's inner side (key `2 * overlap`), outer particles on the
+    /// inner organ's outer side (`2 * overlap + 1`).
+    pub(crate) fn sides(&self) -> impl Iterator<Item = (usize, usize, usize, f64)> + '_ {
+        self.overlaps
+            .iter()
+            .enumerate()
+            .flat_map(|(index, &(inner, outer))| {
+                [
+                    (2 * index, inner, outer, 1.0),
+                    (2 * index + 1, outer, inner, -1.0),
+                ]
+            })
+    }
+}
+
+/// A contact search where the organs are (see `Simulation::search`): each
+/// organ's contacts against the parts and each overlap side's (`2 * overlap`
+/// for the inner organ's particles, `2 * overlap + 1` for the outer's), each
+/// to be put all the way, base particles left out.
+pub(crate) struct Found {
+    pub(crate) parts: Vec<Vec<Contact>>,
+    pub(crate) sides: Vec<Vec<Contact>>,
+    /// Each organ's contacts against itself.
+    pub(crate) selves: Vec<Vec<Contact>>,
+    /// Each free pair's contacts (`Simulation::free`, same order).
+    pub(crate) free: Vec<Vec<Contact>>,
+    /// Where the violated contacts of each side press on the other organ
+    /// (two-sided contact; see `collide::held_where`).
+    pub(crate) side_held: Vec<Vec<Held>>,
+    /// The same for each free pair's.
+    pub(crate) free_held: Vec<Vec<Held>>,
+}
+
+/// One organ's unit normals and nearest-particle lookup where it is:
+/// every collision search needs them, and an organ that has not moved
+/// since keeps them.
+pub(crate) struct Geometry {
+    pub(crate) normals: Vec<DVec3>,
+    pub(crate) tracker: Tracker,
+}
+
+impl Geometry {
+    pub(crate) fn of(organ: &OrganSim) -> Geometry {
+        Geometry {
+            normals: anthesis_mesh::vertex_normals(&organ.positions, &organ.mesh.triangles),
+            tracker: Tracker::new(&organ.positions, 2.0 * organ.mean_edge),
+        }
+    }
+}
+
+/// Every (moving, other) pair of organs with no overlap rule between them
+/// (either way), the moving one growing (a kinematic organ gets no
+/// contacts): issue 35's organs of one whorl, which keep the side of each
+/// other they were on.
+pub(crate) fn free_pairs(organs: &[OrganSim], overlaps: &[(usize, usize)]) -> Vec<(usize, usize)> {
+    let ruled = |a: usize, b: usize| {
+        overlaps
+            .iter()
+            .any(|&(i, o)| (i, o) == (a, b) || (i, o) == (b, a))
+    };
+    let mut pairs = Vec::new();
+    for a in 0..organs.len() {
+        for b in 0..organs.len() {
+            if a != b && !ruled(a, b) && !organs[a].is_kinematic() {
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
+}
+
+/// Nothing known yet of `organs` organs' geometry.
+pub(crate) fn unknown_geometry(organs: usize) -> Vec<Option<Geometry>> {
+    (0..organs).map(|_| None).collect()
+}
