@@ -7,6 +7,7 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use anthesis_render::{Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
+use anthesis_sim::batch::Format;
 use anyhow::{Context, Result, bail};
 use glam::DVec3;
 use image::RgbaImage;
@@ -22,10 +23,7 @@ pub enum AnimationTarget {
 
 impl AnimationTarget {
     pub fn of(path: &Path) -> AnimationTarget {
-        if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
-        {
+        if Format::from_path(path) == Some(Format::Gif) {
             AnimationTarget::Gif(path.to_path_buf())
         } else {
             AnimationTarget::PngFolder(path.to_path_buf())

@@ -2,13 +2,14 @@
 //! (the receptacle, stamens, pistils, the stem) at a keyframe time, the
 //! same pieces [`anthesis_export::flower_tracks`] exports.
 
+use anthesis_export::KeyframeBlend;
 use anthesis_flower::Flower;
 use anthesis_flower::parts::{PartPiece, part_pieces};
 use anthesis_render::OrganMesh;
 
 /// The parts of `flower` at `time_in_keyframes` (0 the bud; between two
-/// keyframes the positions blend linearly, as the timeline and the exports
-/// blend organs), each in its colour.
+/// keyframes the positions blend as [`KeyframeBlend`] places them, as the
+/// timeline and the exports blend organs), each in its colour.
 pub fn part_meshes(flower: &Flower, time_in_keyframes: f64) -> Vec<OrganMesh> {
     let pieces = part_pieces(flower);
     pieces
@@ -21,20 +22,20 @@ pub fn part_meshes(flower: &Flower, time_in_keyframes: f64) -> Vec<OrganMesh> {
 /// [`part_meshes`] draws it.
 pub fn piece_mesh(piece: &PartPiece, time_in_keyframes: f64) -> OrganMesh {
     let time = if time_in_keyframes.is_finite() {
-        time_in_keyframes.max(0.0)
+        time_in_keyframes
     } else {
         0.0
     };
-    let below = time.floor();
-    let fraction = time - below;
-    let below = below.min(f64::from(u32::MAX - 1)) as u32;
-    let mut positions = piece.positions_at(below);
-    if fraction > 0.0 && piece.moves() {
-        let above = piece.positions_at(below + 1);
-        for (p, a) in positions.iter_mut().zip(above) {
-            *p = p.lerp(a, fraction);
-        }
-    }
+    // A part's schedule is defined at every step, so its sequence of
+    // keyframes is as long as a step count can be.
+    let positions = match KeyframeBlend::at(u32::MAX as usize, time) {
+        Some(blend) if blend.fraction > 0.0 && piece.moves() => blend.positions(
+            &piece.positions_at(blend.below as u32),
+            &piece.positions_at(blend.above as u32),
+        ),
+        Some(blend) => piece.positions_at(blend.below as u32),
+        None => piece.positions_at(0),
+    };
     OrganMesh::from_positions(&positions, &piece.mesh.triangles, piece.color)
 }
 

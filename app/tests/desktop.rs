@@ -1844,6 +1844,27 @@ fn five_key_presses_in_one_frame_are_five_steps() {
 }
 
 #[test]
+fn a_brush_setting_is_a_command_and_not_an_undo_step() {
+    use anthesis_maps::brush::BrushMode;
+    let mut harness = opened_small_flower();
+    let mut brush = harness.state_mut().paint_mut().brush;
+    brush.strength = 0.25;
+    brush.mode = BrushMode::Smooth;
+    brush.mirror = !brush.mirror;
+    let label = harness.state().document().undo_label().map(str::to_owned);
+    harness
+        .state_mut()
+        .apply(anthesis_app::desktop::Command::SetBrush(brush));
+    harness.run();
+    assert_eq!(harness.state_mut().paint_mut().brush, brush);
+    assert_eq!(
+        harness.state().document().undo_label().map(str::to_owned),
+        label,
+        "not an undo step"
+    );
+}
+
+#[test]
 fn bracket_keys_change_the_brush_on_every_layout_and_x_swaps_add_and_subtract() {
     use anthesis_maps::brush::BrushMode;
     let mut harness = opened_small_flower();

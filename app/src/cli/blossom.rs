@@ -14,7 +14,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 
 use super::EncodingArg;
-use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
+use super::simulate::{animation_options, check_output, write_tracks};
 use super::stream::{out, say};
 
 /// `anthesis blossom BUD.obj OPEN.obj`.
@@ -140,7 +140,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             keyframes: shapes,
             ..Track::default()
         };
-        write_tracks(out, OutputKind::of(out), &[track], &glb)?;
+        write_tracks(out, &[track], &glb)?;
         say!("wrote {} (keyframes 0 to {})", out.display(), keyframes);
     }
     Ok(())

@@ -5,14 +5,13 @@
 use std::path::{Path, PathBuf};
 
 use super::stream::{out, say};
+use anthesis_bud::formats::{BezierFile, PdeFile};
 use anthesis_bud::{
-    BezierCurve, BezierPatch, Bud, InnerSide, MAX_STRETCH_TO_BEND, MeshQuality, PdeSweep,
-    RemeshOptions, Surface, build_organ, eustoma_petal_surface, lily_petal_surface,
+    BezierPatch, Bud, InnerSide, MeshQuality, PdeSweep, RemeshOptions, Surface, build_organ,
+    eustoma_petal_surface, lily_petal_surface,
 };
 use anyhow::{Context, Result, bail};
 use clap::{ArgGroup, Args, ValueEnum};
-use glam::DVec3;
-use serde::{Deserialize, Serialize};
 
 /// The surface file formats, shown by `anthesis bud --help`.
 pub const SURFACE_FILES_HELP: &str = "\
@@ -190,50 +189,6 @@ fn quality_line(q: &MeshQuality) -> String {
     )
 }
 
-/// The `--bezier` file.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct BezierFile {
-    control: Vec<Vec<[f64; 3]>>,
-}
-
-impl From<&BezierPatch> for BezierFile {
-    fn from(patch: &BezierPatch) -> Self {
-        BezierFile {
-            control: patch
-                .control
-                .iter()
-                .map(|row| row.iter().map(|p| p.to_array()).collect())
-                .collect(),
-        }
-    }
-}
-
-/// The `--pde` file.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PdeFile {
-    margin0: Vec<[f64; 3]>,
-    margin1: Vec<[f64; 3]>,
-    tangent0: Vec<[f64; 3]>,
-    tangent1: Vec<[f64; 3]>,
-    #[serde(default)]
-    stretch_to_bend: f64,
-}
-
-impl From<&PdeSweep> for PdeFile {
-    fn from(sweep: &PdeSweep) -> Self {
-        let points = |curve: &BezierCurve| curve.control.iter().map(|p| p.to_array()).collect();
-        PdeFile {
-            margin0: points(&sweep.curve0),
-            margin1: points(&sweep.curve1),
-            tangent0: points(&sweep.tangent0),
-            tangent1: points(&sweep.tangent1),
-            stretch_to_bend: sweep.stretch_to_bend(),
-        }
-    }
-}
-
 /// A sweep in the `--pde` file format.
 pub(super) fn pde_json(sweep: &PdeSweep) -> Result<String> {
     Ok(serde_json::to_string_pretty(&PdeFile::from(sweep))? + "\n")
@@ -265,45 +220,16 @@ pub(super) fn read_pde(path: &Path) -> Result<PdeSweep> {
     read_surface(path, "PDE sweep surface", parse_pde)
 }
 
-/// Four control points, or an error naming them (`name`) and the count.
-fn four_points(points: &[[f64; 3]], name: &str) -> Result<[DVec3; 4]> {
-    match points {
-        [a, b, c, d] => Ok([a, b, c, d].map(|p| DVec3::from_array(*p))),
-        _ => bail!("{name} needs 4 control points, it has {}", points.len()),
-    }
-}
-
 /// A Bézier patch from the `--bezier` JSON.
 fn parse_bezier(json: &str) -> Result<BezierPatch> {
     let file: BezierFile = serde_json::from_str(json)?;
-    let rows: Vec<[DVec3; 4]> = file
-        .control
-        .iter()
-        .enumerate()
-        .map(|(j, row)| four_points(row, &format!("row {} of `control`", j + 1)))
-        .collect::<Result<_>>()?;
-    let row_count = rows.len();
-    let Ok(control) = <[[DVec3; 4]; 4]>::try_from(rows) else {
-        bail!("`control` needs 4 rows of control points (base to tip), it has {row_count}");
-    };
-    Ok(BezierPatch::new(control))
+    Ok(file.patch()?)
 }
 
 /// A PDE sweep surface from the `--pde` JSON.
 fn parse_pde(json: &str) -> Result<PdeSweep> {
     let file: PdeFile = serde_json::from_str(json)?;
-    let curve = |points: &[[f64; 3]], name| four_points(points, name).map(BezierCurve::new);
-    let s = file.stretch_to_bend;
-    if !(0.0..=MAX_STRETCH_TO_BEND).contains(&s) {
-        bail!("`stretch_to_bend` must be between 0 and {MAX_STRETCH_TO_BEND}, got {s}");
-    }
-    Ok(PdeSweep::new(
-        curve(&file.margin0, "`margin0`")?,
-        curve(&file.margin1, "`margin1`")?,
-        curve(&file.tangent0, "`tangent0`")?,
-        curve(&file.tangent1, "`tangent1`")?,
-        s,
-    ))
+    Ok(file.sweep()?)
 }
 
 #[cfg(test)]
@@ -346,16 +272,16 @@ mod tests {
         let three = format!("{{\"control\": [{row}, {row}, {row}]}}");
         let message = format!("{:#}", parse_bezier(&three).expect_err("3 rows"));
         assert!(
-            message.contains("4 rows") && message.contains("has 3"),
+            message.contains("4 rows") && message.contains("found 3"),
             "{message}"
         );
         let short = format!("{{\"control\": [{row}, [[0,0,0]], {row}, {row}]}}");
         let message = format!("{:#}", parse_bezier(&short).expect_err("short row"));
-        assert!(message.contains("row 2 of `control`"), "{message}");
+        assert!(message.contains("row 2 of control"), "{message}");
         let pde = format!(
             "{{\"margin0\": {row}, \"margin1\": {row}, \"tangent0\": [[0,0,0]], \"tangent1\": {row}}}"
         );
         let message = format!("{:#}", parse_pde(&pde).expect_err("short tangent"));
-        assert!(message.contains("`tangent0` needs 4"), "{message}");
+        assert!(message.contains("tangent0 needs 4"), "{message}");
     }
 }

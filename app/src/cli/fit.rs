@@ -5,7 +5,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use anthesis_fit::{FitSettings, Grid};
+use anthesis_fit::{Fit, FitProgress, FitSettings, Grid, Registered, Target};
 use anthesis_mesh::obj::MAX_OBJ_BYTES;
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -115,18 +115,7 @@ struct RegistrationReport {
 }
 
 pub(super) fn fit(args: &FitArgs) -> Result<()> {
-    if !(args.max_seconds.is_finite() && args.max_seconds > 0.0) {
-        bail!(
-            "--max-seconds must be a positive number, got {}",
-            args.max_seconds
-        );
-    }
-    if args.nodes.is_empty() {
-        bail!("--nodes needs at least one node each way, e.g. 1x3");
-    }
-    if args.keys == 0 {
-        bail!("--keys must be at least 1");
-    }
+    check_numbers(args)?;
     let project = load(&args.project)?;
     let Some(organ) = selection(&project, Some(&args.organ))?
         .organs(project.flower.organs.len())
@@ -197,22 +186,7 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
         &target,
         placement,
         &settings,
-        &mut |p| {
-            let line = format!(
-                "iteration {}: RMS {:.3} %, max {:.3} % of the organ's length, {} simulations, \
-                 {:.1} s",
-                p.iteration,
-                100.0 * p.rms,
-                100.0 * p.max,
-                p.simulations,
-                p.seconds
-            );
-            if terminal {
-                say_part!("\r{line}   ");
-            } else {
-                say!("{line}");
-            }
-        },
+        &mut |p| show_progress(&p, terminal),
         &|| false,
     )
     .with_context(|| format!("cannot fit organ `{}`", args.organ))?;
@@ -251,46 +225,94 @@ pub(super) fn fit(args: &FitArgs) -> Result<()> {
     say!("wrote {}", project_path.display());
 
     if let Some(path) = &args.report {
-        let registration = registered.map(|r| {
-            let placement = r.registration.placement;
-            let (axis, angle) = placement.rotation.to_axis_angle();
-            RegistrationReport {
-                angle_deg: angle.to_degrees(),
-                axis: axis.to_array(),
-                scale: placement.scale,
-                translation: placement.translation.to_array(),
-                rms: r.rms,
-                max: r.max,
-                final_angle_deg: result.placement.angle_deg(),
-                final_translation: result.placement.translation.to_array(),
-            }
-        });
-        let report = Report {
-            project: args.project.display().to_string(),
-            organ: &args.organ,
-            target: args.target.display().to_string(),
-            keys: args.keys,
-            nodes: [args.nodes.nodes_u, args.nodes.nodes_v],
-            direction_nodes: [args.direction_nodes.nodes_u, args.direction_nodes.nodes_v],
-            parameters: result.parameters.len(),
-            target_vertices: target.vertex_count(),
-            target_has_uvs: target.uvs.is_some(),
-            registration,
-            organ_length: result.length,
-            guess_rms: result.guess_rms,
-            rms: result.rms,
-            max: result.max,
-            reached: result.reached(),
-            stopped: result.stop.name(),
-            iterations: result.iterations,
-            simulations: result.simulations,
-            seconds: result.seconds,
-            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-        };
-        let json = serde_json::to_string_pretty(&report)?;
-        anthesis_files::write_atomic(path, json.as_bytes())?;
+        write_report(path, args, registered, (&result, &target))?;
     }
     out!("{}", result.verdict())?;
+    Ok(())
+}
+
+/// Refuses a time limit, node grid or key count that cannot make a fit.
+fn check_numbers(args: &FitArgs) -> Result<()> {
+    if !(args.max_seconds.is_finite() && args.max_seconds > 0.0) {
+        bail!(
+            "--max-seconds must be a positive number, got {}",
+            args.max_seconds
+        );
+    }
+    if args.nodes.is_empty() {
+        bail!("--nodes needs at least one node each way, e.g. 1x3");
+    }
+    if args.keys == 0 {
+        bail!("--keys must be at least 1");
+    }
+    Ok(())
+}
+
+/// One iteration of the fit on stderr: overwritten in place on a
+/// terminal, one line each otherwise.
+fn show_progress(p: &FitProgress, terminal: bool) {
+    let line = format!(
+        "iteration {}: RMS {:.3} %, max {:.3} % of the organ's length, {} simulations, \
+         {:.1} s",
+        p.iteration,
+        100.0 * p.rms,
+        100.0 * p.max,
+        p.simulations,
+        p.seconds
+    );
+    if terminal {
+        say_part!("\r{line}   ");
+    } else {
+        say!("{line}");
+    }
+}
+
+/// Writes the `--report` JSON: what was fitted, the registration, the
+/// error before and after, and how the fit ended.
+fn write_report(
+    path: &Path,
+    args: &FitArgs,
+    registered: Option<Registered>,
+    (result, target): (&Fit, &Target),
+) -> Result<()> {
+    let registration = registered.map(|r| {
+        let placement = r.registration.placement;
+        let (axis, angle) = placement.rotation.to_axis_angle();
+        RegistrationReport {
+            angle_deg: angle.to_degrees(),
+            axis: axis.to_array(),
+            scale: placement.scale,
+            translation: placement.translation.to_array(),
+            rms: r.rms,
+            max: r.max,
+            final_angle_deg: result.placement.angle_deg(),
+            final_translation: result.placement.translation.to_array(),
+        }
+    });
+    let report = Report {
+        project: args.project.display().to_string(),
+        organ: &args.organ,
+        target: args.target.display().to_string(),
+        keys: args.keys,
+        nodes: [args.nodes.nodes_u, args.nodes.nodes_v],
+        direction_nodes: [args.direction_nodes.nodes_u, args.direction_nodes.nodes_v],
+        parameters: result.parameters.len(),
+        target_vertices: target.vertex_count(),
+        target_has_uvs: target.uvs.is_some(),
+        registration,
+        organ_length: result.length,
+        guess_rms: result.guess_rms,
+        rms: result.rms,
+        max: result.max,
+        reached: result.reached(),
+        stopped: result.stop.name(),
+        iterations: result.iterations,
+        simulations: result.simulations,
+        seconds: result.seconds,
+        threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    let json = serde_json::to_string_pretty(&report)?;
+    anthesis_files::write_atomic(path, json.as_bytes())?;
     Ok(())
 }
 

@@ -16,7 +16,7 @@ use glam::{DVec2, DVec3};
 
 use super::EncodingArg;
 use super::bud::read_pde;
-use super::simulate::{OutputKind, animation_options, check_output, write_tracks};
+use super::simulate::{animation_options, check_output, write_tracks};
 use super::stream::{out, say};
 
 /// The fewest intervals of a generator (`--nodes`; the dynamics need 4).
@@ -218,7 +218,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
             keyframes,
             ..Track::default()
         };
-        write_tracks(out, OutputKind::of(out), &[track], &glb)?;
+        write_tracks(out, &[track], &glb)?;
         say!("wrote {} (keyframes 0 to {steps})", out.display());
     }
     Ok(())

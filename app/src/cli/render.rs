@@ -8,13 +8,14 @@ use std::path::{Path, PathBuf};
 use anthesis_flower::Project;
 use anthesis_mesh::Subdivision;
 use anthesis_render::{Background, Camera, OffscreenRenderer, OrganMesh, organs_bounds_in_world};
+use anthesis_sim::batch::step_through;
 use anthesis_sim::memory::KeyframeCost;
 use anthesis_sim::{Selection, Simulation};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use image::RgbaImage;
 
-use super::simulate::{run_keyframes, set_keyframes};
+use super::simulate::{Progress, set_keyframes};
 use super::stream::{say, say_part};
 use super::{at_resolution, load, selection};
 use crate::animation::{self, AnimationOptions, AnimationTarget, write_png};
@@ -209,6 +210,18 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         bail!("--out DIR or --animation OUT.gif|FOLDER says where the pictures go");
     };
 
+    write_stills(args, &mut renderer, &scenes, out, (width, height))
+}
+
+/// Renders each scene as `out/frame-NNN.png` with one camera framing them
+/// all, writes `camera.json` and, with `--tile`, the pictures side by side.
+fn write_stills(
+    args: &RenderArgs,
+    renderer: &mut OffscreenRenderer,
+    scenes: &[(u32, Vec<OrganMesh>)],
+    out: &Path,
+    (width, height): (u32, u32),
+) -> Result<()> {
     // One camera for all pictures, so the flower does not jump between them.
     let bounds = scenes
         .iter()
@@ -219,7 +232,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     };
     let camera = Camera::framing(lo, hi, args.azimuth, args.elevation);
     let mut pictures = Vec::with_capacity(scenes.len());
-    for (index, organs) in &scenes {
+    for (index, organs) in scenes {
         let picture = renderer
             .render(organs, &camera, width, height)
             .with_context(|| format!("cannot render keyframe {index}"))?;
@@ -351,15 +364,18 @@ fn simulate_scenes(
         scenes.push((0, organs_at(&bud.positions_in_world, 0)));
     }
     let last_wanted = frames.last().copied().unwrap_or(0);
-    run_keyframes(&mut sim, last_wanted, &mut |keyframe| {
+    let last = last_wanted.min(sim.keyframe_count());
+    let mut progress = Progress::new();
+    let stepped = step_through(&mut sim, last, &|| false, &mut |sim, keyframe| {
+        progress.show(sim, keyframe.index, last);
         if frames.binary_search(&keyframe.index).is_ok() {
             scenes.push((
                 keyframe.index,
                 organs_at(&keyframe.positions_in_world, keyframe.index),
             ));
         }
-    })
-    .into_result()?;
+    });
+    progress.finish(&sim, stepped.failure)?;
     Ok(scenes)
 }
 

@@ -5,16 +5,18 @@ use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
-use anthesis_export::{GlbOptions, UsdOptions};
+use anthesis_export::GlbOptions;
 use anthesis_flower::{MAX_KEYFRAMES, Resolution};
+use anthesis_sim::batch::{self, Format};
 use anthesis_sim::crossing::OnCrossing;
-use anthesis_sim::memory::{self, KeyframeCost};
-use anthesis_sim::{Keyframe, KeyframeStats, SimError, Simulation};
+use anthesis_sim::memory::KeyframeCost;
+use anthesis_sim::{KeyframeStats, SimError, Simulation};
 use anyhow::{Context, Result, bail};
-use glam::DVec3;
 
 use super::stream::{out, say, say_part};
-use super::{EncodingArg, at_resolution, load, selection};
+use super::{
+    EncodingArg, at_resolution, check_particle_limit, load, selection, warn_about_the_cache,
+};
 
 pub(super) fn info(path: &Path, edge: Option<Resolution>) -> Result<()> {
     let project = at_resolution(load(path)?, edge, None)?;
@@ -84,6 +86,9 @@ pub(super) fn simulate(
 ) -> Result<()> {
     let mut project = load(path)?;
     set_keyframes(&mut project, keyframes)?;
+    if let Some(edge) = edge {
+        project.settings.resolution = edge;
+    }
     let selection = selection(&project, organ)?;
     // Every output is checked before the run: a typo must not cost a
     // simulation.
@@ -93,46 +98,40 @@ pub(super) fn simulate(
     if let Some(out) = out {
         check_output(out, glb, project.settings.keyframes)?;
     }
-    let cost = match out.map(OutputKind::of) {
-        None => KeyframeCost::Kept,
-        Some(OutputKind::Glb) => KeyframeCost::Glb,
-        Some(OutputKind::Usd) => KeyframeCost::Usd,
-        Some(OutputKind::ObjFolder) => KeyframeCost::Obj,
-    };
-    let project = at_resolution(project, edge, Some((&selection, cost)))?;
-    if out.is_some() {
-        // The bud and every keyframe, at the render level asked for, of
-        // the meshes at the project's resolution.
-        anthesis_export::check_render_level(
-            &project.flower,
-            &selection.organs(project.flower.organs.len()),
-            project.settings.keyframes as usize + 1,
-            render_level,
-        )?;
-    }
-    memory::check_run(&project, &selection, cost)?;
+    let cost = out.map_or(KeyframeCost::Kept, |out| output_format(out).keyframe_cost());
+    check_particle_limit(&project, edge.is_some())?;
+    let prepared = batch::prepare(&project, &selection, cost, out.map(|_| render_level));
+    warn_about_the_cache();
+    let project = prepared?;
 
-    let mut sim = Simulation::new(&project, &selection)?;
-    if allow_crossings {
-        sim.on_crossing(OnCrossing::Warn);
-    }
-    let total = sim.keyframe_count();
-    let mut frames: Vec<Vec<Vec<DVec3>>> = vec![sim.bud().positions_in_world];
-    let mut stats = Vec::new();
-    let run = run_keyframes(&mut sim, total, &mut |keyframe| {
-        stats.push(keyframe.stats);
-        frames.push(keyframe.positions_in_world);
-    });
-    // What was computed is kept even when the run failed part way.
-    let done = run.done;
-    let seconds = run.seconds;
+    let on_crossing = if allow_crossings {
+        OnCrossing::Warn
+    } else {
+        OnCrossing::Stop
+    };
+    let mut progress = Progress::new();
+    let mut run = batch::simulate(
+        &project,
+        &selection,
+        on_crossing,
+        &|| false,
+        &mut |sim, k| progress.show(sim, k.index, sim.keyframe_count()),
+    )?;
+    let run_result = progress.finish(&run.simulation, run.stepped.failure.take());
+    let done = run.stepped.done;
 
     if let Some(stats_path) = stats_path {
+        let stats: Vec<KeyframeStats> = run.keyframes[1..].iter().map(|k| k.stats).collect();
         let file = StatsFile {
             project: &project.name,
-            organs: sim.organs().iter().map(|s| s.to_string()).collect(),
+            organs: run
+                .simulation
+                .organs()
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
             keyframes: &stats,
-            total_seconds: seconds,
+            total_seconds: run.stepped.seconds,
             threads: rayon_threads(),
         };
         let json = serde_json::to_string_pretty(&file)?;
@@ -143,26 +142,21 @@ pub(super) fn simulate(
     if let Some(out) = out
         && done > 0
     {
-        let tracks = anthesis_export::flower_tracks(
-            &project.flower,
-            &selection.organs(project.flower.organs.len()),
-            frames.iter().map(Vec::as_slice),
-            render_level,
-        )?;
-        write_tracks(out, OutputKind::of(out), &tracks, glb)?;
+        let tracks = run.tracks(&project, &selection, render_level)?;
+        write_tracks(out, &tracks, glb)?;
         say!("wrote {} (keyframes 0 to {done})", out.display());
         written = Some(out);
     }
-    match (run.failure, written) {
-        (None, _) => Ok(()),
-        (Some(failure), Some(out)) => Err(failure.context(format!(
+    match (run_result, written) {
+        (Ok(_), _) => Ok(()),
+        (Err(failure), Some(out)) => Err(failure.context(format!(
             "the keyframes before it were written to {} (keyframes 0 to {done})",
             out.display()
         ))),
-        (Some(failure), None) if out.is_some() => {
+        (Err(failure), None) if out.is_some() => {
             Err(failure.context("no keyframe was computed, nothing was written"))
         }
-        (Some(failure), None) => Err(failure),
+        (Err(failure), None) => Err(failure),
     }
 }
 
@@ -184,136 +178,84 @@ pub(super) fn set_keyframes(
     Ok(())
 }
 
-/// How far a run got: the keyframes computed, the wall time, and why it
-/// stopped early if it did.
-pub(super) struct Run {
-    pub done: u32,
-    pub seconds: f64,
-    pub failure: Option<anyhow::Error>,
+/// The progress of a run on stderr: the keyframe and the time left while
+/// stderr is a terminal, the crossings it goes on past as warnings, and a
+/// summary line at the end.
+pub(super) struct Progress {
+    started: Instant,
+    show: bool,
+    /// The crossings already warned about.
+    warned: usize,
+    done: u32,
 }
 
-impl Run {
-    /// The run as a result: an error if it stopped early.
-    pub fn into_result(self) -> Result<f64> {
-        match self.failure {
-            None => Ok(self.seconds),
-            Some(failure) => Err(failure),
+impl Progress {
+    pub(super) fn new() -> Progress {
+        Progress {
+            started: Instant::now(),
+            show: std::io::stderr().is_terminal(),
+            warned: 0,
+            done: 0,
         }
     }
-}
 
-/// Steps `sim` through keyframe `last` (at most its keyframe count), handing
-/// each keyframe to `on_keyframe`. Shows progress with the time left when
-/// stderr is a terminal and ends with a summary line on stderr. A failed
-/// step ends the run; the keyframes before it have been handed over.
-pub(super) fn run_keyframes(
-    sim: &mut Simulation,
-    last: u32,
-    on_keyframe: &mut dyn FnMut(Keyframe),
-) -> Run {
-    let last = last.min(sim.keyframe_count());
-    let started = Instant::now();
-    let show_progress = std::io::stderr().is_terminal();
-    let mut done = 0;
-    let mut failure = None;
-    while done < last && !sim.finished() {
-        let warned = sim.crossings().len();
-        let keyframe = match sim.step(&|| false, &mut |_| {}) {
-            Ok(keyframe) => keyframe,
-            Err(error @ SimError::Crossed(_)) => {
-                failure = Some(anyhow::Error::new(error).context(
-                    "the run stopped where organs cross (`--allow-crossings` goes on with a warning)",
-                ));
-                break;
-            }
-            Err(error) => {
-                failure = Some(anyhow::Error::new(error));
-                break;
-            }
-        };
-        for crossing in &sim.crossings()[warned..] {
-            if show_progress {
+    /// Shows that `sim` computed keyframe `done` of `last`.
+    pub(super) fn show(&mut self, sim: &Simulation, done: u32, last: u32) {
+        for crossing in &sim.crossings()[self.warned.min(sim.crossings().len())..] {
+            if self.show {
                 say!();
             }
             say!("warning: {crossing}");
         }
-        done = keyframe.index;
-        if show_progress {
-            let elapsed = started.elapsed().as_secs_f64();
+        self.warned = sim.crossings().len();
+        self.done = done;
+        if self.show {
+            let elapsed = self.started.elapsed().as_secs_f64();
             let left = elapsed / f64::from(done) * f64::from(last - done);
             say_part!("\rkeyframe {done}/{last}  {elapsed:.1} s, about {left:.1} s left   ");
         }
-        on_keyframe(keyframe);
     }
-    let seconds = started.elapsed().as_secs_f64();
-    if show_progress && done > 0 {
-        say!();
-    }
-    if failure.is_none() {
-        say!(
-            "simulated {done} keyframes of {} organ(s) in {seconds:.2} s ({} Hessian factorisations)",
-            sim.organs().len(),
-            sim.factorisations()
-        );
-    }
-    Run {
-        done,
-        seconds,
-        failure,
-    }
-}
 
-/// What `--out` asks for, by its extension.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum OutputKind {
-    Glb,
-    Usd,
-    ObjFolder,
-}
-
-impl OutputKind {
-    pub(super) fn of(path: &Path) -> OutputKind {
-        if path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("glb"))
-        {
-            OutputKind::Glb
-        } else if anthesis_export::is_usd_path(path) {
-            OutputKind::Usd
-        } else {
-            OutputKind::ObjFolder
+    /// Ends the progress of `sim`'s run, which stopped with `failure` if
+    /// it did; returns the run's seconds or why it stopped.
+    pub(super) fn finish(self, sim: &Simulation, failure: Option<SimError>) -> Result<f64> {
+        let seconds = self.started.elapsed().as_secs_f64();
+        if self.show && self.done > 0 {
+            say!();
+        }
+        match failure {
+            None => {
+                say!(
+                    "simulated {} keyframes of {} organ(s) in {seconds:.2} s ({} Hessian factorisations)",
+                    self.done,
+                    sim.organs().len(),
+                    sim.factorisations()
+                );
+                Ok(seconds)
+            }
+            Some(error @ SimError::Crossed(_)) => Err(anyhow::Error::new(error).context(
+                "the run stopped where organs cross (`--allow-crossings` goes on with a warning)",
+            )),
+            Some(error) => Err(anyhow::Error::new(error)),
         }
     }
 }
 
-/// Writes `tracks` to `out` as `kind` says: a .glb, a USD layer, or one OBJ
-/// per keyframe into a folder (created when missing).
+/// What `--out` writes: the format its extension names, else a folder
+/// that receives one OBJ per keyframe.
+pub(super) fn output_format(out: &Path) -> Format {
+    Format::from_path(out).unwrap_or(Format::ObjFolder)
+}
+
+/// Writes `tracks` to `out` in the format its name asks for
+/// ([`output_format`]): a .glb, a USD layer, or one OBJ per keyframe into a
+/// folder (created when missing).
 pub(super) fn write_tracks(
     out: &Path,
-    kind: OutputKind,
     tracks: &[anthesis_export::Track],
     glb: &GlbOptions,
 ) -> Result<()> {
-    match kind {
-        OutputKind::Glb => anthesis_export::write_glb(out, tracks, glb, &mut |_| {})
-            .with_context(|| format!("cannot write {}", out.display()))?,
-        OutputKind::Usd => {
-            let usd = UsdOptions {
-                timing: glb.timing,
-                normals: glb.normals,
-            };
-            anthesis_export::write_usd(out, tracks, &usd, &mut |_| {})
-                .with_context(|| format!("cannot write {}", out.display()))?
-        }
-        OutputKind::ObjFolder => {
-            if !out.is_dir() {
-                std::fs::create_dir(out)
-                    .with_context(|| format!("cannot create the folder {}", out.display()))?;
-            }
-            anthesis_export::write_obj_sequence(out, tracks)
-                .with_context(|| format!("cannot write OBJ files to {}", out.display()))?;
-        }
-    }
+    batch::write(out, output_format(out), tracks, glb, &mut |_| {})?;
     Ok(())
 }
 
@@ -322,19 +264,24 @@ pub(super) fn write_tracks(
 /// for OBJ files may be missing if its parent exists (it is created when
 /// the files are written).
 pub(super) fn check_output(out: &Path, glb: &GlbOptions, keyframes: u32) -> Result<()> {
-    match OutputKind::of(out) {
-        OutputKind::Glb => {
+    match output_format(out) {
+        Format::Glb => {
             anthesis_files::check_destination(out)?;
             // The bud and every keyframe.
             glb.check(keyframes as usize + 1)?;
         }
-        OutputKind::Usd => anthesis_export::check_usd_destination(out)?,
-        OutputKind::ObjFolder if out.exists() && !out.is_dir() => bail!(
+        Format::Usd => anthesis_export::check_usd_destination(out)?,
+        Format::Gif => bail!(
+            "--out {}: a GIF is rendered, by `anthesis render --animation`; --out takes a \
+             .glb, .usda or .usdc file or a folder for OBJ files",
+            out.display()
+        ),
+        Format::ObjFolder if out.exists() && !out.is_dir() => bail!(
             "--out {} must be a .glb, .usda or .usdc file or a folder for OBJ files",
             out.display()
         ),
-        OutputKind::ObjFolder if out.is_dir() => {}
-        OutputKind::ObjFolder => check_creatable_folder(out)?,
+        Format::ObjFolder if out.is_dir() => {}
+        Format::ObjFolder => check_creatable_folder(out)?,
     }
     Ok(())
 }

@@ -218,74 +218,7 @@ fn rows(
 ) {
     state.template = state.template.min(flower.templates.len() - 1);
     let index = state.template;
-    let others = flower.organs.iter().any(|o| o.template != index);
-    ui.horizontal(|ui| {
-        let label = ui.label("petal").id;
-        egui::ComboBox::from_id_salt("bud template")
-            .selected_text(flower.templates[index].name.as_str())
-            .show_ui(ui, |ui| {
-                for (i, t) in flower.templates.iter().enumerate() {
-                    ui.selectable_value(&mut state.template, i, t.name.as_str());
-                }
-            })
-            .response
-            .labelled_by(label);
-    });
-    let has_bud = flower.templates[index].vein.is_some();
-    ui.horizontal(|ui| {
-        let label = ui.label("draw").id;
-        ui.radio_value(&mut state.opening, false, "the bud")
-            .labelled_by(label)
-            .on_hover_text("The stroke is a petal's vein in the bud");
-        ui.add_enabled_ui(has_bud, |ui| {
-            ui.radio_value(&mut state.opening, true, "the opened flower")
-                .on_hover_text(
-                    "The stroke is a petal's vein in the open flower: the petals then open \
-                     from the bud to it by the two-state blossom instead of growing",
-                )
-                .on_disabled_hover_text("Sketch and apply the bud first");
-        });
-    });
-    if !has_bud {
-        state.opening = false;
-    }
-    ui.horizontal(|ui| {
-        ui.add_enabled_ui(!others && !state.opening, |ui| {
-            ui.radio_value(&mut state.spiral, true, "golden-angle spiral")
-                .on_hover_text("Petals 137.5° apart, each later one nested inside")
-                .on_disabled_hover_text(
-                    "The flower has organs of other templates, which a spiral would replace",
-                );
-        });
-        ui.radio_value(&mut state.spiral, false, "the arrangement's places")
-            .on_hover_text("Where the flower's arrangement puts this template's organs");
-    });
-    if others {
-        state.spiral = false;
-    }
-    let turtle_placed = matches!(
-        flower.structure,
-        Some(anthesis_flower::structure::Structure::LSystem { .. })
-    ) && flower.organs[..flower.made_organ_count()]
-        .iter()
-        .any(|o| o.template == index);
-    if turtle_placed && !state.spiral {
-        ui.label(
-            RichText::new(
-                "The L-system places these organs in its turtle's frames: the stroke bends the \
-                 petal as seen in its own frame (its base at the stroke's start) and does not \
-                 move the organs.",
-            )
-            .color(ui.visuals().warn_fg_color),
-        );
-    }
-    if state.spiral && !state.opening {
-        ui.horizontal(|ui| {
-            let label = ui.label("petals").id;
-            ui.add(egui::DragValue::new(&mut state.count).range(1..=40))
-                .labelled_by(label);
-        });
-    }
+    option_rows(ui, flower, index, state);
 
     // The view: the axis up the middle, the ground at the receptacle.
     let template = &flower.templates[index];
@@ -377,6 +310,100 @@ fn rows(
         egui::Stroke::new(1.5, ui.visuals().strong_text_color()),
     ));
 
+    make_from_stroke(
+        state,
+        (flower, keyframes),
+        index,
+        extent,
+        response.dragged(),
+    );
+    draw_results(ui, &painter, (frame, rect), index, state);
+    apply_row(ui, flower, index, state, commands);
+}
+
+/// The rows of what to draw: the bud or its opening, the spiral or the
+/// arrangement's places (and how many petals), and a warning where an
+/// L-system places the organs.
+fn option_rows(ui: &mut egui::Ui, flower: &Flower, index: usize, state: &mut BudSketchState) {
+    let others = flower.organs.iter().any(|o| o.template != index);
+    ui.horizontal(|ui| {
+        let label = ui.label("petal").id;
+        egui::ComboBox::from_id_salt("bud template")
+            .selected_text(flower.templates[index].name.as_str())
+            .show_ui(ui, |ui| {
+                for (i, t) in flower.templates.iter().enumerate() {
+                    ui.selectable_value(&mut state.template, i, t.name.as_str());
+                }
+            })
+            .response
+            .labelled_by(label);
+    });
+    let has_bud = flower.templates[index].vein.is_some();
+    ui.horizontal(|ui| {
+        let label = ui.label("draw").id;
+        ui.radio_value(&mut state.opening, false, "the bud")
+            .labelled_by(label)
+            .on_hover_text("The stroke is a petal's vein in the bud");
+        ui.add_enabled_ui(has_bud, |ui| {
+            ui.radio_value(&mut state.opening, true, "the opened flower")
+                .on_hover_text(
+                    "The stroke is a petal's vein in the open flower: the petals then open \
+                     from the bud to it by the two-state blossom instead of growing",
+                )
+                .on_disabled_hover_text("Sketch and apply the bud first");
+        });
+    });
+    if !has_bud {
+        state.opening = false;
+    }
+    ui.horizontal(|ui| {
+        ui.add_enabled_ui(!others && !state.opening, |ui| {
+            ui.radio_value(&mut state.spiral, true, "golden-angle spiral")
+                .on_hover_text("Petals 137.5° apart, each later one nested inside")
+                .on_disabled_hover_text(
+                    "The flower has organs of other templates, which a spiral would replace",
+                );
+        });
+        ui.radio_value(&mut state.spiral, false, "the arrangement's places")
+            .on_hover_text("Where the flower's arrangement puts this template's organs");
+    });
+    if others {
+        state.spiral = false;
+    }
+    let turtle_placed = matches!(
+        flower.structure,
+        Some(anthesis_flower::structure::Structure::LSystem { .. })
+    ) && flower.organs[..flower.made_organ_count()]
+        .iter()
+        .any(|o| o.template == index);
+    if turtle_placed && !state.spiral {
+        ui.label(
+            RichText::new(
+                "The L-system places these organs in its turtle's frames: the stroke bends the \
+                 petal as seen in its own frame (its base at the stroke's start) and does not \
+                 move the organs.",
+            )
+            .color(ui.visuals().warn_fg_color),
+        );
+    }
+    if state.spiral && !state.opening {
+        ui.horizontal(|ui| {
+            let label = ui.label("petals").id;
+            ui.add(egui::DragValue::new(&mut state.count).range(1..=40))
+                .labelled_by(label);
+        });
+    }
+}
+
+/// Makes the bud or the opening the stroke asks for, once the stroke is
+/// drawn (not while `dragging`) and when it or what it depends on changed.
+fn make_from_stroke(
+    state: &mut BudSketchState,
+    (flower, keyframes): (&Flower, u32),
+    index: usize,
+    extent: f64,
+    dragging: bool,
+) {
     // What the stroke makes.
     let key = (
         index,
@@ -386,7 +413,7 @@ fn rows(
         fingerprint(flower),
     );
     let stale = state.result.as_ref().is_none_or(|(k, _)| *k != key);
-    if !response.dragged() && state.stroke.len() > 1 && stale {
+    if !dragging && state.stroke.len() > 1 && stale {
         let minimum = SHORTEST_STROKE * 1.1 * extent;
         let result = SideStroke::new(&state.stroke, minimum)
             .map_err(|e| e.to_string())
@@ -409,6 +436,18 @@ fn rows(
             });
         state.result = Some((key, result));
     }
+}
+
+/// What the stroke made, over the side view: the open shape's midrib or
+/// the smoothed vein, the bud's top view and its petal count.
+fn draw_results(
+    ui: &mut egui::Ui,
+    painter: &egui::Painter,
+    (frame, rect): (Frame, egui::Rect),
+    index: usize,
+    state: &BudSketchState,
+) {
+    let to_screen = |p: DVec2| frame.to_screen(rect, p);
     if let Some(opened) = state.opening() {
         // The open shape's midrib from the organ's base.
         if let (Some(organ), Some(animation)) = (
@@ -455,6 +494,17 @@ fn rows(
             }
         ));
     }
+}
+
+/// Why nothing was made, or "Apply opening" / "Apply bud" (one undo step
+/// each) when what was made has no crossing.
+fn apply_row(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    index: usize,
+    state: &BudSketchState,
+    commands: &mut Vec<Command>,
+) {
     if let Some(problem) = state.problem() {
         ui.label(RichText::new(problem).color(ui.visuals().error_fg_color));
     }

@@ -5,9 +5,10 @@
 //! restarts the simulation.
 //!
 //! Continuous widget state that is not the document — the camera being
-//! dragged, the playhead being scrubbed, brush and export settings — is
-//! changed by its widget directly; everything that also has a menu entry,
-//! a shortcut or a button goes through here.
+//! dragged, the playhead being scrubbed, export settings — is changed by
+//! its widget directly; everything that also has a menu entry, a shortcut
+//! or a button goes through here, and so do the brush's settings
+//! ([`Command::SetBrush`]; the shortcuts step them too).
 
 use std::path::PathBuf;
 
@@ -103,6 +104,9 @@ pub enum Command {
     },
     /// Add becomes subtract, any other mode add.
     SwapBrushAddSubtract,
+    /// The brush as the paint panel's controls set it (mode, radius,
+    /// strength, hardness, value, mirror); not an undo step.
+    SetBrush(Brush),
 }
 
 /// A change to the project. Indices are into the project's templates and a
@@ -315,6 +319,7 @@ impl AnthesisApp {
             Command::StepBrushStrength { stronger: true } => self.paint.raise_strength(),
             Command::StepBrushStrength { stronger: false } => self.paint.lower_strength(),
             Command::SwapBrushAddSubtract => self.paint.toggle_mode(),
+            Command::SetBrush(brush) => self.paint.brush = brush,
         }
     }
 

@@ -1,22 +1,26 @@
 //! The export dialog: a .glb, .usda, .usdc or .gif path (typed or picked with the
 //! native dialog) and the options; the export runs on a thread named
 //! `anthesis-export` and reports progress, then the result or the error.
+//! The window itself is drawn by `export/dialog.rs`.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, sync_channel};
 use std::sync::{Arc, Mutex};
 
-use anthesis_export::{Encoding, GlbOptions, Timing, Track, UsdOptions};
-use anthesis_flower::resolution::{predicted_size, resolve};
+use anthesis_export::{Encoding, GlbOptions, Timing, Track};
+use anthesis_flower::resolution::predicted_size;
 use anthesis_flower::{Project, Resolution};
 use anthesis_render::{OffscreenRenderer, OrganMesh};
+use anthesis_sim::batch::{self, BatchError, Format};
+use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::memory::{self, KeyframeCost};
-use anthesis_sim::{Keyframe, Selection, SimError, Simulation};
+use anthesis_sim::{Keyframe, Selection, SimError};
 use anyhow::Context;
-use eframe::egui;
 
 use crate::animation::{self, AnimationOptions, AnimationTarget};
+
+mod dialog;
 
 /// How the dialog asks for the animation's timing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -117,27 +121,6 @@ impl Default for ExportDialog {
 /// about 380,000 render vertices per keyframe).
 pub const MAX_DIALOG_RENDER_LEVEL: u32 = 3;
 
-/// A labelled row editing an angle in degrees within `[-limit, limit]`;
-/// returns the editor's response.
-fn angle_row(ui: &mut egui::Ui, name: &str, degrees: &mut f64, limit: f64) -> egui::Response {
-    let label = ui.label(name).id;
-    let response = ui
-        .add(
-            egui::DragValue::new(degrees)
-                .range(-limit..=limit)
-                .suffix("°"),
-        )
-        .labelled_by(label);
-    ui.end_row();
-    response
-}
-
-/// Whether `path` asks for a rendered animation (`.gif`).
-pub fn is_gif_path(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
-}
-
 /// Renders every `step`-th keyframe of `tracks` (and the last) offscreen
 /// and writes them as a looping GIF (see [`animation::write_animation`]).
 fn write_gif(
@@ -208,9 +191,19 @@ pub fn tracks(
 /// writing the file).
 const RUN_SHARE: f32 = 0.9;
 
-/// Writes `tracks` to `target` in the format its name picks: a USD layer
-/// for .usda, .usd (text) or .usdc (binary), a rendered animation for .gif,
-/// else the animated glTF; returns the file's size.
+/// What the dialog writes to `target`: the format its extension names,
+/// else an animated glTF.
+pub fn target_format(target: &Path) -> Format {
+    match Format::from_path(target) {
+        Some(format) if format != Format::ObjFolder => format,
+        _ => Format::Glb,
+    }
+}
+
+/// Writes `tracks` to `target` in the format its name picks
+/// ([`target_format`]): a USD layer for .usda, .usd (text) or .usdc
+/// (binary), a rendered animation for .gif, else the animated glTF;
+/// returns the file's size.
 fn write_tracks(
     target: &Path,
     tracks: &[Track],
@@ -219,18 +212,15 @@ fn write_tracks(
     animation_step: u32,
     progress: &mut dyn FnMut(f32),
 ) -> Result<u64, String> {
-    let written = if anthesis_export::is_usd_path(target) {
-        let usd = UsdOptions {
-            timing: options.timing,
-            normals: options.normals,
-        };
-        anthesis_export::write_usd(target, tracks, &usd, progress).map_err(|e| e.to_string())
-    } else if is_gif_path(target) {
-        write_gif(target, tracks, animation, animation_step, progress).map_err(|e| format!("{e:#}"))
-    } else {
-        anthesis_export::write_glb(target, tracks, options, progress).map_err(|e| e.to_string())
+    let written = match target_format(target) {
+        Format::Gif => write_gif(target, tracks, animation, animation_step, progress),
+        // The export's own error names the file already.
+        format => batch::write(target, format, tracks, options, progress).map_err(|e| match e {
+            BatchError::Write { source, .. } => source.into(),
+            e => e.into(),
+        }),
     };
-    written.and_then(|()| {
+    written.map_err(|e| format!("{e:#}")).and_then(|()| {
         std::fs::metadata(target)
             .map(|m| m.len())
             .map_err(|e| format!("{}: {e}", target.display()))
@@ -248,25 +238,27 @@ fn simulate_at(
     progress: &mut dyn FnMut(f32),
     cancelled: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<Track>, String> {
-    memory::check_run(project, selection, KeyframeCost::Kept)
-        .map_err(|e| format!("does not fit: {e}"))?;
-    let resolved = resolve(project).map_err(|e| format!("cannot start: {e}"))?;
-    let mut sim =
-        Simulation::new(&resolved, selection).map_err(|e| format!("cannot start: {e}"))?;
+    let resolved =
+        batch::prepare(project, selection, KeyframeCost::Kept, None).map_err(|e| match e {
+            BatchError::Memory(e) => format!("does not fit: {e}"),
+            e => format!("cannot start: {e}"),
+        })?;
     let total = resolved.settings.keyframes.max(1);
-    let mut keyframes = vec![Arc::new(sim.bud())];
-    while !sim.finished() {
-        match sim.step(cancelled, &mut |_| {}) {
-            Ok(keyframe) => {
-                progress(keyframe.index as f32 / total as f32);
-                keyframes.push(Arc::new(keyframe));
-            }
-            Err(SimError::Cancelled) => return Err("was cancelled".to_string()),
-            Err(error) => return Err(format!("stopped: {error}")),
-        }
+    let run = batch::simulate(
+        &resolved,
+        selection,
+        OnCrossing::Stop,
+        cancelled,
+        &mut |_, keyframe| progress(keyframe.index as f32 / total as f32),
+    )
+    .map_err(|e| format!("cannot start: {e}"))?;
+    match run.stepped.failure {
+        None => {}
+        Some(SimError::Cancelled) => return Err("was cancelled".to_string()),
+        Some(error) => return Err(format!("stopped: {error}")),
     }
-    let organs = selection.organs(resolved.flower.organs.len());
-    tracks(&resolved, &organs, &keyframes, render_level).map_err(|e| format!("{e}"))
+    run.tracks(&resolved, selection, render_level)
+        .map_err(|e| format!("{e}"))
 }
 
 /// The particles a run of `organs` of `project` at `edge` makes in its
@@ -339,131 +331,6 @@ impl ExportDialog {
             self.resimulate_edge = suggestion;
         }
         self.suggested_edge = suggestion;
-    }
-
-    /// The .gif rows of the options grid: size, keyframe step, camera and
-    /// turn, speed.
-    fn gif_options_ui(&mut self, ui: &mut egui::Ui) {
-        let a = &mut self.animation;
-        let label = ui.label("GIF size").id;
-        ui.horizontal(|ui| {
-            ui.add(
-                egui::DragValue::new(&mut a.width)
-                    .range(16..=4096)
-                    .suffix(" px"),
-            )
-            .labelled_by(label);
-            ui.label("×");
-            ui.add(
-                egui::DragValue::new(&mut a.height)
-                    .range(16..=4096)
-                    .suffix(" px"),
-            )
-            .labelled_by(label);
-        });
-        ui.end_row();
-        let label = ui.label("Every Nth keyframe").id;
-        ui.add(egui::DragValue::new(&mut self.animation_step).range(1..=1000))
-            .labelled_by(label);
-        ui.end_row();
-        angle_row(ui, "Camera azimuth", &mut a.azimuth_deg, 360.0);
-        angle_row(ui, "Camera elevation", &mut a.elevation_deg, 90.0);
-        angle_row(ui, "Camera turn", &mut a.turn_deg, 720.0)
-            .on_hover_text("How far the camera circles the flower over the animation");
-        let label = ui.label("GIF frames per second").id;
-        ui.add(
-            egui::DragValue::new(&mut a.frames_per_second)
-                .range(1.0..=animation::MAX_GIF_FRAMES_PER_SECOND),
-        )
-        .labelled_by(label);
-        ui.end_row();
-    }
-
-    /// The "Organs" row, shown while one organ is previewed: the whole
-    /// flower (the default) or the previewed organ alone.
-    fn scope_ui(&mut self, ui: &mut egui::Ui, project: &Project, organ: usize) {
-        ui.label("Organs").on_hover_text(
-            "The window previews one organ; the export can hold the whole flower (run \
-             with collisions, from the keyframes kept from before the preview or a run of its \
-             own) or the previewed organ alone",
-        );
-        let name = project
-            .flower
-            .organs
-            .get(organ)
-            .map_or("the previewed organ", |o| o.name.as_str());
-        ui.horizontal(|ui| {
-            ui.radio_value(&mut self.whole_flower, true, "whole flower");
-            ui.radio_value(&mut self.whole_flower, false, format!("{name} alone"));
-        });
-        ui.end_row();
-    }
-
-    /// The "Simulation" row: export the window's keyframes, or a run of
-    /// its own at another mean edge, with the particles that makes in the
-    /// largest simulated organ (or why the run would not fit).
-    fn resimulate_ui(
-        &mut self,
-        ui: &mut egui::Ui,
-        project: &Project,
-        selection: &Selection,
-        now: usize,
-    ) {
-        let label = ui
-            .label("Simulation")
-            .on_hover_text(
-                "Paint coarse, export fine: the export can run the flower again with every \
-                 template remeshed at another mean edge (the painted maps kept), without \
-                 changing the project or the window's run",
-            )
-            .id;
-        ui.horizontal(|ui| {
-            ui.checkbox(&mut self.resimulate, "run again at mean edge");
-            let shown = shown_edge(project);
-            let speed = 0.01 * self.resimulate_edge;
-            ui.add_enabled(
-                self.resimulate,
-                egui::DragValue::new(&mut self.resimulate_edge)
-                    .speed(speed)
-                    .range(1e-3 * shown..=1e3 * shown)
-                    .max_decimals(4),
-            )
-            .labelled_by(label);
-        });
-        ui.end_row();
-        if !self.resimulate {
-            return;
-        }
-        ui.label("");
-        // What the run makes and whether it fits, worked out again only
-        // when something it depends on changes (it clones the project and
-        // reads the free memory).
-        let organs = selection.organs(project.flower.organs.len());
-        let key = (
-            self.resimulate_edge.to_bits(),
-            organs.clone(),
-            project.settings.keyframes,
-            project
-                .flower
-                .templates
-                .iter()
-                .map(|t| t.mesh.vertex_count())
-                .collect::<Vec<_>>(),
-            now,
-        );
-        if self.run_note.as_ref().is_none_or(|(k, _)| *k != key) {
-            self.run_note = Some((
-                key,
-                run_note(project, selection, &organs, self.resimulate_edge, now),
-            ));
-        }
-        if let Some((_, note)) = &self.run_note {
-            match note {
-                Ok(text) => ui.label(text),
-                Err(text) => ui.colored_label(egui::Color32::from_rgb(210, 50, 40), text),
-            };
-        }
-        ui.end_row();
     }
 
     pub fn state(&self) -> &ExportState {
@@ -678,224 +545,12 @@ impl ExportDialog {
     pub fn is_running(&self) -> bool {
         self.job.is_some()
     }
-
-    /// The dialog window. `keyframes_ready` and `keyframes_total` describe
-    /// what would be exported; `project` (the document's, meshes as built)
-    /// and `selection` what a run of its own would simulate;
-    /// `simulated_now` the particles of the largest selected organ as the
-    /// window simulates it.
-    pub fn ui(
-        &mut self,
-        ctx: &egui::Context,
-        keyframes_ready: usize,
-        keyframes_total: u32,
-        project: &Project,
-        selection: &Selection,
-        simulated_now: usize,
-    ) -> ExportRequests {
-        self.suggest_edge(project);
-        let mut requests = ExportRequests::default();
-        let mut open = self.open;
-        egui::Window::new("Export the animation")
-            .open(&mut open)
-            .resizable(false)
-            .collapsible(false)
-            .show(ctx, |ui| {
-                ui.horizontal(|ui| {
-                    let label = ui.label("Export to").id;
-                    ui.add(
-                        egui::TextEdit::singleline(&mut self.path)
-                            .hint_text("/path/to/flower.glb")
-                            .desired_width(300.0),
-                    )
-                    .labelled_by(label)
-                    .on_hover_text(
-                        "Where the animation goes (replaced atomically): FILE.glb for an \
-                         animated glTF, FILE.usda or FILE.usdc for a USD layer as text or binary \
-                         (Blender, Houdini), \
-                         FILE.gif for a rendered animation (slides)",
-                    );
-                    if ui.button("Browse…").clicked() {
-                        requests.browse = true;
-                    }
-                });
-                // Only the options of the chosen format: a GIF has its own,
-                // a USD layer has timing and normals.
-                let target = PathBuf::from(self.path.trim());
-                let gif = is_gif_path(&target);
-                let usd = anthesis_export::is_usd_path(&target);
-                egui::Grid::new("export options")
-                    .num_columns(2)
-                    .show(ui, |ui| {
-                        let label = ui
-                            .label("Smooth mesh")
-                            .on_hover_text(
-                                "Levels of Loop subdivision of every organ: a finer render mesh \
-                                 driven by the simulated one, about four times the vertices per \
-                                 level (0 = the simulated mesh as it is)",
-                            )
-                            .id;
-                        ui.add(
-                            egui::DragValue::new(&mut self.render_level)
-                                .range(0..=MAX_DIALOG_RENDER_LEVEL)
-                                .prefix("subdivide ")
-                                .suffix(" ×"),
-                        )
-                        .labelled_by(label);
-                        ui.end_row();
-                        if let Selection::Only(organ) = selection {
-                            self.scope_ui(ui, project, *organ);
-                        }
-                        self.resimulate_ui(ui, project, selection, simulated_now);
-                        if gif {
-                            self.gif_options_ui(ui);
-                            return;
-                        }
-                        ui.label("Timing");
-                        ui.horizontal(|ui| {
-                            ui.radio_value(
-                                &mut self.timing_mode,
-                                TimingMode::FramesPerSecond,
-                                "keyframes per second",
-                            );
-                            ui.radio_value(
-                                &mut self.timing_mode,
-                                TimingMode::Duration,
-                                "total seconds",
-                            );
-                        });
-                        ui.end_row();
-                        match self.timing_mode {
-                            TimingMode::FramesPerSecond => {
-                                let label = ui.label("Keyframes per second").id;
-                                ui.add(
-                                    egui::DragValue::new(&mut self.frames_per_second)
-                                        .range(0.1..=240.0)
-                                        .speed(0.5),
-                                )
-                                .labelled_by(label);
-                            }
-                            TimingMode::Duration => {
-                                let label = ui.label("Duration").id;
-                                ui.add(
-                                    egui::DragValue::new(&mut self.duration_seconds)
-                                        .range(0.1..=3600.0)
-                                        .speed(0.1)
-                                        .suffix(" s"),
-                                )
-                                .labelled_by(label);
-                            }
-                        }
-                        ui.end_row();
-                        if !usd {
-                            let label = ui
-                                .label("Most morph targets")
-                                .on_hover_text(
-                                    "Per mesh; longer runs are resampled to this many keyframes \
-                                     (clients slow down with very many targets)",
-                                )
-                                .id;
-                            ui.add(
-                                egui::DragValue::new(&mut self.max_morph_targets).range(2..=2000),
-                            )
-                            .labelled_by(label);
-                            ui.end_row();
-                        }
-                        ui.label("Normals");
-                        ui.checkbox(&mut self.normals, "store normals")
-                            .on_hover_text("Without them the file is about half as large");
-                        ui.end_row();
-                        if usd {
-                            return;
-                        }
-                        ui.label("Encoding");
-                        ui.horizontal(|ui| {
-                            for encoding in Encoding::ALL {
-                                ui.radio_value(&mut self.encoding, encoding, encoding.to_string());
-                            }
-                        })
-                        .response
-                        .on_hover_text(
-                            "dense: plain floats, read everywhere; sparse: only moving vertices; \
-                             quantized: KHR_mesh_quantization, about half the size; \
-                             meshopt: quantized and compressed (EXT_meshopt_compression), \
-                             the smallest, for three.js with its meshopt decoder",
-                        );
-                        ui.end_row();
-                        ui.label("Opens in");
-                        ui.label(self.encoding.clients());
-                        ui.end_row();
-                    });
-                let after_bud = keyframes_ready.saturating_sub(1);
-                let whole_of_preview = matches!(selection, Selection::Only(_)) && self.whole_flower;
-                if whole_of_preview && !self.resimulate {
-                    ui.label(
-                        "The export holds the whole flower: its keyframes from before the \
-                         preview if nothing changed since, else a run of its own (with progress); \
-                         the window keeps its preview",
-                    );
-                } else if self.resimulate {
-                    ui.label(format!(
-                        "The export runs all {} keyframes again at mean edge {}; \
-                         the window keeps its run",
-                        project.settings.keyframes,
-                        edge_text(self.resimulate_edge)
-                    ));
-                } else {
-                    ui.label(format!(
-                        "{after_bud} of {keyframes_total} keyframes computed{}",
-                        if (after_bud as u32) < keyframes_total {
-                            " — the export holds the computed ones"
-                        } else {
-                            ""
-                        }
-                    ));
-                }
-                ui.horizontal(|ui| {
-                    let running = self.is_running();
-                    if ui
-                        .add_enabled(!running, egui::Button::new("Export"))
-                        .clicked()
-                    {
-                        requests.export = true;
-                    }
-                    match &self.state {
-                        ExportState::Idle => {}
-                        ExportState::Running { progress } => {
-                            let bar = egui::ProgressBar::new(*progress).desired_width(200.0);
-                            ui.add(match self.running_run {
-                                Some(total) if *progress < RUN_SHARE => {
-                                    let done = (progress / RUN_SHARE * total as f32).floor();
-                                    bar.text(format!("running: keyframe {done} of {total}"))
-                                }
-                                Some(_) => bar.text("writing the file"),
-                                None => bar.show_percentage(),
-                            });
-                            if ui.button("Cancel").clicked() {
-                                self.cancel();
-                            }
-                        }
-                        ExportState::Done { path, bytes } => {
-                            ui.label(format!(
-                                "Wrote {} ({:.1} MB)",
-                                path.display(),
-                                *bytes as f64 / 1.0e6
-                            ));
-                        }
-                        ExportState::Failed { message } => {
-                            ui.colored_label(egui::Color32::from_rgb(210, 50, 40), message);
-                        }
-                    }
-                });
-            });
-        self.open = open;
-        requests
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use anthesis_flower::resolution::resolve;
     use std::time::{Duration, Instant};
 
     /// Polls `dialog` until its export ends (failing after a minute).

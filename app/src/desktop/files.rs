@@ -13,14 +13,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 
-use anthesis_render::OrbitCamera;
+use anthesis_sim::batch::Format;
 use eframe::egui;
-
-use super::timeline::Playback;
-use super::viewport::ViewOptions;
-
-/// Most recent files remembered.
-pub const RECENT_LIMIT: usize = 10;
 
 /// The file-name pattern of project files.
 pub const PROJECT_EXTENSION: &str = "toml";
@@ -68,12 +62,12 @@ impl DialogPurpose {
 
     /// The extensions of the files listed (and offered by the native
     /// dialog's filters).
-    pub fn extensions(self) -> &'static [&'static str] {
+    pub fn extensions(self) -> Vec<&'static str> {
         match self {
-            DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => &[PROJECT_EXTENSION],
-            DialogPurpose::ExportGlb => &["glb", "usda", "usdc", "usd", "gif"],
-            DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => &["obj"],
-            DialogPurpose::OpenShape(_) => &["obj"],
+            DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => vec![PROJECT_EXTENSION],
+            DialogPurpose::ExportGlb => Format::file_extensions(),
+            DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => vec!["obj"],
+            DialogPurpose::OpenShape(_) => vec!["obj"],
         }
     }
 }
@@ -278,75 +272,25 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
     }
     match purpose {
         DialogPurpose::OpenProject => dialog
-            .add_filter("Anthesis project", purpose.extensions())
+            .add_filter("Anthesis project", &purpose.extensions())
             .pick_file(),
         DialogPurpose::OpenShape(_) => dialog
-            .add_filter("OBJ mesh", purpose.extensions())
+            .add_filter("OBJ mesh", &purpose.extensions())
             .pick_file(),
         DialogPurpose::SaveProjectAs => dialog
-            .add_filter("Anthesis project", purpose.extensions())
+            .add_filter("Anthesis project", &purpose.extensions())
             .set_file_name(purpose.suggested_name().unwrap_or_default())
             .save_file(),
         DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => dialog
-            .add_filter("OBJ mesh", purpose.extensions())
+            .add_filter("OBJ mesh", &purpose.extensions())
             .pick_file(),
-        DialogPurpose::ExportGlb => dialog
-            .add_filter("glTF binary", &["glb"])
-            .add_filter("USD layer", &["usda", "usdc", "usd"])
-            .add_filter("GIF animation", &["gif"])
+        DialogPurpose::ExportGlb => Format::FILES
+            .into_iter()
+            .fold(dialog, |dialog, format| {
+                dialog.add_filter(format.name(), format.extensions())
+            })
             .set_file_name(purpose.suggested_name().unwrap_or_default())
             .save_file(),
-    }
-}
-
-/// What eframe stores between launches (besides window and panel layout,
-/// which it keeps itself).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default)]
-pub struct Settings {
-    pub recent: Vec<PathBuf>,
-    /// The project open at the last exit, reopened at start.
-    pub last_project: Option<PathBuf>,
-    pub view: ViewOptions,
-    pub camera: Option<OrbitCamera>,
-    pub single_organ_preview: bool,
-    pub looping: bool,
-    pub speed: f64,
-    pub show_log: bool,
-    /// The undo history window is open.
-    pub show_history: bool,
-    /// Unsaved work is saved for recovery at most this often, in seconds.
-    pub autosave_seconds: u64,
-}
-
-impl Default for Settings {
-    fn default() -> Self {
-        let playback = Playback::default();
-        Settings {
-            recent: Vec::new(),
-            last_project: None,
-            view: ViewOptions::default(),
-            camera: None,
-            single_organ_preview: false,
-            looping: playback.looping,
-            speed: playback.speed,
-            show_log: true,
-            show_history: false,
-            autosave_seconds: super::autosave::DEFAULT_INTERVAL_SECONDS,
-        }
-    }
-}
-
-impl Settings {
-    /// Puts `path` first in the recent list.
-    pub fn remember(&mut self, path: &Path) {
-        self.recent.retain(|p| p != path);
-        self.recent.insert(0, path.to_path_buf());
-        self.recent.truncate(RECENT_LIMIT);
-    }
-
-    pub fn forget(&mut self, path: &Path) {
-        self.recent.retain(|p| p != path);
     }
 }
 
@@ -370,34 +314,5 @@ mod tests {
             Some("/nonexistent/bin".as_ref())
         ));
         assert!(!program_on_path("zenity", None));
-    }
-
-    #[test]
-    fn recent_files_are_unique_newest_first_and_bounded() {
-        let mut s = Settings::default();
-        for i in 0..15 {
-            s.remember(Path::new(&format!("/p/{i}.toml")));
-        }
-        s.remember(Path::new("/p/12.toml"));
-        assert_eq!(s.recent.len(), RECENT_LIMIT);
-        assert_eq!(s.recent[0], Path::new("/p/12.toml"));
-        assert_eq!(s.recent[1], Path::new("/p/14.toml"));
-        assert_eq!(
-            s.recent.iter().filter(|p| p.ends_with("12.toml")).count(),
-            1
-        );
-    }
-
-    #[test]
-    fn settings_survive_a_round_trip_and_old_files_get_defaults() {
-        let mut s = Settings::default();
-        s.remember(Path::new("/p/a.toml"));
-        s.view.wireframe = true;
-        let text = serde_json::to_string(&s).expect("serialises");
-        let back: Settings = serde_json::from_str(&text).expect("reads back");
-        assert_eq!(back, s);
-        let partial: Settings = serde_json::from_str(r#"{"show_log": false}"#).expect("partial");
-        assert!(!partial.show_log);
-        assert_eq!(partial.speed, 1.0);
     }
 }

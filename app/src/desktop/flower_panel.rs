@@ -24,6 +24,11 @@ use super::command::{Command, ProjectEdit};
 use super::parts_panel;
 use super::shape_panel::{ShapeState, shape_ui};
 
+mod arrangement;
+mod lsystem;
+
+use arrangement::arrangement_ui;
+
 /// How long typing must pause before the L-system text is applied.
 pub const TYPING_PAUSE_SECONDS: f64 = 0.5;
 
@@ -91,7 +96,7 @@ impl FlowerPanelState {
     }
 
     /// A scanned petal was read: it is reviewed in the panel.
-    pub(super) fn scan_read(&mut self, review: super::pde_panel::ScanReview) {
+    pub(super) fn scan_read(&mut self, review: super::scan_panel::ScanReview) {
         self.refused = None;
         self.shape.pde.scan = Some(review);
     }
@@ -139,81 +144,6 @@ impl Kind {
             Kind::LSystem => "L-system",
         }
     }
-}
-
-/// The byte range of the text an L-system error points at: the character
-/// at its line and column (the end of the line when the column is past
-/// it), or its whole line.
-fn error_range(text: &str, error: &LSystemError) -> Option<Range<usize>> {
-    let (line, column) = match error {
-        LSystemError::Syntax { line, column, .. } => (*line, Some(*column)),
-        LSystemError::UnknownName { line, .. } | LSystemError::Arity { line, .. } => (*line, None),
-        _ => return None,
-    };
-    let mut start = 0;
-    for (n, l) in text.split('\n').enumerate() {
-        let end = start + l.len();
-        if n + 1 == line {
-            return Some(match column {
-                None => start..end,
-                Some(column) => match l.char_indices().nth(column.saturating_sub(1)) {
-                    Some((at, c)) => start + at..start + at + c.len_utf8(),
-                    // Past the end: the line's last character, if any.
-                    None => match l.char_indices().last() {
-                        Some((at, c)) => start + at..start + at + c.len_utf8(),
-                        None => start..end,
-                    },
-                },
-            });
-        }
-        start = end + 1;
-    }
-    None
-}
-
-/// The text laid out with the error's characters on red.
-fn highlighted(
-    ui: &egui::Ui,
-    text: &str,
-    at: Option<&Range<usize>>,
-    wrap: f32,
-) -> egui::text::LayoutJob {
-    let font = egui::TextStyle::Monospace.resolve(ui.style());
-    let normal = egui::TextFormat::simple(font.clone(), ui.visuals().text_color());
-    let mut job = egui::text::LayoutJob {
-        wrap: egui::text::TextWrapping {
-            max_width: wrap,
-            ..Default::default()
-        },
-        ..Default::default()
-    };
-    match at.filter(|r| r.end <= text.len() && text.is_char_boundary(r.start)) {
-        Some(range) if !range.is_empty() => {
-            job.append(&text[..range.start], 0.0, normal.clone());
-            let mut marked = egui::TextFormat::simple(font, Color32::WHITE);
-            marked.background = Color32::from_rgb(200, 40, 40);
-            job.append(&text[range.clone()], 0.0, marked);
-            job.append(&text[range.end..], 0.0, normal);
-        }
-        _ => job.append(text, 0.0, normal),
-    }
-    job
-}
-
-/// The surface letters `~X` of an L-system's text, in order.
-fn surface_letters(text: &str) -> Vec<char> {
-    let mut letters = Vec::new();
-    let mut chars = text.chars().peekable();
-    while let Some(c) = chars.next() {
-        if c == '~'
-            && let Some(&letter) = chars.peek()
-            && letter.is_alphabetic()
-            && !letters.contains(&letter)
-        {
-            letters.push(letter);
-        }
-    }
-    letters
 }
 
 /// What the panel asks for: an edited flower with its label, or a message.
@@ -307,311 +237,6 @@ fn template_combo(
     *template != before
 }
 
-/// The rows of one whorl; returns the field that changed.
-fn whorl_rows(
-    ui: &mut egui::Ui,
-    flower: &Flower,
-    whorl: &mut Whorl,
-    id: usize,
-) -> Option<&'static str> {
-    let mut changed = None;
-    let mut mark = |c: bool, field: &'static str| {
-        if c && changed.is_none() {
-            changed = Some(field);
-        }
-    };
-    egui::Grid::new(("whorl rows", id))
-        .num_columns(2)
-        .spacing([12.0, 4.0])
-        .show(ui, |ui| {
-            let label = ui.label("template").id;
-            mark(
-                template_combo(ui, ("whorl template", id), label, flower, &mut whorl.template),
-                "template",
-            );
-            ui.end_row();
-            let label = ui.label("count").on_hover_text("How many organs around the axis.");
-            let mut count = whorl.count as u32;
-            mark(
-                ui.add(DragValue::new(&mut count).range(1..=64))
-                    .labelled_by(label.id)
-                    .changed(),
-                "count",
-            );
-            whorl.count = count as usize;
-            ui.end_row();
-            mark(
-                number(ui, "offset", "Azimuth of the first organ, in degrees (0 faces +Z).", &mut whorl.offset_deg, -360.0..=360.0),
-                "offset",
-            );
-            mark(
-                number(ui, "radius", "Distance of the organs' bases from the axis.", &mut whorl.radius, 0.0..=1000.0),
-                "radius",
-            );
-            mark(
-                number(ui, "height", "Height of the organs' bases.", &mut whorl.height, -1000.0..=1000.0),
-                "height",
-            );
-            mark(
-                number(ui, "joint angle", "Initial tilt outwards, in degrees.", &mut whorl.joint_angle_deg, -180.0..=180.0),
-                "joint angle",
-            );
-            mark(
-                number(
-                    ui,
-                    "half span",
-                    "Half the angle about the axis an organ covers at its widest: organs of two whorls \
-                     whose spans meet get an overlap rule.",
-                    &mut whorl.half_span_deg,
-                    0.0..=180.0,
-                ),
-                "half span",
-            );
-        });
-    changed
-}
-
-/// The rows of the spiral; returns the field that changed.
-fn spiral_rows(ui: &mut egui::Ui, flower: &Flower, spiral: &mut Spiral) -> Option<&'static str> {
-    let mut changed = None;
-    let mut mark = |c: bool, field: &'static str| {
-        if c && changed.is_none() {
-            changed = Some(field);
-        }
-    };
-    egui::Grid::new("spiral rows")
-        .num_columns(2)
-        .spacing([12.0, 4.0])
-        .show(ui, |ui| {
-            let label = ui.label("template").id;
-            mark(
-                template_combo(ui, "spiral template", label, flower, &mut spiral.template),
-                "template",
-            );
-            ui.end_row();
-            let label = ui
-                .label("count")
-                .on_hover_text("How many organs along the spiral.");
-            let mut count = spiral.count as u32;
-            mark(
-                ui.add(DragValue::new(&mut count).range(1..=256))
-                    .labelled_by(label.id)
-                    .changed(),
-                "count",
-            );
-            spiral.count = count as usize;
-            ui.end_row();
-            mark(
-                number(
-                    ui,
-                    "divergence",
-                    "Angle between consecutive organs (the golden angle: 137.5°).",
-                    &mut spiral.divergence_deg,
-                    -360.0..=360.0,
-                ),
-                "divergence",
-            );
-            mark(
-                number(
-                    ui,
-                    "first radius",
-                    "Distance of the first (outermost) organ from the axis.",
-                    &mut spiral.first_radius,
-                    0.0..=1000.0,
-                ),
-                "first radius",
-            );
-            mark(
-                number(
-                    ui,
-                    "first height",
-                    "Height of the first organ's base.",
-                    &mut spiral.first_height,
-                    -1000.0..=1000.0,
-                ),
-                "first height",
-            );
-            mark(
-                number(
-                    ui,
-                    "radius step",
-                    "Each later organ sits this much nearer the axis.",
-                    &mut spiral.radius_step,
-                    -100.0..=100.0,
-                ),
-                "radius step",
-            );
-            mark(
-                number(
-                    ui,
-                    "height step",
-                    "Each later organ sits this much higher.",
-                    &mut spiral.height_step,
-                    -100.0..=100.0,
-                ),
-                "height step",
-            );
-            mark(
-                number(
-                    ui,
-                    "joint angle",
-                    "Initial tilt outwards, in degrees.",
-                    &mut spiral.joint_angle_deg,
-                    -180.0..=180.0,
-                ),
-                "joint angle",
-            );
-            mark(
-                number(
-                    ui,
-                    "half span",
-                    "Half the angle an organ covers about the axis.",
-                    &mut spiral.half_span_deg,
-                    0.0..=180.0,
-                ),
-                "half span",
-            );
-        });
-    changed
-}
-
-impl FlowerPanelState {
-    /// Checks `text` as the flower's L-system: the flower it makes, or the
-    /// error to show.
-    fn check(
-        &mut self,
-        flower: &Flower,
-        text: &str,
-        steps: u32,
-        surfaces: &BTreeMap<char, usize>,
-    ) -> Option<Flower> {
-        let structure = Structure::LSystem {
-            text: text.to_string(),
-            steps,
-            surfaces: surfaces.clone(),
-            units: self.units,
-        };
-        match flower.with_structure(Some(structure)) {
-            Ok(made) => {
-                self.error = None;
-                Some(made)
-            }
-            Err(error) => {
-                let at = match &error {
-                    anthesis_flower::edit::EditError::Structure(StructureError::LSystem(e)) => {
-                        error_range(text, e)
-                    }
-                    _ => None,
-                };
-                self.error = Some(TextError {
-                    message: error.to_string(),
-                    at,
-                });
-                None
-            }
-        }
-    }
-
-    /// The L-system editor; `now` is the input time in seconds.
-    fn lsystem_ui(
-        &mut self,
-        ui: &mut egui::Ui,
-        flower: &Flower,
-        (text, steps, surfaces): (&str, u32, &BTreeMap<char, usize>),
-        now: f64,
-    ) -> Option<Outcome> {
-        // Follow the project (an undo, another project) unless typing.
-        if self.typed_at.is_none() && self.source.as_deref() != Some(text) {
-            self.text = text.to_string();
-            self.source = Some(text.to_string());
-            self.error = None;
-        }
-        let mut out = None;
-        let error_at = self.error.as_ref().and_then(|e| e.at.clone());
-        let mut layouter = |ui: &egui::Ui, buffer: &dyn egui::TextBuffer, wrap: f32| {
-            let job = highlighted(ui, buffer.as_str(), error_at.as_ref(), wrap);
-            ui.fonts_mut(|f| f.layout_job(job))
-        };
-        let edit = ui.add(
-            egui::TextEdit::multiline(&mut self.text)
-                .id_salt("lsystem text")
-                .code_editor()
-                .desired_rows(6)
-                .desired_width(f32::INFINITY)
-                .layouter(&mut layouter),
-        );
-        let edit = edit.on_hover_text(
-            "One statement a line: constants (angle = 30), axiom: …, productions A(x) -> … . \
-             ~X places an organ of the template chosen for surface X below.",
-        );
-        if edit.changed() {
-            self.typed_at = Some(now);
-            let typed = self.text.clone();
-            self.check(flower, &typed, steps, surfaces);
-        }
-        if let Some(error) = &self.error {
-            ui.label(RichText::new(&error.message).color(ui.visuals().error_fg_color));
-        }
-        if let Some(at) = self.typed_at {
-            let waited = now - at;
-            if waited >= TYPING_PAUSE_SECONDS {
-                self.typed_at = None;
-                let typed = self.text.clone();
-                if typed != text
-                    && let Some(made) = self.check(flower, &typed, steps, surfaces)
-                {
-                    self.source = Some(typed);
-                    out = Some(Outcome::Edit("L-system text".to_string(), made));
-                } else if self.error.is_none() {
-                    self.source = Some(typed);
-                }
-            } else {
-                ui.ctx()
-                    .request_repaint_after(std::time::Duration::from_secs_f64(
-                        TYPING_PAUSE_SECONDS - waited + 0.01,
-                    ));
-            }
-        }
-        // Steps and surfaces apply at once (with the text as it is, when
-        // it is valid).
-        let mut steps_now = steps;
-        let mut surfaces_now = surfaces.clone();
-        let mut label = None;
-        ui.horizontal(|ui| {
-            let l = ui.label("derivation steps");
-            if ui
-                .add(
-                    DragValue::new(&mut steps_now)
-                        .range(0..=anthesis_flower::structure::lsystem::MAX_STEPS),
-                )
-                .labelled_by(l.id)
-                .changed()
-            {
-                label = Some("derivation steps".to_string());
-            }
-        });
-        for letter in surface_letters(&self.text) {
-            ui.horizontal(|ui| {
-                let name = ui.label(format!("surface ~{letter}")).id;
-                let mut template = surfaces_now.get(&letter).copied().unwrap_or(usize::MAX);
-                if template_combo(ui, ("surface", letter), name, flower, &mut template) {
-                    surfaces_now.insert(letter, template);
-                    label = Some(format!("surface ~{letter}"));
-                }
-            });
-        }
-        if let Some(label) = label {
-            let typed = self.text.clone();
-            if let Some(made) = self.check(flower, &typed, steps_now, &surfaces_now) {
-                self.typed_at = None;
-                self.source = Some(typed);
-                out = Some(Outcome::Edit(label, made));
-            }
-        }
-        out
-    }
-}
-
 /// Shows the Flower panel for `project`; returns the edits the user made.
 /// `now` is the input time in seconds (typing pauses are measured in it).
 pub fn flower_ui(
@@ -624,6 +249,64 @@ pub fn flower_ui(
     let mut outcomes: Vec<Outcome> = Vec::new();
     let mut commands_early: Vec<Command> = Vec::new();
 
+    templates_ui(ui, flower, state, &mut outcomes, &mut commands_early);
+    ui.separator();
+
+    // A scanned petal under review.
+    if let Some(index) =
+        super::scan_panel::scan_ui(ui, flower, &mut state.shape.pde.scan, &mut commands_early)
+    {
+        state.shape.template = index;
+        state.shape.edge = None;
+        state.shape.open_now = true;
+    }
+
+    // The shape of one template.
+    shape_ui(ui, flower, &mut state.shape, &mut commands_early);
+    bud_sketch_ui(
+        ui,
+        (flower, project.settings.keyframes),
+        &mut state.bud,
+        &mut commands_early,
+    );
+    ui.separator();
+
+    arrangement_ui(ui, flower, state, now, &mut outcomes);
+    ui.separator();
+
+    organs_ui(ui, flower, state, &mut outcomes);
+    ui.separator();
+
+    overlaps_ui(ui, flower, &mut outcomes);
+    ui.separator();
+
+    let mut commands = commands_early;
+    for out in outcomes {
+        match out {
+            Outcome::Edit(label, flower) => {
+                state.refused = None;
+                commands.push(Command::Edit {
+                    label,
+                    edit: ProjectEdit::Flower(Box::new(flower)),
+                });
+            }
+            Outcome::Refused(message) => state.refused = Some(message),
+        }
+    }
+    // Parts.
+    commands.extend(parts_panel::parts_ui(ui, project));
+    commands
+}
+
+/// The Templates section: each template (renamed in place, removed),
+/// then the buttons that add one (from a shape, a mesh or a scan).
+fn templates_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    outcomes: &mut Vec<Outcome>,
+    commands_early: &mut Vec<Command>,
+) {
     // Templates.
     ui.strong("Templates")
         .on_hover_text("The organ types: a mesh, growth maps and material each.");
@@ -669,6 +352,18 @@ pub fn flower_ui(
             }
         });
     }
+    add_template_ui(ui, flower, state, outcomes, commands_early);
+}
+
+/// The buttons that add a template: the simple petal, a new Bézier, PDE
+/// or sketched petal, an OBJ, a scanned petal, or a copy of the chosen one.
+fn add_template_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    outcomes: &mut Vec<Outcome>,
+    commands_early: &mut Vec<Command>,
+) {
     ui.horizontal_wrapped(|ui| {
         if ui
             .button("Add simple petal")
@@ -760,168 +455,15 @@ pub fn flower_ui(
             outcomes.push(Outcome::Edit(format!("add template {name}"), added));
         }
     });
-    ui.separator();
+}
 
-    // A scanned petal under review.
-    if let Some(index) =
-        super::pde_panel::scan_ui(ui, flower, &mut state.shape.pde, &mut commands_early)
-    {
-        state.shape.template = index;
-        state.shape.edge = None;
-        state.shape.open_now = true;
-    }
-
-    // The shape of one template.
-    shape_ui(ui, flower, &mut state.shape, &mut commands_early);
-    bud_sketch_ui(
-        ui,
-        (flower, project.settings.keyframes),
-        &mut state.bud,
-        &mut commands_early,
-    );
-    ui.separator();
-
-    // Arrangement.
-    ui.strong("Arrangement").on_hover_text(
-        "Where the organs go: listed one by one, whorls (rings, innermost first), a golden-angle \
-         spiral or an L-system whose ~X places an organ.",
-    );
-    let kind = Kind::of(flower.structure.as_ref());
-    let mut chosen = kind;
-    ui.horizontal(|ui| {
-        let label = ui.label("arrange by").id;
-        egui::ComboBox::from_id_salt("arrangement kind")
-            .selected_text(kind.name())
-            .show_ui(ui, |ui| {
-                for k in [Kind::Listed, Kind::Whorls, Kind::Spiral, Kind::LSystem] {
-                    ui.selectable_value(&mut chosen, k, k.name());
-                }
-            })
-            .response
-            .labelled_by(label);
-    });
-    if chosen != kind {
-        let whorls = whorls_like(flower);
-        let result = match chosen {
-            Kind::Listed => flower.with_structure(None),
-            Kind::Whorls => flower.arranged_by(Structure::Whorls {
-                whorls,
-                contorted: false,
-            }),
-            Kind::Spiral => match spiral_like(&whorls) {
-                Some(spiral) => flower.arranged_by(Structure::Spiral(spiral)),
-                None => Err(anthesis_flower::edit::EditError::NoOrgans),
-            },
-            Kind::LSystem => {
-                let (text, steps, surfaces) = lsystem_like(&whorls);
-                flower.arranged_by(Structure::LSystem {
-                    text,
-                    steps,
-                    surfaces,
-                    units: 1.0,
-                })
-            }
-        };
-        outcomes.push(outcome(
-            format!("arrange by {}", chosen.name().to_lowercase()),
-            result,
-        ));
-    }
-    match &flower.structure {
-        None => {
-            ui.label("Each organ is placed on its own (see Organs).");
-        }
-        Some(Structure::Whorls { whorls, contorted }) => {
-            let mut draft = whorls.clone();
-            let mut contorted_now = *contorted;
-            let mut label = None;
-            if ui
-                .checkbox(&mut contorted_now, "contorted")
-                .on_hover_text(
-                    "One ring whose organs each lie beneath their right-hand neighbour (Eustoma)",
-                )
-                .changed()
-            {
-                label = Some("contorted".to_string());
-            }
-            let mut remove = None;
-            for (i, whorl) in draft.iter_mut().enumerate() {
-                egui::CollapsingHeader::new(format!("whorl “{}” × {}", whorl.name, whorl.count))
-                    .id_salt(("whorl", i))
-                    .default_open(draft_len_is_small(whorls.len()))
-                    .show(ui, |ui| {
-                        if let Some(field) = whorl_rows(ui, flower, whorl, i) {
-                            label = Some(format!("{field} of whorl {}", whorl.name));
-                        }
-                        if ui
-                            .add_enabled(whorls.len() > 1, egui::Button::new("Remove whorl"))
-                            .clicked()
-                        {
-                            remove = Some(i);
-                        }
-                    });
-            }
-            if let Some(i) = remove {
-                label = Some(format!("remove whorl {}", draft[i].name));
-                draft.remove(i);
-            }
-            if ui
-                .button("Add whorl")
-                .on_hover_text("A ring outside the others, its organs between theirs")
-                .clicked()
-                && let Some(last) = draft.last()
-            {
-                let name =
-                    anthesis_flower::edit::unique_name(&format!("{} outer", last.name), |n| {
-                        draft.iter().any(|w| w.name == n)
-                    });
-                let step = 360.0 / last.count.max(1) as f64;
-                let added = Whorl {
-                    name,
-                    offset_deg: last.offset_deg + 0.5 * step,
-                    radius: last.radius * 1.15 + 0.1,
-                    ..last.clone()
-                };
-                label = Some(format!("add whorl {}", added.name));
-                draft.push(added);
-            }
-            if let Some(label) = label {
-                outcomes.push(outcome(
-                    label,
-                    flower.with_structure(Some(Structure::Whorls {
-                        whorls: draft,
-                        contorted: contorted_now,
-                    })),
-                ));
-            }
-        }
-        Some(Structure::Spiral(spiral)) => {
-            let mut draft = spiral.clone();
-            if let Some(field) = spiral_rows(ui, flower, &mut draft) {
-                outcomes.push(outcome(
-                    format!("{field} of the spiral"),
-                    flower.with_structure(Some(Structure::Spiral(draft))),
-                ));
-            }
-        }
-        Some(Structure::LSystem {
-            text,
-            steps,
-            surfaces,
-            units,
-        }) => {
-            state.units = *units;
-            let now_text = text.clone();
-            if let Some(out) = state.lsystem_ui(ui, flower, (&now_text, *steps, surfaces), now) {
-                outcomes.push(out);
-            }
-        }
-    }
-    if let Some(refused) = &state.refused {
-        ui.label(RichText::new(refused).color(ui.visuals().error_fg_color));
-    }
-    ui.separator();
-
+/// The Organs section: the organs listed and made, and a new listed organ.
+fn organs_ui(
+    ui: &mut egui::Ui,
+    flower: &Flower,
+    state: &mut FlowerPanelState,
+    outcomes: &mut Vec<Outcome>,
+) {
     // Organs.
     let made = flower.made_organ_count();
     egui::CollapsingHeader::new(format!("Organs ({})", flower.organs.len()))
@@ -977,8 +519,11 @@ pub fn flower_ui(
             ));
         }
     });
-    ui.separator();
+}
 
+/// The Overlap order section: which organ of each overlapping pair lies
+/// inside, and where the rule comes from; a click swaps a pair.
+fn overlaps_ui(ui: &mut egui::Ui, flower: &Flower, outcomes: &mut Vec<Outcome>) {
     // Overlap order.
     let origins = flower.rule_origins();
     egui::CollapsingHeader::new(format!("Overlap order ({} pairs)", flower.overlaps.len()))
@@ -1022,24 +567,6 @@ pub fn flower_ui(
                 });
             }
         });
-    ui.separator();
-
-    let mut commands = commands_early;
-    for out in outcomes {
-        match out {
-            Outcome::Edit(label, flower) => {
-                state.refused = None;
-                commands.push(Command::Edit {
-                    label,
-                    edit: ProjectEdit::Flower(Box::new(flower)),
-                });
-            }
-            Outcome::Refused(message) => state.refused = Some(message),
-        }
-    }
-    // Parts.
-    commands.extend(parts_panel::parts_ui(ui, project));
-    commands
 }
 
 /// Where a listed organ sits: its base's azimuth and distance from the
@@ -1116,32 +643,4 @@ fn placement_rows(
 /// Whorls start open when there are few of them.
 fn draft_len_is_small(n: usize) -> bool {
     n <= 2
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use anthesis_flower::structure::lsystem::LSystem;
-
-    #[test]
-    fn the_error_range_is_the_character_at_the_line_and_column() {
-        let text = "axiom: A\nA -> F(1 B";
-        let error = LSystem::parse(text).unwrap_err();
-        let range = error_range(text, &error).unwrap();
-        assert_eq!(&text[range], "B");
-        // Past the end of the line: its last character.
-        let text = "axiom: A\nA -> F(1";
-        let error = LSystem::parse(text).unwrap_err();
-        let range = error_range(text, &error).unwrap();
-        assert_eq!(&text[range], "1");
-        // An unknown name: its line.
-        let text = "axiom: A\nA -> F(len)";
-        let error = LSystem::parse(text).unwrap_err();
-        assert_eq!(&text[error_range(text, &error).unwrap()], "A -> F(len)");
-    }
-
-    #[test]
-    fn surface_letters_are_found_once_in_order() {
-        assert_eq!(surface_letters("axiom: [~p] ~c ~p F ~"), vec!['p', 'c']);
-    }
 }

@@ -350,40 +350,7 @@ impl AnthesisApp {
         let mut open_fit = false;
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if ui.button("New").clicked() {
-                    chosen.push(Command::NewProject);
-                }
-                if ui.button(with_keys("Open…", "Open a project")).clicked() {
-                    chosen.push(Command::OpenProject(None));
-                }
-                ui.menu_button("Open recent", |ui| {
-                    if self.settings.recent.is_empty() {
-                        ui.label("(none yet)");
-                    }
-                    for path in &self.settings.recent {
-                        if ui.button(path.display().to_string()).clicked() {
-                            chosen.push(Command::OpenProject(Some(path.clone())));
-                        }
-                    }
-                });
-                ui.separator();
-                if ui.button(with_keys("Save", "Save")).clicked() {
-                    chosen.push(Command::Save);
-                }
-                if ui.button(with_keys("Save as…", "Save as")).clicked() {
-                    chosen.push(Command::SaveAs);
-                }
-                ui.separator();
-                if ui
-                    .button(with_keys("Export animation…", "Export the animation"))
-                    .clicked()
-                {
-                    chosen.push(Command::OpenExportDialog);
-                }
-                ui.separator();
-                if ui.button("Quit").clicked() {
-                    chosen.push(Command::Quit);
-                }
+                self.file_menu(ui, &mut chosen);
             });
             ui.menu_button("Edit", |ui| {
                 let undo = self
@@ -464,6 +431,44 @@ impl AnthesisApp {
         self.queued.extend(chosen);
         if open_fit {
             self.fit.open = true;
+        }
+    }
+
+    /// The File menu's entries (the recent projects among them).
+    fn file_menu(&self, ui: &mut egui::Ui, chosen: &mut Vec<Command>) {
+        if ui.button("New").clicked() {
+            chosen.push(Command::NewProject);
+        }
+        if ui.button(with_keys("Open…", "Open a project")).clicked() {
+            chosen.push(Command::OpenProject(None));
+        }
+        ui.menu_button("Open recent", |ui| {
+            if self.settings.recent.is_empty() {
+                ui.label("(none yet)");
+            }
+            for path in &self.settings.recent {
+                if ui.button(path.display().to_string()).clicked() {
+                    chosen.push(Command::OpenProject(Some(path.clone())));
+                }
+            }
+        });
+        ui.separator();
+        if ui.button(with_keys("Save", "Save")).clicked() {
+            chosen.push(Command::Save);
+        }
+        if ui.button(with_keys("Save as…", "Save as")).clicked() {
+            chosen.push(Command::SaveAs);
+        }
+        ui.separator();
+        if ui
+            .button(with_keys("Export animation…", "Export the animation"))
+            .clicked()
+        {
+            chosen.push(Command::OpenExportDialog);
+        }
+        ui.separator();
+        if ui.button("Quit").clicked() {
+            chosen.push(Command::Quit);
         }
     }
 }

@@ -33,12 +33,15 @@ mod project_io;
 mod prompts;
 pub mod rerun;
 pub mod resolution;
+pub mod scan_panel;
 pub mod session;
+pub mod settings;
 pub mod shape_panel;
 pub mod sketch_panel;
 pub mod timeline;
 pub mod two_state;
 pub mod viewport;
+pub mod widgets;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -54,10 +57,11 @@ use anthesis_render::OrbitCamera;
 pub use command::{Command, ProjectEdit};
 use document::Document;
 use export::ExportDialog;
-use files::{Dialogs, Settings};
+use files::Dialogs;
 use log::{Log, Topic};
 use paint::PaintState;
 use session::{DRAIN_BUDGET, SimSession};
+use settings::Settings;
 use timeline::Playback;
 use viewport::{ViewOptions, ViewportGpu};
 

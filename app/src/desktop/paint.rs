@@ -12,6 +12,9 @@ use glam::DVec2;
 use super::command::{Command, ProjectEdit};
 use anthesis_maps::brush::{Brush, BrushMode, PaintTarget, StrokeDab, StrokeSpacing};
 
+mod canvas;
+mod legend;
+
 /// The radius slider's range (UV units) and the `[`/`]` step factor.
 const MIN_RADIUS_IN_UV: f64 = 0.005;
 const MAX_RADIUS_IN_UV: f64 = 0.5;
@@ -301,98 +304,9 @@ impl PaintState {
                 .labelled_by(label);
                 ui.end_row();
 
-                let label = ui.label("Key dg").id;
-                ui.horizontal(|ui| {
-                    let key = &current.maps.keys()[self.key];
-                    let mut own = key.dg.is_some();
-                    let mut dg = key.dg.unwrap_or(current.dg);
-                    let toggled = ui
-                        .checkbox(&mut own, "own")
-                        .on_hover_text(
-                            "This key's own growth scale in place of the template's dg, \
-                             blended between keys like the maps; negative: the organ \
-                             shrinks (wilting after it opened)",
-                        )
-                        .changed();
-                    let dragged = ui
-                        .add_enabled(
-                            own,
-                            egui::DragValue::new(&mut dg)
-                                .speed(0.0001)
-                                .range(-0.5..=0.5)
-                                .max_decimals(4),
-                        )
-                        .labelled_by(label)
-                        .changed();
-                    if toggled || dragged {
-                        let mut value = current.clone();
-                        if let Some(k) = value.maps.keys_mut().get_mut(self.key) {
-                            k.dg = own.then_some(dg);
-                        }
-                        chosen.push(Command::Edit {
-                            label: format!("dg of key {} of {}", key.step, current.name),
-                            edit: ProjectEdit::Template {
-                                template,
-                                value: Box::new(value),
-                                keyframes: project.settings.keyframes,
-                            },
-                        });
-                    }
-                });
-                ui.end_row();
+                self.key_dg_row(ui, (project, template, current), &mut chosen);
 
-                let label = ui.label("New key").id;
-                ui.horizontal(|ui| {
-                    ui.add(egui::DragValue::new(&mut self.new_key_step).range(0..=100_000))
-                        .labelled_by(label)
-                        .on_hover_text("Step of the key to add");
-                    let exists = current
-                        .maps
-                        .keys()
-                        .iter()
-                        .any(|k| k.step == self.new_key_step);
-                    if ui
-                        .add_enabled(!exists, egui::Button::new("Add key"))
-                        .on_hover_text(
-                            "Add a key at this step, starting from the selected key's maps",
-                        )
-                        .clicked()
-                    {
-                        // The new key starts from the selected key's maps;
-                        // applying it selects it for painting.
-                        let maps = current.maps.keys()[self.key].maps.clone();
-                        let step = self.new_key_step;
-                        chosen.push(Command::Edit {
-                            label: format!("add key {step} to {}", current.name),
-                            edit: ProjectEdit::AddKey {
-                                template,
-                                key: Box::new(MapKey {
-                                    dg: None,
-                                    step,
-                                    maps,
-                                }),
-                            },
-                        });
-                    }
-                    if ui
-                        .add_enabled(
-                            current.maps.keys().len() > 1,
-                            egui::Button::new("Remove key"),
-                        )
-                        .on_hover_text("Remove the selected key (the last key cannot go)")
-                        .clicked()
-                    {
-                        chosen.push(Command::Edit {
-                            label: format!("remove key from {}", current.name),
-                            edit: ProjectEdit::RemoveKey {
-                                template,
-                                key: self.key,
-                            },
-                        });
-                        self.key = self.key.saturating_sub(1);
-                    }
-                });
-                ui.end_row();
+                self.new_key_row(ui, (template, current), &mut chosen);
 
                 let label = ui.label("Blend").id;
                 let mut blend = current.maps.blend;
@@ -423,17 +337,130 @@ impl PaintState {
         chosen.extend(self.canvas(ui, project, template, current));
         self.legend_ui(ui, current);
         ui.separator();
-        egui::ScrollArea::vertical()
+        let brush = egui::ScrollArea::vertical()
             .id_salt("brush settings")
-            .show(ui, |ui| self.brush_ui(ui));
+            .show(ui, |ui| self.brush_ui(ui))
+            .inner;
+        chosen.extend(brush);
         chosen
     }
 
-    /// Brush mode, radius, strength, hardness, value, mirror, 3D painting.
-    fn brush_ui(&mut self, ui: &mut egui::Ui) {
+    /// The "Key dg" row of the paint grid: the chosen time key's own growth
+    /// scale, or the template's.
+    fn key_dg_row(
+        &mut self,
+        ui: &mut egui::Ui,
+        (project, template, current): (&Project, usize, &Template),
+        chosen: &mut Vec<Command>,
+    ) {
+        let label = ui.label("Key dg").id;
+        ui.horizontal(|ui| {
+            let key = &current.maps.keys()[self.key];
+            let mut own = key.dg.is_some();
+            let mut dg = key.dg.unwrap_or(current.dg);
+            let toggled = ui
+                .checkbox(&mut own, "own")
+                .on_hover_text(
+                    "This key's own growth scale in place of the template's dg, \
+                             blended between keys like the maps; negative: the organ \
+                             shrinks (wilting after it opened)",
+                )
+                .changed();
+            let dragged = ui
+                .add_enabled(
+                    own,
+                    egui::DragValue::new(&mut dg)
+                        .speed(0.0001)
+                        .range(-0.5..=0.5)
+                        .max_decimals(4),
+                )
+                .labelled_by(label)
+                .changed();
+            if toggled || dragged {
+                let mut value = current.clone();
+                if let Some(k) = value.maps.keys_mut().get_mut(self.key) {
+                    k.dg = own.then_some(dg);
+                }
+                chosen.push(Command::Edit {
+                    label: format!("dg of key {} of {}", key.step, current.name),
+                    edit: ProjectEdit::Template {
+                        template,
+                        value: Box::new(value),
+                        keyframes: project.settings.keyframes,
+                    },
+                });
+            }
+        });
+        ui.end_row();
+    }
+
+    /// The "New key" row of the paint grid: a time key added at a step (a
+    /// copy of the chosen key's maps), or the chosen key removed.
+    fn new_key_row(
+        &mut self,
+        ui: &mut egui::Ui,
+        (template, current): (usize, &Template),
+        chosen: &mut Vec<Command>,
+    ) {
+        let label = ui.label("New key").id;
+        ui.horizontal(|ui| {
+            ui.add(egui::DragValue::new(&mut self.new_key_step).range(0..=100_000))
+                .labelled_by(label)
+                .on_hover_text("Step of the key to add");
+            let exists = current
+                .maps
+                .keys()
+                .iter()
+                .any(|k| k.step == self.new_key_step);
+            if ui
+                .add_enabled(!exists, egui::Button::new("Add key"))
+                .on_hover_text("Add a key at this step, starting from the selected key's maps")
+                .clicked()
+            {
+                // The new key starts from the selected key's maps;
+                // applying it selects it for painting.
+                let maps = current.maps.keys()[self.key].maps.clone();
+                let step = self.new_key_step;
+                chosen.push(Command::Edit {
+                    label: format!("add key {step} to {}", current.name),
+                    edit: ProjectEdit::AddKey {
+                        template,
+                        key: Box::new(MapKey {
+                            dg: None,
+                            step,
+                            maps,
+                        }),
+                    },
+                });
+            }
+            if ui
+                .add_enabled(
+                    current.maps.keys().len() > 1,
+                    egui::Button::new("Remove key"),
+                )
+                .on_hover_text("Remove the selected key (the last key cannot go)")
+                .clicked()
+            {
+                chosen.push(Command::Edit {
+                    label: format!("remove key from {}", current.name),
+                    edit: ProjectEdit::RemoveKey {
+                        template,
+                        key: self.key,
+                    },
+                });
+                self.key = self.key.saturating_sub(1);
+            }
+        });
+        ui.end_row();
+    }
+
+    /// Brush mode, radius, strength, hardness, value, mirror, 3D painting;
+    /// a change of the brush as a command ([`Command::SetBrush`]).
+    fn brush_ui(&mut self, ui: &mut egui::Ui) -> Option<Command> {
+        let mut brush = self.brush;
         ui.horizontal_wrapped(|ui| {
             for mode in BrushMode::ALL {
-                ui.selectable_value(&mut self.brush.mode, mode, mode.label())
+                ui.selectable_value(&mut brush.mode, mode, mode.label())
                     .on_hover_text(match mode {
                         BrushMode::Set => "Move values towards the brush value",
                         BrushMode::Add => "Add the brush value",
@@ -453,11 +480,8 @@ impl PaintState {
             };
             let label = ui.label("radius").id;
             ui.add(
-                egui::Slider::new(
-                    &mut self.brush.radius_in_uv,
-                    MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV,
-                )
-                .logarithmic(true),
+                egui::Slider::new(&mut brush.radius_in_uv, MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV)
+                    .logarithmic(true),
             )
             .labelled_by(label)
             .on_hover_text("Brush radius in UV units (the layout is 1 wide)");
@@ -465,19 +489,19 @@ impl PaintState {
             slider(
                 ui,
                 "strength",
-                &mut self.brush.strength,
+                &mut brush.strength,
                 "How much one dab changes a value",
             );
             slider(
                 ui,
                 "hardness",
-                &mut self.brush.hardness,
+                &mut brush.hardness,
                 "Fraction of the radius at full strength",
             );
             slider(
                 ui,
                 "value",
-                &mut self.brush.value,
+                &mut brush.value,
                 "What set moves towards, and what add and subtract add or take away",
             );
         });
@@ -486,381 +510,13 @@ impl PaintState {
                 "Click the canvas (or the organ, when painting on the 3D organ) to pick the \
                  value under the pointer as a set brush (Alt+click always picks)",
             );
-        ui.checkbox(&mut self.brush.mirror, "Mirror about the midrib (u = 0.5)");
+        ui.checkbox(&mut brush.mirror, "Mirror about the midrib (u = 0.5)");
         ui.checkbox(&mut self.on_3d, "Paint on the 3D organ (drag on it)")
             .on_hover_text(
                 "Dragging on the selected organ in the viewport paints; Alt+click picks the \
                  value there; Shift+drag orbits",
             );
-    }
-
-    /// The UV canvas: the map, the UV layout, arrows for the direction map.
-    fn canvas(
-        &mut self,
-        ui: &mut egui::Ui,
-        project: &Project,
-        template: usize,
-        current: &Template,
-    ) -> Vec<Command> {
-        let side = ui
-            .available_width()
-            .min(0.6 * ui.available_height())
-            .max(120.0);
-        let (rect, response) = ui.allocate_exact_size(Vec2::splat(side), Sense::click_and_drag());
-        response
-            .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "UV paint canvas"));
-        if response.hovered() {
-            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            if scroll != 0.0 {
-                let factor = (scroll * 0.003).exp();
-                if let Some(pointer) = response.hover_pos() {
-                    // Zoom about the pointer.
-                    let before = (pointer - rect.min - self.pan) / self.zoom;
-                    self.zoom = (self.zoom * factor).clamp(0.5, 16.0);
-                    self.pan = pointer - rect.min - before * self.zoom;
-                }
-            }
-        }
-        if response.dragged_by(egui::PointerButton::Secondary)
-            || response.dragged_by(egui::PointerButton::Middle)
-        {
-            self.pan += response.drag_delta();
-        }
-        if response.double_clicked() {
-            self.zoom = 1.0;
-            self.pan = Vec2::ZERO;
-        }
-        let (pan, size) = (self.pan, side * self.zoom);
-        let to_screen = |uv: DVec2| {
-            Pos2::new(
-                rect.left() + pan.x + uv.x as f32 * size,
-                rect.top() + pan.y + (1.0 - uv.y as f32) * size,
-            )
-        };
-        let to_uv = |p: Pos2| {
-            DVec2::new(
-                f64::from((p.x - rect.left() - pan.x) / size),
-                1.0 - f64::from((p.y - rect.top() - pan.y) / size),
-            )
-        };
-
-        // Strokes: from where the drag began along the pointer's path,
-        // dabs spaced along each frame's segment (whatever the frame rate).
-        // A click is one dab, painted once the double-click time has passed
-        // without a second click: a double-click resets the view and paints
-        // nothing. Alt+click, or a click with the eyedropper, picks.
-        let (now, alt, press_origin) =
-            ui.input(|i| (i.time, i.modifiers.alt, i.pointer.press_origin()));
-        let double_click_seconds = ui.ctx().options(|o| o.input_options.max_double_click_delay);
-        let picking = alt || self.eyedropper;
-        let mut dabs = Vec::new();
-        if response.drag_started_by(egui::PointerButton::Primary) && !picking {
-            // A pending click belongs to no stroke: paint it first.
-            dabs.extend(self.flush_click(project, template));
-            if let Some(origin) = press_origin {
-                dabs.extend(self.stroke_to(project, template, to_uv(origin)));
-            }
-        }
-        if response.dragged_by(egui::PointerButton::Primary)
-            && !picking
-            && let Some(pointer) = response.interact_pointer_pos()
-        {
-            dabs.extend(self.stroke_to(project, template, to_uv(pointer)));
-        }
-        if response.clicked_by(egui::PointerButton::Primary)
-            && let Some(pointer) = response.interact_pointer_pos()
-        {
-            if picking {
-                self.pick(current, to_uv(pointer));
-            } else if response.double_clicked() {
-                self.pending_click = None;
-            } else {
-                self.pending_click = Some((to_uv(pointer), now));
-            }
-        }
-        match self.pending_click {
-            Some((_, at)) if now - at > double_click_seconds => {
-                dabs.extend(self.flush_click(project, template));
-            }
-            Some((_, at)) => ui
-                .ctx()
-                .request_repaint_after(std::time::Duration::from_secs_f64(
-                    (double_click_seconds - (now - at)).max(0.0) + 0.01,
-                )),
-            None => {}
-        }
-
-        // The document as it is before this frame's dab (the app draws
-        // again once the dab is applied).
-        let shown = current;
-        let image = map_image(shown, self.key, self.target);
-        let options = egui::TextureOptions::NEAREST;
-        match &mut self.texture {
-            Some(texture) => texture.set(image, options),
-            None => {
-                self.texture = Some(ui.ctx().load_texture("paint map", image, options));
-            }
-        }
-        let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, 0.0, ui.visuals().extreme_bg_color);
-        let image_rect = Rect::from_min_max(
-            to_screen(DVec2::new(0.0, 1.0)),
-            to_screen(DVec2::new(1.0, 0.0)),
-        );
-        if let Some(texture) = &self.texture {
-            painter.image(
-                texture.id(),
-                image_rect,
-                Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
-                Color32::WHITE,
-            );
-        }
-        let mesh = &current.mesh;
-        let stroke = Stroke::new(0.5, Color32::from_black_alpha(140));
-        let mut shapes = Vec::with_capacity(mesh.triangles.len() * 3);
-        for tri in &mesh.triangles {
-            for (a, b) in [(tri[0], tri[1]), (tri[1], tri[2]), (tri[2], tri[0])] {
-                if a < b {
-                    shapes.push(egui::Shape::line_segment(
-                        [
-                            to_screen(mesh.uvs[a as usize]),
-                            to_screen(mesh.uvs[b as usize]),
-                        ],
-                        stroke,
-                    ));
-                }
-            }
-        }
-        painter.extend(shapes);
-        // The midrib.
-        painter.line_segment(
-            [
-                to_screen(DVec2::new(0.5, 0.0)),
-                to_screen(DVec2::new(0.5, 1.0)),
-            ],
-            Stroke::new(1.0, Color32::from_white_alpha(90)),
-        );
-        if self.target == PaintTarget::Direction {
-            let map = &shown.maps.key_clamped(self.key).maps.direction;
-            let n = 14;
-            let cell = 1.0 / f64::from(n);
-            for j in 0..n {
-                for i in 0..n {
-                    let uv = DVec2::new((f64::from(i) + 0.5) * cell, (f64::from(j) + 0.5) * cell);
-                    let d = map.sample(uv);
-                    let tip = uv + d.clamp_length_max(1.0) * cell * 0.8;
-                    let from = to_screen(uv);
-                    painter.arrow(
-                        from,
-                        to_screen(tip) - from,
-                        Stroke::new(1.2, Color32::from_rgb(20, 40, 140)),
-                    );
-                }
-            }
-        }
-        self.hover_uv = response.hover_pos().map(to_uv);
-        if let Some(pointer) = response.hover_pos() {
-            // The brush outline: a circle of the brush radius in canvas
-            // pixels (and its mirror image with mirroring).
-            let r = self.brush.radius_in_uv as f32 * size;
-            painter.circle_stroke(
-                pointer,
-                r + 1.0,
-                Stroke::new(1.0, Color32::from_black_alpha(160)),
-            );
-            painter.circle_stroke(pointer, r, Stroke::new(1.0, Color32::WHITE));
-            if self.brush.mirror {
-                let uv = to_uv(pointer);
-                painter.circle_stroke(
-                    to_screen(DVec2::new(1.0 - uv.x, uv.y)),
-                    r,
-                    Stroke::new(1.0, Color32::from_white_alpha(120)),
-                );
-            }
-        }
-        dabs
-    }
-
-    /// The pending click as one dab, if there is one.
-    fn flush_click(&mut self, project: &Project, template: usize) -> Option<Command> {
-        let (point_in_uv, _) = self.pending_click.take()?;
-        self.dab(project, template, point_in_uv)
-    }
-
-    /// The growth scale of the selected key of `current`: its own, else the
-    /// template's.
-    fn key_dg(&self, current: &Template) -> f64 {
-        current
-            .maps
-            .keys()
-            .get(self.key)
-            .and_then(|k| k.dg)
-            .unwrap_or(current.dg)
-    }
-
-    /// The colour bar of the shown map with its values, what 0 and 1 mean
-    /// for that map, and the value under the pointer on the canvas.
-    fn legend_ui(&mut self, ui: &mut egui::Ui, current: &Template) {
-        let hovered = self.hover_uv.take();
-        // The canvas's hint as a line, not a tooltip over the legend.
-        ui.label(
-            egui::RichText::new(
-                "Drag to paint, click for one dab; Alt+click picks; scroll to zoom; \
-                 right- or middle-drag to pan; double-click to reset the view",
-            )
-            .small()
-            .weak(),
-        );
-        let colours = (self.target == PaintTarget::Colour).then(|| {
-            let second = current
-                .colouring
-                .as_ref()
-                .map_or(anthesis_flower::DEFAULT_SECOND_COLOR, |c| c.second_color);
-            (current.color, second)
-        });
-        match self.target {
-            PaintTarget::Scalar(_) | PaintTarget::Colour => {
-                let (area, _) =
-                    ui.allocate_exact_size(Vec2::new(ui.available_width(), 26.0), Sense::hover());
-                let bar = Rect::from_min_size(area.min, Vec2::new(area.width(), 12.0));
-                let painter = ui.painter_at(area);
-                let steps = 64;
-                for i in 0..steps {
-                    let t0 = i as f32 / steps as f32;
-                    let t1 = (i + 1) as f32 / steps as f32;
-                    painter.rect_filled(
-                        Rect::from_x_y_ranges(
-                            bar.left() + t0 * bar.width()..=bar.left() + t1 * bar.width(),
-                            bar.y_range(),
-                        ),
-                        0.0,
-                        match colours {
-                            Some((base, second)) => blend_colour(base, second, (t0 + t1) / 2.0),
-                            None => ramp((t0 + t1) / 2.0),
-                        },
-                    );
-                }
-                let value_under = hovered.and_then(|uv| self.value_at(current, uv));
-                if let Some(value) = value_under {
-                    let x = bar.left() + value.clamp(0.0, 1.0) * bar.width();
-                    painter.line_segment(
-                        [Pos2::new(x, bar.top()), Pos2::new(x, bar.bottom())],
-                        Stroke::new(2.0, Color32::BLACK),
-                    );
-                }
-                // Values under the bar.
-                for t in [0.0_f32, 0.25, 0.5, 0.75, 1.0] {
-                    let x = bar.left() + t * bar.width();
-                    let align = if t == 0.0 {
-                        egui::Align2::LEFT_TOP
-                    } else if t == 1.0 {
-                        egui::Align2::RIGHT_TOP
-                    } else {
-                        egui::Align2::CENTER_TOP
-                    };
-                    painter.line_segment(
-                        [Pos2::new(x, bar.bottom()), Pos2::new(x, bar.bottom() + 3.0)],
-                        Stroke::new(1.0, ui.visuals().text_color()),
-                    );
-                    painter.text(
-                        Pos2::new(x, bar.bottom() + 2.0),
-                        align,
-                        format!("{t}"),
-                        egui::FontId::proportional(11.0),
-                        ui.visuals().text_color(),
-                    );
-                }
-                let (text, meant) = match self.target {
-                    PaintTarget::Scalar(kind) => (
-                        legend(kind, self.key_dg(current)),
-                        value_under.map(|v| meaning(kind, self.key_dg(current), v)),
-                    ),
-                    _ => (
-                        "colour: how much of the second colour shows over the base colour \
-                         (both picked in the parameters panel). 0 = the base colour, 1 = the \
-                         second colour; not simulated, so painting it recomputes no keyframe."
-                            .to_string(),
-                        value_under.map(|v| format!(" = {:.0} % second colour", 100.0 * v)),
-                    ),
-                };
-                ui.label(egui::RichText::new(text).small());
-                ui.label(match (hovered, value_under) {
-                    (Some(uv), Some(value)) => format!(
-                        "under the pointer (u {:.2}, v {:.2}): {value:.3}{}",
-                        uv.x,
-                        uv.y,
-                        meant.unwrap_or_default()
-                    ),
-                    _ => "under the pointer: –".to_string(),
-                });
-            }
-            PaintTarget::Direction => {
-                ui.label(
-                    egui::RichText::new(
-                        "direction: arrows show the growth direction in UV (e-growth acts \
-                         along it, w-growth across it); brighter grey = longer vector, \
-                         dark = no direction painted",
-                    )
-                    .small(),
-                );
-                let under = hovered.map(|uv| {
-                    let d = current.maps.key_clamped(self.key).maps.direction.sample(uv);
-                    format!(
-                        "under the pointer (u {:.2}, v {:.2}): direction ({:.2}, {:.2})",
-                        uv.x, uv.y, d.x, d.y
-                    )
-                });
-                ui.label(under.unwrap_or_else(|| "under the pointer: –".to_string()));
-            }
-        }
-    }
-}
-
-/// The base colour blended towards the second by `t` (linear colours, as
-/// the renderer blends them), for the screen.
-fn blend_colour(base: [f32; 4], second: [f32; 4], t: f32) -> Color32 {
-    let c = |i: usize| base[i] + (second[i] - base[i]) * t;
-    egui::Rgba::from_rgb(c(0), c(1), c(2)).into()
-}
-
-/// What 0 and 1 mean for map `kind` of a template growing at most `dg` per
-/// step (rate = 1 + dg · value, paper eq. 2; stiffness = template constant
-/// · value).
-pub fn legend(kind: MapKind, dg: f64) -> String {
-    let percent = 100.0 * dg;
-    match kind {
-        MapKind::EGrowth | MapKind::WGrowth | MapKind::EGrowthIn | MapKind::WGrowthIn => {
-            let (layer, way) = match kind {
-                MapKind::EGrowth => ("base layer", "along the growth direction"),
-                MapKind::WGrowth => ("base layer", "across the growth direction"),
-                MapKind::EGrowthIn => ("inner layer", "along the growth direction"),
-                _ => ("inner layer", "across the growth direction"),
-            };
-            format!(
-                "{}: relative growth per step of the {layer} {way}. 0 = no growth, \
-                 1 = {percent:+.1} % per step (dg = {dg} at this key; rate = 1 + dg · value). \
-                 Inner > base bends the organ outwards.",
-                kind.label()
-            )
-        }
-        MapKind::Stretch | MapKind::Bend => format!(
-            "{}: multiplier of the template's {} stiffness. 0 = none (limp), \
-             1 = the template's full stiffness (the default).",
-            kind.label(),
-            if kind == MapKind::Stretch {
-                "stretch"
-            } else {
-                "bend"
-            }
-        ),
-    }
-}
-
-/// `value` of map `kind` in the map's own terms, e.g. " = +1.2 % per step".
-fn meaning(kind: MapKind, dg: f64, value: f32) -> String {
-    match kind {
-        MapKind::Stretch | MapKind::Bend => format!(" = {:.0} % of the stiffness", 100.0 * value),
-        _ => format!(" = {:+.2} % per step", 100.0 * dg * f64::from(value)),
+        (brush != self.brush).then_some(Command::SetBrush(brush))
     }
 }
 

@@ -136,6 +136,36 @@ pub fn parameters_ui_viewing(
             ui.end_row();
         });
 
+    base_region_ui(ui, &mut draft, &mut mark);
+    joint_schedule_ui(ui, &mut draft, &mut mark);
+
+    ui.separator();
+    if let Some(command) = two_state_ui(ui, project, template, &mut draft, viewed, &mut mark) {
+        return Some(command);
+    }
+    ui.separator();
+    if let Some(edit) = resolution_ui(ui, project, resolved, template) {
+        return Some(edit);
+    }
+    colour_ui(ui, &mut draft, &mut mark);
+
+    let field = changed_field?;
+    Some(Command::Edit {
+        label: edit_label(field, &name),
+        edit: ProjectEdit::Template {
+            template,
+            value: Box::new(draft),
+            keyframes,
+        },
+    })
+}
+
+/// The Base region section: the UV box whose particles attach the organ.
+fn base_region_ui(
+    ui: &mut egui::Ui,
+    draft: &mut Template,
+    mark: &mut dyn FnMut(bool, &'static str),
+) {
     ui.separator();
     ui.strong("Base region")
         .on_hover_text("Particles whose UV lies here attach the organ to the receptacle.");
@@ -178,7 +208,15 @@ pub fn parameters_ui_viewing(
                 "base u max",
             );
         });
+}
 
+/// The Joint schedule section: each ramp's steps and degrees, removed or
+/// added.
+fn joint_schedule_ui(
+    ui: &mut egui::Ui,
+    draft: &mut Template,
+    mark: &mut dyn FnMut(bool, &'static str),
+) {
     ui.separator();
     ui.strong("Joint schedule").on_hover_text(
         "How the organ tilts outwards at its base over the steps: each ramp adds its degrees \
@@ -246,15 +284,11 @@ pub fn parameters_ui_viewing(
         });
         mark(true, "add joint ramp");
     }
+}
 
-    ui.separator();
-    if let Some(command) = two_state_ui(ui, project, template, &mut draft, viewed, &mut mark) {
-        return Some(command);
-    }
-    ui.separator();
-    if let Some(edit) = resolution_ui(ui, project, resolved, template) {
-        return Some(edit);
-    }
+/// The Colour section: the base colour, the colour map's second colour,
+/// and removing the colour map.
+fn colour_ui(ui: &mut egui::Ui, draft: &mut Template, mark: &mut dyn FnMut(bool, &'static str)) {
     ui.separator();
     ui.strong("Colour").on_hover_text(
         "What the organ looks like (not simulated): the base colour, and a second colour \
@@ -305,16 +339,6 @@ pub fn parameters_ui_viewing(
         draft.colouring = None;
         mark(true, "colour map");
     }
-
-    let field = changed_field?;
-    Some(Command::Edit {
-        label: edit_label(field, &name),
-        edit: ProjectEdit::Template {
-            template,
-            value: Box::new(draft),
-            keyframes,
-        },
-    })
 }
 
 /// A labelled colour button (linear RGBA, alpha kept); returns the colour

@@ -144,7 +144,31 @@ fn part_rows(ui: &mut egui::Ui, part: &mut Part) -> Option<&'static str> {
         ),
         "height",
     );
-    match &mut part.shape {
+    shape_fields(ui, &mut part.shape, &mut mark);
+    mark(color_row(ui, "colour", &mut part.color), "colour");
+    if matches!(
+        part.shape,
+        PartShape::Stamen { .. } | PartShape::Pistil { .. }
+    ) {
+        mark(
+            color_row(ui, "head colour", &mut part.head_color),
+            "head colour",
+        );
+    } else {
+        part.head_color = part.color;
+    }
+    changed
+}
+
+/// The rows of what the part is: a stamen's filament and anther, a
+/// pistil's style, stigma and ovary, a stem, or the receptacle's radius
+/// and depth.
+fn shape_fields(
+    ui: &mut egui::Ui,
+    shape: &mut PartShape,
+    mark: &mut dyn FnMut(bool, &'static str),
+) {
+    match shape {
         PartShape::Stamen {
             filament,
             anther_length,
@@ -252,19 +276,6 @@ fn part_rows(ui: &mut egui::Ui, part: &mut Part) -> Option<&'static str> {
             );
         }
     }
-    mark(color_row(ui, "colour", &mut part.color), "colour");
-    if matches!(
-        part.shape,
-        PartShape::Stamen { .. } | PartShape::Pistil { .. }
-    ) {
-        mark(
-            color_row(ui, "head colour", &mut part.head_color),
-            "head colour",
-        );
-    } else {
-        part.head_color = part.color;
-    }
-    changed
 }
 
 /// The schedule rows of one part; returns the field that changed.

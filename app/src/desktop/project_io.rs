@@ -354,7 +354,7 @@ impl AnthesisApp {
     /// a scan that cannot be read or has no single outline is refused with
     /// the reason, in the log and the Flower panel.
     pub(super) fn import_scan(&mut self, path: &Path) {
-        match super::pde_panel::ScanReview::read(path, 1.0) {
+        match super::scan_panel::ScanReview::read(path, 1.0) {
             Ok((review, notes)) => {
                 self.flower_panel.scan_read(review);
                 // The review starts its fit when it is next drawn.

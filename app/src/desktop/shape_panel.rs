@@ -18,6 +18,7 @@ use glam::DVec3;
 
 use super::background::Background;
 use super::command::{Command, ProjectEdit};
+use super::widgets::{quality_text, view_point};
 
 /// What the remesher said about one template at one edge.
 type Preview = Background<Bud, BudError>;
@@ -120,45 +121,6 @@ fn fingerprint(mesh: &Mesh) -> u64 {
     h.finish()
 }
 
-/// One row of mesh numbers.
-pub(super) fn quality_text(q: &MeshQuality) -> String {
-    format!(
-        "{} particles, mean edge {:.3}, smallest angle {:.1}°, edge spread {:.0} %",
-        q.vertices,
-        q.mean_edge,
-        q.min_angle_deg,
-        100.0 * q.edge_spread
-    )
-}
-
-/// A control point drawn at `at` (a square of `size` pixels) in a 2D view
-/// of the template frame, front (x, y) or `side` (z, y), at `scale` pixels
-/// per unit: whether it was picked (clicked, or a drag started on it), and
-/// while it is dragged, how far it moved in the template frame.
-pub(super) fn view_point(
-    ui: &egui::Ui,
-    id: egui::Id,
-    at: egui::Pos2,
-    size: f32,
-    (scale, side): (f64, bool),
-) -> (bool, Option<DVec3>) {
-    let hit = ui.interact(
-        egui::Rect::from_center_size(at, egui::vec2(size, size)),
-        id,
-        egui::Sense::click_and_drag(),
-    );
-    let shift = hit.dragged().then(|| {
-        let d = hit.drag_delta();
-        let (across, up) = (f64::from(d.x) / scale, -f64::from(d.y) / scale);
-        if side {
-            DVec3::new(0.0, up, across)
-        } else {
-            DVec3::new(across, up, 0.0)
-        }
-    });
-    (hit.clicked() || hit.drag_started(), shift)
-}
-
 /// The Shape section for the flower's templates; pushes the edits chosen
 /// onto `commands`.
 pub fn shape_ui(
@@ -224,34 +186,7 @@ fn shape_rows(
     };
     ui.label(format!("now: {}", quality_text(&current)));
 
-    // Inner side.
-    ui.horizontal(|ui| {
-        match anthesis_bud::inner_side_faces_minus_z(mesh) {
-            Some(true) => ui.label("inner side: −Z (the template frame's inner side)"),
-            Some(false) => ui.label(
-                RichText::new("inner side: +Z (the template frame wants −Z: flip it?)")
-                    .color(ui.visuals().warn_fg_color),
-            ),
-            None => ui.label("inner side: edge-on to Z (no side faces the axis)"),
-        }
-        .on_hover_text(
-            "The side the triangles wind counter-clockwise around: the organ's inner (adaxial) \
-             side, which the growth maps' 'in' layers belong to.",
-        );
-        if ui
-            .button("Flip inner side")
-            .on_hover_text("Wind every triangle the other way (one undo step)")
-            .clicked()
-        {
-            commands.push(Command::Edit {
-                label: format!("flip inner side of {}", template.name),
-                edit: ProjectEdit::Mesh {
-                    template: index,
-                    mesh: Box::new(anthesis_bud::with_inner_side_flipped(mesh)),
-                },
-            });
-        }
-    });
+    inner_side_row(ui, (template, index), commands);
 
     // Remeshing.
     let mut edge = state.edge.unwrap_or(current.mean_edge);
@@ -288,6 +223,74 @@ fn shape_rows(
     if let Some((_, preview)) = &mut state.preview {
         preview.poll();
     }
+    remesh_result(ui, (flower, index), edge, state, commands);
+    if let Some(TemplateSource::Bezier { net: saved, .. }) = &template.source {
+        let saved = *saved;
+        let draft = match state.drafts.get(&template.name) {
+            Some((from, draft)) if *from == saved => *draft,
+            _ => saved,
+        };
+        state.drafts.insert(template.name.clone(), (saved, draft));
+        ui.separator();
+        bezier_ui(ui, (flower, index), draft, edge, state, commands);
+    } else if let Some(TemplateSource::Pde { sweep, .. }) = template.source {
+        state.on_screen = None;
+        ui.separator();
+        super::pde_panel::pde_ui(ui, (flower, index), sweep, edge, &mut state.pde, commands);
+    } else {
+        state.on_screen = None;
+        ui.separator();
+        super::sketch_panel::sketch_ui(ui, (flower, index), edge, &mut state.sketch, commands);
+    }
+}
+
+/// Which side of template `index` is inner, with a button that flips it
+/// when it faces the wrong way (one undo step).
+fn inner_side_row(
+    ui: &mut egui::Ui,
+    (template, index): (&anthesis_flower::Template, usize),
+    commands: &mut Vec<Command>,
+) {
+    let mesh = &template.mesh;
+    ui.horizontal(|ui| {
+        match anthesis_bud::inner_side_faces_minus_z(mesh) {
+            Some(true) => ui.label("inner side: −Z (the template frame's inner side)"),
+            Some(false) => ui.label(
+                RichText::new("inner side: +Z (the template frame wants −Z: flip it?)")
+                    .color(ui.visuals().warn_fg_color),
+            ),
+            None => ui.label("inner side: edge-on to Z (no side faces the axis)"),
+        }
+        .on_hover_text(
+            "The side the triangles wind counter-clockwise around: the organ's inner (adaxial) \
+             side, which the growth maps' 'in' layers belong to.",
+        );
+        if ui
+            .button("Flip inner side")
+            .on_hover_text("Wind every triangle the other way (one undo step)")
+            .clicked()
+        {
+            commands.push(Command::Edit {
+                label: format!("flip inner side of {}", template.name),
+                edit: ProjectEdit::Mesh {
+                    template: index,
+                    mesh: Box::new(anthesis_bud::with_inner_side_flipped(mesh)),
+                },
+            });
+        }
+    });
+}
+
+/// The remeshed preview's numbers with "Remesh" (one undo step), or why
+/// the template cannot be remeshed at `edge`.
+fn remesh_result(
+    ui: &mut egui::Ui,
+    (flower, index): (&Flower, usize),
+    edge: f64,
+    state: &ShapeState,
+    commands: &mut Vec<Command>,
+) {
+    let template = &flower.templates[index];
     match state.preview.as_ref().and_then(|(_, p)| p.answer()) {
         Some(Ok(bud)) => {
             ui.label(format!("remeshed: {}", quality_text(&bud.quality)));
@@ -325,24 +328,6 @@ fn shape_rows(
             ui.label("remeshing…");
         }
     }
-    if let Some(TemplateSource::Bezier { net: saved, .. }) = &template.source {
-        let saved = *saved;
-        let draft = match state.drafts.get(&template.name) {
-            Some((from, draft)) if *from == saved => *draft,
-            _ => saved,
-        };
-        state.drafts.insert(template.name.clone(), (saved, draft));
-        ui.separator();
-        bezier_ui(ui, (flower, index), draft, edge, state, commands);
-    } else if let Some(TemplateSource::Pde { sweep, .. }) = template.source {
-        state.on_screen = None;
-        ui.separator();
-        super::pde_panel::pde_ui(ui, (flower, index), sweep, edge, &mut state.pde, commands);
-    } else {
-        state.on_screen = None;
-        ui.separator();
-        super::sketch_panel::sketch_ui(ui, (flower, index), edge, &mut state.sketch, commands);
-    }
 }
 
 /// The names of a net's rows, base to tip.
@@ -379,6 +364,86 @@ fn bezier_ui(
     state.asymmetric = !symmetric;
     let (row, column) = state.point;
 
+    net = net_view(ui, state, net, symmetric);
+
+    // The chosen point's coordinates.
+    ui.horizontal(|ui| {
+        let label = ui.label("control point").id;
+        egui::ComboBox::from_id_salt("bezier point")
+            .selected_text(format!("{} row, column {}", ROW_NAMES[row], column + 1))
+            .show_ui(ui, |ui| {
+                for (j, name) in ROW_NAMES.iter().enumerate() {
+                    for i in 0..4 {
+                        ui.selectable_value(
+                            &mut state.point,
+                            (j, i),
+                            format!("{name} row, column {}", i + 1),
+                        );
+                    }
+                }
+            })
+            .response
+            .labelled_by(label);
+    });
+    let (row, column) = state.point;
+    let mut p = net.control[row][column];
+    let mut typed = false;
+    ui.horizontal(|ui| {
+        for (axis, value) in [("x", &mut p.x), ("y", &mut p.y), ("z", &mut p.z)] {
+            let label = ui.label(axis).id;
+            typed |= ui
+                .add(DragValue::new(value).speed(0.05).max_decimals(3))
+                .labelled_by(label)
+                .changed();
+        }
+    });
+    if typed {
+        net = net.with_point(row, column, p, symmetric);
+    }
+    if net != before
+        && let Some((_, draft)) = state.drafts.get_mut(name)
+    {
+        *draft = net;
+    }
+
+    if ui
+        .button("Apply net")
+        .on_hover_text(
+            "Mesh the patch at the remesh edge and use it for the template (one undo step)",
+        )
+        .clicked()
+    {
+        match anthesis_bud::build_organ(&net, &RemeshOptions::new(edge)) {
+            Ok(bud) => {
+                // The mesh and the net it was made of, in one step.
+                match flower.with_shape(index, bud.mesh, TemplateSource::Bezier { net, edge }) {
+                    Ok(edited) => {
+                        state.net_error = None;
+                        commands.push(Command::Edit {
+                            label: format!("Bézier net of {name}"),
+                            edit: ProjectEdit::Flower(Box::new(edited)),
+                        });
+                    }
+                    Err(e) => state.net_error = Some(format!("cannot use the net: {e}")),
+                }
+            }
+            Err(e) => state.net_error = Some(format!("cannot mesh the net: {e}")),
+        }
+    }
+    if let Some(error) = &state.net_error {
+        ui.label(RichText::new(error).color(ui.visuals().error_fg_color));
+    }
+}
+
+/// The 2D view of the net, front (x, y) or side (z, y): its rows and
+/// columns, the midrib plane, its control points; returns the net with the
+/// point dragged moved (and its mirror image when `symmetric`).
+fn net_view(
+    ui: &mut egui::Ui,
+    state: &mut ShapeState,
+    mut net: BezierPatch,
+    symmetric: bool,
+) -> BezierPatch {
     // The 2D view.
     let across = |p: DVec3, side: bool| if side { p.z } else { p.x };
     let side = state.side_view;
@@ -449,72 +514,5 @@ fn bezier_ui(
     if let Some((j, i, q)) = moved {
         net = net.with_point(j, i, q, symmetric);
     }
-
-    // The chosen point's coordinates.
-    ui.horizontal(|ui| {
-        let label = ui.label("control point").id;
-        egui::ComboBox::from_id_salt("bezier point")
-            .selected_text(format!("{} row, column {}", ROW_NAMES[row], column + 1))
-            .show_ui(ui, |ui| {
-                for (j, name) in ROW_NAMES.iter().enumerate() {
-                    for i in 0..4 {
-                        ui.selectable_value(
-                            &mut state.point,
-                            (j, i),
-                            format!("{name} row, column {}", i + 1),
-                        );
-                    }
-                }
-            })
-            .response
-            .labelled_by(label);
-    });
-    let (row, column) = state.point;
-    let mut p = net.control[row][column];
-    let mut typed = false;
-    ui.horizontal(|ui| {
-        for (axis, value) in [("x", &mut p.x), ("y", &mut p.y), ("z", &mut p.z)] {
-            let label = ui.label(axis).id;
-            typed |= ui
-                .add(DragValue::new(value).speed(0.05).max_decimals(3))
-                .labelled_by(label)
-                .changed();
-        }
-    });
-    if typed {
-        net = net.with_point(row, column, p, symmetric);
-    }
-    if net != before
-        && let Some((_, draft)) = state.drafts.get_mut(name)
-    {
-        *draft = net;
-    }
-
-    if ui
-        .button("Apply net")
-        .on_hover_text(
-            "Mesh the patch at the remesh edge and use it for the template (one undo step)",
-        )
-        .clicked()
-    {
-        match anthesis_bud::build_organ(&net, &RemeshOptions::new(edge)) {
-            Ok(bud) => {
-                // The mesh and the net it was made of, in one step.
-                match flower.with_shape(index, bud.mesh, TemplateSource::Bezier { net, edge }) {
-                    Ok(edited) => {
-                        state.net_error = None;
-                        commands.push(Command::Edit {
-                            label: format!("Bézier net of {name}"),
-                            edit: ProjectEdit::Flower(Box::new(edited)),
-                        });
-                    }
-                    Err(e) => state.net_error = Some(format!("cannot use the net: {e}")),
-                }
-            }
-            Err(e) => state.net_error = Some(format!("cannot mesh the net: {e}")),
-        }
-    }
-    if let Some(error) = &state.net_error {
-        ui.label(RichText::new(error).color(ui.visuals().error_fg_color));
-    }
+    net
 }

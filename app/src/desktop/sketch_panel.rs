@@ -23,7 +23,7 @@ use glam::{DVec2, DVec3};
 
 use super::background::Background;
 use super::command::{Command, ProjectEdit};
-use super::shape_panel::quality_text;
+use super::widgets::quality_text;
 
 /// The canvas's height, in points.
 const CANVAS_HEIGHT: f32 = 300.0;
@@ -210,26 +210,7 @@ pub fn sketch_ui(
         Some(TemplateSource::Sketch { sketch, .. }) => Some(sketch.clone()),
         _ => None,
     };
-    // A saved sketch that changed (an Apply, an undo, a project opened)
-    // replaces the draft.
-    match state.drafts.get(name) {
-        Some(draft) if draft.saved == saved => {}
-        _ => match &saved {
-            Some(sketch) => {
-                state.drafts.insert(
-                    name.to_string(),
-                    Draft {
-                        saved: saved.clone(),
-                        sketch: sketch.clone(),
-                        undo: Vec::new(),
-                    },
-                );
-            }
-            None => {
-                state.drafts.remove(name);
-            }
-        },
-    }
+    sync_draft(state, name, &saved);
     let Some(draft) = state.drafts.get(name).cloned() else {
         if ui
             .button("Sketch a new shape")
@@ -265,40 +246,10 @@ pub fn sketch_ui(
         }
     });
     let mut sketch = draft.sketch.clone();
-    let mut undone = false;
-    ui.horizontal(|ui| {
-        if ui
-            .add_enabled(!draft.undo.is_empty(), egui::Button::new("Undo stroke"))
-            .on_hover_text("Take back the last stroke (or Clear strokes, or Remove cross-sections)")
-            .clicked()
-            && let Some(previous) = draft.undo.last()
-        {
-            sketch = previous.clone();
-            undone = true;
-        }
-        if ui
-            .add_enabled(
-                !sketch.sections.is_empty(),
-                egui::Button::new("Remove cross-sections"),
-            )
-            .on_hover_text("Make the petal flat again")
-            .clicked()
-        {
-            sketch.sections.clear();
-        }
-        if ui
-            .add_enabled(
-                sketch != PetalSketch::default(),
-                egui::Button::new("Clear strokes"),
-            )
-            .on_hover_text("Start again from an empty canvas")
-            .clicked()
-        {
-            sketch = PetalSketch::default();
-        }
-    });
+    let undone = stroke_row(ui, &draft, &mut sketch);
     let built = sketch.build();
     let before = sketch.clone();
+
     canvas(ui, template, &mut sketch, built.as_ref().ok(), state);
     let built = if sketch == before {
         built
@@ -333,11 +284,102 @@ pub fn sketch_ui(
         side_view(ui, petal);
     }
 
+    let k = preview_ui(ui, state, (&sketch, edge), &built);
+    apply_ui(
+        ui,
+        (flower, index),
+        (&sketch, edge, k),
+        &built,
+        state,
+        commands,
+    );
+    if let Some(d) = state.drafts.get_mut(name) {
+        if undone {
+            d.undo.pop();
+        } else if sketch != d.sketch {
+            d.undo.push(std::mem::take(&mut d.sketch));
+            if d.undo.len() > UNDO_STROKES {
+                d.undo.remove(0);
+            }
+        }
+        d.sketch = sketch;
+    }
+}
+
+/// A saved sketch that changed (an Apply, an undo, a project opened)
+/// replaces the draft of the template named `name`.
+fn sync_draft(state: &mut SketchState, name: &str, saved: &Option<PetalSketch>) {
+    match state.drafts.get(name) {
+        Some(draft) if draft.saved == *saved => {}
+        _ => match saved {
+            Some(sketch) => {
+                state.drafts.insert(
+                    name.to_string(),
+                    Draft {
+                        saved: saved.clone(),
+                        sketch: sketch.clone(),
+                        undo: Vec::new(),
+                    },
+                );
+            }
+            None => {
+                state.drafts.remove(name);
+            }
+        },
+    }
+}
+
+/// "Undo stroke", "Remove cross-sections" and "Clear strokes" on
+/// `sketch`; whether the last stroke was taken back.
+fn stroke_row(ui: &mut egui::Ui, draft: &Draft, sketch: &mut PetalSketch) -> bool {
+    let mut undone = false;
+    ui.horizontal(|ui| {
+        if ui
+            .add_enabled(!draft.undo.is_empty(), egui::Button::new("Undo stroke"))
+            .on_hover_text("Take back the last stroke (or Clear strokes, or Remove cross-sections)")
+            .clicked()
+            && let Some(previous) = draft.undo.last()
+        {
+            *sketch = previous.clone();
+            undone = true;
+        }
+        if ui
+            .add_enabled(
+                !sketch.sections.is_empty(),
+                egui::Button::new("Remove cross-sections"),
+            )
+            .on_hover_text("Make the petal flat again")
+            .clicked()
+        {
+            sketch.sections.clear();
+        }
+        if ui
+            .add_enabled(
+                *sketch != PetalSketch::default(),
+                egui::Button::new("Clear strokes"),
+            )
+            .on_hover_text("Start again from an empty canvas")
+            .clicked()
+        {
+            *sketch = PetalSketch::default();
+        }
+    });
+    undone
+}
+
+/// The preview of `sketch` meshed at `edge`, made on a thread of its own
+/// when either changed, and its numbers; returns what the preview is of.
+fn preview_ui(
+    ui: &mut egui::Ui,
+    state: &mut SketchState,
+    (sketch, edge): (&PetalSketch, f64),
+    built: &Result<SketchedPetal, SketchError>,
+) -> u64 {
     // The preview at the section's edge, meshed on a thread of its own
     // (no spinner: the thread asks for a frame when it is done).
-    let k = key(&sketch, edge);
+    let k = key(sketch, edge);
     if state.preview.as_ref().is_none_or(|(old, _)| *old != k) {
-        let preview = match &built {
+        let preview = match built {
             Ok(petal) => {
                 let options = RemeshOptions {
                     max_vertices: PREVIEW_MAX_VERTICES,
@@ -376,6 +418,21 @@ pub fn sketch_ui(
             }
         }
     }
+    k
+}
+
+/// "Apply sketch": the preview's mesh when it is of these strokes and this
+/// edge (`k`, [`key`]), else the sketch meshed now, as the template's shape
+/// (one undo step); or why not.
+fn apply_ui(
+    ui: &mut egui::Ui,
+    (flower, index): (&Flower, usize),
+    (sketch, edge, k): (&PetalSketch, f64, u64),
+    built: &Result<SketchedPetal, SketchError>,
+    state: &mut SketchState,
+    commands: &mut Vec<Command>,
+) {
+    let name = flower.templates[index].name.as_str();
     if ui
         .add_enabled(built.is_ok(), egui::Button::new("Apply sketch"))
         .on_hover_text(
@@ -383,7 +440,7 @@ pub fn sketch_ui(
              stay; one undo step)",
         )
         .clicked()
-        && let Ok(petal) = &built
+        && let Ok(petal) = built
     {
         // The preview's mesh when it is of these strokes and this edge (the
         // mesher is deterministic), else meshed now.
@@ -412,17 +469,6 @@ pub fn sketch_ui(
     }
     if let Some(error) = &state.apply_error {
         ui.label(RichText::new(error).color(ui.visuals().error_fg_color));
-    }
-    if let Some(d) = state.drafts.get_mut(name) {
-        if undone {
-            d.undo.pop();
-        } else if sketch != d.sketch {
-            d.undo.push(std::mem::take(&mut d.sketch));
-            if d.undo.len() > UNDO_STROKES {
-                d.undo.remove(0);
-            }
-        }
-        d.sketch = sketch;
     }
 }
 
@@ -485,28 +531,7 @@ fn canvas(
     painter.line_segment([origin, origin - egui::vec2(0.0, 16.0)], axis);
     // The petal: its control net and its outline.
     if let Some(petal) = petal {
-        let net = petal.control_in_sketch();
-        let line = Stroke::new(1.0, Color32::from_rgb(150, 150, 170));
-        for (j, row) in net.iter().enumerate() {
-            for (i, p) in row.iter().enumerate() {
-                let at = view.to_screen(*p);
-                if let Some(q) = row.get(i + 1) {
-                    painter.line_segment([at, view.to_screen(*q)], line);
-                }
-                if let Some(q) = net.get(j + 1).map(|r| r[i]) {
-                    painter.line_segment([at, view.to_screen(q)], line);
-                }
-                painter.circle_filled(at, 2.5, Color32::from_rgb(200, 200, 220));
-            }
-        }
-        let outline: Vec<Pos2> = boundary(&petal.surface)
-            .into_iter()
-            .map(|p| view.to_screen(petal.frame.to_sketch(p.truncate())))
-            .collect();
-        painter.add(egui::Shape::closed_line(
-            outline,
-            Stroke::new(1.5, Color32::from_rgb(235, 150, 175)),
-        ));
+        draw_petal(&painter, view, petal);
     }
     // The strokes as drawn.
     let colours = [
@@ -557,6 +582,32 @@ fn canvas(
         state.drawing = None;
     }
     state.view = Some(view);
+}
+
+/// The sketched petal over the canvas: its control net and its outline.
+fn draw_petal(painter: &egui::Painter, view: View, petal: &SketchedPetal) {
+    let net = petal.control_in_sketch();
+    let line = Stroke::new(1.0, Color32::from_rgb(150, 150, 170));
+    for (j, row) in net.iter().enumerate() {
+        for (i, p) in row.iter().enumerate() {
+            let at = view.to_screen(*p);
+            if let Some(q) = row.get(i + 1) {
+                painter.line_segment([at, view.to_screen(*q)], line);
+            }
+            if let Some(q) = net.get(j + 1).map(|r| r[i]) {
+                painter.line_segment([at, view.to_screen(q)], line);
+            }
+            painter.circle_filled(at, 2.5, Color32::from_rgb(200, 200, 220));
+        }
+    }
+    let outline: Vec<Pos2> = boundary(&petal.surface)
+        .into_iter()
+        .map(|p| view.to_screen(petal.frame.to_sketch(p.truncate())))
+        .collect();
+    painter.add(egui::Shape::closed_line(
+        outline,
+        Stroke::new(1.5, Color32::from_rgb(235, 150, 175)),
+    ));
 }
 
 /// The surface's outline: base, right margin, tip, left margin.

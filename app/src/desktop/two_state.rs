@@ -124,6 +124,41 @@ pub fn two_state_ui(
         ui.label("Grown by its maps (no open shape).");
         return command;
     };
+    timing_grid(ui, animation, mark);
+    let mut follow = animation.velocity == VelocityCurve::FollowGrowth;
+    if ui
+        .checkbox(&mut follow, "velocity follows G")
+        .on_hover_text(
+            "The cells' growth directions turn with G's timing; untick to draw the velocity \
+             curve by points (time / T, fraction of the turn)",
+        )
+        .changed()
+    {
+        animation.velocity = if follow {
+            VelocityCurve::FollowGrowth
+        } else {
+            VelocityCurve::Points(vec![[0.0, 0.0], [0.5, 0.5], [1.0, 1.0]])
+        };
+        mark(true, "velocity curve");
+    }
+    if let VelocityCurve::Points(points) = &mut animation.velocity {
+        velocity_points_ui(ui, points, mark);
+    }
+    plot(
+        ui,
+        animation,
+        project.settings.keyframes,
+        viewed.map(|v| v.keyframe),
+    );
+    command
+}
+
+/// The growth function's g and T of the two-state opening.
+fn timing_grid(
+    ui: &mut egui::Ui,
+    animation: &mut TwoStateAnimation,
+    mark: &mut dyn FnMut(bool, &'static str),
+) {
     egui::Grid::new("two-state timing")
         .num_columns(2)
         .spacing([12.0, 6.0])
@@ -160,32 +195,6 @@ pub fn two_state_ui(
             );
             ui.end_row();
         });
-    let mut follow = animation.velocity == VelocityCurve::FollowGrowth;
-    if ui
-        .checkbox(&mut follow, "velocity follows G")
-        .on_hover_text(
-            "The cells' growth directions turn with G's timing; untick to draw the velocity \
-             curve by points (time / T, fraction of the turn)",
-        )
-        .changed()
-    {
-        animation.velocity = if follow {
-            VelocityCurve::FollowGrowth
-        } else {
-            VelocityCurve::Points(vec![[0.0, 0.0], [0.5, 0.5], [1.0, 1.0]])
-        };
-        mark(true, "velocity curve");
-    }
-    if let VelocityCurve::Points(points) = &mut animation.velocity {
-        velocity_points_ui(ui, points, mark);
-    }
-    plot(
-        ui,
-        animation,
-        project.settings.keyframes,
-        viewed.map(|v| v.keyframe),
-    );
-    command
 }
 
 /// The velocity curve's points, each time kept between its neighbours'.

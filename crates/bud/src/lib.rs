@@ -30,6 +30,7 @@
 pub mod bspline;
 pub mod dynamic;
 mod examples;
+pub mod formats;
 mod from_mesh;
 mod net;
 mod quality;

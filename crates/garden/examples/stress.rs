@@ -15,11 +15,11 @@
 //! maps), `lily-maps-x2` (every map value doubled), `eustoma-thin` (the
 //! Eustoma Maite Lady at half its thickness) and `lily-random-SEED` for
 //! seeds 1 to 3 (the lily's e_in maps replaced by smooth random fields).
-use std::time::Instant;
 
 use anthesis_flower::Project;
 use anthesis_garden::flowers::{EDGE_SCALE, flower_at_resolution};
 use anthesis_maps::MapKind;
+use anthesis_sim::batch::step_through;
 use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::{Selection, Simulation};
 
@@ -174,22 +174,15 @@ fn random_e_in(project: &mut Project, seed: u64) {
 fn run_case(name: &str, project: &Project, selection: &Selection) -> String {
     let mut sim = Simulation::new(project, selection).expect("the case simulates");
     sim.on_crossing(OnCrossing::Warn);
-    let started = Instant::now();
-    let (mut contacts, mut keyframes) = (0u64, 0u32);
-    let mut ended = "finished".to_string();
-    while !sim.finished() {
-        match sim.step(&|| false, &mut |_| {}) {
-            Ok(k) => {
-                contacts += u64::from(k.stats.contact_particles);
-                keyframes = k.index;
-            }
-            Err(error) => {
-                ended = format!("stopped: {error}");
-                break;
-            }
-        }
-    }
-    let seconds = started.elapsed().as_secs_f64();
+    let mut contacts = 0u64;
+    let last = sim.keyframe_count();
+    let stepped = step_through(&mut sim, last, &|| false, &mut |_, k| {
+        contacts += u64::from(k.stats.contact_particles);
+    });
+    let (keyframes, seconds) = (stepped.done, stepped.seconds);
+    let ended = stepped
+        .failure
+        .map_or("finished".to_string(), |error| format!("stopped: {error}"));
     let crossed: Vec<u32> = sim.crossings().iter().map(|c| c.keyframe).collect();
     let pairs: usize = sim.crossings().iter().map(|c| c.pairs).sum();
     let first = sim

@@ -470,45 +470,19 @@ impl Loader<'_> {
                 stretch_to_bend,
                 edge,
             }) => {
-                let curve = |field: &str, points: &[[f64; 3]]| {
-                    let points: Vec<glam::DVec3> =
-                        points.iter().map(|p| glam::DVec3::from(*p)).collect();
-                    match <[glam::DVec3; 4]>::try_from(points) {
-                        Ok(control) if control.iter().all(|p| p.is_finite()) => {
-                            Ok(anthesis_bud::BezierCurve::new(control))
-                        }
-                        Ok(_) => Err(self.invalid(format!(
-                            "template \"{name}\": a PDE source's {field} has a non-finite \
-                             point"
-                        ))),
-                        Err(points) => Err(self.invalid(format!(
-                            "template \"{name}\": a PDE source's {field} needs 4 points \
-                             [x, y, z] (Bézier control points, base to tip), found {}",
-                            points.len()
-                        ))),
-                    }
-                };
-                let (c0, c1) = (curve("margin0", &margin0)?, curve("margin1", &margin1)?);
-                let (t0, t1) = (curve("tangent0", &tangent0)?, curve("tangent1", &tangent1)?);
-                if !(stretch_to_bend.is_finite()
-                    && (0.0..=anthesis_bud::MAX_STRETCH_TO_BEND).contains(&stretch_to_bend))
-                {
-                    return Err(self.invalid(format!(
-                        "template \"{name}\": a PDE source's stretch_to_bend (k_s/k_b) must \
-                         be from 0 to {}, found {stretch_to_bend}",
-                        anthesis_bud::MAX_STRETCH_TO_BEND
-                    )));
-                }
+                // The checks and messages of `anthesis bud --pde`'s file.
+                let sweep = anthesis_bud::formats::pde_sweep(
+                    [&margin0, &margin1, &tangent0, &tangent1],
+                    stretch_to_bend,
+                )
+                .map_err(|e| self.invalid(format!("template \"{name}\": a PDE source's {e}")))?;
                 if !(edge.is_finite() && edge > 0.0) {
                     return Err(self.invalid(format!(
                         "template \"{name}\": a PDE source's edge must be a positive number, \
                          found {edge}"
                     )));
                 }
-                Some(crate::TemplateSource::Pde {
-                    sweep: anthesis_bud::PdeSweep::new(c0, c1, t0, t1, stretch_to_bend),
-                    edge,
-                })
+                Some(crate::TemplateSource::Pde { sweep, edge })
             }
         };
         let vein = match file.vein {
