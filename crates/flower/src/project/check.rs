@@ -98,13 +98,24 @@ pub(super) fn check_unique<'a>(
 /// The rules every loaded or saved project obeys, apart from the mesh and
 /// map-size checks, which need the file names.
 pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), ProjectError> {
-    let invalid = |message: String| {
-        Err(ProjectError::Invalid {
-            path: path.to_path_buf(),
-            message,
-        })
-    };
-    let flower = &project.flower;
+    check_naming(&project.flower, path)?;
+    check_settings(&project.settings, path)?;
+    check_references(&project.flower, path)
+}
+
+/// The error for a project that breaks a rule, with `message` saying which.
+fn invalid_at(path: &Path, message: String) -> Result<(), ProjectError> {
+    Err(ProjectError::Invalid {
+        path: path.to_path_buf(),
+        message,
+    })
+}
+
+/// Names and counts: short clean names, at least one template and organ,
+/// no name used twice (exports name a node after every organ and part
+/// instance), and parts that are well formed.
+fn check_naming(flower: &crate::Flower, path: &Path) -> Result<(), ProjectError> {
+    let invalid = |message: String| invalid_at(path, message);
     check_names(
         flower.templates.iter().map(|t| t.name.as_str()),
         flower.organs.iter().map(|o| o.name.as_str()),
@@ -146,8 +157,13 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
         "organ or part",
         path,
     )?;
+    Ok(())
+}
 
-    let settings = &project.settings;
+/// The `[simulation]` numbers: keyframe count, solver and collision
+/// settings, mesh resolution.
+fn check_settings(settings: &crate::SimulationSettings, path: &Path) -> Result<(), ProjectError> {
+    let invalid = |message: String| invalid_at(path, message);
     if settings.keyframes == 0 {
         return invalid("simulation: keyframes must be at least 1".to_string());
     }
@@ -181,13 +197,19 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
             short_number(edge)
         ));
     }
+    Ok(())
+}
 
+/// Each template's numbers, then every index into the lists: organs name
+/// a template that exists and are placed by finite numbers; overlaps name
+/// two different organs that exist.
+fn check_references(flower: &crate::Flower, path: &Path) -> Result<(), ProjectError> {
+    let invalid = |message: String| invalid_at(path, message);
     for template in &flower.templates {
         if let Some(message) = template.problem() {
             return invalid(format!("template \"{}\": {message}", template.name));
         }
     }
-
     for organ in &flower.organs {
         let placement = &organ.placement;
         if organ.template >= flower.templates.len() {
@@ -208,7 +230,6 @@ pub(super) fn check_project(project: &Project, path: &Path) -> Result<(), Projec
             ));
         }
     }
-
     for overlap in &flower.overlaps {
         let count = flower.organs.len();
         if overlap.inner >= count || overlap.outer >= count {
@@ -323,7 +344,24 @@ fn two_state_problem(
     animation.velocity.check().err()
 }
 
+/// The rules of [`Template::problem`], phase by phase; the first problem
+/// found is the one reported.
 fn template_problem(template: &Template) -> Option<String> {
+    scale_problem(template)
+        .or_else(|| base_region_problem(template))
+        .or_else(|| {
+            let animation = template.two_state.as_ref()?;
+            let problem = two_state_problem(animation, &template.mesh)?;
+            Some(format!("two_state: {problem}"))
+        })
+        .or_else(|| colour_problem(template))
+        .or_else(|| schedule_problem(template))
+        .or_else(|| map_key_problem(template))
+}
+
+/// The growth factor `dg` and the positive scales: thickness and the two
+/// stiffnesses.
+fn scale_problem(template: &Template) -> Option<String> {
     let positive = |value: f64| value > 0.0 && value.is_finite();
     if !template.dg.is_finite() || template.dg <= -1.0 {
         return Some(format!(
@@ -345,6 +383,12 @@ fn template_problem(template: &Template) -> Option<String> {
             ));
         }
     }
+    None
+}
+
+/// The base region: a band of UV space inside the unit square that holds
+/// enough particles to attach the organ.
+fn base_region_problem(template: &Template) -> Option<String> {
     let region = &template.base_region;
     let in_unit = |value: f64| (0.0..=1.0).contains(&value);
     if !(in_unit(region.v_max) && in_unit(region.u_min) && in_unit(region.u_max)) {
@@ -375,11 +419,12 @@ fn template_problem(template: &Template) -> Option<String> {
                 .unwrap_or_default()
         ));
     }
-    if let Some(animation) = &template.two_state
-        && let Some(problem) = two_state_problem(animation, &template.mesh)
-    {
-        return Some(format!("two_state: {problem}"));
-    }
+    None
+}
+
+/// The colours and the colour maps: every component and every mix value
+/// in [0, 1].
+fn colour_problem(template: &Template) -> Option<String> {
     if template.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
         return Some(format!(
             "color components must lie in [0, 1], found {:?}",
@@ -419,6 +464,12 @@ fn template_problem(template: &Template) -> Option<String> {
             ));
         }
     }
+    None
+}
+
+/// Motion over time: the joint schedule's ramps and the blend between map
+/// keys.
+fn schedule_problem(template: &Template) -> Option<String> {
     for ramp in &template.joint_schedule {
         if ramp.from_step > ramp.to_step || !ramp.angle_deg.is_finite() {
             return Some(format!(
@@ -438,6 +489,12 @@ fn template_problem(template: &Template) -> Option<String> {
             short_number(steepness)
         ));
     }
+    None
+}
+
+/// The map keys: each key's `dg`, finite scalar maps with no negative
+/// values, and a finite direction map.
+fn map_key_problem(template: &Template) -> Option<String> {
     for key in template.maps.keys() {
         if let Some(dg) = key.dg
             && (!dg.is_finite() || dg <= -1.0)
