@@ -13,8 +13,8 @@ use glam::{DQuat, DVec2, DVec3};
 use super::check::{SizeCheck, check_names, check_project, check_unique};
 use super::error::{ProjectError, map_error};
 use super::schema::{
-    ColourLayerFile, DirectionEntry, ProjectFile, ScalarEntry, SourceFile, StructureFile,
-    StructureKind, TemplateFile, TwoStateFile,
+    BlendFile, ColourLayerFile, DirectionEntry, KeyFile, OrganFile, OverlapFile, ProjectFile,
+    ScalarEntry, SourceFile, StructureFile, StructureKind, TemplateFile, TwoStateFile, VeinFile,
 };
 use super::{FORMAT_NAME, FORMAT_VERSION};
 use crate::structure::{Arrangement, Spiral, Structure, Whorl};
@@ -195,6 +195,8 @@ impl Loader<'_> {
         }
     }
 
+    /// The project from its parsed file: templates read, the structure's
+    /// organs and overlaps derived, the listed ones added after them.
     fn project(&self, file: ProjectFile) -> Result<Project, ProjectError> {
         let path = self.project_path;
         // Names are quoted in the messages below: check them first.
@@ -234,38 +236,75 @@ impl Loader<'_> {
         )?;
         let mut organs = derived.organs;
         for organ in &file.organs {
-            let template = templates
-                .iter()
-                .position(|t| t.name == organ.template)
-                .ok_or_else(|| ProjectError::UnknownTemplate {
-                    path: path.to_path_buf(),
-                    organ: organ.name.clone(),
-                    template: organ.template.clone(),
-                })?;
-            let orientation = match organ.orientation {
-                None => DQuat::IDENTITY,
-                Some(q) => {
-                    let q = DQuat::from_array(q);
-                    if !q.is_finite() || q.length() < 1e-9 {
-                        return Err(self.invalid(format!(
-                            "organ \"{}\": orientation must be a rotation (a non-zero quaternion [x, y, z, w])",
-                            organ.name
-                        )));
-                    }
-                    q.normalize()
-                }
-            };
-            organs.push(Organ {
-                name: organ.name.clone(),
-                template,
-                placement: Placement {
-                    position: DVec3::from_array(organ.position),
-                    azimuth_deg: organ.azimuth_deg,
-                    joint_angle_deg: organ.joint_angle_deg,
-                    orientation,
-                },
-            });
+            organs.push(self.organ(organ, &templates)?);
         }
+        let overlaps = self.overlaps(derived.overlaps, &organs, &file.overlaps)?;
+        let parts = file
+            .parts
+            .iter()
+            .map(|part| part.part().map_err(|message| self.invalid(message)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let unit = self.unit(file.unit.as_deref())?;
+        Ok(Project {
+            name: file.name,
+            flower: Flower {
+                templates,
+                organs,
+                overlaps,
+                structure,
+                parts,
+                unit,
+            },
+            settings: file.simulation.settings(file.version),
+        })
+    }
+
+    /// An organ listed in `[[organs]]`: the template it names, and its
+    /// placement with the orientation made a unit quaternion.
+    fn organ(&self, organ: &OrganFile, templates: &[Template]) -> Result<Organ, ProjectError> {
+        let path = self.project_path;
+        let template = templates
+            .iter()
+            .position(|t| t.name == organ.template)
+            .ok_or_else(|| ProjectError::UnknownTemplate {
+                path: path.to_path_buf(),
+                organ: organ.name.clone(),
+                template: organ.template.clone(),
+            })?;
+        let orientation = match organ.orientation {
+            None => DQuat::IDENTITY,
+            Some(q) => {
+                let q = DQuat::from_array(q);
+                if !q.is_finite() || q.length() < 1e-9 {
+                    return Err(self.invalid(format!(
+                        "organ \"{}\": orientation must be a rotation (a non-zero quaternion [x, y, z, w])",
+                        organ.name
+                    )));
+                }
+                q.normalize()
+            }
+        };
+        Ok(Organ {
+            name: organ.name.clone(),
+            template,
+            placement: Placement {
+                position: DVec3::from_array(organ.position),
+                azimuth_deg: organ.azimuth_deg,
+                joint_angle_deg: organ.joint_angle_deg,
+                orientation,
+            },
+        })
+    }
+
+    /// The overlap rules: the derived ones, then the listed ones, which
+    /// override a derived rule for the same pair of organs.
+    fn overlaps(
+        &self,
+        derived: Vec<Overlap>,
+        organs: &[Organ],
+        listed_files: &[OverlapFile],
+    ) -> Result<Vec<Overlap>, ProjectError> {
+        let path = self.project_path;
         let organ_index = |name: &str| {
             organs
                 .iter()
@@ -279,9 +318,9 @@ impl Loader<'_> {
         // rule for the same pair of organs.
         // Two listed rules for one pair the opposite way round are refused
         // naming both (the later silently won).
-        let mut overlaps = derived.overlaps;
+        let mut overlaps = derived;
         let mut listed_at: std::collections::HashMap<(usize, usize), usize> = Default::default();
-        for (k, overlap) in file.overlaps.iter().enumerate() {
+        for (k, overlap) in listed_files.iter().enumerate() {
             let listed = Overlap {
                 inner: organ_index(&overlap.inner)?,
                 outer: organ_index(&overlap.outer)?,
@@ -308,24 +347,7 @@ impl Loader<'_> {
                 .map(|(_, o)| o)
                 .filter(|o| !made.contains(&(o.inner, o.outer))),
         );
-        let parts = file
-            .parts
-            .iter()
-            .map(|part| part.part().map_err(|message| self.invalid(message)))
-            .collect::<Result<Vec<_>, _>>()?;
-        let unit = self.unit(file.unit.as_deref())?;
-        Ok(Project {
-            name: file.name,
-            flower: Flower {
-                templates,
-                organs,
-                overlaps,
-                structure,
-                parts,
-                unit,
-            },
-            settings: file.simulation.settings(file.version),
-        })
+        Ok(overlaps)
     }
 
     /// The project's `unit`, if it states one (one that does not keeps the
@@ -395,9 +417,50 @@ impl Loader<'_> {
             )));
         }
         let mesh = self.mesh(&file.mesh, name)?;
+        let maps = self.keyed_maps(name, file.keys, &file.blend)?;
+        let colouring =
+            self.colouring(name, file.second_color, file.colour_map, file.colour_layers)?;
+        let two_state = match file.two_state {
+            None => None,
+            Some(two) => Some(self.two_state(two, &mesh, name)?),
+        };
+        let source = self.source(name, file.source)?;
+        let vein = self.vein(name, file.vein)?;
+        let template = Template {
+            vein,
+            two_state,
+            name: file.name,
+            mesh,
+            maps,
+            dg: file.dg,
+            thickness: file.thickness,
+            stretch_stiffness: file.stretch_stiffness,
+            bend_stiffness: file.bend_stiffness,
+            base_region: BaseRegion {
+                v_max: file.base_region.v_max,
+                u_min: file.base_region.u_min,
+                u_max: file.base_region.u_max,
+            },
+            joint_schedule: file.joint_schedule.iter().map(JointRamp::from).collect(),
+            color: file.color,
+            colouring,
+            source,
+        };
+        self.note_uv_layout(&template);
+        Ok(template)
+    }
+
+    /// A template's map keys: each key's scalar and direction maps read
+    /// (all raster maps of one size), blended as the file says.
+    fn keyed_maps(
+        &self,
+        name: &str,
+        file_keys: Vec<KeyFile>,
+        blend: &BlendFile,
+    ) -> Result<KeyedMaps, ProjectError> {
         let mut size = SizeCheck::default();
-        let mut keys = Vec::with_capacity(file.keys.len());
-        for mut key in file.keys {
+        let mut keys = Vec::with_capacity(file_keys.len());
+        for mut key in file_keys {
             let mut maps = GrowthMaps::uniform();
             let step = key.step;
             let entry_name = |map: &str| format!("template \"{name}\", key {step}: {map}");
@@ -421,15 +484,18 @@ impl Loader<'_> {
             });
         }
         size.finish()?;
-        let maps = KeyedMaps::new(keys, Blend::from(&file.blend))
-            .map_err(|error| self.invalid(format!("template \"{name}\": {error}")))?;
-        let colouring =
-            self.colouring(name, file.second_color, file.colour_map, file.colour_layers)?;
-        let two_state = match file.two_state {
-            None => None,
-            Some(two) => Some(self.two_state(two, &mesh, name)?),
-        };
-        let source = match file.source {
+        KeyedMaps::new(keys, Blend::from(blend))
+            .map_err(|error| self.invalid(format!("template \"{name}\": {error}")))
+    }
+
+    /// A template's `[templates.source]`, the shape it was made from, if
+    /// any: a Bézier net, a sketched petal or a PDE sweep, checked.
+    fn source(
+        &self,
+        name: &str,
+        source: Option<SourceFile>,
+    ) -> Result<Option<crate::TemplateSource>, ProjectError> {
+        let source = match source {
             None => None,
             Some(SourceFile::Bezier { net, edge }) => {
                 let points: Vec<glam::DVec3> = net.iter().map(|p| glam::DVec3::from(*p)).collect();
@@ -485,7 +551,16 @@ impl Loader<'_> {
                 Some(crate::TemplateSource::Pde { sweep, edge })
             }
         };
-        let vein = match file.vein {
+        Ok(source)
+    }
+
+    /// A template's `[templates.vein]`, if any.
+    fn vein(
+        &self,
+        name: &str,
+        vein: Option<VeinFile>,
+    ) -> Result<Option<anthesis_bud::Vein>, ProjectError> {
+        let vein = match vein {
             None => None,
             Some(vein) => {
                 let points: Vec<glam::DVec2> =
@@ -495,38 +570,21 @@ impl Loader<'_> {
                 })?)
             }
         };
-        let template = Template {
-            vein,
-            two_state,
-            name: file.name,
-            mesh,
-            maps,
-            dg: file.dg,
-            thickness: file.thickness,
-            stretch_stiffness: file.stretch_stiffness,
-            bend_stiffness: file.bend_stiffness,
-            base_region: BaseRegion {
-                v_max: file.base_region.v_max,
-                u_min: file.base_region.u_min,
-                u_max: file.base_region.u_max,
-            },
-            joint_schedule: file.joint_schedule.iter().map(JointRamp::from).collect(),
-            color: file.color,
-            colouring,
-            source,
-        };
-        // A UV layout from another tool that loads but is read otherwise
-        // than its author meant.
+        Ok(vein)
+    }
+
+    /// Warnings for a UV layout from another tool that loads but is read
+    /// otherwise than its author meant.
+    fn note_uv_layout(&self, template: &Template) {
         let notes = [
             super::check::uv_outside_unit_square(&template.mesh),
-            super::check::base_not_at_base(&template),
+            super::check::base_not_at_base(template),
         ];
         for note in notes.into_iter().flatten() {
             self.warnings
                 .borrow_mut()
                 .push(format!("template \"{}\": {note}", template.name));
         }
-        Ok(template)
     }
 
     /// A sketched petal's `[templates.source]`: every stroke at least two
