@@ -200,6 +200,51 @@ pub(super) fn template_file(
         anthesis_mesh::obj_string(&template.mesh).into_bytes(),
     ));
 
+    let keys = key_files(template, stem, folder, files)?;
+    let (second_color, colour_map, colour_layers) =
+        colouring_entries(template, stem, folder, files)?;
+
+    let two_state = two_state_file(template, stem, files);
+    let region = &template.base_region;
+    Ok(TemplateFile {
+        name: template.name.clone(),
+        mesh: mesh_relative,
+        dg: template.dg,
+        thickness: template.thickness,
+        stretch_stiffness: template.stretch_stiffness,
+        bend_stiffness: template.bend_stiffness,
+        color: template.color,
+        second_color,
+        colour_map,
+        colour_layers,
+        blend: BlendFile::from(template.maps.blend),
+        base_region: BaseRegionFile {
+            v_max: region.v_max,
+            u_min: region.u_min,
+            u_max: region.u_max,
+        },
+        joint_schedule: template
+            .joint_schedule
+            .iter()
+            .map(JointRampFile::from)
+            .collect(),
+        two_state,
+        source: template.source.as_ref().map(source_file),
+        vein: template.vein.as_ref().map(|vein| VeinFile {
+            points: vein.points().iter().map(|p| p.to_array()).collect(),
+        }),
+        keys,
+    })
+}
+
+/// The map keys' entries: constants as numbers, other maps as 16-bit PNG
+/// files added to `files` (all raster maps of one size, values in range).
+fn key_files(
+    template: &Template,
+    stem: &str,
+    folder: &Path,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> Result<Vec<KeyFile>, ProjectError> {
     let mut size = SizeCheck::default();
     let mut keys = Vec::with_capacity(template.maps.keys().len());
     for key in template.maps.keys() {
@@ -250,10 +295,17 @@ pub(super) fn template_file(
         keys.push(key_file);
     }
     size.finish()?;
-    let (second_color, colour_map, colour_layers) =
-        colouring_entries(template, stem, folder, files)?;
+    Ok(keys)
+}
 
-    let two_state = template.two_state.as_ref().map(|animation| {
+/// The two-state animation's entry, its open shape saved as a mesh added
+/// to `files`.
+fn two_state_file(
+    template: &Template,
+    stem: &str,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> Option<TwoStateFile> {
+    template.two_state.as_ref().map(|animation| {
         // A stem never holds a dot, so no template's files clash with this.
         let open_mesh = format!("{MESH_FOLDER}/{stem}.open.obj");
         files.push((
@@ -269,65 +321,39 @@ pub(super) fn template_file(
                 VelocityCurve::Points(points) => Some(points.clone()),
             },
         }
-    });
-    let region = &template.base_region;
-    Ok(TemplateFile {
-        name: template.name.clone(),
-        mesh: mesh_relative,
-        dg: template.dg,
-        thickness: template.thickness,
-        stretch_stiffness: template.stretch_stiffness,
-        bend_stiffness: template.bend_stiffness,
-        color: template.color,
-        second_color,
-        colour_map,
-        colour_layers,
-        blend: BlendFile::from(template.maps.blend),
-        base_region: BaseRegionFile {
-            v_max: region.v_max,
-            u_min: region.u_min,
-            u_max: region.u_max,
-        },
-        joint_schedule: template
-            .joint_schedule
-            .iter()
-            .map(JointRampFile::from)
-            .collect(),
-        two_state,
-        source: template.source.as_ref().map(|source| match source {
-            crate::TemplateSource::Bezier { net, edge } => SourceFile::Bezier {
-                net: net.control.iter().flatten().map(|p| p.to_array()).collect(),
-                edge: *edge,
-            },
-            crate::TemplateSource::Sketch { sketch, edge } => {
-                let points = |s: &[glam::DVec2]| s.iter().map(|p| p.to_array()).collect();
-                SourceFile::Sketch {
-                    left: points(&sketch.left),
-                    right: points(&sketch.right),
-                    vein: points(&sketch.vein),
-                    sections: sketch.sections.iter().map(|s| points(s)).collect(),
-                    edge: *edge,
-                }
-            }
-            crate::TemplateSource::Pde { sweep, edge } => {
-                let points = |c: &anthesis_bud::BezierCurve| {
-                    c.control.iter().map(|p| p.to_array()).collect()
-                };
-                SourceFile::Pde {
-                    margin0: points(&sweep.curve0),
-                    margin1: points(&sweep.curve1),
-                    tangent0: points(&sweep.tangent0),
-                    tangent1: points(&sweep.tangent1),
-                    stretch_to_bend: sweep.stretch_to_bend(),
-                    edge: *edge,
-                }
-            }
-        }),
-        vein: template.vein.as_ref().map(|vein| VeinFile {
-            points: vein.points().iter().map(|p| p.to_array()).collect(),
-        }),
-        keys,
     })
+}
+
+/// The entry of the shape a template was made from.
+fn source_file(source: &crate::TemplateSource) -> SourceFile {
+    match source {
+        crate::TemplateSource::Bezier { net, edge } => SourceFile::Bezier {
+            net: net.control.iter().flatten().map(|p| p.to_array()).collect(),
+            edge: *edge,
+        },
+        crate::TemplateSource::Sketch { sketch, edge } => {
+            let points = |s: &[glam::DVec2]| s.iter().map(|p| p.to_array()).collect();
+            SourceFile::Sketch {
+                left: points(&sketch.left),
+                right: points(&sketch.right),
+                vein: points(&sketch.vein),
+                sections: sketch.sections.iter().map(|s| points(s)).collect(),
+                edge: *edge,
+            }
+        }
+        crate::TemplateSource::Pde { sweep, edge } => {
+            let points =
+                |c: &anthesis_bud::BezierCurve| c.control.iter().map(|p| p.to_array()).collect();
+            SourceFile::Pde {
+                margin0: points(&sweep.curve0),
+                margin1: points(&sweep.curve1),
+                tangent0: points(&sweep.tangent0),
+                tangent1: points(&sweep.tangent1),
+                stretch_to_bend: sweep.stretch_to_bend(),
+                edge: *edge,
+            }
+        }
+    }
 }
 
 /// The entry of a colour map saved as `maps/<name>.png` (16-bit, as the
