@@ -186,10 +186,6 @@ impl AnthesisApp {
         }
     }
 
-    pub fn autosave_mut(&mut self) -> Option<&mut Autosave> {
-        self.autosave.as_mut()
-    }
-
     /// The recovery offered to the user, if one waits for an answer.
     pub fn recovery_offer(&self) -> Option<&Recovery> {
         self.recovery_offer.as_ref()

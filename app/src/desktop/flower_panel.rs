@@ -110,11 +110,6 @@ impl FlowerPanelState {
     pub fn bud_sketch(&self) -> &BudSketchState {
         &self.bud
     }
-
-    /// Sets the mean edge the Shape section remeshes at (as typing it).
-    pub fn set_remesh_edge(&mut self, edge: f64) {
-        self.shape.edge = Some(edge);
-    }
 }
 
 /// Which kind of arrangement.

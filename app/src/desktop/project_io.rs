@@ -501,6 +501,15 @@ impl AnthesisApp {
                 }
             }
         } else {
+            let crossed: Vec<u32> = self.session.crossed_keyframes().collect();
+            if let (Some(first), Some(last)) = (crossed.first(), crossed.last()) {
+                self.log.warn(format!(
+                    "the export holds {} keyframe{} where organs pass through each other \
+                     ({first} to {last}; red on the timeline)",
+                    crossed.len(),
+                    if crossed.len() == 1 { "" } else { "s" }
+                ));
+            }
             self.session.keyframes().to_vec()
         };
         let tracks = export::tracks(&project, &organs, &keyframes, self.export.render_level);

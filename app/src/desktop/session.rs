@@ -170,11 +170,6 @@ impl SimSession {
         }
     }
 
-    /// Whether a worker computes the keyframes.
-    pub fn is_live(&self) -> bool {
-        matches!(self.source, Source::Worker(_))
-    }
-
     /// Starts a new run of `project`, superseding (and cancelling) the
     /// current one. What was shown so far stays shown, as stale keyframes,
     /// until the new run's keyframes arrive (see [`SimSession::shown_end`]);

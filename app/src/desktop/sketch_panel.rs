@@ -155,11 +155,6 @@ impl SketchState {
                 .map_err(String::as_str),
         )
     }
-
-    /// Chooses the drawing tool (as clicking it).
-    pub fn set_tool(&mut self, tool: SketchTool) {
-        self.tool = tool;
-    }
 }
 
 /// A hash of the sketch and the edge: whether the preview was made of them.

@@ -410,11 +410,6 @@ impl Worker {
         self.current.fetch_add(1, Ordering::SeqCst);
     }
 
-    /// The id of the newest run asked for.
-    pub fn current_run(&self) -> RunId {
-        self.current.load(Ordering::SeqCst)
-    }
-
     /// The next event, if one is waiting.
     pub fn try_event(&self) -> Option<Event> {
         self.events.try_recv().ok()

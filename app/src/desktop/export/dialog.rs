@@ -15,6 +15,7 @@ use super::{
     edge_text, run_note, shown_edge, target_format,
 };
 use crate::animation;
+use crate::desktop::checked_field::checked_number;
 
 /// A labelled row editing an angle in degrees within `[-limit, limit]`;
 /// returns the editor's response.
@@ -116,9 +117,12 @@ impl ExportDialog {
         angle_row(ui, "Camera turn", &mut a.turn_deg, 720.0)
             .on_hover_text("How far the camera circles the flower over the animation");
         let label = ui.label("GIF frames per second").id;
-        ui.add(
-            egui::DragValue::new(&mut a.frames_per_second)
-                .range(1.0..=animation::MAX_GIF_FRAMES_PER_SECOND),
+        checked_number(
+            ui,
+            "GIF frames per second",
+            &mut a.frames_per_second,
+            1.0,
+            1.0..=animation::MAX_GIF_FRAMES_PER_SECOND,
         )
         .labelled_by(label);
         ui.end_row();
@@ -262,20 +266,23 @@ impl ExportDialog {
                 match self.timing_mode {
                     TimingMode::FramesPerSecond => {
                         let label = ui.label("Keyframes per second").id;
-                        ui.add(
-                            egui::DragValue::new(&mut self.frames_per_second)
-                                .range(0.1..=240.0)
-                                .speed(0.5),
+                        checked_number(
+                            ui,
+                            "Keyframes per second",
+                            &mut self.frames_per_second,
+                            0.5,
+                            0.1..=240.0,
                         )
                         .labelled_by(label);
                     }
                     TimingMode::Duration => {
-                        let label = ui.label("Duration").id;
-                        ui.add(
-                            egui::DragValue::new(&mut self.duration_seconds)
-                                .range(0.1..=3600.0)
-                                .speed(0.1)
-                                .suffix(" s"),
+                        let label = ui.label("Duration (s)").id;
+                        checked_number(
+                            ui,
+                            "Duration (s)",
+                            &mut self.duration_seconds,
+                            0.1,
+                            0.1..=3600.0,
                         )
                         .labelled_by(label);
                     }
