@@ -7,9 +7,10 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anthesis_bud::dynamic::{Dynamics, SweepInBetween};
-use anthesis_bud::{RemeshOptions, Surface, build_organ};
+use anthesis_bud::{PdeSweep, RemeshOptions, Surface, build_organ};
 use anthesis_export::Track;
 use anthesis_flower::MAX_KEYFRAMES;
+use anthesis_mesh::Mesh;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::{DVec2, DVec3};
@@ -86,37 +87,93 @@ pub struct PdeBlossomArgs {
 }
 
 pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
-    let keyframes = super::check_count("--keyframes", args.keyframes, 1, MAX_KEYFRAMES as usize)?;
-    let nodes = super::check_count("--nodes", args.nodes, MIN_NODES, MAX_NODES)?;
-    let rows = super::check_count("--rows", args.rows, 1, MAX_ROWS)?;
-    let max_corrections = super::check_count(
-        "--max-corrections",
-        args.max_corrections,
-        0,
-        MAX_CORRECTIONS,
-    )?;
-    // Each generator keeps its nodes' deformation at every keyframe.
-    let work = (rows + 1) * (nodes + 1) * keyframes;
-    if work > MAX_NODE_STEPS {
-        bail!(
-            "(--rows {rows} + 1) x (--nodes {nodes} + 1) x --keyframes {keyframes} is {} \
-             node-steps, more than the limit of {}: use fewer rows, nodes or keyframes",
-            crate::desktop::params::grouped(work as u64),
-            crate::desktop::params::grouped(MAX_NODE_STEPS as u64),
-        );
-    }
-    if let Some(edge) = args.edge
-        && !(edge.is_finite() && edge > 0.0)
-    {
-        bail!("--edge must be a positive length, got {edge}");
-    }
-    if !(args.tolerance >= 0.0 && args.tolerance.is_finite()) {
-        bail!("--tolerance must be 0 or more, got {}", args.tolerance);
-    }
+    let sizes = Sizes::checked(args)?;
     let glb = animation_options(args.fps, args.encoding)?;
     if let Some(out) = &args.out {
-        check_output(out, &glb, keyframes as u32)?;
+        check_output(out, &glb, sizes.keyframes as u32)?;
     }
+    let (bud, open, mesh) = read_states(args, sizes.keyframes)?;
+    let started = Instant::now();
+    let steps = sizes.keyframes;
+    let motion = in_between(args, &bud, &open, &sizes)?;
+    let keyframes = keyframe_positions(args, &bud, &mesh, &motion, steps)?;
+    let seconds = started.elapsed().as_secs_f64();
+    report(args, &motion, &sizes, mesh.positions.len(), seconds)?;
+    if let Some(out) = &args.out {
+        let name = args
+            .bud
+            .file_stem()
+            .map_or_else(|| "organ".to_owned(), |s| s.to_string_lossy().into_owned());
+        let track = Track {
+            name,
+            triangles: mesh.triangles.clone(),
+            uvs: mesh.uvs.clone(),
+            base_color: [0.95, 0.93, 0.88, 1.0],
+            keyframes,
+            ..Track::default()
+        };
+        write_tracks(out, &[track], &glb)?;
+        say!("wrote {} (keyframes 0 to {steps})", out.display());
+    }
+    Ok(())
+}
+
+/// The checked sizes of a run.
+struct Sizes {
+    /// Keyframes after the bud (`--keyframes`): the in-betweening's steps.
+    keyframes: usize,
+    /// Intervals of a generator (`--nodes`).
+    nodes: usize,
+    /// Generators along the sweep (`--rows`).
+    rows: usize,
+    /// Force corrections at most (`--max-corrections`).
+    max_corrections: usize,
+}
+
+impl Sizes {
+    /// Checks the counts, their product and the other numbers of `args`
+    /// (`--edge`, `--tolerance`), before any file is read.
+    fn checked(args: &PdeBlossomArgs) -> Result<Sizes> {
+        let keyframes =
+            super::check_count("--keyframes", args.keyframes, 1, MAX_KEYFRAMES as usize)?;
+        let nodes = super::check_count("--nodes", args.nodes, MIN_NODES, MAX_NODES)?;
+        let rows = super::check_count("--rows", args.rows, 1, MAX_ROWS)?;
+        let max_corrections = super::check_count(
+            "--max-corrections",
+            args.max_corrections,
+            0,
+            MAX_CORRECTIONS,
+        )?;
+        // Each generator keeps its nodes' deformation at every keyframe.
+        let work = (rows + 1) * (nodes + 1) * keyframes;
+        if work > MAX_NODE_STEPS {
+            bail!(
+                "(--rows {rows} + 1) x (--nodes {nodes} + 1) x --keyframes {keyframes} is {} \
+                 node-steps, more than the limit of {}: use fewer rows, nodes or keyframes",
+                crate::desktop::params::grouped(work as u64),
+                crate::desktop::params::grouped(MAX_NODE_STEPS as u64),
+            );
+        }
+        if let Some(edge) = args.edge
+            && !(edge.is_finite() && edge > 0.0)
+        {
+            bail!("--edge must be a positive length, got {edge}");
+        }
+        if !(args.tolerance >= 0.0 && args.tolerance.is_finite()) {
+            bail!("--tolerance must be 0 or more, got {}", args.tolerance);
+        }
+        Ok(Sizes {
+            keyframes,
+            nodes,
+            rows,
+            max_corrections,
+        })
+    }
+}
+
+/// Reads the two states, checks that their margins correspond and meshes
+/// the bud (a mesh of `keyframes` + 1 keyframes must fit the limits).
+fn read_states(args: &PdeBlossomArgs, keyframes: usize) -> Result<(PdeSweep, PdeSweep, Mesh)> {
     let bud = read_pde(&args.bud)?;
     let open = read_pde(&args.open)?;
     check_margins_correspond(&bud, &open).with_context(|| {
@@ -134,21 +191,29 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
         .with_context(|| format!("cannot mesh the bud {}", args.bud.display()))?
         .mesh;
     super::check_positions(mesh.vertex_count(), keyframes as u32)?;
-    let started = Instant::now();
-    let steps = keyframes;
-    let motion = SweepInBetween::new(
-        &bud,
-        &open,
-        nodes,
-        rows,
+    Ok((bud, open, mesh))
+}
+
+/// Solves the in-betweening of `bud` and `open` (Chaudhry et al. §V).
+fn in_between(
+    args: &PdeBlossomArgs,
+    bud: &PdeSweep,
+    open: &PdeSweep,
+    sizes: &Sizes,
+) -> Result<SweepInBetween> {
+    SweepInBetween::new(
+        bud,
+        open,
+        sizes.nodes,
+        sizes.rows,
         Dynamics {
             bend: args.bend,
             stretch: args.stretch,
             mass: args.mass,
         },
-        steps,
+        sizes.keyframes,
         args.tolerance,
-        max_corrections,
+        sizes.max_corrections,
     )
     .with_context(|| {
         format!(
@@ -156,7 +221,19 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
             args.bud.display(),
             args.open.display()
         )
-    })?;
+    })
+}
+
+/// The positions of `mesh`'s vertices at each of the `steps` + 1
+/// keyframes: the bud's points moved by `motion`'s deformation. Refuses
+/// positions that are not finite numbers.
+fn keyframe_positions(
+    args: &PdeBlossomArgs,
+    bud: &PdeSweep,
+    mesh: &Mesh,
+    motion: &SweepInBetween,
+    steps: usize,
+) -> Result<Vec<Vec<DVec3>>> {
     let keyframes: Vec<Vec<glam::DVec3>> = (0..=steps)
         .map(|level| {
             mesh.uvs
@@ -173,7 +250,19 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
             args.open.display()
         );
     }
-    let seconds = started.elapsed().as_secs_f64();
+    Ok(keyframes)
+}
+
+/// Prints how the in-betweening went and writes it to `--report` if asked.
+fn report(
+    args: &PdeBlossomArgs,
+    motion: &SweepInBetween,
+    sizes: &Sizes,
+    particles: usize,
+    seconds: f64,
+) -> Result<()> {
+    let nodes = sizes.nodes;
+    let steps = sizes.keyframes;
     let summary = motion.summary();
     out!(
         "{} generators of {} intervals, {} keyframes: force corrections (eq. 21) at most {}{}, \
@@ -189,7 +278,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
         },
         summary.final_error,
         args.tolerance,
-        mesh.positions.len(),
+        particles,
     )?;
     if let Some(path) = &args.report {
         let report = serde_json::json!({
@@ -204,22 +293,6 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
         });
         anthesis_files::write_atomic(path, serde_json::to_string_pretty(&report)?.as_bytes())
             .with_context(|| format!("cannot write the report {}", path.display()))?;
-    }
-    if let Some(out) = &args.out {
-        let name = args
-            .bud
-            .file_stem()
-            .map_or_else(|| "organ".to_owned(), |s| s.to_string_lossy().into_owned());
-        let track = Track {
-            name,
-            triangles: mesh.triangles.clone(),
-            uvs: mesh.uvs.clone(),
-            base_color: [0.95, 0.93, 0.88, 1.0],
-            keyframes,
-            ..Track::default()
-        };
-        write_tracks(out, &[track], &glb)?;
-        say!("wrote {} (keyframes 0 to {steps})", out.display());
     }
     Ok(())
 }

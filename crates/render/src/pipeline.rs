@@ -226,6 +226,180 @@ fn round_up(value: u64, alignment: u64) -> u64 {
     value.div_ceil(alignment.max(1)) * alignment.max(1)
 }
 
+/// The bind group layouts the organ shader reads and the pipeline layout
+/// that lists them as groups 0, 1 and 2.
+struct OrganLayouts {
+    /// Group 0: the frame's uniforms, one per draw.
+    frame: wgpu::BindGroupLayout,
+    /// Group 1: one organ's uniforms, at a dynamic offset.
+    organ: wgpu::BindGroupLayout,
+    /// Group 2: the organ's texture and sampler.
+    texture: wgpu::BindGroupLayout,
+    /// Both pipelines' layout.
+    pipeline: wgpu::PipelineLayout,
+}
+
+/// Creates the three bind group layouts and the pipeline layout over them.
+fn organ_layouts(device: &wgpu::Device) -> OrganLayouts {
+    let uniform_entry = |has_dynamic_offset: bool, size: usize| wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset,
+            min_binding_size: wgpu::BufferSize::new(size as u64),
+        },
+        count: None,
+    };
+    let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("anthesis frame uniforms"),
+        entries: &[uniform_entry(false, size_of::<FrameUniform>())],
+    });
+    let organ = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("anthesis organ uniforms"),
+        entries: &[uniform_entry(true, size_of::<OrganUniform>())],
+    });
+    let texture = texture_layout(device, "anthesis organ texture");
+    let pipeline = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("anthesis organs"),
+        bind_group_layouts: &[Some(&frame), Some(&organ), Some(&texture)],
+        immediate_size: 0,
+    });
+    OrganLayouts {
+        frame,
+        organ,
+        texture,
+        pipeline,
+    }
+}
+
+/// The one colour attachment both pipelines write, unblended.
+fn color_targets(format: TargetFormat) -> [Option<wgpu::ColorTargetState>; 1] {
+    [Some(wgpu::ColorTargetState {
+        format: format.color,
+        blend: None,
+        write_mask: wgpu::ColorWrites::ALL,
+    })]
+}
+
+/// Multisampling at the target's sample count, every sample written.
+fn multisample(format: TargetFormat) -> wgpu::MultisampleState {
+    wgpu::MultisampleState {
+        count: format.sample_count,
+        mask: !0,
+        alpha_to_coverage_enabled: false,
+    }
+}
+
+/// The organ pipeline: two-sided triangles from the vertex buffer,
+/// depth-tested (reversed depth) and written.
+fn create_organ_pipeline(
+    device: &wgpu::Device,
+    shader: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    format: TargetFormat,
+) -> wgpu::RenderPipeline {
+    let color_targets = color_targets(format);
+    let vertex_buffers = [Some(wgpu::VertexBufferLayout {
+        array_stride: size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &VERTEX_ATTRIBUTES,
+    })];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("anthesis organs"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some("vs_organ"),
+            compilation_options: Default::default(),
+            buffers: &vertex_buffers,
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            front_face: wgpu::FrontFace::Ccw,
+            // Two-sided: both sides are drawn and shaded.
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: format.depth,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: multisample(format),
+        fragment: Some(wgpu::FragmentState {
+            module: shader,
+            entry_point: Some("fs_organ"),
+            compilation_options: Default::default(),
+            targets: &color_targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The background pipeline: a full-screen triangle made in the vertex
+/// shader, drawn everywhere and leaving depth untouched.
+fn create_background_pipeline(
+    device: &wgpu::Device,
+    shader: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    format: TargetFormat,
+) -> wgpu::RenderPipeline {
+    let color_targets = color_targets(format);
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("anthesis background"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module: shader,
+            entry_point: Some("vs_background"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: format.depth,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: multisample(format),
+        fragment: Some(wgpu::FragmentState {
+            module: shader,
+            entry_point: Some("fs_background"),
+            compilation_options: Default::default(),
+            targets: &color_targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The frame's uniform buffer and its bind group (group 0).
+fn create_frame_uniforms(
+    device: &wgpu::Device,
+    frame_layout: &wgpu::BindGroupLayout,
+) -> (wgpu::Buffer, wgpu::BindGroup) {
+    let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("anthesis frame uniforms"),
+        size: size_of::<FrameUniform>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let frame_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("anthesis frame uniforms"),
+        layout: frame_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: frame_buffer.as_entire_binding(),
+        }],
+    });
+    (frame_buffer, frame_bind_group)
+}
+
 impl OrganPipeline {
     /// Builds the pipelines for passes with attachments of `format`
     /// (`queue` uploads the white texture untextured organs are drawn with).
@@ -234,125 +408,16 @@ impl OrganPipeline {
             label: Some("anthesis organ.wgsl"),
             source: wgpu::ShaderSource::Wgsl(organ_shader_source().into()),
         });
-        let uniform_entry = |has_dynamic_offset: bool, size: usize| wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset,
-                min_binding_size: wgpu::BufferSize::new(size as u64),
-            },
-            count: None,
-        };
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("anthesis frame uniforms"),
-            entries: &[uniform_entry(false, size_of::<FrameUniform>())],
-        });
-        let organ_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("anthesis organ uniforms"),
-            entries: &[uniform_entry(true, size_of::<OrganUniform>())],
-        });
-        let texture_layout = texture_layout(device, "anthesis organ texture");
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("anthesis organs"),
-            bind_group_layouts: &[
-                Some(&frame_layout),
-                Some(&organ_layout),
-                Some(&texture_layout),
-            ],
-            immediate_size: 0,
-        });
+        let OrganLayouts {
+            frame: frame_layout,
+            organ: organ_layout,
+            texture: texture_layout,
+            pipeline: layout,
+        } = organ_layouts(device);
+        let organ_pipeline = create_organ_pipeline(device, &shader, &layout, format);
+        let background_pipeline = create_background_pipeline(device, &shader, &layout, format);
 
-        let color_targets = [Some(wgpu::ColorTargetState {
-            format: format.color,
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        })];
-        let multisample = wgpu::MultisampleState {
-            count: format.sample_count,
-            mask: !0,
-            alpha_to_coverage_enabled: false,
-        };
-        let vertex_buffers = [Some(wgpu::VertexBufferLayout {
-            array_stride: size_of::<Vertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &VERTEX_ATTRIBUTES,
-        })];
-        let organ_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("anthesis organs"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_organ"),
-                compilation_options: Default::default(),
-                buffers: &vertex_buffers,
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                // Two-sided: both sides are drawn and shaded.
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: format.depth,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_organ"),
-                compilation_options: Default::default(),
-                targets: &color_targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let background_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("anthesis background"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_background"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: format.depth,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_background"),
-                compilation_options: Default::default(),
-                targets: &color_targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-
-        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("anthesis frame uniforms"),
-            size: size_of::<FrameUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let frame_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("anthesis frame uniforms"),
-            layout: &frame_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: frame_buffer.as_entire_binding(),
-            }],
-        });
+        let (frame_buffer, frame_bind_group) = create_frame_uniforms(device, &frame_layout);
         let organ_uniform_stride = round_up(
             size_of::<OrganUniform>() as u64,
             u64::from(device.limits().min_uniform_buffer_offset_alignment),

@@ -19,7 +19,7 @@ use builder::{
     CLAMP_TO_EDGE, GltfBuilder, KHR_MESH_QUANTIZATION, LINEAR, LINEAR_MIPMAP_LINEAR, TRIANGLES,
     f32_json,
 };
-use encode::{TargetDeltas, encode_mesh};
+use encode::{QuantizationBox, TargetDeltas, encode_mesh};
 
 /// Builds the animated .glb of `tracks` in memory (see the crate
 /// documentation for its layout). `progress` is called with values rising
@@ -39,51 +39,147 @@ pub fn glb_bytes(
     validate_options(options, keyframe_count)?;
     progress(0.0);
 
-    let sample_at = sample_positions(keyframe_count, options.max_morph_targets);
-    let target_count = sample_at.len() - 1;
-    let target_names: Vec<Value> = sample_at[1..]
-        .iter()
-        .map(|&x| Value::from(target_name(x)))
-        .collect();
-
-    let total_work = tracks
-        .iter()
-        .map(|t| {
-            if t.keyframes.len() > 1 {
-                sample_at.len()
-            } else {
-                1
-            }
-        })
-        .sum::<usize>() as f32
-        + 1.0;
-    let mut work_done = 0usize;
-    let mut tick = |progress: &mut dyn FnMut(f32)| {
-        work_done += 1;
-        progress(work_done as f32 / total_work);
-    };
-
-    let mut gltf = GltfBuilder::new(options.encoding);
-    let mut nodes = Vec::with_capacity(tracks.len());
-    let mut meshes = Vec::with_capacity(tracks.len());
-    let mut materials = Vec::with_capacity(tracks.len());
-    let mut textures = Textures::default();
-    let mut animated_nodes = Vec::new();
-    let mut top_nodes = Vec::with_capacity(tracks.len());
-    // Rigid tracks: the node that moves, and its pose at each exported
-    // keyframe.
-    let mut moving_nodes: Vec<(usize, Vec<Pose>)> = Vec::new();
-
+    let samples = Samples::new(keyframe_count, options.max_morph_targets);
+    let mut work = Work::new(progress, tracks, samples.at.len());
+    let mut scene = Scene::new(options, tracks.len());
     for (index, track) in tracks.iter().enumerate() {
-        let rigid = track.rigid.as_ref().filter(|_| track.keyframes.len() > 1);
-        let frames = frames_in_metres(track, &sample_at);
-        let inner_material = materials.len();
-        materials.push(material(&mut gltf, &mut textures, track, Face::Inner));
+        scene.add_track(index, track, &samples, options, &mut work);
+    }
+    let bytes = scene.finish(&samples, keyframe_count, options)?;
+    progress(1.0);
+    Ok(bytes)
+}
+
+/// Where the exported keyframes are sampled (`at[0]` is the base mesh,
+/// each later sample a morph target) and the morph targets' names.
+struct Samples {
+    at: Vec<f64>,
+    target_names: Vec<Value>,
+}
+
+impl Samples {
+    /// The samples of `keyframe_count` keyframes with at most
+    /// `max_morph_targets` morph targets.
+    fn new(keyframe_count: usize, max_morph_targets: usize) -> Samples {
+        let at = sample_positions(keyframe_count, max_morph_targets);
+        let target_names = at[1..]
+            .iter()
+            .map(|&x| Value::from(target_name(x)))
+            .collect();
+        Samples { at, target_names }
+    }
+
+    /// How many morph targets an animated mesh has.
+    fn target_count(&self) -> usize {
+        self.at.len() - 1
+    }
+}
+
+/// The export's progress: one unit of work per exported keyframe of each
+/// animated track, one per still track, and one for writing the file.
+struct Work<'p> {
+    progress: &'p mut dyn FnMut(f32),
+    done: usize,
+    total: f32,
+}
+
+impl<'p> Work<'p> {
+    /// Counts the work of `tracks` with `sample_count` samples each.
+    fn new(progress: &'p mut dyn FnMut(f32), tracks: &[Track], sample_count: usize) -> Work<'p> {
+        let total = tracks
+            .iter()
+            .map(|t| {
+                if t.keyframes.len() > 1 {
+                    sample_count
+                } else {
+                    1
+                }
+            })
+            .sum::<usize>() as f32
+            + 1.0;
+        Work {
+            progress,
+            done: 0,
+            total,
+        }
+    }
+
+    /// One more unit done: reports the fraction done so far.
+    fn tick(&mut self) {
+        self.done += 1;
+        (self.progress)(self.done as f32 / self.total);
+    }
+}
+
+/// The glTF document being built, one track at a time.
+struct Scene<'a> {
+    gltf: GltfBuilder,
+    nodes: Vec<Value>,
+    meshes: Vec<Value>,
+    materials: Vec<Value>,
+    textures: Textures<'a>,
+    /// The nodes whose meshes have morph targets.
+    animated_nodes: Vec<usize>,
+    /// The scene's top nodes, one per track.
+    top_nodes: Vec<usize>,
+    /// Rigid tracks: the node that moves, and its pose at each exported
+    /// keyframe.
+    moving_nodes: Vec<(usize, Vec<Pose>)>,
+}
+
+impl<'a> Scene<'a> {
+    /// An empty document for `track_count` tracks.
+    fn new(options: &GlbOptions, track_count: usize) -> Scene<'a> {
+        Scene {
+            gltf: GltfBuilder::new(options.encoding),
+            nodes: Vec::with_capacity(track_count),
+            meshes: Vec::with_capacity(track_count),
+            materials: Vec::with_capacity(track_count),
+            textures: Textures::default(),
+            animated_nodes: Vec::new(),
+            top_nodes: Vec::with_capacity(track_count),
+            moving_nodes: Vec::new(),
+        }
+    }
+
+    /// Adds `track` (the `index`th, whose mesh is the `index`th): its
+    /// materials, its mesh and the nodes that place it.
+    fn add_track(
+        &mut self,
+        index: usize,
+        track: &'a Track,
+        samples: &Samples,
+        options: &GlbOptions,
+        work: &mut Work<'_>,
+    ) {
+        let frames = frames_in_metres(track, &samples.at);
+        let dequantization = self.add_mesh(track, &frames, samples, options, work);
+        self.add_nodes(index, track, dequantization, &samples.at);
+    }
+
+    /// Adds the mesh of `track` at `frames` with its materials: one
+    /// primitive, or two when its sides differ. Returns how the node must
+    /// dequantize the mesh's positions, if they are quantized.
+    fn add_mesh(
+        &mut self,
+        track: &'a Track,
+        frames: &[Vec<DVec3>],
+        samples: &Samples,
+        options: &GlbOptions,
+        work: &mut Work<'_>,
+    ) -> Option<QuantizationBox> {
+        let inner_material = self.materials.len();
+        self.materials.push(material(
+            &mut self.gltf,
+            &mut self.textures,
+            track,
+            Face::Inner,
+        ));
 
         // A two-sided track's outer primitive shares every accessor whose
         // data is the same as the inner one's (all but normals and indices).
-        gltf.share_accessors(track.outer_color_png.is_some());
-        let encoded = encode_mesh(&mut gltf, track, &frames, options, &mut || tick(progress));
+        self.gltf.share_accessors(track.outer_color_png.is_some());
+        let encoded = encode_mesh(&mut self.gltf, track, frames, options, &mut || work.tick());
 
         let mut primitive = json!({
             "attributes": encoded.attributes,
@@ -94,29 +190,47 @@ pub fn glb_bytes(
         let mut mesh = json!({ "name": track.name });
         if !encoded.targets.is_empty() {
             primitive["targets"] = Value::Array(encoded.targets);
-            mesh["weights"] = Value::Array(vec![json!(0.0); target_count]);
-            mesh["extras"] = json!({ "targetNames": target_names });
-            animated_nodes.push(nodes.len());
+            mesh["weights"] = Value::Array(vec![json!(0.0); samples.target_count()]);
+            mesh["extras"] = json!({ "targetNames": samples.target_names });
+            self.animated_nodes.push(self.nodes.len());
         }
         let mut primitives = vec![primitive];
         if track.outer_color_png.is_some() {
-            let outer_material = materials.len();
-            materials.push(material(&mut gltf, &mut textures, track, Face::Outer));
-            primitives.push(outer_primitive(
-                &mut gltf,
+            let outer_material = self.materials.len();
+            self.materials.push(material(
+                &mut self.gltf,
+                &mut self.textures,
                 track,
-                &frames,
+                Face::Outer,
+            ));
+            primitives.push(outer_primitive(
+                &mut self.gltf,
+                track,
+                frames,
                 options,
                 outer_material,
             ));
         }
-        gltf.share_accessors(false);
+        self.gltf.share_accessors(false);
         mesh["primitives"] = Value::Array(primitives);
-        meshes.push(mesh);
+        self.meshes.push(mesh);
+        encoded.dequantization
+    }
 
-        let top = nodes.len();
+    /// Adds the node of `track`'s mesh (the `index`th), which applies
+    /// `dequantization`, below a node that carries its rigid motion if it
+    /// has one.
+    fn add_nodes(
+        &mut self,
+        index: usize,
+        track: &Track,
+        dequantization: Option<QuantizationBox>,
+        sample_at: &[f64],
+    ) {
+        let rigid = track.rigid.as_ref().filter(|_| track.keyframes.len() > 1);
+        let top = self.nodes.len();
         let mut node = json!({ "name": track.name, "mesh": index });
-        if let Some(qbox) = encoded.dequantization {
+        if let Some(qbox) = dequantization {
             node["translation"] = json!(qbox.center.map(f32_json));
             node["scale"] = json!([
                 f32_json(qbox.scale),
@@ -127,49 +241,56 @@ pub fn glb_bytes(
         if let Some(rigid) = rigid {
             // The mesh (with its dequantisation) hangs below a node that
             // carries the rigid motion.
-            let poses = poses_in_metres(&rigid.poses, &sample_at, track.unit.metres());
-            let mover_index = nodes.len();
+            let poses = poses_in_metres(&rigid.poses, sample_at, track.unit.metres());
+            let mover_index = self.nodes.len();
             let mut mover = json!({ "name": track.name, "children": [mover_index + 1] });
             set_pose(&mut mover, &poses[0]);
             node["name"] = json!(format!("{} mesh", track.name));
-            nodes.push(mover);
-            moving_nodes.push((mover_index, poses));
+            self.nodes.push(mover);
+            self.moving_nodes.push((mover_index, poses));
         }
-        top_nodes.push(top);
-        nodes.push(node);
+        self.top_nodes.push(top);
+        self.nodes.push(node);
     }
 
-    let mut root = json!({
-        "asset": {
-            "version": "2.0",
-            "generator": concat!("Anthesis (anthesis-export ", env!("CARGO_PKG_VERSION"), ")"),
-        },
-        "scene": 0,
-        "scenes": [{ "name": "flower", "nodes": top_nodes }],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": materials,
-    });
+    /// The .glb of the document: the glTF root with the scene, its
+    /// animation (if anything moves), textures and extensions, and the
+    /// binary chunk.
+    fn finish(
+        mut self,
+        samples: &Samples,
+        keyframe_count: usize,
+        options: &GlbOptions,
+    ) -> Result<Vec<u8>, ExportError> {
+        let mut root = json!({
+            "asset": {
+                "version": "2.0",
+                "generator": concat!("Anthesis (anthesis-export ", env!("CARGO_PKG_VERSION"), ")"),
+            },
+            "scene": 0,
+            "scenes": [{ "name": "flower", "nodes": self.top_nodes }],
+            "nodes": self.nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+        });
 
-    if !animated_nodes.is_empty() || !moving_nodes.is_empty() {
-        let animation = Animation {
-            sample_at: &sample_at,
-            keyframe_count,
-            target_count,
-            morphed: &animated_nodes,
-            moving: &moving_nodes,
-        };
-        root["animations"] = json!([animation.json(&mut gltf, options)?]);
+        if !self.animated_nodes.is_empty() || !self.moving_nodes.is_empty() {
+            let animation = Animation {
+                sample_at: &samples.at,
+                keyframe_count,
+                target_count: samples.target_count(),
+                morphed: &self.animated_nodes,
+                moving: &self.moving_nodes,
+            };
+            root["animations"] = json!([animation.json(&mut self.gltf, options)?]);
+        }
+        self.textures.add_to(&mut root);
+        if self.gltf.uses_quantization {
+            root["extensionsUsed"] = json!([KHR_MESH_QUANTIZATION]);
+            root["extensionsRequired"] = json!([KHR_MESH_QUANTIZATION]);
+        }
+        self.gltf.finish(root)
     }
-    textures.add_to(&mut root);
-    if gltf.uses_quantization {
-        root["extensionsUsed"] = json!([KHR_MESH_QUANTIZATION]);
-        root["extensionsRequired"] = json!([KHR_MESH_QUANTIZATION]);
-    }
-
-    let bytes = gltf.finish(root)?;
-    progress(1.0);
-    Ok(bytes)
 }
 
 /// The outer side of a two-sided track: the same surface wound the other
