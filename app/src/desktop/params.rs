@@ -124,15 +124,21 @@ pub fn parameters_ui_viewing(
             let label = ui.label("keyframes").on_hover_text(
                 "Simulation steps after the bud, one keyframe each (whole project). Paper: 100.",
             );
-            mark(
-                ui.add(DragValue::new(&mut keyframes).range(1..=10_000))
-                    .labelled_by(label.id)
-                    .on_hover_text(
-                        "Simulation steps after the bud, one keyframe each (whole project).",
-                    )
-                    .changed(),
+            // A checked field, as the others: a typed count out of range or
+            // not a number is marked and logged, not silently clamped.
+            let mut count = f64::from(keyframes);
+            let changed = super::checked_field::checked_number(
+                ui,
                 "keyframes",
-            );
+                &mut count,
+                1.0,
+                1.0..=10_000.0,
+            )
+            .labelled_by(label.id)
+            .on_hover_text("Simulation steps after the bud, one keyframe each (whole project).")
+            .changed();
+            keyframes = count.round() as u32;
+            mark(changed, "keyframes");
             ui.end_row();
         });
 
