@@ -38,16 +38,18 @@ impl Simulation {
     }
 
     /// No silent crossing (see [`crate::crossing`]): stops the run at a
-    /// keyframe with crossing triangles, or keeps what was found, as the
-    /// caller chose.
+    /// keyframe with crossing triangles, or keeps what was found, or does
+    /// not look, as the caller chose.
     pub(crate) fn check_crossings(&mut self, step: u32) -> Result<(), SimError> {
-        if self.on_crossing != OnCrossing::Skip
-            && let Some(crossings) = self.find_crossings(step)
-        {
-            match self.on_crossing {
-                OnCrossing::Stop => return Err(SimError::Crossed(Box::new(crossings))),
-                OnCrossing::Warn | OnCrossing::Skip => self.crossings.push(crossings),
+        let on_crossing = self.on_crossing;
+        if on_crossing == OnCrossing::Skip {
+            return Ok(());
+        }
+        if let Some(crossings) = self.find_crossings(step) {
+            if on_crossing == OnCrossing::Stop {
+                return Err(SimError::Crossed(Box::new(crossings)));
             }
+            self.crossings.push(crossings);
         }
         Ok(())
     }
