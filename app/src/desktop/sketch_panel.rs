@@ -131,12 +131,19 @@ pub struct SketchState {
     preview: Option<(u64, Preview)>,
     /// Why Apply could not mesh the petal.
     apply_error: Option<String>,
+    /// The editor is in the large canvas (a window over the viewport).
+    large: bool,
 }
 
 impl SketchState {
     /// The strokes being edited for template `name`, once shown.
     pub fn sketch(&self, name: &str) -> Option<&PetalSketch> {
         self.drafts.get(name).map(|d| &d.sketch)
+    }
+
+    /// Whether the editor is open in the large canvas.
+    pub fn large(&self) -> bool {
+        self.large
     }
 
     /// Where sketch-plane point `p` was on the canvas in the last frame.
@@ -206,7 +213,7 @@ pub fn sketch_ui(
         _ => None,
     };
     sync_draft(state, name, &saved);
-    let Some(draft) = state.drafts.get(name).cloned() else {
+    if !state.drafts.contains_key(name) {
         if ui
             .button("Sketch a new shape")
             .on_hover_text(
@@ -226,13 +233,114 @@ pub fn sketch_ui(
         }
         state.view = None;
         return;
+    }
+    let large = state.large;
+    if !in_room(ui, "Sketched petal", large, |ui| {
+        editor(ui, (flower, index), edge, state, commands, large);
+    }) {
+        state.large = false;
+    }
+}
+
+/// Shows `body` (an editor's rows) in the panel, or when `large` in a
+/// resizable window over the viewport (the large canvas), with a line in
+/// the panel that says so and brings it back; false when the window was
+/// closed. The same `body` draws both: strokes follow the same rules.
+pub(super) fn in_room(
+    ui: &mut egui::Ui,
+    title: &str,
+    large: bool,
+    body: impl FnOnce(&mut egui::Ui),
+) -> bool {
+    if !large {
+        body(ui);
+        return true;
+    }
+    let mut open = true;
+    ui.horizontal_wrapped(|ui| {
+        ui.label(format!("{title}: open in the large canvas."));
+        if ui
+            .button("Back to the panel")
+            .on_hover_text("Close the large canvas and edit here again")
+            .clicked()
+        {
+            open = false;
+        }
+    });
+    if open {
+        // Over the viewport, right of the left panel, as large as fits.
+        let screen = ui.ctx().content_rect();
+        let min = egui::pos2(screen.left() + 290.0, screen.top() + 40.0);
+        let max = egui::pos2(
+            (min.x + 960.0).min(screen.right() - 20.0),
+            (screen.bottom() - 60.0).max(min.y + LARGE_MIN.y),
+        );
+        egui::Window::new(title)
+            .id(egui::Id::unique(("large canvas", title)))
+            .open(&mut open)
+            .default_rect(egui::Rect::from_min_max(min, max.max(min + LARGE_MIN)))
+            .min_size(LARGE_MIN)
+            .collapsible(false)
+            .resizable(true)
+            .show(ui.ctx(), body);
+    }
+    open
+}
+
+/// A button that opens an editor in the large canvas (`large`).
+pub(super) fn large_button(ui: &mut egui::Ui, label: &str, large: &mut bool) {
+    if !*large
+        && ui
+            .button(label)
+            .on_hover_text(
+                "Edit in a large resizable window over the viewport (the same strokes and \
+                 rules; close it to come back here)",
+            )
+            .clicked()
+    {
+        *large = true;
+    }
+}
+
+/// A canvas's height: `small` in the panel; in the large canvas what the
+/// window has left after `below` points of rows under it (at least
+/// `small`).
+pub(super) fn canvas_height(ui: &egui::Ui, small: f32, below: f32, large: bool) -> f32 {
+    if large {
+        (ui.available_height() - below).max(small)
+    } else {
+        small
+    }
+}
+
+/// The smallest large canvas window.
+const LARGE_MIN: egui::Vec2 = egui::vec2(420.0, 480.0);
+
+/// The editor's rows: the tools, the canvas, what the strokes make and
+/// Apply; in the panel or (`state.large`) in the large canvas's window,
+/// by the same code.
+fn editor(
+    ui: &mut egui::Ui,
+    (flower, index): (&Flower, usize),
+    edge: f64,
+    state: &mut SketchState,
+    commands: &mut Vec<Command>,
+    large: bool,
+) {
+    let template = &flower.templates[index];
+    let name = template.name.as_str();
+    let Some(draft) = state.drafts.get(name).cloned() else {
+        return;
     };
-    ui.strong("Sketched petal").on_hover_text(
-        "Draw with the mouse on the canvas: the two margins and the primary vein (any order, any \
-         direction), then cross-sections across the petal. The petal is a B-spline surface \
-         whose control points are spread evenly inside the outline; Apply meshes it at the \
-         remesh edge above.",
-    );
+    ui.horizontal_wrapped(|ui| {
+        ui.strong("Sketched petal").on_hover_text(
+            "Draw with the mouse on the canvas: the two margins and the primary vein (any \
+             order, any direction), then cross-sections across the petal. The petal is a \
+             B-spline surface whose control points are spread evenly inside the outline; Apply \
+             meshes it at the remesh edge above.",
+        );
+        large_button(ui, "Large sketch canvas", &mut state.large);
+    });
     ui.horizontal_wrapped(|ui| {
         ui.label("draw");
         for (tool, label, hover) in TOOLS {
@@ -245,7 +353,17 @@ pub fn sketch_ui(
     let built = sketch.build();
     let before = sketch.clone();
 
-    canvas(ui, template, &mut sketch, built.as_ref().ok(), state);
+    // In the large canvas, the rows under it (messages, side view,
+    // preview, Apply) keep about this much room.
+    let height = canvas_height(ui, CANVAS_HEIGHT, 260.0, large);
+    canvas(
+        ui,
+        template,
+        &mut sketch,
+        built.as_ref().ok(),
+        state,
+        height,
+    );
     let built = if sketch == before {
         built
     } else {
@@ -328,7 +446,7 @@ fn sync_draft(state: &mut SketchState, name: &str, saved: &Option<PetalSketch>) 
 /// `sketch`; whether the last stroke was taken back.
 fn stroke_row(ui: &mut egui::Ui, draft: &Draft, sketch: &mut PetalSketch) -> bool {
     let mut undone = false;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if ui
             .add_enabled(!draft.undo.is_empty(), egui::Button::new("Undo stroke"))
             .on_hover_text("Take back the last stroke (or Clear strokes, or Remove cross-sections)")
@@ -475,8 +593,9 @@ fn canvas(
     sketch: &mut PetalSketch,
     petal: Option<&SketchedPetal>,
     state: &mut SketchState,
+    height: f32,
 ) {
-    let size = egui::vec2(ui.available_width().max(160.0), CANVAS_HEIGHT);
+    let size = egui::vec2(ui.available_width().max(160.0), height);
     let (response, painter) = ui.allocate_painter(size, egui::Sense::drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "sketch canvas"));
     let rect = response.rect;
