@@ -173,6 +173,9 @@ fn the_bud_view_opens_in_the_large_canvas_and_a_stroke_there_makes_the_bud() {
 #[test]
 fn the_pde_editor_opens_in_the_large_canvas_and_its_points_drag_there() {
     let (mut harness, _) = new_shape_template("New PDE petal", "pde petal");
+    // The remesh preview's answer moves the rows below it: wait for it
+    // before clicking there.
+    wait_for_remesh_preview(&mut harness).expect("the petal remeshes");
     let pde = |h: &Harness<'_, AnthesisApp>| {
         *h.state()
             .flower_panel()
