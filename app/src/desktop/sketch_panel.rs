@@ -133,6 +133,9 @@ pub struct SketchState {
     apply_error: Option<String>,
     /// The editor is in the large canvas (a window over the viewport).
     large: bool,
+    /// The canvas zoomed by Ctrl+wheel: times the fitted view, and the
+    /// sketch point at its centre (`None`: fitted).
+    zoom: Option<(f64, DVec2)>,
 }
 
 impl SketchState {
@@ -599,34 +602,33 @@ fn canvas(
     let (response, painter) = ui.allocate_painter(size, egui::Sense::drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "sketch canvas"));
     let rect = response.rect;
-    // The map: kept while drawing, else fitted to what there is to show.
+    // The map: kept while drawing, else fitted to what there is to show
+    // (zoomed by Ctrl+wheel).
     let view = match (state.view, &state.drawing) {
         (Some(view), Some(_)) if view.centre_on_screen == rect.center() => view,
-        _ => {
-            let (mut low, mut high) = (DEFAULT_VIEW[0], DEFAULT_VIEW[1]);
-            let strokes = [&sketch.left, &sketch.right, &sketch.vein]
-                .into_iter()
-                .chain(&sketch.sections);
-            for p in strokes.flatten() {
-                low = low.min(*p);
-                high = high.max(*p);
+        (_, drawing) => {
+            let fitted = fitted_view(rect, template, sketch);
+            if drawing.is_none() {
+                zoom_on_wheel(ui, &response, fitted, state);
             }
-            for p in &template.mesh.positions {
-                low = low.min(p.truncate());
-                high = high.max(p.truncate());
-            }
-            let inner = rect.shrink(12.0);
-            let extent = (high - low).max(DVec2::splat(1e-6));
-            let scale =
-                (f64::from(inner.width()) / extent.x).min(f64::from(inner.height()) / extent.y);
-            View {
-                centre_on_screen: rect.center(),
-                centre: (low + high) * 0.5,
-                scale,
+            match state.zoom {
+                Some((zoom, centre)) => View {
+                    centre,
+                    scale: fitted.scale * zoom,
+                    ..fitted
+                },
+                None => fitted,
             }
         }
     };
     painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
+    painter.text(
+        rect.left_bottom() + egui::vec2(6.0, -4.0),
+        egui::Align2::LEFT_BOTTOM,
+        "Ctrl+wheel zooms (the wheel scrolls the panel)",
+        egui::FontId::proportional(11.0),
+        ui.visuals().weak_text_color(),
+    );
     let faint = Stroke::new(1.0, ui.visuals().weak_text_color().gamma_multiply(0.35));
     // The template's mesh seen from its inner side's back (x, y).
     for t in &template.mesh.triangles {
@@ -697,6 +699,59 @@ fn canvas(
     }
     state.view = Some(view);
 }
+
+/// The map that fits the default view, the strokes and the template's
+/// mesh into `rect` (less 12 points a side).
+fn fitted_view(
+    rect: egui::Rect,
+    template: &anthesis_flower::Template,
+    sketch: &PetalSketch,
+) -> View {
+    let (mut low, mut high) = (DEFAULT_VIEW[0], DEFAULT_VIEW[1]);
+    let strokes = [&sketch.left, &sketch.right, &sketch.vein]
+        .into_iter()
+        .chain(&sketch.sections);
+    for p in strokes.flatten() {
+        low = low.min(*p);
+        high = high.max(*p);
+    }
+    for p in &template.mesh.positions {
+        low = low.min(p.truncate());
+        high = high.max(p.truncate());
+    }
+    let inner = rect.shrink(12.0);
+    let extent = (high - low).max(DVec2::splat(1e-6));
+    let scale = (f64::from(inner.width()) / extent.x).min(f64::from(inner.height()) / extent.y);
+    View {
+        centre_on_screen: rect.center(),
+        centre: (low + high) * 0.5,
+        scale,
+    }
+}
+
+/// Ctrl+wheel over the canvas (egui's zoom modifier; the wheel alone
+/// scrolls the panel): zooms the view about the pointer, from the fitted
+/// view (1) to [`MAX_ZOOM`] times it.
+fn zoom_on_wheel(ui: &egui::Ui, response: &egui::Response, fitted: View, state: &mut SketchState) {
+    let factor = f64::from(ui.input(egui::InputState::zoom_delta));
+    let Some(pointer) = response.hover_pos().filter(|_| factor != 1.0) else {
+        return;
+    };
+    let (zoom, centre) = state.zoom.unwrap_or((1.0, fitted.centre));
+    let now = View {
+        centre,
+        scale: fitted.scale * zoom,
+        ..fitted
+    };
+    let under = now.to_sketch(pointer);
+    let zoom = (zoom * factor).clamp(1.0, MAX_ZOOM);
+    let d = pointer - fitted.centre_on_screen;
+    let offset = DVec2::new(f64::from(d.x), -f64::from(d.y)) / (fitted.scale * zoom);
+    state.zoom = (zoom > 1.0).then_some((zoom, under - offset));
+}
+
+/// How far Ctrl+wheel zooms the sketch canvas in, times the fitted view.
+const MAX_ZOOM: f64 = 20.0;
 
 /// The sketched petal over the canvas: its control net and its outline.
 fn draw_petal(painter: &egui::Painter, view: View, petal: &SketchedPetal) {

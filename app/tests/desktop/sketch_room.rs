@@ -211,7 +211,7 @@ fn the_pde_editor_opens_in_the_large_canvas_and_its_points_drag_there() {
 }
 
 #[test]
-fn the_wheel_over_the_sketch_canvas_scrolls_the_panel_and_does_not_zoom() {
+fn the_wheel_over_the_sketch_canvas_scrolls_the_panel_and_ctrl_wheel_zooms_it() {
     let mut harness = opened_small_flower();
     harness.get_by_label("Flower").click();
     settle(&mut harness);
@@ -249,6 +249,37 @@ fn the_wheel_over_the_sketch_canvas_scrolls_the_panel_and_does_not_zoom() {
         d - c,
         b - a
     );
+
+    // Ctrl+wheel zooms the canvas about the pointer, and zooms back out
+    // to the fitted view.
+    harness.get_by_label("sketch canvas").scroll_to_me();
+    settle(&mut harness);
+    let (a, b) = (
+        sketch(&harness, DVec2::ZERO),
+        sketch(&harness, DVec2::Y * 10.0),
+    );
+    let at = a + egui::vec2(0.0, -30.0);
+    wheel_at(&mut harness, at, wheel(120.0, egui::Modifiers::COMMAND));
+    let (c, d) = (
+        sketch(&harness, DVec2::ZERO),
+        sketch(&harness, DVec2::Y * 10.0),
+    );
+    let zoom = (d - c).length() / (b - a).length();
+    assert!(zoom > 1.3, "zoomed in: {zoom}");
+    // The sketch point under the pointer stays there.
+    let under = at.y + (a.y - at.y) * zoom;
+    assert!((c.y - under).abs() < 1.0, "{} vs {under}", c.y);
+    assert!((c.x - a.x).abs() < 1.0);
+    wheel_at(&mut harness, at, wheel(-2000.0, egui::Modifiers::COMMAND));
+    let (e, f) = (
+        sketch(&harness, DVec2::ZERO),
+        sketch(&harness, DVec2::Y * 10.0),
+    );
+    assert!(
+        ((f - e) - (b - a)).length() < 1e-3,
+        "back to the fitted view"
+    );
+    assert!((e - a).length() < 1e-3);
 }
 
 #[test]
