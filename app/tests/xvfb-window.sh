@@ -119,11 +119,13 @@ BESIDE_PROMPT=50x50+1000+200
 # The left edge of the recovery prompt's box in picture $1, on the row of
 # its buttons (y $2, default 529): where the first 5 pixels in a row as
 # dark as its box (not its buttons) start, from x 300 on. Its width
-# follows its text, so its buttons move.
+# follows its text, so its buttons move. (awk reads to the end: a reader
+# that stops early would make convert fail on a closed pipe.)
 prompt_left() {
   "$convert" "$1" -crop 1000x1+300+"${2:-529}" +repage -colorspace Gray -depth 8 txt:- |
-    awk -F'[,:() ]+' 'NR > 1 {
+    awk -F'[,:() ]+' 'NR > 1 && left == "" {
       x = $1; v = $(NF - 1) + 0
-      if (v < 35) { run++; if (run == 5) { print 300 + x - 5; exit } } else run = 0
-    }'
+      if (v < 35) { run++; if (run == 5) left = 300 + x - 4 } else run = 0
+    }
+    END { print left }'
 }
