@@ -9,7 +9,7 @@
 # screenshots to OUT_DIR: before.png (the five petals as shipped),
 # sketch-canvas.png (the empty large canvas), sketch-drawn.png (the
 # strokes), sketch-applied.png and sketched.png (the flower with the
-# sketched petals, the large canvas closed).
+# sketched petals, the large canvas closed) and bud.png (keyframe 0).
 # Fails when the large canvas is not found or the viewport did not change
 # (fewer than 20000 pixels).
 #
@@ -109,6 +109,10 @@ if [ "${1:-}" = "--in-xvfb" ]; then
   xdotool mousemove 83 583; sleep 0.5; xdotool click 1; sleep 2
   xdotool mousemove 800 10; sleep 1
   "$import" -window root "$out/sketched.png"
+  # Keyframe 0 (Start): the bud of the sketched petals.
+  xdotool mousemove 30 903; sleep 0.5; xdotool click 1; sleep 3
+  xdotool mousemove 800 10; sleep 1
+  "$import" -window root "$out/bud.png"
   exit 0
 fi
 
