@@ -540,10 +540,10 @@ pub const GETTING_STARTED: &[(&str, &[&str])] = &[
     (
         "Export",
         &[
-            "File → Export animation… (Ctrl+E) writes .glb (glTF), .usda/.usdc (USD) or a .gif.",
+            "File > Export animation… (Ctrl+E) writes .glb (glTF), .usda/.usdc (USD) or a .gif.",
             "The file is named after the project and goes beside it unless you choose \
              another place.",
-            "File → Save keeps the project (a .anthesis.toml with its maps) to open again.",
+            "File > Save keeps the project (a .anthesis.toml with its maps) to open again.",
         ],
     ),
 ];

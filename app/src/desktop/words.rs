@@ -29,7 +29,7 @@ pub const WORDS: &[Word] = &[
     },
     Word {
         symbol: "thickness",
-        plain: "Petal thickness",
+        plain: "Thickness",
         does: "Distance to the imaginary inner surface. Inner growth larger than base growth \
                bends the petal outwards; a thinner petal bends more for the same difference. \
                Paper: lily 0.2, Eustoma 0.1.",
@@ -51,7 +51,7 @@ pub const WORDS: &[Word] = &[
     },
     Word {
         symbol: "keyframes",
-        plain: "Steps (keyframes)",
+        plain: "Steps",
         does: "How many simulation steps follow the bud, one keyframe each, for the whole \
                project. More steps: a longer, finer opening. Paper: 100.",
         unit: "keyframes",

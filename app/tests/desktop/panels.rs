@@ -14,7 +14,7 @@ use anthesis_app::desktop::AnthesisApp;
 /// scrolling down) with the pointer at `at`, over a few frames.
 fn wheel_at(harness: &mut Harness<'_, AnthesisApp>, at: egui::Pos2, dy: f32) {
     harness.hover_at(at);
-    harness.run();
+    harness.run_steps(2);
     for _ in 0..6 {
         harness.event(egui::Event::MouseWheel {
             unit: egui::MouseWheelUnit::Point,
@@ -25,7 +25,8 @@ fn wheel_at(harness: &mut Harness<'_, AnthesisApp>, at: egui::Pos2, dy: f32) {
         });
         harness.step();
     }
-    harness.run();
+    // (Tooltips may still fade: steps, not run-until-settled.)
+    harness.run_steps(8);
 }
 
 /// The top of the bottom panels (the timeline's buttons): what the side
@@ -60,13 +61,17 @@ fn the_wheel_scrolls_each_side_panel_to_its_last_control_at_1280_by_800() {
     // The left panel: its last control is the second colour.
     let last_left = "second colour";
     assert!(harness.get_by_label(last_left).rect().bottom() > bottom);
-    let organs = harness.get_by_label("Organs").rect().center();
-    wheel_at(&mut harness, organs, -3000.0);
+    // (Over the parameters, not the organ list, which scrolls itself.)
+    let parameters = harness.get_by_label("Base region").rect().center();
+    wheel_at(&mut harness, parameters, -3000.0);
     let shown = harness.get_by_label(last_left).rect();
     assert!(
         shown.bottom() <= bottom && shown.top() > 0.0,
         "{last_left} at {shown:?}, the panels end at {bottom}"
     );
+    // The pointer off the panels, so no tooltip covers them.
+    harness.hover_at(egui::pos2(640.0, 300.0));
+    harness.run_steps(8);
     harness.snapshot("panels_scrolled_to_the_end_1280x800");
 }
 
@@ -77,7 +82,11 @@ fn sections_fold_and_parameters_say_what_they_are() {
     // words.
     harness.get_by_label("Growth per step (dg)");
     harness.get_by_label("Stretch stiffness (Ks)");
-    harness.get_by_label("Growth along, inner side (e-growth-in)");
+    let map = "Growth along, inner side (e-growth-in)";
+    assert!(
+        harness.query_by_label(map).is_some() || harness.query_by_value(map).is_some(),
+        "the map chosen is named in plain words"
+    );
     // A folded section hides its controls; unfolded, they are back.
     assert!(harness.query_by_label("Eyedropper").is_some());
     harness.get_by_label("Brush").click();
@@ -105,7 +114,7 @@ fn help_has_a_getting_started_page_and_an_about_box_with_the_version() {
             "{section} is explained"
         );
     }
-    harness.get_by_label_contains("File → Export animation…");
+    harness.get_by_label_contains("File > Export animation…");
     harness.get_by_label("Help").click();
     harness.run();
     harness.get_by_label("About Anthesis").click();
