@@ -137,18 +137,21 @@ pub enum Polled {
     InAppInstead(String),
 }
 
+/// A native dialog open: what for, where, the file name it offers, and
+/// where its answer comes.
+type Pending = (
+    DialogPurpose,
+    Option<PathBuf>,
+    Option<String>,
+    Receiver<Answer>,
+);
+
 /// At most one file dialog at a time: native ones answered on a thread
 /// named `anthesis-dialog`, or the in-app browser.
 #[derive(Default)]
 pub struct Dialogs {
-    /// The native dialog open: what for, where, the name it offers, and
-    /// where its answer comes.
-    pending: Option<(
-        DialogPurpose,
-        Option<PathBuf>,
-        Option<String>,
-        Receiver<Answer>,
-    )>,
+    /// The native dialog open, if any.
+    pending: Option<Pending>,
     browser: Option<(DialogPurpose, egui_file::FileDialog)>,
     /// No native dialog can be shown: use the in-app browser.
     in_app: bool,
