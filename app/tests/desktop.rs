@@ -20,6 +20,8 @@ use egui_kittest::kittest::Queryable;
 mod common;
 #[path = "desktop/sketch_room.rs"]
 mod sketch_room;
+#[path = "desktop/panels.rs"]
+mod panels;
 
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {
@@ -393,7 +395,9 @@ fn view_menu_turns_on_the_wireframe_and_a_map_overlay() {
     harness.run();
     harness.get_by_label("Map overlay").hover();
     harness.run();
-    harness.get_by_label("e-growth-in").click();
+    harness
+        .get_by_label("Growth along, inner side (e-growth-in)")
+        .click();
     harness.run();
     harness.key_press(egui::Key::Escape);
     harness.run();
@@ -1671,7 +1675,7 @@ fn the_parameters_panel_with_a_resolution() {
     assert_eq!(particles, 2, "one row per template");
     harness.snapshot("parameters_resolution");
     // Unticking goes back to the meshes as built, as an undoable edit.
-    harness.get_by_label("mean edge").click();
+    harness.get_by_label("Mesh detail (mean edge)").click();
     harness.run();
     let edits: Vec<String> = chosen.borrow().iter().map(|c| format!("{c:?}")).collect();
     assert!(
@@ -1692,7 +1696,11 @@ fn a_typed_resolution_is_one_edit_when_entered_not_one_per_key() {
     let resolved = anthesis_flower::resolution::resolve(&project).expect("remeshes");
     let (mut harness, chosen) = parameters_panel(project, resolved, 560.0);
     harness.run();
-    let row = harness.get_by_label("mean edge").rect().center().y;
+    let row = harness
+        .get_by_label("Mesh detail (mean edge)")
+        .rect()
+        .center()
+        .y;
     fn field<'h>(harness: &'h Harness<'static>, row: f32) -> egui_kittest::Node<'h> {
         harness
             .get_all_by_role(egui::accesskit::Role::SpinButton)
@@ -2182,9 +2190,11 @@ fn the_in_app_file_browser_navigates_filters_and_opens_saves_and_exports() {
     harness.run();
     harness.get_by_label("Save").click();
     harness.run();
+    // The name the export dialog's field proposed, from the project's name.
+    let named = anthesis_app::desktop::export::default_file_name(&harness.state().project().name);
     assert_eq!(
         harness.state().export_dialog().path,
-        sub.join("flower.glb").display().to_string()
+        sub.join(&named).display().to_string()
     );
     harness.get_by_label("Browse…").click();
     harness.run();
@@ -2192,7 +2202,7 @@ fn the_in_app_file_browser_navigates_filters_and_opens_saves_and_exports() {
     harness.run();
     assert_eq!(
         harness.state().export_dialog().path,
-        sub.join("flower.glb").display().to_string()
+        sub.join(&named).display().to_string()
     );
     let _ = std::fs::remove_dir_all(root);
 }

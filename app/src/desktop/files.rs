@@ -48,15 +48,17 @@ impl DialogPurpose {
         }
     }
 
-    /// The file name offered when saving.
-    fn suggested_name(self) -> Option<&'static str> {
+    /// The file name offered when saving, for a project named
+    /// `project_name`: an export is named as the export dialog names it
+    /// ([`super::export::default_file_name`]).
+    pub fn suggested_name(self, project_name: &str) -> Option<String> {
         match self {
             DialogPurpose::OpenProject
             | DialogPurpose::ImportTemplateObj
             | DialogPurpose::ImportScan
             | DialogPurpose::OpenShape(_) => None,
-            DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml"),
-            DialogPurpose::ExportGlb => Some("flower.glb"),
+            DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml".to_owned()),
+            DialogPurpose::ExportGlb => Some(super::export::default_file_name(project_name)),
         }
     }
 
@@ -135,11 +137,21 @@ pub enum Polled {
     InAppInstead(String),
 }
 
+/// A native dialog open: what for, where, the file name it offers, and
+/// where its answer comes.
+type Pending = (
+    DialogPurpose,
+    Option<PathBuf>,
+    Option<String>,
+    Receiver<Answer>,
+);
+
 /// At most one file dialog at a time: native ones answered on a thread
 /// named `anthesis-dialog`, or the in-app browser.
 #[derive(Default)]
 pub struct Dialogs {
-    pending: Option<(DialogPurpose, Option<PathBuf>, Receiver<Answer>)>,
+    /// The native dialog open, if any.
+    pending: Option<Pending>,
     browser: Option<(DialogPurpose, egui_file::FileDialog)>,
     /// No native dialog can be shown: use the in-app browser.
     in_app: bool,
@@ -159,41 +171,49 @@ impl Dialogs {
         self.pending.is_some() || self.browser.is_some()
     }
 
-    /// Opens a dialog for `purpose` in `folder`; `wake` is called when a
-    /// native one is answered. Does nothing while another dialog is open.
+    /// Opens a dialog for `purpose` in `folder`, offering the file name
+    /// `name` when saving; `wake` is called when a native one is answered.
+    /// Does nothing while another dialog is open.
     pub fn open(
         &mut self,
         purpose: DialogPurpose,
         folder: Option<&Path>,
+        name: Option<String>,
         wake: impl Fn() + Send + 'static,
     ) {
         if self.is_open() {
             return;
         }
         if self.in_app {
-            self.open_browser(purpose, folder);
+            self.open_browser(purpose, folder, name);
             return;
         }
         // One answer per dialog.
         let (send, receive) = sync_channel(1);
         let folder = folder.map(Path::to_path_buf);
         let thread_folder = folder.clone();
+        let thread_name = name.clone();
         let spawned = std::thread::Builder::new()
             .name("anthesis-dialog".into())
             .spawn(move || {
                 let answer = match native_dialog_missing() {
                     Some(why) => Answer::NoNativeDialog(why),
-                    None => Answer::Chosen(native_dialog(purpose, thread_folder)),
+                    None => Answer::Chosen(native_dialog(purpose, thread_folder, thread_name)),
                 };
                 let _ = send.send(answer);
                 wake();
             });
         if spawned.is_ok() {
-            self.pending = Some((purpose, folder, receive));
+            self.pending = Some((purpose, folder, name, receive));
         }
     }
 
-    fn open_browser(&mut self, purpose: DialogPurpose, folder: Option<&Path>) {
+    fn open_browser(
+        &mut self,
+        purpose: DialogPurpose,
+        folder: Option<&Path>,
+        name: Option<String>,
+    ) {
         let start = folder
             .map(Path::to_path_buf)
             .or_else(|| std::env::current_dir().ok())
@@ -218,7 +238,7 @@ impl Dialogs {
         .show_files_filter(listed)
         .show_rename(false)
         .default_size(egui::vec2(560.0, 420.0));
-        if let Some(name) = purpose.suggested_name() {
+        if let Some(name) = name {
             browser = browser.default_filename(name);
         }
         browser.open();
@@ -241,7 +261,7 @@ impl Dialogs {
     /// The answer of the open native dialog, once there is one; when no
     /// native dialog could be shown, the in-app browser is opened instead.
     pub fn poll(&mut self) -> Option<Polled> {
-        let (purpose, folder, receive) = self.pending.as_ref()?;
+        let (purpose, folder, name, receive) = self.pending.as_ref()?;
         let purpose = *purpose;
         match receive.try_recv() {
             Ok(Answer::Chosen(answer)) => {
@@ -249,10 +269,10 @@ impl Dialogs {
                 Some(Polled::Chosen(purpose, answer))
             }
             Ok(Answer::NoNativeDialog(why)) => {
-                let folder = folder.clone();
+                let (folder, name) = (folder.clone(), name.clone());
                 self.pending = None;
                 self.in_app = true;
-                self.open_browser(purpose, folder.as_deref());
+                self.open_browser(purpose, folder.as_deref(), name);
                 Some(Polled::InAppInstead(why))
             }
             Err(TryRecvError::Empty) => None,
@@ -265,7 +285,12 @@ impl Dialogs {
 }
 
 /// Shows the native dialog for `purpose` (blocks until answered).
-fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<PathBuf> {
+fn native_dialog(
+    purpose: DialogPurpose,
+    folder: Option<PathBuf>,
+    name: Option<String>,
+) -> Option<PathBuf> {
+    let name = name.unwrap_or_default();
     let mut dialog = rfd::FileDialog::new().set_title(purpose.title());
     if let Some(folder) = folder {
         dialog = dialog.set_directory(folder);
@@ -279,7 +304,7 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
             .pick_file(),
         DialogPurpose::SaveProjectAs => dialog
             .add_filter("Anthesis project", &purpose.extensions())
-            .set_file_name(purpose.suggested_name().unwrap_or_default())
+            .set_file_name(&name)
             .save_file(),
         DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => dialog
             .add_filter("OBJ mesh", &purpose.extensions())
@@ -289,7 +314,7 @@ fn native_dialog(purpose: DialogPurpose, folder: Option<PathBuf>) -> Option<Path
             .fold(dialog, |dialog, format| {
                 dialog.add_filter(format.name(), format.extensions())
             })
-            .set_file_name(purpose.suggested_name().unwrap_or_default())
+            .set_file_name(&name)
             .save_file(),
     }
 }

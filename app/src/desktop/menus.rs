@@ -298,6 +298,31 @@ impl AnthesisApp {
         }
     }
 
+    /// Help → Getting started and Help → About, when open.
+    pub(super) fn help_windows(&mut self, ctx: &egui::Context) {
+        egui::Window::new("Getting started")
+            .open(&mut self.help.getting_started)
+            .default_width(420.0)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                for (title, lines) in GETTING_STARTED {
+                    ui.strong(*title);
+                    for line in *lines {
+                        ui.label(format!("•  {line}"));
+                    }
+                    ui.add_space(6.0);
+                }
+            });
+        egui::Window::new("About Anthesis")
+            .open(&mut self.help.about)
+            .resizable(false)
+            .collapsible(false)
+            .show(ctx, |ui| {
+                ui.heading(format!("Anthesis {}", env!("CARGO_PKG_VERSION")));
+                ui.label(ABOUT);
+            });
+    }
+
     /// The undo history: every step by its label, the applied ones first;
     /// a click undoes or redoes up to that step.
     pub(super) fn history_window(&mut self, ctx: &egui::Context) {
@@ -395,7 +420,12 @@ impl AnthesisApp {
                 ui.menu_button("Map overlay", |ui| {
                     ui.radio_value(&mut view.overlay, None, "none");
                     for kind in anthesis_maps::MapKind::ALL {
-                        ui.radio_value(&mut view.overlay, Some(kind), kind.label());
+                        ui.radio_value(
+                            &mut view.overlay,
+                            Some(kind),
+                            super::words::label(kind.label()),
+                        )
+                        .on_hover_text(super::words::tooltip(kind.label()));
                     }
                 });
                 if view != self.view {
@@ -423,8 +453,14 @@ impl AnthesisApp {
                 }
             });
             ui.menu_button("Help", |ui| {
+                if ui.button("Getting started").clicked() {
+                    self.help.getting_started = true;
+                }
                 if ui.button("Shortcuts").clicked() {
                     chosen.push(Command::ShowShortcuts(true));
+                }
+                if ui.button("About Anthesis").clicked() {
+                    self.help.about = true;
                 }
             });
         });
@@ -472,6 +508,51 @@ impl AnthesisApp {
         }
     }
 }
+
+/// Which Help windows are open.
+#[derive(Debug, Default)]
+pub struct HelpWindows {
+    pub getting_started: bool,
+    pub about: bool,
+}
+
+/// Help → Getting started: the three jobs, a few lines each.
+pub const GETTING_STARTED: &[(&str, &[&str])] = &[
+    (
+        "Paint",
+        &[
+            "Pick an organ on the left (or click it in the viewport); the paint panel on the \
+             right shows its template's maps.",
+            "Choose a map (Growth along, inner side bends petals outwards) and drag on the UV \
+             canvas; tick “Paint on the 3D organ” to paint on the flower itself.",
+            "[ and ] change the brush size, X swaps add and subtract, Ctrl+Z undoes a stroke.",
+            "Every stroke restarts the simulation: a coarse preview first, then the full run.",
+        ],
+    ),
+    (
+        "Scrub",
+        &[
+            "Drag on the timeline at the bottom to see any keyframe; Left and Right step one.",
+            "Space plays the opening; the bar turns green as keyframes are computed.",
+            "P simulates the selected organ alone, much faster while painting.",
+        ],
+    ),
+    (
+        "Export",
+        &[
+            "File > Export animation… (Ctrl+E) writes .glb (glTF), .usda/.usdc (USD) or a .gif.",
+            "The file is named after the project and goes beside it unless you choose \
+             another place.",
+            "File > Save keeps the project (a .anthesis.toml with its maps) to open again.",
+        ],
+    ),
+];
+
+/// Help → About: what the program is (no links: the window opens none).
+pub const ABOUT: &str = "Authoring flower-opening animations by painted growth, after \
+    Ijiri, Yokoo, Kawabata and Igarashi, “Surface-based Growth Simulation for Opening \
+    Flowers” (2008). Paint where a petal grows; the simulation opens the bud; export the \
+    animation.";
 
 /// A menu entry's text with its shortcut (from [`SHORTCUTS`]), if any.
 fn with_keys(text: &str, does: &str) -> String {

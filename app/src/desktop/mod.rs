@@ -42,6 +42,7 @@ pub mod timeline;
 pub mod two_state;
 pub mod viewport;
 pub mod widgets;
+pub mod words;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -101,10 +102,15 @@ const SETTINGS_KEY: &str = "anthesis-settings";
 /// read past, in the log; returns when it is closed.
 pub fn run(project: Option<(Project, Option<PathBuf>)>, warnings: Vec<String>) -> Result<()> {
     let options = eframe::NativeOptions {
+        // eframe makes the window no larger than the largest monitor (and
+        // a size restored from the last launch too); the first frame
+        // maximises it where even that leaves no room for the window's
+        // frame ([`too_large_for`]).
         viewport: egui::ViewportBuilder::default()
             .with_title("Anthesis")
-            .with_inner_size([1400.0, 900.0])
-            .with_min_inner_size([800.0, 500.0]),
+            .with_inner_size(DEFAULT_WINDOW_SIZE)
+            .with_min_inner_size([800.0, 500.0])
+            .with_clamp_size_to_monitor_size(true),
         renderer: eframe::Renderer::Wgpu,
         ..Default::default()
     };
@@ -131,6 +137,20 @@ pub fn run(project: Option<(Project, Option<PathBuf>)>, warnings: Vec<String>) -
         }),
     )
     .map_err(|e| anyhow!("cannot open the window: {e}"))
+}
+
+/// The window's size at the first launch, in points.
+pub const DEFAULT_WINDOW_SIZE: [f32; 2] = [1400.0, 900.0];
+
+/// Room a window's frame and the desktop's panels take, at most, in
+/// points.
+const WINDOW_FRAME_ROOM: f32 = 60.0;
+
+/// Whether a window of `inner` size (points) leaves no room for its frame
+/// and the desktop's panels on a monitor of `monitor` size: then it is
+/// maximised, which fits it to the monitor's work area.
+pub fn too_large_for(inner: egui::Vec2, monitor: egui::Vec2) -> bool {
+    inner.x + WINDOW_FRAME_ROOM > monitor.x || inner.y + WINDOW_FRAME_ROOM > monitor.y
 }
 
 /// How the app starts.
@@ -215,6 +235,10 @@ pub struct AnthesisApp {
     queued: Vec<Command>,
     /// The Help → Shortcuts window is open.
     show_shortcuts: bool,
+    /// Help → Getting started and About.
+    help: menus::HelpWindows,
+    /// The window has been checked against the monitor's size once.
+    fitted_to_monitor: bool,
     /// What the left panel shows: the selected organ's parameters or the
     /// whole flower.
     left_tab: LeftTab,
@@ -318,6 +342,8 @@ impl AnthesisApp {
             resolved: resolution::Resolved::default(),
             queued: Vec::new(),
             show_shortcuts: false,
+            help: menus::HelpWindows::default(),
+            fitted_to_monitor: false,
             left_tab: LeftTab::Organ,
             flower_panel: flower_panel::FlowerPanelState::default(),
             gallery: gallery::Gallery::default(),
@@ -534,6 +560,25 @@ impl AnthesisApp {
         }
     }
 
+    /// Once the monitor's size is known: a window too large for it is
+    /// maximised (see [`too_large_for`]).
+    fn fit_to_monitor(&mut self, ctx: &egui::Context) {
+        if self.fitted_to_monitor {
+            return;
+        }
+        let (monitor, inner) = ctx.input(|i| {
+            let viewport = i.viewport();
+            (viewport.monitor_size, viewport.inner_rect.map(|r| r.size()))
+        });
+        let (Some(monitor), Some(inner)) = (monitor, inner) else {
+            return;
+        };
+        self.fitted_to_monitor = true;
+        if too_large_for(inner, monitor) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Maximized(true));
+        }
+    }
+
     fn update_title(&mut self, ctx: &egui::Context) {
         let title = format!("{} — Anthesis", self.doc.title());
         if title != self.title {
@@ -608,6 +653,7 @@ impl eframe::App for AnthesisApp {
         self.fit_window(&ctx);
         self.history_window(&ctx);
         self.shortcuts_window(&ctx);
+        self.help_windows(&ctx);
         self.gallery_window(&ctx);
         self.file_browser(&ctx);
         self.apply_queued();
@@ -618,6 +664,7 @@ impl eframe::App for AnthesisApp {
 
         self.run_if_needed(&ctx);
         self.update_title(&ctx);
+        self.fit_to_monitor(&ctx);
         if self.playback.playing {
             ctx.request_repaint();
         } else if self.session.is_running() || self.export.is_running() {
@@ -648,5 +695,26 @@ impl eframe::App for AnthesisApp {
         if let Some(autosave) = self.autosave.as_mut() {
             autosave.finish();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_window_is_maximised_only_where_its_frame_has_no_room() {
+        let default = egui::Vec2::from(DEFAULT_WINDOW_SIZE);
+        assert!(!too_large_for(default, egui::vec2(1920.0, 1080.0)));
+        // eframe clamps 1400×900 to a 1280×800 monitor: no room left.
+        assert!(too_large_for(
+            egui::vec2(1280.0, 800.0),
+            egui::vec2(1280.0, 800.0)
+        ));
+        assert!(too_large_for(default, egui::vec2(1440.0, 900.0)));
+        assert!(!too_large_for(
+            egui::vec2(1200.0, 700.0),
+            egui::vec2(1280.0, 800.0)
+        ));
     }
 }

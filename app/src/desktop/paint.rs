@@ -10,6 +10,8 @@ use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use glam::DVec2;
 
 use super::command::{Command, ProjectEdit};
+use super::panels::section;
+use super::words;
 use anthesis_maps::brush::{Brush, BrushMode, PaintTarget, StrokeDab, StrokeSpacing};
 
 mod canvas;
@@ -255,9 +257,16 @@ impl PaintState {
         self.stroke.end();
     }
 
-    /// The paint panel for template `template` of `project`; returns the
-    /// edits the user made.
-    pub fn ui(&mut self, ui: &mut egui::Ui, project: &Project, template: usize) -> Vec<Command> {
+    /// The paint panel for template `template` of `project`, in a panel
+    /// `shown_height` points tall (the canvas takes at most 60 % of it);
+    /// returns the edits the user made.
+    pub fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        project: &Project,
+        template: usize,
+        shown_height: f32,
+    ) -> Vec<Command> {
         let Some(current) = project.flower.templates.get(template) else {
             ui.label("No template.");
             return Vec::new();
@@ -266,33 +275,65 @@ impl PaintState {
         ui.heading(format!("Paint “{}”", current.name));
         self.key = current.maps.clamped_index(self.key);
 
+        egui::Grid::new("paint map").num_columns(2).show(ui, |ui| {
+            let label = ui.label("Map").id;
+            egui::ComboBox::from_id_salt("paint map")
+                .selected_text(words::label(self.target.label()))
+                .show_ui(ui, |ui| {
+                    let targets = MapKind::ALL
+                        .into_iter()
+                        .map(PaintTarget::Scalar)
+                        .chain([PaintTarget::Direction, PaintTarget::Colour]);
+                    for target in targets {
+                        ui.selectable_value(&mut self.target, target, words::label(target.label()))
+                            .on_hover_text(words::tooltip(target.label()));
+                    }
+                })
+                .response
+                .labelled_by(label)
+                .on_hover_text(words::tooltip(self.target.label()));
+            ui.end_row();
+        });
+        let top = ui.cursor().top();
+        section(
+            ui,
+            "Time keys",
+            "The maps hold at time keys (steps) and blend between them: which key is \
+             painted, its own growth per step, keys added or removed, the blend.",
+            |ui| self.keys_grid(ui, project, template, current, &mut chosen),
+        );
+        // The canvas takes at most 60 % of what the panel shows below the
+        // map and keys, as it did before the panel scrolled.
+        let room = (shown_height - (ui.cursor().top() - top) - 40.0).max(200.0);
+        ui.allocate_ui(egui::vec2(ui.available_width(), room), |ui| {
+            chosen.extend(self.canvas(ui, project, template, current));
+        });
+        self.legend_ui(ui, current);
+        if let Some(Some(brush)) = section(
+            ui,
+            "Brush",
+            "How a stroke paints: mode, size, strength, hardness, value; the eyedropper, the \
+             mirror and painting on the 3D organ.",
+            |ui| self.brush_ui(ui),
+        ) {
+            chosen.push(brush);
+        }
+        chosen
+    }
+
+    /// The time keys' grid: which key is painted, its own dg, a new key,
+    /// the blend.
+    fn keys_grid(
+        &mut self,
+        ui: &mut egui::Ui,
+        project: &Project,
+        template: usize,
+        current: &Template,
+        chosen: &mut Vec<Command>,
+    ) {
         egui::Grid::new("paint target")
             .num_columns(2)
             .show(ui, |ui| {
-                let label = ui.label("Map").id;
-                egui::ComboBox::from_id_salt("paint map")
-                    .selected_text(self.target.label())
-                    .show_ui(ui, |ui| {
-                        for kind in MapKind::ALL {
-                            ui.selectable_value(
-                                &mut self.target,
-                                PaintTarget::Scalar(kind),
-                                kind.label(),
-                            );
-                        }
-                        ui.selectable_value(&mut self.target, PaintTarget::Direction, "direction");
-                        ui.selectable_value(&mut self.target, PaintTarget::Colour, "colour");
-                    })
-                    .response
-                    .labelled_by(label)
-                    .on_hover_text(
-                        "e/w-growth: growth along/across the growth direction of the base layer; \
-                     -in: of the inner layer (inner > base bends the petal outwards); stretch, \
-                     bend: stiffness multipliers; direction: drag to paint the growth direction; \
-                     colour: where the second colour shows over the base colour (not simulated).",
-                    );
-                ui.end_row();
-
                 let label = ui.label("Time key").id;
                 ui.horizontal(|ui| {
                     for (i, key) in current.maps.keys().iter().enumerate() {
@@ -304,9 +345,9 @@ impl PaintState {
                 .labelled_by(label);
                 ui.end_row();
 
-                self.key_dg_row(ui, (project, template, current), &mut chosen);
+                self.key_dg_row(ui, (project, template, current), chosen);
 
-                self.new_key_row(ui, (template, current), &mut chosen);
+                self.new_key_row(ui, (template, current), chosen);
 
                 let label = ui.label("Blend").id;
                 let mut blend = current.maps.blend;
@@ -333,16 +374,6 @@ impl PaintState {
                 }
                 ui.end_row();
             });
-
-        chosen.extend(self.canvas(ui, project, template, current));
-        self.legend_ui(ui, current);
-        ui.separator();
-        let brush = egui::ScrollArea::vertical()
-            .id_salt("brush settings")
-            .show(ui, |ui| self.brush_ui(ui))
-            .inner;
-        chosen.extend(brush);
-        chosen
     }
 
     /// The "Key dg" row of the paint grid: the chosen time key's own growth
@@ -471,39 +502,29 @@ impl PaintState {
             }
         });
         egui::Grid::new("brush").num_columns(2).show(ui, |ui| {
-            let slider = |ui: &mut egui::Ui, name: &str, value: &mut f32, tip: &str| {
-                let label = ui.label(name).id;
+            let name = |ui: &mut egui::Ui, symbol: &str| {
+                ui.label(words::label(symbol))
+                    .on_hover_text(words::tooltip(symbol))
+                    .id
+            };
+            let slider = |ui: &mut egui::Ui, symbol: &str, value: &mut f32| {
+                let label = name(ui, symbol);
                 ui.add(egui::Slider::new(value, 0.0..=1.0))
                     .labelled_by(label)
-                    .on_hover_text(tip);
+                    .on_hover_text(words::tooltip(symbol));
                 ui.end_row();
             };
-            let label = ui.label("radius").id;
+            let label = name(ui, "radius");
             ui.add(
                 egui::Slider::new(&mut brush.radius_in_uv, MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV)
                     .logarithmic(true),
             )
             .labelled_by(label)
-            .on_hover_text("Brush radius in UV units (the layout is 1 wide)");
+            .on_hover_text(words::tooltip("radius"));
             ui.end_row();
-            slider(
-                ui,
-                "strength",
-                &mut brush.strength,
-                "How much one dab changes a value",
-            );
-            slider(
-                ui,
-                "hardness",
-                &mut brush.hardness,
-                "Fraction of the radius at full strength",
-            );
-            slider(
-                ui,
-                "value",
-                &mut brush.value,
-                "What set moves towards, and what add and subtract add or take away",
-            );
+            slider(ui, "strength", &mut brush.strength);
+            slider(ui, "hardness", &mut brush.hardness);
+            slider(ui, "value", &mut brush.value);
         });
         ui.toggle_value(&mut self.eyedropper, "Eyedropper")
             .on_hover_text(

@@ -10,10 +10,43 @@ use super::timeline;
 use super::viewport;
 use super::{AnthesisApp, LeftTab, flower_panel};
 
+/// A section of a side panel that the user can fold away: its title with
+/// `tooltip`, open at first; egui remembers (and eframe saves between
+/// launches) whether it is open. Returns what `add_contents` returned
+/// when the section is open.
+pub(super) fn section<R>(
+    ui: &mut egui::Ui,
+    title: &str,
+    tooltip: &str,
+    add_contents: impl FnOnce(&mut egui::Ui) -> R,
+) -> Option<R> {
+    let shown = egui::CollapsingHeader::new(egui::RichText::new(title).strong())
+        .id_salt(("section", title))
+        .default_open(true)
+        .show(ui, add_contents);
+    shown.header_response.on_hover_text(tooltip);
+    shown.body_returned
+}
+
+/// The scroll area a whole side panel scrolls in (the wheel over the
+/// panel scrolls it; widgets that take the wheel themselves say so).
+pub(super) fn panel_scroll(id: &str) -> egui::ScrollArea {
+    egui::ScrollArea::vertical()
+        .id_salt(id)
+        .auto_shrink([false, false])
+}
+
 impl AnthesisApp {
     /// The left panel: organs, preview switch, and the selected organ's
     /// parameters or the Flower panel.
     pub(super) fn organs_panel(&mut self, ui: &mut egui::Ui) {
+        // The whole panel scrolls as one, organ list and all, so every
+        // control can be reached in a short window.
+        panel_scroll("organs panel").show(ui, |ui| self.organs_panel_contents(ui));
+    }
+
+    /// What [`AnthesisApp::organs_panel`] scrolls.
+    fn organs_panel_contents(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             ui.heading("Organs");
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
@@ -54,33 +87,25 @@ impl AnthesisApp {
         ui.separator();
         if self.left_tab == LeftTab::Flower {
             let now = ui.input(|i| i.time);
-            egui::ScrollArea::vertical()
-                .id_salt("flower panel")
-                .show(ui, |ui| {
-                    chosen.extend(flower_panel::flower_ui(
-                        ui,
-                        self.doc.project(),
-                        &mut self.flower_panel,
-                        now,
-                    ));
-                });
+            chosen.extend(flower_panel::flower_ui(
+                ui,
+                self.doc.project(),
+                &mut self.flower_panel,
+                now,
+            ));
             self.queued.extend(chosen);
             return;
         }
         let template = self.selected_template();
         let resolved = self.resolved_project();
         let viewed = self.viewed_organ();
-        egui::ScrollArea::vertical()
-            .id_salt("parameters")
-            .show(ui, |ui| {
-                chosen.extend(params::parameters_ui_viewing(
-                    ui,
-                    self.doc.project(),
-                    &resolved,
-                    template,
-                    viewed.as_ref(),
-                ));
-            });
+        chosen.extend(params::parameters_ui_viewing(
+            ui,
+            self.doc.project(),
+            &resolved,
+            template,
+            viewed.as_ref(),
+        ));
         self.queued.extend(chosen);
     }
 
@@ -118,7 +143,15 @@ impl AnthesisApp {
     /// The paint panel for the selected organ's template.
     pub(super) fn paint_panel(&mut self, ui: &mut egui::Ui) {
         let template = self.selected_template();
-        let chosen = self.paint.ui(ui, self.doc.project(), template);
+        // The canvas is sized by the panel's height as shown, not by the
+        // scrolled content's (which has no end).
+        let shown_height = ui.available_height();
+        let chosen = panel_scroll("paint panel")
+            .show(ui, |ui| {
+                self.paint
+                    .ui(ui, self.doc.project(), template, shown_height)
+            })
+            .inner;
         self.queued.extend(chosen);
     }
 

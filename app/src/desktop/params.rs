@@ -11,22 +11,26 @@ use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOR, JointRamp, Project, Resol
 use eframe::egui::{self, DragValue};
 
 use super::command::{Command, ProjectEdit};
+use super::panels::section;
 use super::two_state::{ViewedOrgan, two_state_ui};
+use super::words;
 
-/// A labelled number row; returns whether it changed.
+/// A labelled number row of the parameter `symbol`, named and explained
+/// by [`words`]; returns whether it changed.
 fn number(
     ui: &mut egui::Ui,
-    label: &str,
-    tooltip: &str,
+    symbol: &str,
     value: &mut f64,
     speed: f64,
     range: std::ops::RangeInclusive<f64>,
 ) -> bool {
-    let label_response = ui.label(label).on_hover_text(tooltip);
-    let changed = super::checked_field::checked_number(ui, label, value, speed, range)
-        .labelled_by(label_response.id)
-        .on_hover_text(tooltip)
-        .changed();
+    let tooltip = words::tooltip(symbol);
+    let label_response = ui.label(words::label(symbol)).on_hover_text(&tooltip);
+    let changed =
+        super::checked_field::checked_number(ui, &words::label(symbol), value, speed, range)
+            .labelled_by(label_response.id)
+            .on_hover_text(tooltip)
+            .changed();
     ui.end_row();
     changed
 }
@@ -72,70 +76,33 @@ pub fn parameters_ui_viewing(
         .num_columns(2)
         .spacing([12.0, 6.0])
         .show(ui, |ui| {
+            mark(number(ui, "dg", &mut draft.dg, 0.0001, -0.5..=0.5), "dg");
             mark(
-                number(
-                    ui,
-                    "dg",
-                    "Maximum growth per step: each triangle grows by a factor 1 + dg × map \
-                     value every step. Negative values shrink (wilting). Paper: 0.003.",
-                    &mut draft.dg,
-                    0.0001,
-                    -0.5..=0.5,
-                ),
-                "dg",
-            );
-            mark(
-                number(
-                    ui,
-                    "thickness",
-                    "Distance to the imaginary inner surface. Inner growth larger than base \
-                     growth bends the petal outwards; a thinner petal bends more for the same \
-                     difference. Paper: lily 0.2, Eustoma 0.1.",
-                    &mut draft.thickness,
-                    0.005,
-                    0.001..=100.0,
-                ),
+                number(ui, "thickness", &mut draft.thickness, 0.005, 0.001..=100.0),
                 "thickness",
             );
             mark(
-                number(
-                    ui,
-                    "Ks (stretch)",
-                    "Stretch stiffness: how strongly edges keep their grown rest length. \
-                     Multiplied by the stretch map. Paper: 20 (lily), 10 (Eustoma).",
-                    &mut draft.stretch_stiffness,
-                    0.1,
-                    0.001..=1.0e6,
-                ),
+                number(ui, "Ks", &mut draft.stretch_stiffness, 0.1, 0.001..=1.0e6),
                 "Ks",
             );
             mark(
-                number(
-                    ui,
-                    "Kb (bend)",
-                    "Bend stiffness: how strongly hinges keep their grown rest angle. \
-                     Multiplied by the bend map. Paper: 20 (lily), 10 (Eustoma).",
-                    &mut draft.bend_stiffness,
-                    0.1,
-                    0.001..=1.0e6,
-                ),
+                number(ui, "Kb", &mut draft.bend_stiffness, 0.1, 0.001..=1.0e6),
                 "Kb",
             );
-            let label = ui.label("keyframes").on_hover_text(
-                "Simulation steps after the bud, one keyframe each (whole project). Paper: 100.",
-            );
+            let tooltip = words::tooltip("keyframes");
+            let label = ui.label(words::label("keyframes")).on_hover_text(&tooltip);
             // A checked field, as the others: a typed count out of range or
             // not a number is marked and logged, not silently clamped.
             let mut count = f64::from(keyframes);
             let changed = super::checked_field::checked_number(
                 ui,
-                "keyframes",
+                &words::label("keyframes"),
                 &mut count,
                 1.0,
                 1.0..=10_000.0,
             )
             .labelled_by(label.id)
-            .on_hover_text("Simulation steps after the bud, one keyframe each (whole project).")
+            .on_hover_text(tooltip)
             .changed();
             keyframes = count.round() as u32;
             mark(changed, "keyframes");
@@ -145,11 +112,9 @@ pub fn parameters_ui_viewing(
     base_region_ui(ui, &mut draft, &mut mark);
     joint_schedule_ui(ui, &mut draft, &mut mark);
 
-    ui.separator();
     if let Some(command) = two_state_ui(ui, project, template, &mut draft, viewed, &mut mark) {
         return Some(command);
     }
-    ui.separator();
     if let Some(edit) = resolution_ui(ui, project, resolved, template) {
         return Some(edit);
     }
@@ -172,48 +137,30 @@ fn base_region_ui(
     draft: &mut Template,
     mark: &mut dyn FnMut(bool, &'static str),
 ) {
-    ui.separator();
-    ui.strong("Base region")
-        .on_hover_text("Particles whose UV lies here attach the organ to the receptacle.");
-    egui::Grid::new("base region")
-        .num_columns(2)
-        .show(ui, |ui| {
-            let base = &mut draft.base_region;
-            mark(
-                number(
-                    ui,
-                    "v max",
-                    "Particles with v ≤ this (v runs from the base, 0, to the tip, 1) are base \
-                 particles, shape-matched onto the receptacle each iteration.",
-                    &mut base.v_max,
-                    0.002,
-                    0.0..=1.0,
-                ),
-                "base v max",
-            );
-            mark(
-                number(
-                    ui,
-                    "u min",
-                    "Leftmost u of the base region (u runs across the organ, midrib at 0.5).",
-                    &mut base.u_min,
-                    0.005,
-                    0.0..=1.0,
-                ),
-                "base u min",
-            );
-            mark(
-                number(
-                    ui,
-                    "u max",
-                    "Rightmost u of the base region.",
-                    &mut base.u_max,
-                    0.005,
-                    0.0..=1.0,
-                ),
-                "base u max",
-            );
-        });
+    section(
+        ui,
+        "Base region",
+        "Particles whose UV lies here attach the organ to the receptacle.",
+        |ui| {
+            egui::Grid::new("base region")
+                .num_columns(2)
+                .show(ui, |ui| {
+                    let base = &mut draft.base_region;
+                    mark(
+                        number(ui, "v max", &mut base.v_max, 0.002, 0.0..=1.0),
+                        "base v max",
+                    );
+                    mark(
+                        number(ui, "u min", &mut base.u_min, 0.005, 0.0..=1.0),
+                        "base u min",
+                    );
+                    mark(
+                        number(ui, "u max", &mut base.u_max, 0.005, 0.0..=1.0),
+                        "base u max",
+                    );
+                });
+        },
+    );
 }
 
 /// The Joint schedule section: each ramp's steps and degrees, removed or
@@ -223,31 +170,46 @@ fn joint_schedule_ui(
     draft: &mut Template,
     mark: &mut dyn FnMut(bool, &'static str),
 ) {
-    ui.separator();
-    ui.strong("Joint schedule").on_hover_text(
+    section(
+        ui,
+        "Joint schedule",
         "How the organ tilts outwards at its base over the steps: each ramp adds its degrees \
          evenly over its steps. Paper: lily +23° over steps 1–60.",
+        |ui| joint_ramps_ui(ui, draft, mark),
     );
+}
+
+/// The joint schedule's ramps and "Add ramp".
+fn joint_ramps_ui(
+    ui: &mut egui::Ui,
+    draft: &mut Template,
+    mark: &mut dyn FnMut(bool, &'static str),
+) {
     let mut remove = None;
     egui::Grid::new("joint schedule")
         .num_columns(4)
         .show(ui, |ui| {
-            let from_label = ui.label("from step").id;
-            let to_label = ui.label("to step").id;
-            let degrees_label = ui.label("degrees").id;
+            let header = |ui: &mut egui::Ui, symbol: &str| {
+                ui.label(words::label(symbol))
+                    .on_hover_text(words::tooltip(symbol))
+                    .id
+            };
+            let from_label = header(ui, "from step");
+            let to_label = header(ui, "to step");
+            let degrees_label = header(ui, "degrees");
             ui.end_row();
             for (i, ramp) in draft.joint_schedule.iter_mut().enumerate() {
                 mark(
                     ui.add(DragValue::new(&mut ramp.from_step).range(0..=100_000))
                         .labelled_by(from_label)
-                        .on_hover_text("The ramp starts after this step")
+                        .on_hover_text(words::tooltip("from step"))
                         .changed(),
                     "joint from",
                 );
                 mark(
                     ui.add(DragValue::new(&mut ramp.to_step).range(0..=100_000))
                         .labelled_by(to_label)
-                        .on_hover_text("The ramp has added all its degrees at this step")
+                        .on_hover_text(words::tooltip("to step"))
                         .changed(),
                     "joint to",
                 );
@@ -259,7 +221,7 @@ fn joint_schedule_ui(
                             .suffix("°"),
                     )
                     .labelled_by(degrees_label)
-                    .on_hover_text("Degrees added; positive tilts the organ outwards")
+                    .on_hover_text(words::tooltip("degrees"))
                     .changed(),
                     "joint degrees",
                 );
@@ -295,11 +257,17 @@ fn joint_schedule_ui(
 /// The Colour section: the base colour, the colour map's second colour,
 /// and removing the colour map.
 fn colour_ui(ui: &mut egui::Ui, draft: &mut Template, mark: &mut dyn FnMut(bool, &'static str)) {
-    ui.separator();
-    ui.strong("Colour").on_hover_text(
+    section(
+        ui,
+        "Colour",
         "What the organ looks like (not simulated): the base colour, and a second colour \
          painted over it with the paint panel's colour map.",
+        |ui| colour_rows(ui, draft, mark),
     );
+}
+
+/// The Colour section's rows.
+fn colour_rows(ui: &mut egui::Ui, draft: &mut Template, mark: &mut dyn FnMut(bool, &'static str)) {
     egui::Grid::new("template colours")
         .num_columns(2)
         .show(ui, |ui| {
@@ -379,16 +347,25 @@ fn edit_label(field: &str, template_name: &str) -> String {
     }
 }
 
-/// What the resolution control says while its value is dragged: the counts
-/// are predicted from the areas until the drag ends and the meshes are
-/// remeshed (remeshing on every frame of a drag would stall the window).
-const RESOLUTION_TOOLTIP: &str = "Every template is simulated remeshed at this mean edge \
-    length (project units), with the painted maps unchanged: coarse to paint quickly, fine for \
-    the final export. Off: the meshes as built. The project keeps the meshes as built; the \
-    setting is saved with it. Paper: lily 1.3, Eustoma 2.0.";
+/// The Resolution section: the mean edge every template is simulated at
+/// and the particles per organ; returns the edit made.
+fn resolution_ui(
+    ui: &mut egui::Ui,
+    project: &Project,
+    resolved: &Project,
+    template: usize,
+) -> Option<Command> {
+    section(
+        ui,
+        "Resolution (whole flower)",
+        &words::tooltip("mean edge"),
+        |ui| resolution_rows(ui, project, resolved, template),
+    )
+    .flatten()
+}
 
 /// The resolution row and the particles per organ; returns the edit made.
-fn resolution_ui(
+fn resolution_rows(
     ui: &mut egui::Ui,
     project: &Project,
     resolved: &Project,
@@ -404,16 +381,15 @@ fn resolution_ui(
     let draft_id = ui.scope_id().with("mean edge while dragged");
     let dragged_edge: Option<f64> = ui.data(|d| d.get_temp(draft_id));
     let mut chosen = None;
-    ui.strong("Resolution (whole flower)")
-        .on_hover_text(RESOLUTION_TOOLTIP);
+    let tooltip = words::tooltip("mean edge");
     egui::Grid::new("resolution")
         .num_columns(2)
         .spacing([12.0, 6.0])
         .show(ui, |ui| {
             let mut remesh = current.mean_edge().is_some();
             if ui
-                .checkbox(&mut remesh, "mean edge")
-                .on_hover_text(RESOLUTION_TOOLTIP)
+                .checkbox(&mut remesh, words::label("mean edge"))
+                .on_hover_text(&tooltip)
                 .changed()
             {
                 chosen = Some(if remesh {
@@ -436,7 +412,7 @@ fn resolution_ui(
                                 // edge, remeshed (or refused) at once.
                                 .update_while_editing(false),
                         )
-                        .on_hover_text(RESOLUTION_TOOLTIP);
+                        .on_hover_text(&tooltip);
                     if response.dragged() {
                         ui.data_mut(|d| d.insert_temp(draft_id, value));
                     } else {

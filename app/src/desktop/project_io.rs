@@ -188,10 +188,23 @@ impl AnthesisApp {
     /// Opens the file dialog for `purpose`, starting in the project's
     /// folder; the answer arrives in a later frame.
     pub(super) fn ask_for_path(&mut self, purpose: DialogPurpose) {
-        let folder = self.project_folder();
+        let mut folder = self.project_folder();
+        let mut name = purpose.suggested_name(&self.project().name);
+        // Browsing for the export's path starts from what its field says.
+        let typed = Path::new(self.export.path.trim());
+        if purpose == DialogPurpose::ExportGlb
+            && let Some(file) = typed.file_name()
+        {
+            name = Some(file.to_string_lossy().into_owned());
+            if let Some(parent) = typed.parent().filter(|p| p.is_dir()) {
+                folder = Some(parent.to_path_buf());
+            }
+        }
         let wake = self.ctx.clone();
         self.dialogs
-            .open(purpose, folder.as_deref(), move || wake.request_repaint());
+            .open(purpose, folder.as_deref(), name, move || {
+                wake.request_repaint()
+            });
     }
 
     /// Saves to the document's path, or asks for one. Returns whether the
@@ -452,19 +465,8 @@ impl AnthesisApp {
         self.export.open = true;
         if self.export.path.trim().is_empty() {
             let folder = self.project_folder().unwrap_or_default();
-            let stem: String = self
-                .project()
-                .name
-                .chars()
-                .map(|c| {
-                    if c.is_ascii_alphanumeric() || c == '-' {
-                        c
-                    } else {
-                        '_'
-                    }
-                })
-                .collect();
-            self.export.path = folder.join(format!("{stem}.glb")).display().to_string();
+            let name = export::default_file_name(&self.project().name);
+            self.export.path = folder.join(name).display().to_string();
         }
     }
 

@@ -419,14 +419,21 @@ fn scrubber(
     let size = Vec2::new(ui.available_width(), 22.0);
     let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Slider, true, "Timeline"));
-    let response = response.on_hover_text(format!(
-        "Timeline: green cells are computed keyframes, blue ones the coarse proxy (shown \
+    // No tooltip while the playhead is dragged: it would cover the
+    // keyframe read-out above the scrubber, the one thing to read then.
+    let scrubbing = response.is_pointer_button_down_on() || response.dragged();
+    let response = if scrubbing {
+        response
+    } else {
+        response.on_hover_text(format!(
+            "Timeline: green cells are computed keyframes, blue ones the coarse proxy (shown \
          until the full-resolution run reaches them), brown ones the previous result \
          (stale, shown until the new run reaches them), empty ones pending; a red bar marks \
          a keyframe where organs pass through each other (the log says which). Triangles mark \
          the time keys of {} (filled: the key being painted). Click or drag to scrub.",
-        keys.template
-    ));
+            keys.template
+        ))
+    };
     let x_of = |time: f64| rect.left() + (time / f64::from(total)) as f32 * rect.width();
     if (response.dragged() || response.clicked())
         && let Some(pointer) = response.interact_pointer_pos()

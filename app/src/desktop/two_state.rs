@@ -63,12 +63,27 @@ pub fn two_state_ui(
     viewed: Option<&ViewedOrgan>,
     mark: &mut dyn FnMut(bool, &'static str),
 ) -> Option<Command> {
-    let mut command = None;
-    ui.strong("Two-state opening").on_hover_text(
+    super::panels::section(
+        ui,
+        "Two-state opening",
         "Animate this template's organs from the bud to an open shape (the two-state blossom) \
          instead of growing them: no growth maps, no solve. Growing organs keep off them; \
          they never give way.",
-    );
+        |ui| two_state_rows(ui, project, template, draft, viewed, mark),
+    )
+    .flatten()
+}
+
+/// What the Two-state opening section holds.
+fn two_state_rows(
+    ui: &mut egui::Ui,
+    project: &Project,
+    template: usize,
+    draft: &mut Template,
+    viewed: Option<&ViewedOrgan>,
+    mark: &mut dyn FnMut(bool, &'static str),
+) -> Option<Command> {
+    let mut command = None;
     ui.horizontal_wrapped(|ui| {
         if ui
             .button("Open shape from OBJ…")
@@ -163,9 +178,8 @@ fn timing_grid(
         .num_columns(2)
         .spacing([12.0, 6.0])
         .show(ui, |ui| {
-            let tip = "The growth rate g of G(t; g, T) (eq. 4): 6 reaches the open shape at T, \
-                       more overshoots it, less stops short.";
-            let label = ui.label("g").on_hover_text(tip);
+            let tip = super::words::tooltip("g");
+            let label = ui.label(super::words::label("g")).on_hover_text(&tip);
             mark(
                 ui.add(
                     DragValue::new(&mut animation.growth.g)
@@ -174,13 +188,13 @@ fn timing_grid(
                         .max_decimals(3),
                 )
                 .labelled_by(label.id)
-                .on_hover_text(tip)
+                .on_hover_text(&tip)
                 .changed(),
                 "g",
             );
             ui.end_row();
-            let tip = "T of G(t; g, T): the keyframe at which the opening ends (held after).";
-            let label = ui.label("T (keyframes)").on_hover_text(tip);
+            let tip = super::words::tooltip("T");
+            let label = ui.label(super::words::label("T")).on_hover_text(&tip);
             mark(
                 ui.add(
                     DragValue::new(&mut animation.growth.duration)
@@ -189,7 +203,7 @@ fn timing_grid(
                         .max_decimals(2),
                 )
                 .labelled_by(label.id)
-                .on_hover_text(tip)
+                .on_hover_text(&tip)
                 .changed(),
                 "T",
             );

@@ -157,13 +157,13 @@ pub fn legend(kind: MapKind, dg: f64) -> String {
                 "{}: relative growth per step of the {layer} {way}. 0 = no growth, \
                  1 = {percent:+.1} % per step (dg = {dg} at this key; rate = 1 + dg · value). \
                  Inner > base bends the organ outwards.",
-                kind.label()
+                crate::desktop::words::label(kind.label())
             )
         }
         MapKind::Stretch | MapKind::Bend => format!(
             "{}: multiplier of the template's {} stiffness. 0 = none (limp), \
              1 = the template's full stiffness (the default).",
-            kind.label(),
+            crate::desktop::words::label(kind.label()),
             if kind == MapKind::Stretch {
                 "stretch"
             } else {
