@@ -208,6 +208,12 @@ pub const SHORTCUTS: &[Shortcut] = &[
         command: |app| Command::SetSingleOrganPreview(!app.single_organ_preview),
     },
     Shortcut {
+        keys: &[plain(super::difference::BEFORE_KEY)],
+        does: "Hold: the result before the last edit (release: the current one)",
+        scope: Scope::NotTyping,
+        command: |app| Command::SetView(app.view),
+    },
+    Shortcut {
         keys: &[plain(Key::H)],
         does: "Undo history window",
         scope: Scope::NotTyping,

@@ -15,6 +15,7 @@ mod background;
 pub mod bud_sketch;
 pub mod checked_field;
 pub mod command;
+mod difference;
 pub mod document;
 pub mod export;
 pub mod files;
