@@ -380,30 +380,50 @@ impl TriangleGrid {
 /// another organ's triangles. `organs` are each organ's positions and
 /// triangles at one keyframe.
 pub fn contact_triangles(organs: &[(&[DVec3], &[[u32; 3]])], distance: f64) -> Vec<Vec<bool>> {
-    let grids: Vec<TriangleGrid> = organs
-        .par_iter()
-        .map(|(x, t)| TriangleGrid::new(x, t, distance))
-        .collect();
+    let grids = grids(organs, distance);
+    (0..organs.len())
+        .into_par_iter()
+        .map(|o| contact_of(&grids, organs, o, distance))
+        .collect()
+}
+
+/// [`contact_triangles`] of organ `organ` only.
+pub fn contact_triangles_of(
+    organs: &[(&[DVec3], &[[u32; 3]])],
+    organ: usize,
+    distance: f64,
+) -> Vec<bool> {
+    contact_of(&grids(organs, distance), organs, organ, distance)
+}
+
+fn grids(organs: &[(&[DVec3], &[[u32; 3]])], distance: f64) -> Vec<TriangleGrid> {
     organs
         .par_iter()
-        .enumerate()
-        .map(|(o, (x, triangles))| {
-            let others: Vec<usize> = (0..organs.len())
-                .filter(|&b| {
-                    b != o
-                        && !(grids[o].high.cmplt(grids[b].low).any()
-                            || grids[o].low.cmpgt(grids[b].high).any())
-                })
-                .collect();
-            triangles
+        .map(|(x, t)| TriangleGrid::new(x, t, distance))
+        .collect()
+}
+
+fn contact_of(
+    grids: &[TriangleGrid],
+    organs: &[(&[DVec3], &[[u32; 3]])],
+    o: usize,
+    distance: f64,
+) -> Vec<bool> {
+    let (x, triangles) = organs[o];
+    let others: Vec<usize> = (0..organs.len())
+        .filter(|&b| {
+            b != o
+                && !(grids[o].high.cmplt(grids[b].low).any()
+                    || grids[o].low.cmpgt(grids[b].high).any())
+        })
+        .collect();
+    triangles
+        .iter()
+        .map(|t| {
+            let centroid = t.map(|i| x[i as usize]).iter().sum::<DVec3>() / 3.0;
+            others
                 .iter()
-                .map(|t| {
-                    let centroid = t.map(|i| x[i as usize]).iter().sum::<DVec3>() / 3.0;
-                    others
-                        .iter()
-                        .any(|&b| grids[b].near(centroid, organs[b].0, organs[b].1, distance))
-                })
-                .collect()
+                .any(|&b| grids[b].near(centroid, organs[b].0, organs[b].1, distance))
         })
         .collect()
 }
@@ -421,11 +441,17 @@ pub struct OrganLayout {
 impl OrganLayout {
     /// The layout of an organ whose mesh (template) is `mesh`.
     pub fn new(mesh: &Mesh) -> OrganLayout {
+        OrganLayout::with_margin_base(mesh, MARGIN_BASE_V)
+    }
+
+    /// [`OrganLayout::new`] with the margin's base at v = `base_v`
+    /// instead of [`MARGIN_BASE_V`].
+    pub fn with_margin_base(mesh: &Mesh, base_v: f64) -> OrganLayout {
         OrganLayout {
             triangles: mesh.triangles.clone(),
             boundary: boundary_vertices(&mesh.triangles, mesh.vertex_count()),
             midrib: UvPath::midrib(&mesh.uvs, &mesh.triangles, MIDRIB_SAMPLES),
-            margin: margin_edges(&mesh.uvs, &mesh.triangles, MARGIN_BASE_V),
+            margin: margin_edges(&mesh.uvs, &mesh.triangles, base_v),
         }
     }
 
