@@ -721,12 +721,12 @@ pub fn measure_organ(
         stretch_minor_mean: weighted_mean(&minor, &area_bud),
         midrib_length: layout.midrib.length(x, triangles),
         margin_length: edges_length(x, &layout.margin),
+        // Folded from +0 (a sum of nothing is -0 in Rust, "-0" in a table).
         contact_area: area_now
             .iter()
             .zip(&contact)
             .filter(|(_, c)| **c)
-            .map(|(a, _)| a)
-            .sum(),
+            .fold(0.0, |sum, (a, _)| sum + a),
     };
     OrganMeasure {
         mean_curvature: curvature.mean,
