@@ -404,6 +404,7 @@ impl AnthesisApp {
                         ui.radio_value(&mut view.overlay, Some(kind), kind.label());
                     }
                 });
+                super::measure_panel::menu_entry(ui);
                 if view != self.view {
                     chosen.push(Command::SetView(view));
                 }

@@ -24,6 +24,7 @@ pub mod flower_panel;
 mod framing;
 mod gallery;
 pub mod log;
+pub mod measure_panel;
 mod menus;
 pub mod paint;
 mod panels;

@@ -202,6 +202,7 @@ impl AnthesisApp {
             self.paint.on_3d,
             self.paint.brush.radius_in_uv,
         );
+        self.measure_window(ui.ctx());
         let mut row = self.difference_ui(ui, viewport_rect, &key, 0);
         if let Some((badge, color)) =
             timeline::viewport_badge(&self.session, key.time_in_keyframes).filter(|_| !key.before)

@@ -25,16 +25,27 @@ pub enum ViewField {
     /// How far each point moved between the result before the last edit
     /// and the one shown (`crate::desktop::difference`).
     Difference,
+    /// A measurement of the organs at the time shown
+    /// (`crate::desktop::measure_panel`).
+    Measure(crate::desktop::measure_panel::MeasureField),
 }
 
 impl ViewField {
     /// Every field, in the order menus list them.
-    pub const ALL: [ViewField; 1] = [ViewField::Difference];
+    pub const ALL: [ViewField; 6] = [
+        ViewField::Difference,
+        ViewField::Measure(crate::desktop::measure_panel::MeasureField::MeanCurvature),
+        ViewField::Measure(crate::desktop::measure_panel::MeasureField::GaussianCurvature),
+        ViewField::Measure(crate::desktop::measure_panel::MeasureField::StretchMajor),
+        ViewField::Measure(crate::desktop::measure_panel::MeasureField::StretchMinor),
+        ViewField::Measure(crate::desktop::measure_panel::MeasureField::Contact),
+    ];
 
     /// The field's name, as menus and the legend say it.
     pub fn label(self) -> &'static str {
         match self {
             ViewField::Difference => "Moved by the last edit",
+            ViewField::Measure(field) => field.label(),
         }
     }
 }
@@ -64,6 +75,7 @@ pub struct FieldInput<'a> {
 pub fn compute(field: ViewField, input: &FieldInput<'_>) -> FieldShown {
     match field {
         ViewField::Difference => crate::desktop::difference::difference_field(input),
+        ViewField::Measure(field) => crate::desktop::measure_panel::measure_field(field, input),
     }
 }
 
