@@ -18,6 +18,8 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
 mod common;
+#[path = "desktop/difference.rs"]
+mod difference;
 #[path = "desktop/measure.rs"]
 mod measure;
 

@@ -183,8 +183,9 @@ impl AnthesisApp {
     }
 
     /// Over the viewport `rect`: the before badge (at badge `row`; returns
-    /// the rows used), the toolbar (hold "Before", the "Difference" toggle)
-    /// and the chosen field's legend.
+    /// the rows used), the toolbar (hold "Before", the "Difference" toggle;
+    /// once an edit has a result before it to compare with) and the chosen
+    /// field's legend.
     pub(super) fn difference_ui(
         &mut self,
         ui: &mut egui::Ui,
@@ -207,7 +208,13 @@ impl AnthesisApp {
             }
             rows += 1;
         }
-        self.difference_toolbar(ui, rect);
+        // Once there is something to compare (or a field is chosen).
+        if self.session.before().is_some() || self.view.field.is_some() {
+            self.difference_toolbar(ui, rect);
+        } else {
+            ui.ctx()
+                .data_mut(|d| d.insert_temp(before_button_id(), false));
+        }
         if let (Some(chosen), Some(shown)) = (key.field, self.scene.field()) {
             viewport::field::legend(ui, rect, chosen.label(), &shown);
         }
@@ -346,6 +353,37 @@ mod tests {
 
     fn first_x(positions: Option<Vec<Vec<DVec3>>>) -> f64 {
         positions.expect("a result")[0][0].x
+    }
+
+    fn organ_of(mesh: &Mesh, offset: DVec3) -> SceneOrgan {
+        SceneOrgan {
+            organ: 0,
+            positions_in_world: mesh.positions.iter().map(|p| *p + offset).collect(),
+            triangles: mesh.triangles.clone(),
+            uvs: mesh.uvs.clone(),
+            simulated: true,
+        }
+    }
+
+    #[test]
+    fn a_coarser_mesh_is_compared_through_its_uvs_with_the_same_points_of_the_finer() {
+        // A proxy's points lie on the fine surface at their UVs: with the
+        // fine result moved by t, every proxy point is |t| from its match.
+        let project = anthesis_sim::fixtures::whorl(1, 16, 28, 2);
+        let template = project.flower.template_of(0);
+        let coarse = anthesis_flower::resolution::proxy_mesh(template).expect("a proxy");
+        assert!(coarse.vertex_count() * 2 < template.mesh.vertex_count());
+        let moved = DVec3::new(0.3, -0.4, 1.2);
+        let here = organ_of(&coarse, DVec3::ZERO);
+        let there = organ_of(&template.mesh, moved);
+        let found = distances(&here, &there);
+        assert_eq!(found.len(), coarse.vertex_count());
+        for d in found {
+            assert!((d - moved.length()).abs() < 1e-9, "{d}");
+        }
+        // The same mesh: point by point.
+        let same = distances(&organ_of(&template.mesh, DVec3::ZERO), &there);
+        assert!(same.iter().all(|d| (d - moved.length()).abs() < 1e-12));
     }
 
     #[test]
