@@ -20,8 +20,8 @@ Discrete differential geometry on the triangle meshes of a run, numpy only:
   triangle to the current one; 1 = unchanged, 1.4 = 40 % longer), largest
   first.
 - :func:`organ_measures`: all of them for every keyframe of a run, with
-  the contact area (the area of the organ's triangles whose centroid lies
-  within twice the collision offset of another organ) and the summaries
+  the contact area (the mixed Voronoi area of the organ's vertices within
+  twice the collision offset of another organ or a part) and the summaries
   ``anthesis measure`` writes.
 
 The computations are the engine's (``anthesis_sim::measure`` in Rust, the
@@ -113,12 +113,13 @@ def organ_measures(result: Any, organ: str | int, base_v: float = 0.05) -> dict[
     ``margin_length`` [k + 1], and ``principal_stretches`` [k + 1, m, 2]
     against the bud (keyframe 0).
 
-    Also, as ``Result.measures`` gives them: ``contact`` (bool [k + 1, m]:
-    the triangles within twice the collision offset of another organ),
+    Also, as ``Result.measures`` gives them: ``contact`` (bool [k + 1, n]:
+    the vertices within twice the collision offset of another organ or a
+    part), ``contact_area`` (their mixed Voronoi area),
     ``contact_area``, ``area``, ``mean_curvature_median``,
     ``mean_curvature_mean`` and ``gaussian_curvature_mean`` (means weighted
     by the vertices' areas), ``gaussian_curvature_median``,
     ``stretch_major_mean``, ``stretch_minor_mean`` [k + 1] (the columns of
     ``anthesis measure``, here in project units), and per vertex
-    ``vertex_stretches`` [k + 1, n, 2] and ``vertex_contact`` [k + 1, n]."""
+    ``vertex_stretches`` [k + 1, n, 2]."""
     return dict(result.measures(organ, base_v=base_v))

@@ -1292,9 +1292,9 @@ impl PyRunResult {
     /// Every measurement of one organ over the run
     /// (`anthesis_sim::measure`, as `anthesis measure` writes them), in
     /// project units: per vertex `mean_curvature`, `gaussian_curvature`
-    /// (NaN on the rim), `vertex_stretches` [k + 1, n, 2], `vertex_contact`
-    /// (share of the area around it touching another organ); per triangle
-    /// `principal_stretches` [k + 1, m, 2] and `contact` (bool); per
+    /// (NaN on the rim), `vertex_stretches` [k + 1, n, 2], `contact` (bool:
+    /// within the contact distance of another organ or a part); per
+    /// triangle `principal_stretches` [k + 1, m, 2]; per
     /// keyframe the summaries `area`, `mean_curvature_median`,
     /// `mean_curvature_mean`, `gaussian_curvature_median` (also
     /// `median_gaussian`), `gaussian_curvature_mean`,
@@ -1331,15 +1331,28 @@ impl PyRunResult {
                 .iter()
                 .map(|&i| OrganLayout::with_margin_base(&flower.template_of(i).mesh, base_v))
                 .collect();
+            // The parts (receptacle, stamens, pistils, stem) at a keyframe.
+            let pieces = anthesis_flower::parts::part_pieces(flower);
+            let at = |k: usize| -> Vec<Vec<DVec3>> {
+                let step = u32::try_from(k).unwrap_or(u32::MAX);
+                pieces.iter().map(|p| p.positions_at(step)).collect()
+            };
             data.frames
                 .iter()
-                .map(|frame| {
+                .enumerate()
+                .map(|(frame_index, frame)| {
                     let surfaces: Vec<(&[DVec3], &[[u32; 3]])> = layouts
                         .iter()
                         .zip(frame)
                         .map(|(l, x)| (x.as_slice(), l.triangles()))
                         .collect();
-                    let contact = m::contact_triangles_of(&surfaces, slot, distance);
+                    let parts_at = at(frame_index);
+                    let parts: Vec<m::Surface<'_>> = pieces
+                        .iter()
+                        .zip(&parts_at)
+                        .map(|(p, x)| (x.as_slice(), p.mesh.triangles.as_slice()))
+                        .collect();
+                    let contact = m::contact_vertices_of(&surfaces, &parts, slot, distance);
                     m::measure_organ(&layouts[slot], &data.frames[0][slot], &frame[slot], contact)
                 })
                 .collect()
@@ -1361,14 +1374,10 @@ impl PyRunResult {
             "gaussian_curvature",
             per(&|f| f.gaussian_curvature.clone(), n)?.into_pyarray(py),
         )?;
-        dict.set_item(
-            "vertex_contact",
-            per(&|f| f.vertex_contact.clone(), n)?.into_pyarray(py),
-        )?;
         let contact: Vec<bool> = measures.iter().flat_map(|f| f.contact.clone()).collect();
         dict.set_item(
             "contact",
-            Array2::from_shape_vec((k, t), contact)
+            Array2::from_shape_vec((k, n), contact)
                 .map_err(shape_error)?
                 .into_pyarray(py),
         )?;

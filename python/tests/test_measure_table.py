@@ -8,7 +8,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from anthesis.measure import organ_measures
+from anthesis.measure import angle_defects_and_areas, organ_measures
 
 
 def test_organ_measures_are_the_command_lines_table(five_petal, anthesis_bin, tmp_path):
@@ -45,8 +45,8 @@ def test_contact_area_is_the_area_of_the_touching_triangles(five_petal):
     result = five_petal.simulate(keyframes=2)
     organ = result.organs[0]
     m = result.measures(organ, contact_distance=1e6)
-    # Everything is within a distance larger than the flower of another
-    # organ; nothing within 0 (the organs do not cross).
+    # Every vertex is within a distance larger than the flower of another
+    # organ; none within 0 (the organs do not cross).
     assert m["contact"].all()
     np.testing.assert_allclose(m["contact_area"], m["area"], rtol=1e-12)
     none = result.measures(organ, contact_distance=0.0)
@@ -55,8 +55,14 @@ def test_contact_area_is_the_area_of_the_touching_triangles(five_petal):
     x, f = result.positions(organ)[-1], result.faces(organ).astype(np.int64)
     areas = 0.5 * np.linalg.norm(np.cross(x[f[:, 1]] - x[f[:, 0]], x[f[:, 2]] - x[f[:, 0]]), axis=1)
     assert m["area"][-1] == pytest.approx(areas.sum(), rel=1e-12)
-    # Alone, an organ touches nothing.
-    alone = five_petal.simulate(keyframes=1, organ=organ).measures(organ, contact_distance=1e6)
-    assert alone["contact_area"].max() == 0.0
+    # The contact area is the vertices' mixed areas, which tile the surface.
+    _, vertex_areas = angle_defects_and_areas(result.positions(organ)[0], f)
+    assert m["contact_area"][0] == pytest.approx(vertex_areas.sum(), rel=1e-12)
+    # Alone, an organ touches only the parts: the receptacle it sits on,
+    # within a distance larger than the flower, all over.
+    alone = five_petal.simulate(keyframes=1, organ=organ)
+    near = alone.measures(organ, contact_distance=1e6)
+    np.testing.assert_allclose(near["contact_area"], near["area"], rtol=1e-12)
+    assert alone.measures(organ, contact_distance=0.0)["contact_area"].max() == 0.0
     with pytest.raises(ValueError, match="contact_distance"):
         result.measures(organ, contact_distance=-1.0)

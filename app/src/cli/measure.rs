@@ -13,7 +13,7 @@ use anthesis_flower::Resolution;
 use anthesis_sim::batch;
 use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::measure::{
-    OrganLayout, QUANTITIES, default_contact_distance, measure_keyframe, real_scale,
+    OrganLayout, QUANTITIES, Surface, default_contact_distance, measure_keyframe, real_scale,
 };
 use anthesis_sim::memory::KeyframeCost;
 use anthesis_sim::{Keyframe, Selection};
@@ -37,7 +37,7 @@ pub struct MeasureArgs {
     #[arg(long, value_name = "NAME,…", value_delimiter = ',')]
     pub organs: Vec<String>,
     /// Simulate only this organ, alone (the single-organ preview: no
-    /// collisions, so no contact).
+    /// collisions with other organs; it may still touch the parts).
     #[arg(long, value_name = "NAME", conflicts_with = "organs")]
     pub alone: Option<String>,
     /// Number of keyframes simulated, 1 to 10,000 (default: the project's).
@@ -51,9 +51,9 @@ pub struct MeasureArgs {
     /// Simulate at this mean edge length (see `simulate --edge`).
     #[arg(long, value_name = "LENGTH|as-built", value_parser = parse_edge)]
     pub edge: Option<Resolution>,
-    /// A triangle touches another organ when its centroid lies within this
-    /// distance of it, in project units (default: twice the project's
-    /// collision offset).
+    /// A vertex touches another organ or a part when it lies within this
+    /// distance of its surface, in project units (default: twice the
+    /// project's collision offset).
     #[arg(long, value_name = "LENGTH")]
     pub contact_distance: Option<f64>,
     /// Go on past a keyframe whose triangles cross, with a warning.
@@ -198,6 +198,8 @@ fn table(
         .map(|&i| template_layouts[flower.organs[i].template].clone())
         .collect();
     let (scale, unit) = real_scale(flower.unit);
+    // The parts (receptacle, stamens, pistils, stem) organs may touch.
+    let pieces = anthesis_flower::parts::part_pieces(flower);
     let mut text = String::from("keyframe,organ,template");
     for q in &QUANTITIES {
         let _ = write!(text, ",{} [{}]", q.name, q.unit(unit));
@@ -210,10 +212,17 @@ fn table(
         let Some(keyframe) = keyframes.get(k as usize) else {
             continue;
         };
+        let at: Vec<Vec<glam::DVec3>> = pieces.iter().map(|p| p.positions_at(k)).collect();
+        let parts: Vec<Surface<'_>> = pieces
+            .iter()
+            .zip(&at)
+            .map(|(p, x)| (x.as_slice(), p.mesh.triangles.as_slice()))
+            .collect();
         let measures = measure_keyframe(
             &layouts,
             &bud.positions_in_world,
             &keyframe.positions_in_world,
+            &parts,
             contact_distance,
         );
         for (&i, m) in simulated.iter().zip(&measures) {

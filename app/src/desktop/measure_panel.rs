@@ -71,8 +71,8 @@ impl MeasureField {
                  point the mean of its triangles weighted by their area in the bud."
             }
             MeasureField::Contact => {
-                "The share of the area around each point whose triangles lie within twice the \
-                 collision offset of another organ."
+                "Points within twice the collision offset of another organ or a part \
+                 (receptacle, stamens, pistil): 100 %; the contact area is their Voronoi area."
             }
         }
     }
@@ -91,12 +91,32 @@ fn suffixes(unit: &str) -> (&'static str, &'static str) {
 /// The organs' measures at one frame: per organ of `organs` (positions
 /// and the template mesh they are on), against `bud` (the same organs at
 /// keyframe 0, `None` where its mesh differs: no stretch there), in
-/// contact with each other within `distance`.
+/// contact with each other and the parts of `flower` at `time` within
+/// `distance`.
 fn measure_organs(
     organs: &[(&[DVec3], &Mesh)],
     bud: &[Option<&[DVec3]>],
+    flower: &anthesis_flower::Flower,
+    time: f64,
     distance: f64,
 ) -> Vec<OrganMeasure> {
+    let pieces: Vec<anthesis_render::OrganMesh> = crate::parts::part_meshes(flower, time);
+    let parts: Vec<(Vec<DVec3>, Vec<[u32; 3]>)> = pieces
+        .iter()
+        .map(|p| {
+            (
+                p.positions_in_world
+                    .iter()
+                    .map(|q| DVec3::from_array(q.map(f64::from)))
+                    .collect(),
+                p.triangles.clone(),
+            )
+        })
+        .collect();
+    let surfaces: Vec<engine::Surface<'_>> = parts
+        .iter()
+        .map(|(x, t)| (x.as_slice(), t.as_slice()))
+        .collect();
     let layouts: Vec<OrganLayout> = organs.iter().map(|(_, m)| OrganLayout::new(m)).collect();
     let now: Vec<Vec<DVec3>> = organs.iter().map(|(x, _)| x.to_vec()).collect();
     let buds: Vec<Vec<DVec3>> = bud
@@ -104,7 +124,7 @@ fn measure_organs(
         .zip(&now)
         .map(|(b, x)| b.unwrap_or(x).to_vec())
         .collect();
-    let mut measures = engine::measure_keyframe(&layouts, &buds, &now, distance);
+    let mut measures = engine::measure_keyframe(&layouts, &buds, &now, &surfaces, distance);
     for (m, b) in measures.iter_mut().zip(bud) {
         if b.is_none() {
             m.vertex_stretches
@@ -147,7 +167,13 @@ pub(crate) fn measure_field(field: MeasureField, input: &FieldInput<'_>) -> Fiel
         })
         .collect();
     let distance = engine::default_contact_distance(input.project.settings.collision_offset);
-    let measures = measure_organs(&organs, &buds, distance);
+    let measures = measure_organs(
+        &organs,
+        &buds,
+        &input.project.flower,
+        input.time_in_keyframes,
+        distance,
+    );
     let (scale, unit) = real_scale(input.project.flower.unit);
     let (per_length, per_area) = suffixes(unit);
     let mut by_organ: HashMap<usize, Vec<f64>> = HashMap::new();
@@ -161,7 +187,11 @@ pub(crate) fn measure_field(field: MeasureField, input: &FieldInput<'_>) -> Fiel
                 .collect(),
             MeasureField::StretchMajor => m.vertex_stretches.iter().map(|s| s[0]).collect(),
             MeasureField::StretchMinor => m.vertex_stretches.iter().map(|s| s[1]).collect(),
-            MeasureField::Contact => m.vertex_contact.iter().map(|c| 100.0 * c).collect(),
+            MeasureField::Contact => m
+                .contact
+                .iter()
+                .map(|&c| if c { 100.0 } else { 0.0 })
+                .collect(),
         };
         by_organ.insert(o.organ, values);
     }
@@ -326,7 +356,7 @@ fn summaries_at(
         );
         which.push(organ);
     }
-    let measures = measure_organs(&organs, &buds, distance);
+    let measures = measure_organs(&organs, &buds, flower, f64::from(index), distance);
     let found: HashMap<usize, Summary> = which
         .into_iter()
         .zip(measures)

@@ -135,7 +135,7 @@ fn measure_picks_organs_keyframes_and_the_contact_distance() {
         .iter()
         .position(|h| h.starts_with("contact_area ["))
         .expect("contact_area");
-    // Every triangle is within a distance larger than the flower of another
+    // Every vertex is within a distance larger than the flower of another
     // organ, and none within 0 of one (the organs never cross).
     let (_, all) = measure(dir.path(), &[p, "--contact-distance", "1000"]);
     for row in &all {
@@ -143,17 +143,22 @@ fn measure_picks_organs_keyframes_and_the_contact_distance() {
     }
     let (_, none) = measure(dir.path(), &[p, "--contact-distance", "0"]);
     assert!(none.iter().all(|row| number(row, contact) == 0.0));
-    // An organ simulated alone touches nothing.
-    let (_, alone) = measure(
-        dir.path(),
-        &[p, "--alone", "petal-1", "--contact-distance", "1000"],
-    );
+    // An organ simulated alone touches only the parts: the receptacle it
+    // sits on, within a distance larger than the flower, all over.
+    let alone_at = |distance: &str| {
+        measure(
+            dir.path(),
+            &[p, "--alone", "petal-1", "--contact-distance", distance],
+        )
+        .1
+    };
+    let alone = alone_at("1000");
     assert_eq!(alone.len(), 4);
-    assert!(
-        alone
-            .iter()
-            .all(|row| row[1] == "petal-1" && number(row, contact) == 0.0)
-    );
+    for row in &alone {
+        assert_eq!(row[1], "petal-1");
+        assert!((number(row, contact) - number(row, area)).abs() < 1e-9 * number(row, area));
+    }
+    assert!(alone_at("0").iter().all(|row| number(row, contact) == 0.0));
     // Mistakes are refused before the run, in one line naming them.
     for (args, says) in [
         (vec![p, "--at", "9"], "past the run's last keyframe, 3"),

@@ -24,15 +24,18 @@
 //!   triangle that holds it), summed as a polyline.
 //! - **Margin length**: the rim without its base: the boundary edges with
 //!   at least one end above v = [`MARGIN_BASE_V`].
-//! - **Contact area**: the area of the organ's triangles whose centroid lies
-//!   within the contact distance of another simulated organ's surface (its
-//!   flat triangles) at that keyframe. The simulation holds a particle it
-//!   keeps off a neighbour at the collision offset from the neighbour's
-//!   (Phong) surface, so the distance is by default twice the project's
-//!   `collision_offset` ([`default_contact_distance`]): everything the
-//!   simulation holds in contact counts, with room for the centroid lying
-//!   between held particles. Parts (stamens, pistil) are not organs and do
-//!   not count. An organ simulated alone has no contact.
+//! - **Contact area**: the mixed Voronoi area (as for the curvatures;
+//!   these areas tile the surface) of the organ's vertices that lie within
+//!   the contact distance of another simulated organ's surface or of a
+//!   part's (receptacle, stamens, pistil, stem; their flat triangles) at
+//!   that keyframe. The simulation holds a particle it keeps off a
+//!   neighbour at the collision offset from the neighbour's (Phong)
+//!   surface, so the distance is by default twice the project's
+//!   `collision_offset` ([`default_contact_distance`]): every particle the
+//!   simulation holds in contact counts, with room for the flat triangles
+//!   lying inside the Phong surface. Per vertex, as the simulation counts
+//!   particles (its `contact_particles`, which also counts an organ held
+//!   off itself); an organ simulated alone touches only the parts.
 //!
 //! Everything is in the project's length units; [`Quantity`] scales a
 //! summary into the project's real unit (millimetres) for tables.
@@ -376,28 +379,43 @@ impl TriangleGrid {
     }
 }
 
-/// Per organ, per triangle: whether its centroid lies within `distance` of
-/// another organ's triangles. `organs` are each organ's positions and
-/// triangles at one keyframe.
-pub fn contact_triangles(organs: &[(&[DVec3], &[[u32; 3]])], distance: f64) -> Vec<Vec<bool>> {
+/// A surface as positions and triangles.
+pub type Surface<'a> = (&'a [DVec3], &'a [[u32; 3]]);
+
+/// Per organ, per vertex: whether it lies within `distance` of another
+/// organ of `organs` or of one of `parts` (each organ's and part's
+/// positions and triangles at one keyframe).
+pub fn contact_vertices(
+    organs: &[Surface<'_>],
+    parts: &[Surface<'_>],
+    distance: f64,
+) -> Vec<Vec<bool>> {
     let grids = grids(organs, distance);
+    let part_grids = grids_of(parts, distance);
     (0..organs.len())
         .into_par_iter()
-        .map(|o| contact_of(&grids, organs, o, distance))
+        .map(|o| contact_of(&grids, organs, &part_grids, parts, o, distance))
         .collect()
 }
 
-/// [`contact_triangles`] of organ `organ` only.
-pub fn contact_triangles_of(
-    organs: &[(&[DVec3], &[[u32; 3]])],
+/// [`contact_vertices`] of organ `organ` only.
+pub fn contact_vertices_of(
+    organs: &[Surface<'_>],
+    parts: &[Surface<'_>],
     organ: usize,
     distance: f64,
 ) -> Vec<bool> {
-    contact_of(&grids(organs, distance), organs, organ, distance)
+    let grids = grids(organs, distance);
+    let part_grids = grids_of(parts, distance);
+    contact_of(&grids, organs, &part_grids, parts, organ, distance)
 }
 
-fn grids(organs: &[(&[DVec3], &[[u32; 3]])], distance: f64) -> Vec<TriangleGrid> {
-    organs
+fn grids(organs: &[Surface<'_>], distance: f64) -> Vec<TriangleGrid> {
+    grids_of(organs, distance)
+}
+
+fn grids_of(surfaces: &[Surface<'_>], distance: f64) -> Vec<TriangleGrid> {
+    surfaces
         .par_iter()
         .map(|(x, t)| TriangleGrid::new(x, t, distance))
         .collect()
@@ -405,25 +423,26 @@ fn grids(organs: &[(&[DVec3], &[[u32; 3]])], distance: f64) -> Vec<TriangleGrid>
 
 fn contact_of(
     grids: &[TriangleGrid],
-    organs: &[(&[DVec3], &[[u32; 3]])],
+    organs: &[Surface<'_>],
+    part_grids: &[TriangleGrid],
+    parts: &[Surface<'_>],
     o: usize,
     distance: f64,
 ) -> Vec<bool> {
-    let (x, triangles) = organs[o];
-    let others: Vec<usize> = (0..organs.len())
-        .filter(|&b| {
-            b != o
-                && !(grids[o].high.cmplt(grids[b].low).any()
-                    || grids[o].low.cmpgt(grids[b].high).any())
-        })
+    let (x, _) = organs[o];
+    let apart =
+        |a: &TriangleGrid, b: &TriangleGrid| a.high.cmplt(b.low).any() || a.low.cmpgt(b.high).any();
+    let others: Vec<(&TriangleGrid, Surface<'_>)> = (0..organs.len())
+        .filter(|&b| b != o)
+        .map(|b| (&grids[b], organs[b]))
+        .chain(part_grids.iter().zip(parts.iter().copied()))
+        .filter(|(grid, _)| !apart(&grids[o], grid))
         .collect();
-    triangles
-        .iter()
-        .map(|t| {
-            let centroid = t.map(|i| x[i as usize]).iter().sum::<DVec3>() / 3.0;
+    x.iter()
+        .map(|&p| {
             others
                 .iter()
-                .any(|&b| grids[b].near(centroid, organs[b].0, organs[b].1, distance))
+                .any(|(grid, (y, t))| grid.near(p, y, t, distance))
         })
         .collect()
 }
@@ -474,11 +493,8 @@ pub struct OrganMeasure {
     /// Principal stretches per vertex: its triangles' weighted by their
     /// area in the bud.
     pub vertex_stretches: Vec<[f64; 2]>,
-    /// Per triangle: whether it touches another organ.
+    /// Per vertex: whether it touches another organ or a part.
     pub contact: Vec<bool>,
-    /// Per vertex: the share of its triangles' area that touches another
-    /// organ (0 to 1).
-    pub vertex_contact: Vec<f64>,
     /// The summary.
     pub summary: Summary,
 }
@@ -505,7 +521,8 @@ pub struct Summary {
     pub midrib_length: f64,
     /// Length of the margin.
     pub margin_length: f64,
-    /// Area of the triangles touching another organ (length²).
+    /// The mixed area of the vertices touching another organ or a part
+    /// (length²).
     pub contact_area: f64,
 }
 
@@ -635,20 +652,21 @@ pub fn weighted_mean(values: &[f64], weights: &[f64]) -> f64 {
 }
 
 /// Every organ at one keyframe: `layouts`, `bud` and `now` per organ, in
-/// the same order, contact measured against the other organs of `now`
-/// within `contact_distance`.
+/// the same order, contact measured against the other organs of `now` and
+/// the `parts` (their surfaces at that keyframe) within `contact_distance`.
 pub fn measure_keyframe(
     layouts: &[OrganLayout],
     bud: &[Vec<DVec3>],
     now: &[Vec<DVec3>],
+    parts: &[Surface<'_>],
     contact_distance: f64,
 ) -> Vec<OrganMeasure> {
-    let surfaces: Vec<(&[DVec3], &[[u32; 3]])> = layouts
+    let surfaces: Vec<Surface<'_>> = layouts
         .iter()
         .zip(now)
         .map(|(l, x)| (x.as_slice(), l.triangles.as_slice()))
         .collect();
-    let contact = contact_triangles(&surfaces, contact_distance);
+    let contact = contact_vertices(&surfaces, parts, contact_distance);
     layouts
         .par_iter()
         .zip(bud)
@@ -658,7 +676,7 @@ pub fn measure_keyframe(
         .collect()
 }
 
-/// One organ at one keyframe, its triangles' `contact` given.
+/// One organ at one keyframe, its vertices' `contact` given.
 pub fn measure_organ(
     layout: &OrganLayout,
     bud: &[DVec3],
@@ -685,29 +703,18 @@ pub fn measure_organ(
     let n = x.len();
     let mut stretch_sum = vec![[0.0; 2]; n];
     let mut bud_weight = vec![0.0; n];
-    let mut contact_sum = vec![0.0; n];
-    let mut area_sum = vec![0.0; n];
     for (m, t) in triangles.iter().enumerate() {
         for &i in t {
             let i = i as usize;
             stretch_sum[i][0] += area_bud[m] * stretches[m][0];
             stretch_sum[i][1] += area_bud[m] * stretches[m][1];
             bud_weight[i] += area_bud[m];
-            area_sum[i] += area_now[m];
-            if contact[m] {
-                contact_sum[i] += area_now[m];
-            }
         }
     }
     let vertex_stretches = stretch_sum
         .iter()
         .zip(&bud_weight)
         .map(|(s, w)| [s[0] / w, s[1] / w])
-        .collect();
-    let vertex_contact = contact_sum
-        .iter()
-        .zip(&area_sum)
-        .map(|(c, a)| if *a > 0.0 { c / a } else { 0.0 })
         .collect();
     let major: Vec<f64> = stretches.iter().map(|s| s[0]).collect();
     let minor: Vec<f64> = stretches.iter().map(|s| s[1]).collect();
@@ -722,7 +729,8 @@ pub fn measure_organ(
         midrib_length: layout.midrib.length(x, triangles),
         margin_length: edges_length(x, &layout.margin),
         // Folded from +0 (a sum of nothing is -0 in Rust, "-0" in a table).
-        contact_area: area_now
+        contact_area: curvature
+            .area
             .iter()
             .zip(&contact)
             .filter(|(_, c)| **c)
@@ -734,7 +742,6 @@ pub fn measure_organ(
         stretches,
         vertex_stretches,
         contact,
-        vertex_contact,
         summary,
     }
 }

@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use anthesis_mesh::Mesh;
 use anthesis_mesh::generate::{flat_sheet, parametric_grid};
 use anthesis_sim::measure::{
-    OrganLayout, QUANTITIES, angle_defects_and_areas, boundary_vertices, contact_triangles,
+    OrganLayout, QUANTITIES, angle_defects_and_areas, boundary_vertices, contact_vertices,
     measure_keyframe, nan_median, principal_stretches, vertex_curvatures,
 };
 use glam::DVec3;
@@ -210,49 +210,67 @@ fn moved(mesh: &Mesh, by: DVec3) -> Vec<DVec3> {
     mesh.positions.iter().map(|p| *p + by).collect()
 }
 
+/// The contact areas of two `width` x 1 sheets of `columns` x `rows`
+/// vertices, the second moved 1 along X and `gap` up, and of a third far
+/// away, against `parts` too.
+fn overlapping_sheets(columns: usize, rows: usize, gap: f64, parts: &[Mesh]) -> Vec<f64> {
+    let sheet = flat_sheet(2.0, 1.0, columns, rows);
+    let a = sheet.positions.clone();
+    let b = moved(&sheet, DVec3::new(1.0, 0.0, gap));
+    let far = moved(&sheet, DVec3::new(0.0, 0.0, 5.0));
+    let layout = OrganLayout::new(&sheet);
+    let layouts = [layout.clone(), layout.clone(), layout];
+    let now = [a, b, far];
+    let surfaces: Vec<(&[DVec3], &[[u32; 3]])> = parts
+        .iter()
+        .map(|p| (p.positions.as_slice(), p.triangles.as_slice()))
+        .collect();
+    measure_keyframe(&layouts, &now, &now, &surfaces, 0.02)
+        .iter()
+        .map(|m| {
+            assert!((m.summary.area - 2.0).abs() < 1e-12);
+            m.summary.contact_area
+        })
+        .collect()
+}
+
 #[test]
 fn two_sheets_overlapping_by_one_square_touch_over_it() {
     // Two 2 x 1 sheets, the second moved 1 along X and 0.005 up: they
-    // overlap over [0, 1] x [0, 1], area 1 (the grid's lines fall on x = 0
-    // and x = 1, spacing 0.1).
+    // overlap over [0, 1] x [0, 1], area 1. The contact area is the
+    // vertices' areas, so it meets the overlap within the vertices along
+    // its edge: half a column of the grid (spacing h) either side.
+    for (columns, rows, h) in [(21, 11, 0.1), (41, 21, 0.05), (81, 41, 0.025)] {
+        let areas = overlapping_sheets(columns, rows, 0.005, &[]);
+        for area in &areas[..2] {
+            assert!(
+                (area - 1.0).abs() <= 0.5 * h + 1e-12,
+                "{area} with spacing {h}"
+            );
+        }
+        assert_eq!(areas[2], 0.0);
+    }
+    // Further apart than the distance: no contact.
+    let areas = overlapping_sheets(21, 11, 0.05, &[]);
+    assert!(areas.iter().all(|&a| a == 0.0));
+    // A part touching the far sheet over all of it: its whole area.
+    let mut part = flat_sheet(2.0, 1.0, 5, 3);
+    part.positions.iter_mut().for_each(|p| p.z = 5.01);
+    let areas = overlapping_sheets(21, 11, 0.05, &[part]);
+    assert_eq!(areas[..2], [0.0, 0.0]);
+    assert!((areas[2] - 2.0).abs() < 1e-12);
+}
+
+#[test]
+fn contact_vertices_are_those_within_the_distance() {
     let sheet = flat_sheet(2.0, 1.0, 21, 11);
     let a = sheet.positions.clone();
     let b = moved(&sheet, DVec3::new(1.0, 0.0, 0.005));
-    let far = moved(&sheet, DVec3::new(0.0, 0.0, 5.0));
     let t = sheet.triangles.as_slice();
-    let contact = contact_triangles(&[(&a, t), (&b, t), (&far, t)], 0.02);
-    let area = |organ: &[DVec3], flags: &[bool]| -> f64 {
-        t.iter()
-            .zip(flags)
-            .filter(|(_, c)| **c)
-            .map(|(t, _)| {
-                let [p, q, r] = t.map(|i| organ[i as usize]);
-                0.5 * (q - p).cross(r - p).length()
-            })
-            .sum()
-    };
-    assert!((area(&a, &contact[0]) - 1.0).abs() < 1e-12);
-    assert!((area(&b, &contact[1]) - 1.0).abs() < 1e-12);
-    assert!(!contact[2].iter().any(|&c| c));
-    // Further apart than the distance: no contact.
-    let apart = moved(&sheet, DVec3::new(1.0, 0.0, 0.05));
-    let contact = contact_triangles(&[(&a, t), (&apart, t)], 0.02);
-    assert!(!contact.iter().flatten().any(|&c| c));
-
-    // The same through measure_keyframe, the table's summary.
-    let layout = OrganLayout::new(&sheet);
-    let layouts = [layout.clone(), layout];
-    let measures = measure_keyframe(
-        &layouts,
-        &[a.clone(), b.clone()],
-        &[a.clone(), b.clone()],
-        0.02,
-    );
-    for m in &measures {
-        assert!((m.summary.contact_area - 1.0).abs() < 1e-12);
-        assert!((m.summary.area - 2.0).abs() < 1e-12);
-        // Every vertex of the overlap's inside is touched all round.
-        assert!(m.vertex_contact.iter().filter(|&&c| c == 1.0).count() >= 9 * 9);
+    let contact = contact_vertices(&[(&a, t), (&b, t)], &[], 0.02);
+    for (p, touching) in a.iter().zip(&contact[0]) {
+        // x from -1 to 1; the other sheet covers x from 0 to 2.
+        assert_eq!(*touching, p.x >= -1e-12, "{p}");
     }
 }
 
@@ -264,7 +282,7 @@ fn a_sheet_has_its_midrib_and_margin_lengths_and_they_scale() {
     let sheet = flat_sheet(w, h, 7, 13);
     let layout = OrganLayout::new(&sheet);
     let bud = vec![sheet.positions.clone()];
-    let m = &measure_keyframe(std::slice::from_ref(&layout), &bud, &bud, 0.01)[0];
+    let m = &measure_keyframe(std::slice::from_ref(&layout), &bud, &bud, &[], 0.01)[0];
     assert!((m.summary.midrib_length - h).abs() < 1e-12);
     assert!((m.summary.margin_length - (2.0 * h + w)).abs() < 1e-12);
     assert!((m.summary.stretch_major_mean - 1.0).abs() < 1e-12);
@@ -272,7 +290,7 @@ fn a_sheet_has_its_midrib_and_margin_lengths_and_they_scale() {
     assert_eq!(m.summary.gaussian_curvature_median, 0.0);
 
     let grown = vec![sheet.positions.iter().map(|p| 1.5 * *p).collect::<Vec<_>>()];
-    let m = &measure_keyframe(std::slice::from_ref(&layout), &bud, &grown, 0.01)[0];
+    let m = &measure_keyframe(std::slice::from_ref(&layout), &bud, &grown, &[], 0.01)[0];
     assert!((m.summary.midrib_length - 1.5 * h).abs() < 1e-12);
     assert!((m.summary.margin_length - 1.5 * (2.0 * h + w)).abs() < 1e-12);
     assert!((m.summary.stretch_major_mean - 1.5).abs() < 1e-12);
@@ -294,7 +312,7 @@ fn a_bent_petal_midrib_follows_the_uv_line() {
     });
     let layout = OrganLayout::new(&mesh);
     let x = vec![mesh.positions.clone()];
-    let m = &measure_keyframe(std::slice::from_ref(&layout), &x, &x, 0.01)[0];
+    let m = &measure_keyframe(std::slice::from_ref(&layout), &x, &x, &[], 0.01)[0];
     // The polyline through chords of the 40 rows: within their sagitta.
     assert!(
         (m.summary.midrib_length - PI).abs() < 2e-3,
