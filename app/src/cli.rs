@@ -8,6 +8,7 @@ mod fit;
 #[cfg(test)]
 mod fuzz;
 mod import_scan;
+mod measure;
 pub mod pde_blossom;
 mod render;
 mod simulate;
@@ -136,6 +137,9 @@ pub enum Command {
     /// Fit growth maps to a target open shape of one organ ("which maps make
     /// it open like this?") and write the project with the fitted maps.
     Fit(fit::FitArgs),
+    /// Simulate a project and write its measurements per keyframe and organ
+    /// as a CSV table (curvatures, stretches, midrib, margin, contact area).
+    Measure(measure::MeasureArgs),
     /// Write a starting point as a project folder: a flower built into the
     /// binary (lily, eustoma-maite-lady, eustoma-mellow-yellow,
     /// eustoma-pinocchio, apple, lily-decay, or five-petal: an empty flower
@@ -360,6 +364,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Blossom(args)) => blossom::blossom(&args),
         Some(Command::PdeBlossom(args)) => pde_blossom::pde_blossom(&args),
         Some(Command::Fit(args)) => fit::fit(&args),
+        Some(Command::Measure(args)) => measure::measure(&args),
         Some(Command::New { from, dir }) => new_project(&from, &dir),
     }
 }

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
+#[path = "cli/measure.rs"]
+mod measure;
 
 use common::{anthesis, one_line_error, text};
 

@@ -22,6 +22,10 @@ mod common;
 mod sketch_room;
 #[path = "desktop/panels.rs"]
 mod panels;
+#[path = "desktop/difference.rs"]
+mod difference;
+#[path = "desktop/measure.rs"]
+mod measure;
 
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {

@@ -21,6 +21,12 @@ __all__ = [
     "builtins",
     "load",
     "map_names",
+    "measure_angle_defects",
+    "measure_boundary",
+    "measure_curvatures",
+    "measure_margin",
+    "measure_midrib",
+    "measure_stretches",
 ]
 
 MAX_KEYFRAMES: int
@@ -165,6 +171,10 @@ class Result:
         """uint32 [m, 3]."""
     def uvs(self, organ: str | int) -> npt.NDArray[np.float64]:
         """float64 [n, 2]."""
+    def measures(
+        self, organ: str | int, base_v: float = 0.05, contact_distance: float | None = None
+    ) -> dict[str, npt.NDArray[Any]]:
+        """Every measurement of one organ per keyframe (see ``anthesis.measure.organ_measures``)."""
     def export(
         self,
         path: str | os.PathLike[str],
@@ -183,3 +193,34 @@ class Result:
     ) -> npt.NDArray[np.uint8]:
         """RGBA uint8 [height, width, 4] of one keyframe (default: the last)."""
     def __len__(self) -> int: ...
+
+# The measurements of ``anthesis.measure`` (``anthesis_sim::measure``); use
+# that module, which checks and converts its arguments.
+def measure_curvatures(
+    positions: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Mean and Gaussian curvature per vertex, NaN on the rim."""
+def measure_angle_defects(
+    positions: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Angle defect and mixed Voronoi area per vertex."""
+def measure_boundary(faces: npt.NDArray[np.int64], n: int) -> npt.NDArray[np.bool_]:
+    """Whether each vertex lies on the rim."""
+def measure_stretches(
+    rest: npt.NDArray[np.float64], current: npt.NDArray[np.float64], faces: npt.NDArray[np.int64]
+) -> npt.NDArray[np.float64]:
+    """Principal stretches per triangle, [m, 2], largest first."""
+def measure_midrib(
+    positions: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    uvs: npt.NDArray[np.float64],
+    samples: int,
+) -> float:
+    """Length of the curve u = 0.5 through the UV layout."""
+def measure_margin(
+    positions: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    uvs: npt.NDArray[np.float64],
+    base_v: float,
+) -> float:
+    """Length of the rim edges with an end above v = base_v."""

@@ -1289,6 +1289,126 @@ impl PyRunResult {
         Ok(uv_array(py, &template.mesh.uvs))
     }
 
+    /// Every measurement of one organ over the run
+    /// (`anthesis_sim::measure`, as `anthesis measure` writes them), in
+    /// project units: per vertex `mean_curvature`, `gaussian_curvature`
+    /// (NaN on the rim), `vertex_stretches` [k + 1, n, 2], `contact` (bool:
+    /// within the contact distance of another organ or a part); per
+    /// triangle `principal_stretches` [k + 1, m, 2]; per
+    /// keyframe the summaries `area`, `mean_curvature_median`,
+    /// `mean_curvature_mean`, `gaussian_curvature_median` (also
+    /// `median_gaussian`), `gaussian_curvature_mean`,
+    /// `stretch_major_mean`, `stretch_minor_mean`, `midrib_length`,
+    /// `margin_length`, `contact_area`.
+    #[pyo3(signature = (organ, base_v = 0.05, contact_distance = None))]
+    fn measures<'py>(
+        &self,
+        py: Python<'py>,
+        organ: &Bound<'_, PyAny>,
+        base_v: f64,
+        contact_distance: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        use anthesis_sim::measure::{self as m, OrganLayout};
+        let slot = self.slot(organ)?;
+        if !(0.0..=1.0).contains(&base_v) {
+            return Err(PyValueError::new_err(format!(
+                "base_v must be from 0 to 1, got {base_v}"
+            )));
+        }
+        let distance = contact_distance.unwrap_or_else(|| {
+            m::default_contact_distance(self.data.project.settings.collision_offset)
+        });
+        if !(distance >= 0.0 && distance.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "contact_distance must be 0 or more (and finite), got {distance}"
+            )));
+        }
+        let data = Arc::clone(&self.data);
+        let measures: Vec<m::OrganMeasure> = py.detach(move || {
+            let flower = &data.project.flower;
+            let layouts: Vec<OrganLayout> = data
+                .organs
+                .iter()
+                .map(|&i| OrganLayout::with_margin_base(&flower.template_of(i).mesh, base_v))
+                .collect();
+            // The parts (receptacle, stamens, pistils, stem) at a keyframe.
+            let pieces = anthesis_flower::parts::part_pieces(flower);
+            let at = |k: usize| -> Vec<Vec<DVec3>> {
+                let step = u32::try_from(k).unwrap_or(u32::MAX);
+                pieces.iter().map(|p| p.positions_at(step)).collect()
+            };
+            data.frames
+                .iter()
+                .enumerate()
+                .map(|(frame_index, frame)| {
+                    let surfaces: Vec<(&[DVec3], &[[u32; 3]])> = layouts
+                        .iter()
+                        .zip(frame)
+                        .map(|(l, x)| (x.as_slice(), l.triangles()))
+                        .collect();
+                    let parts_at = at(frame_index);
+                    let parts: Vec<m::Surface<'_>> = pieces
+                        .iter()
+                        .zip(&parts_at)
+                        .map(|(p, x)| (x.as_slice(), p.mesh.triangles.as_slice()))
+                        .collect();
+                    let contact = m::contact_vertices_of(&surfaces, &parts, slot, distance);
+                    m::measure_organ(&layouts[slot], &data.frames[0][slot], &frame[slot], contact)
+                })
+                .collect()
+        });
+        let k = measures.len();
+        let n = measures.first().map_or(0, |f| f.mean_curvature.len());
+        let t = measures.first().map_or(0, |f| f.stretches.len());
+        let shape_error = |e: numpy::ndarray::ShapeError| PyValueError::new_err(e.to_string());
+        let per = |get: &dyn Fn(&m::OrganMeasure) -> Vec<f64>, width: usize| {
+            let flat: Vec<f64> = measures.iter().flat_map(get).collect();
+            Array2::from_shape_vec((k, width), flat).map_err(shape_error)
+        };
+        let dict = PyDict::new(py);
+        dict.set_item(
+            "mean_curvature",
+            per(&|f| f.mean_curvature.clone(), n)?.into_pyarray(py),
+        )?;
+        dict.set_item(
+            "gaussian_curvature",
+            per(&|f| f.gaussian_curvature.clone(), n)?.into_pyarray(py),
+        )?;
+        let contact: Vec<bool> = measures.iter().flat_map(|f| f.contact.clone()).collect();
+        dict.set_item(
+            "contact",
+            Array2::from_shape_vec((k, n), contact)
+                .map_err(shape_error)?
+                .into_pyarray(py),
+        )?;
+        for (name, width, get) in [
+            (
+                "principal_stretches",
+                t,
+                (|f: &m::OrganMeasure| f.stretches.clone())
+                    as fn(&m::OrganMeasure) -> Vec<[f64; 2]>,
+            ),
+            ("vertex_stretches", n, |f| f.vertex_stretches.clone()),
+        ] {
+            let flat: Vec<f64> = measures
+                .iter()
+                .flat_map(|f| get(f).into_iter().flatten())
+                .collect();
+            let array = Array3::from_shape_vec((k, width, 2), flat).map_err(shape_error)?;
+            dict.set_item(name, array.into_pyarray(py))?;
+        }
+        for q in &m::QUANTITIES {
+            let values: Vec<f64> = measures.iter().map(|f| (q.get)(&f.summary)).collect();
+            dict.set_item(q.name, vector(py, values))?;
+        }
+        let median: Vec<f64> = measures
+            .iter()
+            .map(|f| f.summary.gaussian_curvature_median)
+            .collect();
+        dict.set_item("median_gaussian", vector(py, median))?;
+        Ok(dict)
+    }
+
     /// Per keyframe statistics as float64 or int arrays of length
     /// keyframes + 1: energy (total elastic energy), iterations (Newton
     /// iterations), relative_gradient, contact_particles,
@@ -1338,8 +1458,9 @@ impl PyRunResult {
 
     /// Renders keyframe `keyframe` offscreen (wgpu; lavapipe without a
     /// GPU) as the command line's `anthesis render` frames it: uint8
-    /// [height, width, 4] RGBA. Organs are drawn in their template colours
-    /// (painted colour maps and the non-growing parts are left out).
+    /// [height, width, 4] RGBA. Organs are drawn in their templates' painted
+    /// colour maps (or colours), with the parts that do not grow, as
+    /// `anthesis render` draws them.
     #[pyo3(signature = (keyframe = None, width = 640, height = 480, azimuth = 30.0, elevation = 20.0))]
     fn render<'py>(
         &self,
@@ -1451,22 +1572,51 @@ fn render(
             "{width}x{height} is too large: this GPU renders at most {max_side} pixels a side"
         )));
     }
-    let meshes_at = |frame: &[Vec<DVec3>]| -> Vec<anthesis_render::OrganMesh> {
-        frame
-            .iter()
-            .zip(&data.organs)
-            .map(|(positions, &organ)| {
-                let template = data.project.flower.template_of(organ);
-                anthesis_render::OrganMesh::from_positions(
+    let flower = &data.project.flower;
+    // What `anthesis render` draws (app/src/look.rs, app/src/parts.rs):
+    // each organ in its template's colour, or white times the template's
+    // baked colour map (both sides in an atlas when they differ), and the
+    // parts (receptacle, stamens, pistils, stem) at the keyframe.
+    let mut organs: Vec<anthesis_render::OrganMesh> = data.frames[keyframe]
+        .iter()
+        .zip(&data.organs)
+        .map(|(positions, &organ)| {
+            let template = flower.template_of(organ);
+            if template.colouring.is_none() {
+                return anthesis_render::OrganMesh::from_positions(
                     positions,
                     &template.mesh.triangles,
                     template.color,
-                )
-            })
-            .collect()
-    };
+                );
+            }
+            let mesh = anthesis_render::OrganMesh::from_positions(
+                positions,
+                &template.mesh.triangles,
+                [1.0; 4],
+            );
+            let uvs = template
+                .mesh
+                .uvs
+                .iter()
+                .map(|uv| uv.as_vec2().to_array())
+                .collect();
+            let (width, height) = template.colour_image_size();
+            if template.is_two_sided() {
+                mesh.with_two_sided_texture(uvs, Arc::new(template.colour_atlas(width, height)))
+            } else {
+                mesh.with_texture(uvs, Arc::new(template.colour_image(width, height)))
+            }
+        })
+        .collect();
+    let step = u32::try_from(keyframe).unwrap_or(u32::MAX);
+    for piece in anthesis_flower::parts::part_pieces(flower) {
+        organs.push(anthesis_render::OrganMesh::from_positions(
+            &piece.positions_at(step),
+            &piece.mesh.triangles,
+            piece.color,
+        ));
+    }
     // Framed as `anthesis render --frames KEYFRAME` frames it.
-    let organs = meshes_at(&data.frames[keyframe]);
     let Some((lo, hi)) = anthesis_render::organs_bounds_in_world(&organs) else {
         return Err(RenderError::new_err(
             "there is nothing to render: the organs have no vertices",
@@ -1479,6 +1629,181 @@ fn render(
     Ok(picture.into_raw())
 }
 
+/// `positions` as points: float64 [n, 3] (measure.py makes it so).
+fn points_in(positions: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
+    let array: numpy::PyReadonlyArray2<f64> = positions
+        .extract()
+        .map_err(|_| PyValueError::new_err(format!("{what} must be a float64 array [n, 3]")))?;
+    let view = array.as_array();
+    if view.ncols() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{what} must be [n, 3], got {:?}",
+            view.shape()
+        )));
+    }
+    Ok(view
+        .rows()
+        .into_iter()
+        .map(|r| DVec3::new(r[0], r[1], r[2]))
+        .collect())
+}
+
+/// `faces` as triangles of `n` vertices: int64 [m, 3], each index in 0..n.
+fn faces_in(faces: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<[u32; 3]>> {
+    let array: numpy::PyReadonlyArray2<i64> = faces
+        .extract()
+        .map_err(|_| PyValueError::new_err("faces must be an int64 array [m, 3]"))?;
+    let view = array.as_array();
+    if view.ncols() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "faces must be [m, 3], got {:?}",
+            view.shape()
+        )));
+    }
+    view.rows()
+        .into_iter()
+        .map(|r| {
+            let mut t = [0u32; 3];
+            for k in 0..3 {
+                t[k] = u32::try_from(r[k])
+                    .ok()
+                    .filter(|&i| (i as usize) < n)
+                    .ok_or_else(|| {
+                        PyValueError::new_err(format!(
+                            "faces index {} is out of range for {n} vertices",
+                            r[k]
+                        ))
+                    })?;
+            }
+            Ok(t)
+        })
+        .collect()
+}
+
+/// `uvs` as float64 [n, 2].
+fn uvs_in(uvs: &Bound<'_, PyAny>, n: usize) -> PyResult<Vec<glam::DVec2>> {
+    let array: numpy::PyReadonlyArray2<f64> = uvs
+        .extract()
+        .map_err(|_| PyValueError::new_err("uvs must be a float64 array [n, 2]"))?;
+    let view = array.as_array();
+    if view.ncols() != 2 || view.nrows() != n {
+        return Err(PyValueError::new_err(format!(
+            "uvs must be [{n}, 2], got {:?}",
+            view.shape()
+        )));
+    }
+    Ok(view
+        .rows()
+        .into_iter()
+        .map(|r| glam::DVec2::new(r[0], r[1]))
+        .collect())
+}
+
+fn vector<'py>(py: Python<'py>, values: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
+    Array1::from_vec(values).into_pyarray(py)
+}
+
+fn pairs<'py>(py: Python<'py>, values: &[[f64; 2]]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = values.iter().flatten().copied().collect();
+    Array2::from_shape_vec((values.len(), 2), flat)
+        .unwrap_or_else(|_| Array2::zeros((0, 2)))
+        .into_pyarray(py)
+}
+
+/// Mean and Gaussian curvature per vertex (H [n], K [n]), NaN on the rim
+/// (`anthesis_sim::measure::vertex_curvatures`).
+#[pyfunction]
+fn measure_curvatures<'py>(
+    py: Python<'py>,
+    positions: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let x = points_in(positions, "positions")?;
+    let f = faces_in(faces, x.len())?;
+    let c = py.detach(|| {
+        let boundary = anthesis_sim::measure::boundary_vertices(&f, x.len());
+        anthesis_sim::measure::vertex_curvatures(&x, &f, &boundary)
+    });
+    Ok((vector(py, c.mean), vector(py, c.gaussian)))
+}
+
+/// Per vertex the angle defect (radians) and the mixed Voronoi area.
+#[pyfunction]
+fn measure_angle_defects<'py>(
+    py: Python<'py>,
+    positions: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    let x = points_in(positions, "positions")?;
+    let f = faces_in(faces, x.len())?;
+    let (defect, area) = py.detach(|| anthesis_sim::measure::angle_defects_and_areas(&x, &f));
+    Ok((vector(py, defect), vector(py, area)))
+}
+
+/// Whether each of `n` vertices lies on an edge of one triangle only.
+#[pyfunction]
+fn measure_boundary<'py>(
+    py: Python<'py>,
+    faces: &Bound<'py, PyAny>,
+    n: usize,
+) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let f = faces_in(faces, n)?;
+    Ok(Array1::from_vec(anthesis_sim::measure::boundary_vertices(&f, n)).into_pyarray(py))
+}
+
+/// Principal stretches per triangle from `rest` to `current`: [m, 2],
+/// largest first.
+#[pyfunction]
+fn measure_stretches<'py>(
+    py: Python<'py>,
+    rest: &Bound<'py, PyAny>,
+    current: &Bound<'py, PyAny>,
+    faces: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let x0 = points_in(rest, "rest")?;
+    let x1 = points_in(current, "current")?;
+    if x0.len() != x1.len() {
+        return Err(PyValueError::new_err(format!(
+            "rest and current must have as many points, got {} and {}",
+            x0.len(),
+            x1.len()
+        )));
+    }
+    let f = faces_in(faces, x0.len())?;
+    let s = py.detach(|| anthesis_sim::measure::principal_stretches(&x0, &x1, &f));
+    Ok(pairs(py, &s))
+}
+
+/// The length of the midrib (u = 0.5, v from 0 to 1, `samples` points).
+#[pyfunction]
+fn measure_midrib(
+    py: Python<'_>,
+    positions: &Bound<'_, PyAny>,
+    faces: &Bound<'_, PyAny>,
+    uvs: &Bound<'_, PyAny>,
+    samples: usize,
+) -> PyResult<f64> {
+    let x = points_in(positions, "positions")?;
+    let f = faces_in(faces, x.len())?;
+    let uv = uvs_in(uvs, x.len())?;
+    Ok(py.detach(|| anthesis_sim::measure::UvPath::midrib(&uv, &f, samples).length(&x, &f)))
+}
+
+/// The length of the margin: rim edges with an end above v = `base_v`.
+#[pyfunction]
+fn measure_margin(
+    positions: &Bound<'_, PyAny>,
+    faces: &Bound<'_, PyAny>,
+    uvs: &Bound<'_, PyAny>,
+    base_v: f64,
+) -> PyResult<f64> {
+    let x = points_in(positions, "positions")?;
+    let f = faces_in(faces, x.len())?;
+    let uv = uvs_in(uvs, x.len())?;
+    let edges = anthesis_sim::measure::margin_edges(&uv, &f, base_v);
+    Ok(anthesis_sim::measure::edges_length(&x, &edges))
+}
+
 /// The engine of Anthesis for Python; use the `anthesis` package.
 #[pymodule]
 fn _anthesis(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -1486,6 +1811,12 @@ fn _anthesis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(builtins, m)?)?;
     m.add_function(wrap_pyfunction!(map_names, m)?)?;
+    m.add_function(wrap_pyfunction!(measure_curvatures, m)?)?;
+    m.add_function(wrap_pyfunction!(measure_angle_defects, m)?)?;
+    m.add_function(wrap_pyfunction!(measure_boundary, m)?)?;
+    m.add_function(wrap_pyfunction!(measure_stretches, m)?)?;
+    m.add_function(wrap_pyfunction!(measure_midrib, m)?)?;
+    m.add_function(wrap_pyfunction!(measure_margin, m)?)?;
     m.add_class::<PyProject>()?;
     m.add_class::<PyRunResult>()?;
     m.add("AnthesisError", py.get_type::<AnthesisError>())?;

@@ -208,6 +208,12 @@ pub const SHORTCUTS: &[Shortcut] = &[
         command: |app| Command::SetSingleOrganPreview(!app.single_organ_preview),
     },
     Shortcut {
+        keys: &[plain(super::difference::BEFORE_KEY)],
+        does: "Hold: the result before the last edit (release: the current one)",
+        scope: Scope::NotTyping,
+        command: |app| Command::SetView(app.view),
+    },
+    Shortcut {
         keys: &[plain(Key::H)],
         does: "Undo history window",
         scope: Scope::NotTyping,
@@ -428,6 +434,7 @@ impl AnthesisApp {
                         .on_hover_text(super::words::tooltip(kind.label()));
                     }
                 });
+                super::measure_panel::menu_entry(ui);
                 if view != self.view {
                     chosen.push(Command::SetView(view));
                 }

@@ -190,6 +190,7 @@ impl AnthesisApp {
         self.log.banner_ui(ui);
         let overlay = self.view.overlay.map(|kind| (kind, self.paint.key));
         let fit_target = self.fit.target_overlay().0;
+        let (before, before_revision) = self.before_in_key(ui.ctx());
         let key = viewport::SceneKey {
             document_revision: self.doc.revision(),
             run: self.session.run(),
@@ -198,6 +199,9 @@ impl AnthesisApp {
             time_in_keyframes: self.playback.time_in_keyframes,
             selected_organ: self.selected_organ,
             overlay,
+            field: self.view.field,
+            before,
+            before_revision,
             show_others: self.shows_others(),
             fit_target,
         };
@@ -231,13 +235,17 @@ impl AnthesisApp {
             self.paint.on_3d,
             self.paint.brush.radius_in_uv,
         );
-        let mut row = 0;
-        if let Some((badge, color)) = timeline::viewport_badge(&self.session, key.time_in_keyframes)
+        self.measure_window(ui.ctx());
+        let mut row = self.difference_ui(ui, viewport_rect, &key, 0);
+        if let Some((badge, color)) =
+            timeline::viewport_badge(&self.session, key.time_in_keyframes).filter(|_| !key.before)
         {
             viewport::badge(ui, viewport_rect, row, badge, color);
             row += 1;
         }
-        if let Some(warning) = timeline::crossing_badge(&self.session, key.time_in_keyframes) {
+        if let Some(warning) =
+            timeline::crossing_badge(&self.session, key.time_in_keyframes).filter(|_| !key.before)
+        {
             viewport::badge(ui, viewport_rect, row, &warning, timeline::CROSSING_COLOR);
         }
         let template = self.selected_template();

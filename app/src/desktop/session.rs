@@ -8,6 +8,15 @@
 //! so an edit keeps the frame the user looks at). Each frame keeps the
 //! project whose meshes its positions belong to, so a proxy is drawn on the
 //! proxy's meshes.
+//!
+//! The session also keeps the result before the last change, for the
+//! viewport's before/after view and its difference overlay: the converged
+//! keyframes of the last run that finished ([`Outcome`]) become "before"
+//! when a run of the same organs starts on another project (an edit, an
+//! undo or a redo alike: after an undo, "before" is the result with the
+//! undone edit, so the view shows what the undo changed). A run superseded
+//! before it finished never becomes "before": during a stroke, which starts
+//! several runs, "before" stays the result from before the stroke.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -93,6 +102,16 @@ pub struct ShownAt {
     pub stale: bool,
 }
 
+/// Every converged keyframe of one finished run, the bud first.
+#[derive(Clone)]
+pub struct Outcome {
+    /// The organs run, indices into the project's organs.
+    pub organs: Vec<usize>,
+    /// The project run: its template meshes are the keyframes'.
+    pub project: Arc<Project>,
+    pub keyframes: Vec<Arc<Keyframe>>,
+}
+
 /// The frames shown for one selection of organs, set aside while another
 /// selection is simulated (the whole flower while one organ is previewed).
 struct Stash {
@@ -131,7 +150,18 @@ pub struct SimSession {
     crossed: BTreeMap<u32, Arc<Crossings>>,
     /// The serial number of the next frame.
     next_serial: u64,
+    /// The newest finished run's result for each selection of organs run
+    /// lately (at most [`FINISHED_KEPT`], the newest last).
+    finished: Vec<Outcome>,
+    /// The result before the last change (see the module documentation).
+    before: Option<Outcome>,
+    /// Counts the changes of `before`.
+    before_revision: u64,
 }
+
+/// How many selections' finished results the session keeps (the whole
+/// flower and a previewed organ or two), for "before".
+pub const FINISHED_KEPT: usize = 3;
 
 /// Longest time one frame spends taking events from the worker.
 pub const DRAIN_BUDGET: Duration = Duration::from_millis(4);
@@ -167,6 +197,9 @@ impl SimSession {
             proxy_running: false,
             crossed: BTreeMap::new(),
             next_serial: 0,
+            finished: Vec::new(),
+            before: None,
+            before_revision: 0,
         }
     }
 
@@ -190,6 +223,19 @@ impl SimSession {
         selection: Selection,
     ) -> RunId {
         let organs = selection.organs(project.flower.organs.len());
+        // The newest finished result of these organs becomes "before" when
+        // this run is of another project (see the module documentation).
+        if let Some(finished) = self.finished.iter().find(|f| f.organs == organs)
+            && !Arc::ptr_eq(&finished.project, &project)
+            && *finished.project != *project
+            && !self
+                .before
+                .as_ref()
+                .is_some_and(|b| Arc::ptr_eq(&b.project, &finished.project))
+        {
+            self.before = Some(finished.clone());
+            self.before_revision += 1;
+        }
         if organs != self.organs {
             let frames = std::mem::take(&mut self.frames);
             let previous = self.stash.replace(Stash {
@@ -259,6 +305,10 @@ impl SimSession {
         self.keyframes.clear();
         self.frames.clear();
         self.stash = None;
+        self.finished.clear();
+        if self.before.take().is_some() {
+            self.before_revision += 1;
+        }
     }
 
     /// Cancels the current run, if any; the keyframes so far stay.
@@ -385,6 +435,19 @@ impl SimSession {
                 // Every keyframe of the run is converged now; earlier runs'
                 // keyframes past its end (the count was lowered) go too.
                 self.frames.truncate(self.keyframes.len());
+                if let Some(project) = &self.project
+                    && self.keyframes.len() == self.total as usize + 1
+                {
+                    self.finished.retain(|f| f.organs != self.organs);
+                    if self.finished.len() >= FINISHED_KEPT {
+                        self.finished.remove(0);
+                    }
+                    self.finished.push(Outcome {
+                        organs: self.organs.clone(),
+                        project: Arc::clone(project),
+                        keyframes: self.keyframes.clone(),
+                    });
+                }
                 if let Some(note) = self.crossing_note() {
                     drained.warnings.push(note);
                 }
@@ -640,6 +703,40 @@ impl SimSession {
         }
         let stash = self.stash.as_ref().filter(|s| s.organs == organs)?;
         complete(&stash.frames, project.settings.keyframes)
+    }
+
+    /// The result before the last change (see the module documentation),
+    /// if there is one and it is of the organs run now.
+    pub fn before(&self) -> Option<&Outcome> {
+        self.before.as_ref().filter(|b| b.organs == self.organs)
+    }
+
+    /// Counts the changes of [`SimSession::before`]: the scene of the
+    /// result before needs building again when it changes.
+    pub fn before_revision(&self) -> u64 {
+        self.before_revision
+    }
+
+    /// The organs of the result before the last change at
+    /// `time_in_keyframes`, interpolated as [`SimSession::shown_at`] does
+    /// (times past its end show its last keyframe); `None` when there is
+    /// no such result (see [`SimSession::before`]).
+    pub fn before_at(&self, time_in_keyframes: f64) -> Option<ShownAt> {
+        let before = self.before()?;
+        let blend = KeyframeBlend::at(before.keyframes.len(), time_in_keyframes)?;
+        let below = before.keyframes.get(blend.below)?;
+        let above = before.keyframes.get(blend.above)?;
+        Some(ShownAt {
+            positions: below
+                .positions_in_world
+                .iter()
+                .zip(&above.positions_in_world)
+                .map(|(a, b)| blend.positions(a, b))
+                .collect(),
+            meshes: Arc::clone(&before.project),
+            kind: FrameKind::Converged,
+            stale: false,
+        })
     }
 
     /// Positions of every simulated organ at `time_in_keyframes` (see

@@ -22,6 +22,7 @@ pub mod fault;
 #[cfg(any(test, feature = "fixtures"))]
 pub mod fixtures;
 mod keyframe;
+pub mod measure;
 pub mod memory;
 mod obstacle;
 mod organ;

@@ -4,6 +4,7 @@
 //! shown are built in [`scene`], drawn on the GPU by [`gpu`] (through
 //! `anthesis-render`), with egui overlays from [`overlays`].
 
+pub mod field;
 pub mod gpu;
 pub mod overlays;
 pub mod scene;
@@ -18,16 +19,23 @@ use eframe::egui::{self, Color32, Pos2, Sense, Stroke, Vec2};
 use eframe::egui_wgpu;
 use glam::{DVec2, DVec3};
 
+pub use field::{FieldShown, Quantity, ScalarField, ViewField};
 pub use gpu::ViewportGpu;
 pub use overlays::Outline;
-pub use scene::{SceneCache, SceneKey, SceneOrgan, build_scene, scene_bounds, scene_meshes};
+pub use scene::{
+    SceneCache, SceneKey, SceneOrgan, build_scene, build_scene_of, scene_bounds, scene_meshes,
+};
 
 /// What the viewport shows besides the organs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct ViewOptions {
     pub wireframe: bool,
     /// A scalar map shown as a colour ramp on the surface.
     pub overlay: Option<MapKind>,
+    /// A per-vertex field ([`field`]) shown as a colour ramp with a legend,
+    /// instead of the map overlay.
+    pub field: Option<ViewField>,
     /// Arrows of the growth direction on the selected organ.
     pub direction_arrows: bool,
     /// In single-organ preview: show the other organs in their bud state
@@ -95,6 +103,13 @@ pub fn badge(ui: &egui::Ui, rect: egui::Rect, row: usize, text: &str, color: egu
     let painter = ui.painter_at(rect);
     painter.rect_filled(frame, 4.0, color);
     painter.galley(at + Vec2::new(6.0, 3.0), galley, egui::Color32::WHITE);
+    // Said to screen readers (and found by tests) as a label.
+    ui.interact(
+        frame,
+        ui.scope_id().with(("viewport badge", row)),
+        Sense::hover(),
+    )
+    .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Label, true, text));
 }
 
 /// The zoom of one mouse-wheel line (egui scrolls

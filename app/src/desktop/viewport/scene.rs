@@ -1,7 +1,9 @@
 //! The scene the viewport shows: the organs at the playhead (simulated or
-//! in their bud placement), their bounds, and the meshes handed to the
-//! renderer (template colour, selection highlight, map overlay), kept in a
-//! [`SceneCache`] while what they show does not change.
+//! in their bud placement; the current result or, while asked, the one
+//! before the last edit), their bounds, and the meshes handed to the
+//! renderer (template colour, selection highlight, a map overlay or a
+//! per-vertex [`ScalarField`]), kept in a [`SceneCache`] while what they
+//! show does not change.
 
 use std::sync::Arc;
 
@@ -13,7 +15,8 @@ use glam::{DVec2, DVec3};
 
 use anthesis_sim::worker::RunId;
 
-use crate::desktop::session::SimSession;
+use super::field::{self, FieldInput, FieldShown, ScalarField, ViewField};
+use crate::desktop::session::{ShownAt, SimSession};
 
 /// One organ as displayed.
 #[derive(Debug, Clone)]
@@ -37,13 +40,28 @@ pub fn build_scene(
     time: f64,
     show_others: bool,
 ) -> Vec<SceneOrgan> {
-    let shown = session.shown_at(time);
+    build_scene_of(
+        project,
+        session.shown_at(time).as_ref(),
+        session.organs(),
+        show_others,
+    )
+}
+
+/// The organs of `shown` (the frames at one time, one position list per
+/// organ of `organs`, in that order), as [`build_scene`] places them.
+pub fn build_scene_of(
+    project: &Project,
+    shown: Option<&ShownAt>,
+    organs: &[usize],
+    show_others: bool,
+) -> Vec<SceneOrgan> {
     let flower = &project.flower;
     let mut scene = Vec::new();
     for (i, organ) in flower.organs.iter().enumerate() {
-        let slot = session.organs().iter().position(|&o| o == i);
+        let slot = organs.iter().position(|&o| o == i);
         let simulated = slot.and_then(|s| {
-            let shown = shown.as_ref()?;
+            let shown = shown?;
             let mesh = &shown
                 .meshes
                 .flower
@@ -96,18 +114,20 @@ const HIGHLIGHT_LINEAR: [f32; 3] = [1.0, 0.71, 0.17];
 /// is the same: the renderer keeps a texture uploaded while the same image
 /// comes back); the selected one tinted towards a warm highlight; organs
 /// not simulated (bud placeholders in preview) washed out towards grey;
-/// the overlay map as a ramp.
+/// the overlay map as a ramp, or `field` (which wins) where it has values.
 pub fn scene_meshes(
     project: &Project,
     scene: &[SceneOrgan],
     selected: Option<usize>,
     overlay: Option<(MapKind, usize)>,
+    field: Option<&ScalarField>,
     looks: &mut Vec<Option<crate::look::Look>>,
 ) -> Vec<OrganMesh> {
     looks.resize(project.flower.templates.len(), None);
     scene
         .iter()
-        .map(|o| {
+        .enumerate()
+        .map(|(in_scene, o)| {
             let template = project.flower.template_of(o.organ);
             let index = project.flower.organs[o.organ].template;
             let (mut color_linear, texture) = looks[index]
@@ -124,6 +144,12 @@ pub fn scene_meshes(
             }
             let mesh = OrganMesh::from_positions(&o.positions_in_world, &o.triangles, color_linear);
             let mesh = crate::look::with_texture(mesh, &o.uvs, texture.as_ref());
+            if let Some(field) = field {
+                return match field.ramp_values(in_scene) {
+                    Some(values) => mesh.with_overlay(values),
+                    None => mesh,
+                };
+            }
             match overlay {
                 Some((kind, key)) => {
                     let map = template.maps.key_clamped(key).maps.scalar(kind);
@@ -156,6 +182,12 @@ pub struct SceneKey {
     pub selected_organ: usize,
     /// The overlaid map and its time key.
     pub overlay: Option<(MapKind, usize)>,
+    /// The per-vertex field drawn instead of the map overlay.
+    pub field: Option<ViewField>,
+    /// The result before the last edit is shown instead of the current
+    /// one, and which ([`SimSession::before_revision`]).
+    pub before: bool,
+    pub before_revision: u64,
     pub show_others: bool,
     /// The registered fit target shown over the organ
     /// (`crate::desktop::fit::FitDialog::target_overlay`; 0: none).
@@ -210,17 +242,28 @@ pub struct SceneCache {
     key: Option<SceneKey>,
     scene: Arc<Vec<SceneOrgan>>,
     meshes: Arc<Vec<OrganMesh>>,
+    /// The field drawn on the scene, when one is asked for.
+    field: Option<Arc<FieldShown>>,
     /// Counts the builds; the GPU side uploads the meshes when it changes.
     revision: u64,
     statics: Option<ProjectStatics>,
 }
 
+/// What one build makes.
+struct Built {
+    scene: Vec<SceneOrgan>,
+    meshes: Vec<OrganMesh>,
+    field: Option<FieldShown>,
+}
+
 impl SceneCache {
     /// The scene of `project` (the project as simulated and shown) and
-    /// `session` for `key`, the meshes handed to the renderer (the
-    /// organs, then the parts, then the fit's registered target if shown)
-    /// and their revision; built again only when
-    /// `key` differs from the previous call's.
+    /// `session` for `key` (the current result, or the one before the last
+    /// edit when `key.before` and the session has it), the meshes handed
+    /// to the renderer (the organs, then the parts, then the fit's
+    /// registered target if shown) and their revision; built again only
+    /// when `key` differs from the previous call's. The field `key.field`
+    /// asks for is computed with it ([`SceneCache::field`]).
     pub fn get(
         &mut self,
         key: SceneKey,
@@ -233,19 +276,51 @@ impl SceneCache {
                 Some(kept) if Arc::ptr_eq(&kept.project, project) => statics.insert(kept),
                 _ => statics.insert(ProjectStatics::of(project)),
             };
-            let scene = build_scene(project, session, key.time_in_keyframes, key.show_others);
+            let before = if key.before {
+                session.before_at(key.time_in_keyframes)
+            } else {
+                None
+            };
+            let shown = match before {
+                Some(before) => Some(before),
+                None => session.shown_at(key.time_in_keyframes),
+            };
+            let scene = build_scene_of(project, shown.as_ref(), session.organs(), key.show_others);
+            let field = key.field.map(|chosen| {
+                let meshes = shown.as_ref().map_or(&**project, |s| &*s.meshes);
+                field::compute(
+                    chosen,
+                    &FieldInput {
+                        project,
+                        meshes,
+                        session,
+                        time_in_keyframes: key.time_in_keyframes,
+                        scene: &scene,
+                        before: key.before,
+                    },
+                )
+            });
+            let drawn = match &field {
+                Some(FieldShown::Field(field)) => Some(field),
+                _ => None,
+            };
             let mut meshes = scene_meshes(
                 project,
                 &scene,
                 Some(key.selected_organ),
                 key.overlay,
+                drawn,
                 &mut statics.looks,
             );
             meshes.extend(statics.part_meshes(key.time_in_keyframes));
             // The fit dialog's registered target, last (`key.fit_target`
             // changes with it).
             meshes.extend(fit_target.cloned());
-            (scene, meshes)
+            Built {
+                scene,
+                meshes,
+                field,
+            }
         })
     }
 
@@ -255,12 +330,13 @@ impl SceneCache {
     fn get_or_build(
         &mut self,
         key: SceneKey,
-        build: impl FnOnce(&mut Option<ProjectStatics>) -> (Vec<SceneOrgan>, Vec<OrganMesh>),
+        build: impl FnOnce(&mut Option<ProjectStatics>) -> Built,
     ) -> (Arc<Vec<SceneOrgan>>, Arc<Vec<OrganMesh>>, u64) {
         if self.key != Some(key) {
-            let (scene, meshes) = build(&mut self.statics);
-            self.scene = Arc::new(scene);
-            self.meshes = Arc::new(meshes);
+            let built = build(&mut self.statics);
+            self.scene = Arc::new(built.scene);
+            self.meshes = Arc::new(built.meshes);
+            self.field = built.field.map(Arc::new);
             self.key = Some(key);
             self.revision += 1;
         }
@@ -269,6 +345,17 @@ impl SceneCache {
             Arc::clone(&self.meshes),
             self.revision,
         )
+    }
+
+    /// The field drawn on the scene last built (see [`SceneKey::field`]),
+    /// or why there is none.
+    pub fn field(&self) -> Option<Arc<FieldShown>> {
+        self.field.clone()
+    }
+
+    /// The scene last built and what it was built for.
+    pub fn last(&self) -> (Option<SceneKey>, Arc<Vec<SceneOrgan>>) {
+        (self.key, Arc::clone(&self.scene))
     }
 
     /// How many times the scene has been built.
@@ -290,6 +377,9 @@ mod tests {
             time_in_keyframes: 4.5,
             selected_organ: 1,
             overlay: None,
+            field: None,
+            before: false,
+            before_revision: 0,
             show_others: true,
             fit_target: 0,
         }
@@ -303,7 +393,11 @@ mod tests {
             cache
                 .get_or_build(key, |_| {
                     builds += 1;
-                    (Vec::new(), Vec::new())
+                    Built {
+                        scene: Vec::new(),
+                        meshes: Vec::new(),
+                        field: None,
+                    }
                 })
                 .2
         };
@@ -339,12 +433,24 @@ mod tests {
                 show_others: false,
                 ..key()
             },
+            SceneKey {
+                field: Some(ViewField::Difference),
+                ..key()
+            },
+            SceneKey {
+                before: true,
+                ..key()
+            },
+            SceneKey {
+                before_revision: 1,
+                ..key()
+            },
         ];
         for (i, changed) in changes.into_iter().enumerate() {
             assert_eq!(get(&mut cache, changed), 2 + 2 * i as u64, "{changed:?}");
             assert_eq!(get(&mut cache, key()), 3 + 2 * i as u64, "back");
         }
-        assert_eq!(builds, 17);
-        assert_eq!(cache.builds(), 17);
+        assert_eq!(builds, 23);
+        assert_eq!(cache.builds(), 23);
     }
 }
