@@ -20,6 +20,8 @@ use egui_kittest::kittest::Queryable;
 mod common;
 #[path = "desktop/difference.rs"]
 mod difference;
+#[path = "desktop/sketch_room.rs"]
+mod sketch_room;
 
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {
@@ -3876,7 +3878,7 @@ fn a_petal_is_sketched_with_the_pointer_and_applied_in_one_undo_step_keeping_its
     });
     draw_stroke(&mut harness, &section);
     // Undo stroke takes it back; drawn again, it is there again.
-    harness.get_by_label("Undo stroke").click();
+    click_settled(&mut harness, "Undo stroke");
     settle(&mut harness);
     assert_eq!(
         harness

@@ -3,18 +3,32 @@
 # waits for the flower to open, paints a stroke on the UV canvas with
 # xdotool, and saves screenshots (ImageMagick's `import`) to OUT_DIR.
 #
-#   app/tests/xvfb-screenshots.sh [OUT_DIR]      (default: target/screenshots)
+#   app/tests/xvfb-screenshots.sh [--binary PATH] [OUT_DIR]
 #
-# Needs: xvfb xdotool imagemagick mesa-vulkan-drivers libvulkan1.
-# Builds the release binary first. A fresh config folder is used so the
-# first launch (the default flower) is what is shown.
+#   --binary PATH  the anthesis binary to drive (also BINARY=PATH; default:
+#                  build this checkout's release binary with cargo)
+#   OUT_DIR        where the screenshots go (default: target/screenshots)
+#
+# Needs: xvfb xdotool imagemagick mesa-vulkan-drivers libvulkan1. A fresh
+# config folder is used so the first launch (the default flower) is what
+# is shown. Takes screenshots only (the checks are in
+# xvfb-crash-recovery.sh and xvfb-sketch-petal.sh).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-out="${1:-target/screenshots}"
+binary=""
+out=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --binary) binary="$2"; shift 2 ;;
+    -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+    -*) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
+    *) out="$1"; shift ;;
+  esac
+done
+out="${out:-target/screenshots}"
 mkdir -p "$out"
-cargo build --release --bin anthesis
-binary="${CARGO_TARGET_DIR:-target}/release/anthesis"
-import=/usr/bin/import   # ImageMagick's own, not a stand-in earlier on PATH
+. app/tests/xvfb-window.sh
+binary="$(anthesis_binary "$binary")"
 
 config="$(mktemp -d)"
 trap 'rm -rf "$config"' EXIT

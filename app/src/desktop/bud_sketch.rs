@@ -18,6 +18,7 @@ use eframe::egui::{self, Color32, RichText};
 use glam::DVec2;
 
 use super::command::{Command, ProjectEdit};
+use super::sketch_panel::{canvas_height, in_room, large_button};
 
 /// The shortest stroke accepted, as a fraction of the view's height.
 const SHORTEST_STROKE: f64 = 0.05;
@@ -39,6 +40,8 @@ pub struct BudSketchState {
     result: Option<(Key, Result<Made, String>)>,
     /// The view's side-view rectangle and its screen rectangle, last frame.
     view: Option<(Frame, egui::Rect)>,
+    /// The section is in the large canvas (a window over the viewport).
+    large: bool,
 }
 
 /// What a result was made of: template, spiral, count, opening, flower.
@@ -71,11 +74,17 @@ impl Default for BudSketchState {
             opening: false,
             result: None,
             view: None,
+            large: false,
         }
     }
 }
 
 impl BudSketchState {
+    /// Whether the section is open in the large canvas.
+    pub fn large(&self) -> bool {
+        self.large
+    }
+
     /// Where side-view point `(r, h)` was drawn in the last frame.
     pub fn on_screen(&self, side: DVec2) -> Option<egui::Pos2> {
         let (frame, rect) = self.view?;
@@ -201,7 +210,14 @@ pub fn bud_sketch_ui(
     }
     egui::CollapsingHeader::new("Sketched bud")
         .id_salt("sketched bud")
-        .show(ui, |ui| rows(ui, (flower, keyframes), state, commands))
+        .show(ui, |ui| {
+            let large = state.large;
+            if !in_room(ui, "Sketched bud", large, |ui| {
+                rows(ui, (flower, keyframes), state, commands, large);
+            }) {
+                state.large = false;
+            }
+        })
         .header_response
         .on_hover_text(
             "Draw one curved stroke in the side view: the primary vein of a petal in the bud. \
@@ -215,9 +231,11 @@ fn rows(
     (flower, keyframes): (&Flower, u32),
     state: &mut BudSketchState,
     commands: &mut Vec<Command>,
+    large: bool,
 ) {
     state.template = state.template.min(flower.templates.len() - 1);
     let index = state.template;
+    large_button(ui, "Large bud canvas", &mut state.large);
     option_rows(ui, flower, index, state);
 
     // The view: the axis up the middle, the ground at the receptacle.
@@ -239,7 +257,16 @@ fn rows(
     // The axis a fifth of the way in from the left, the ground near the
     // bottom: room for a petal leaning out or curving in.
     let extent = 1.15 * length.max(base.x + 0.6 * length);
-    let size = egui::vec2(ui.available_width().clamp(160.0, 360.0), 260.0);
+    // In the large canvas, the rows under the view (the top view, the
+    // petal count, Apply) keep about this much room.
+    let size = if large {
+        egui::vec2(
+            ui.available_width().max(160.0),
+            canvas_height(ui, 260.0, 220.0, true),
+        )
+    } else {
+        egui::vec2(ui.available_width().clamp(160.0, 360.0), 260.0)
+    };
     let (response, painter) = ui.allocate_painter(size, egui::Sense::drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "bud side view"));
     let rect = response.rect;
@@ -339,7 +366,7 @@ fn option_rows(ui: &mut egui::Ui, flower: &Flower, index: usize, state: &mut Bud
             .labelled_by(label);
     });
     let has_bud = flower.templates[index].vein.is_some();
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         let label = ui.label("draw").id;
         ui.radio_value(&mut state.opening, false, "the bud")
             .labelled_by(label)
@@ -356,7 +383,7 @@ fn option_rows(ui: &mut egui::Ui, flower: &Flower, index: usize, state: &mut Bud
     if !has_bud {
         state.opening = false;
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.add_enabled_ui(!others && !state.opening, |ui| {
             ui.radio_value(&mut state.spiral, true, "golden-angle spiral")
                 .on_hover_text("Petals 137.5° apart, each later one nested inside")

@@ -27,6 +27,7 @@ use glam::{DVec2, DVec3};
 
 use super::command::{Command, ProjectEdit};
 use super::scan_panel::ScanReview;
+use super::sketch_panel::{canvas_height, in_room, large_button};
 use super::widgets::quality_text;
 
 /// The names of a curve's control points, base to tip.
@@ -65,6 +66,8 @@ pub struct PdeState {
     error: Option<String>,
     /// A scanned petal being reviewed.
     pub(super) scan: Option<ScanReview>,
+    /// The editor is in the large canvas (a window over the viewport).
+    large: bool,
 }
 
 impl PdeState {
@@ -87,6 +90,11 @@ impl PdeState {
             Ok(bud) => Ok(&bud.quality),
             Err(e) => Err(e.as_str()),
         })
+    }
+
+    /// Whether the editor is open in the large canvas.
+    pub fn large(&self) -> bool {
+        self.large
     }
 
     /// The scanned petal under review.
@@ -112,7 +120,8 @@ fn edge_bits(edge: f64) -> u64 {
 }
 
 /// The PDE editor of template `index` whose saved sweep is `saved`; `edge`
-/// is the Shape section's remesh edge.
+/// is the Shape section's remesh edge. In the panel, or in the large
+/// canvas (`sketch_panel::in_room`).
 pub fn pde_ui(
     ui: &mut egui::Ui,
     (flower, index): (&Flower, usize),
@@ -121,20 +130,41 @@ pub fn pde_ui(
     state: &mut PdeState,
     commands: &mut Vec<Command>,
 ) {
+    let large = state.large;
+    if !in_room(ui, "PDE surface", large, |ui| {
+        editor(ui, (flower, index), saved, edge, state, commands, large);
+    }) {
+        state.large = false;
+    }
+}
+
+/// The editor's rows, in the panel or in the large canvas.
+fn editor(
+    ui: &mut egui::Ui,
+    (flower, index): (&Flower, usize),
+    saved: PdeSweep,
+    edge: f64,
+    state: &mut PdeState,
+    commands: &mut Vec<Command>,
+    large: bool,
+) {
     let name = flower.templates[index].name.clone();
     let mut sweep = match state.drafts.get(&name) {
         Some((from, draft)) if *from == saved => *draft,
         _ => saved,
     };
     let before = sweep;
-    ui.strong("PDE surface").on_hover_text(
-        "A sweep between the two margins (curves from the base to the tip) meeting them with \
-         the across-tangents drawn as handles (pde-surfaces-lily.txt eq. 12). Drag a point or \
-         a handle's head, or type the chosen point's numbers; Apply surface meshes it at the \
-         remesh edge above.",
-    );
+    ui.horizontal_wrapped(|ui| {
+        ui.strong("PDE surface").on_hover_text(
+            "A sweep between the two margins (curves from the base to the tip) meeting them \
+             with the across-tangents drawn as handles (pde-surfaces-lily.txt eq. 12). Drag a \
+             point or a handle's head, or type the chosen point's numbers; Apply surface meshes \
+             it at the remesh edge above.",
+        );
+        large_button(ui, "Large PDE canvas", &mut state.large);
+    });
     let mut symmetric = !state.asymmetric;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.checkbox(&mut symmetric, "symmetric about the midrib")
             .on_hover_text("A point's mirror image across the midrib moves with it");
         ui.selectable_value(&mut state.side_view, false, "front")
@@ -143,7 +173,9 @@ pub fn pde_ui(
             .on_hover_text("From the side: z across, y from base to tip");
     });
     state.asymmetric = !symmetric;
-    sweep = sweep_view(ui, state, sweep, symmetric);
+    // In the large canvas, the rows under the view keep about this much.
+    let height = canvas_height(ui, 240.0, 170.0, large);
+    sweep = sweep_view(ui, state, (sweep, height), symmetric);
 
     // The chosen point's numbers.
     ui.horizontal(|ui| {
@@ -228,7 +260,7 @@ pub fn pde_ui(
 fn sweep_view(
     ui: &mut egui::Ui,
     state: &mut PdeState,
-    sweep: PdeSweep,
+    (sweep, height): (PdeSweep, f32),
     symmetric: bool,
 ) -> PdeSweep {
     let side = state.side_view;
@@ -261,7 +293,7 @@ fn sweep_view(
         low = low.min(flat(*p));
         high = high.max(flat(*p));
     }
-    let size = egui::vec2(ui.available_width().max(120.0), 240.0);
+    let size = egui::vec2(ui.available_width().max(120.0), height);
     let (response, painter) = ui.allocate_painter(size, egui::Sense::hover());
     let rect = response.rect.shrink(14.0);
     let extent = (high - low).max(DVec2::splat(1e-6));

@@ -215,7 +215,7 @@ pub fn scan_ui(
         }
 
         outline_view(ui, review, &mut changed);
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             if ui
                 .checkbox(&mut review.flip, "inner side convex")
                 .on_hover_text(
@@ -299,7 +299,7 @@ pub fn scan_ui(
 /// span, and goes back to the corners found; sets `changed` when the
 /// corners changed.
 fn corner_row(ui: &mut egui::Ui, review: &mut ScanReview, changed: &mut bool) {
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         let label = ui.label("move").id;
         let pointed = review.corners.pointed();
         egui::ComboBox::from_id_salt("scan corner")
@@ -461,7 +461,7 @@ fn make_row(
     (made, close): (&mut Option<usize>, &mut bool),
 ) {
     let mut refused = None;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         match (&review.fit, review.built.as_ref().map(|(_, b)| b)) {
             _ if fitting => {}
             (Ok(fit), Some(Ok(bud))) => {

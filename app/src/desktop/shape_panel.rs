@@ -252,7 +252,7 @@ fn inner_side_row(
     commands: &mut Vec<Command>,
 ) {
     let mesh = &template.mesh;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         match anthesis_bud::inner_side_faces_minus_z(mesh) {
             Some(true) => ui.label("inner side: −Z (the template frame's inner side)"),
             Some(false) => ui.label(
@@ -353,7 +353,7 @@ fn bezier_ui(
     );
     let before = net;
     let mut symmetric = !state.asymmetric;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.checkbox(&mut symmetric, "symmetric about the midrib")
             .on_hover_text("A point's mirror image across the midrib moves with it");
         ui.selectable_value(&mut state.side_view, false, "front")

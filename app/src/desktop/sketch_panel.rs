@@ -131,12 +131,22 @@ pub struct SketchState {
     preview: Option<(u64, Preview)>,
     /// Why Apply could not mesh the petal.
     apply_error: Option<String>,
+    /// The editor is in the large canvas (a window over the viewport).
+    large: bool,
+    /// The canvas zoomed by Ctrl+wheel: times the fitted view, and the
+    /// sketch point at its centre (`None`: fitted).
+    zoom: Option<(f64, DVec2)>,
 }
 
 impl SketchState {
     /// The strokes being edited for template `name`, once shown.
     pub fn sketch(&self, name: &str) -> Option<&PetalSketch> {
         self.drafts.get(name).map(|d| &d.sketch)
+    }
+
+    /// Whether the editor is open in the large canvas.
+    pub fn large(&self) -> bool {
+        self.large
     }
 
     /// Where sketch-plane point `p` was on the canvas in the last frame.
@@ -206,7 +216,7 @@ pub fn sketch_ui(
         _ => None,
     };
     sync_draft(state, name, &saved);
-    let Some(draft) = state.drafts.get(name).cloned() else {
+    if !state.drafts.contains_key(name) {
         if ui
             .button("Sketch a new shape")
             .on_hover_text(
@@ -226,13 +236,114 @@ pub fn sketch_ui(
         }
         state.view = None;
         return;
+    }
+    let large = state.large;
+    if !in_room(ui, "Sketched petal", large, |ui| {
+        editor(ui, (flower, index), edge, state, commands, large);
+    }) {
+        state.large = false;
+    }
+}
+
+/// Shows `body` (an editor's rows) in the panel, or when `large` in a
+/// resizable window over the viewport (the large canvas), with a line in
+/// the panel that says so and brings it back; false when the window was
+/// closed. The same `body` draws both: strokes follow the same rules.
+pub(super) fn in_room(
+    ui: &mut egui::Ui,
+    title: &str,
+    large: bool,
+    body: impl FnOnce(&mut egui::Ui),
+) -> bool {
+    if !large {
+        body(ui);
+        return true;
+    }
+    let mut open = true;
+    ui.horizontal_wrapped(|ui| {
+        ui.label(format!("{title}: open in the large canvas."));
+        if ui
+            .button("Back to the panel")
+            .on_hover_text("Close the large canvas and edit here again")
+            .clicked()
+        {
+            open = false;
+        }
+    });
+    if open {
+        // Over the viewport, right of the left panel, as large as fits.
+        let screen = ui.ctx().content_rect();
+        let min = egui::pos2(screen.left() + 290.0, screen.top() + 40.0);
+        let max = egui::pos2(
+            (min.x + 960.0).min(screen.right() - 20.0),
+            (screen.bottom() - 60.0).max(min.y + LARGE_MIN.y),
+        );
+        egui::Window::new(title)
+            .id(egui::Id::unique(("large canvas", title)))
+            .open(&mut open)
+            .default_rect(egui::Rect::from_min_max(min, max.max(min + LARGE_MIN)))
+            .min_size(LARGE_MIN)
+            .collapsible(false)
+            .resizable(true)
+            .show(ui.ctx(), body);
+    }
+    open
+}
+
+/// A button that opens an editor in the large canvas (`large`).
+pub(super) fn large_button(ui: &mut egui::Ui, label: &str, large: &mut bool) {
+    if !*large
+        && ui
+            .button(label)
+            .on_hover_text(
+                "Edit in a large resizable window over the viewport (the same strokes and \
+                 rules; close it to come back here)",
+            )
+            .clicked()
+    {
+        *large = true;
+    }
+}
+
+/// A canvas's height: `small` in the panel; in the large canvas what the
+/// window has left after `below` points of rows under it (at least
+/// `small`).
+pub(super) fn canvas_height(ui: &egui::Ui, small: f32, below: f32, large: bool) -> f32 {
+    if large {
+        (ui.available_height() - below).max(small)
+    } else {
+        small
+    }
+}
+
+/// The smallest large canvas window.
+const LARGE_MIN: egui::Vec2 = egui::vec2(420.0, 480.0);
+
+/// The editor's rows: the tools, the canvas, what the strokes make and
+/// Apply; in the panel or (`state.large`) in the large canvas's window,
+/// by the same code.
+fn editor(
+    ui: &mut egui::Ui,
+    (flower, index): (&Flower, usize),
+    edge: f64,
+    state: &mut SketchState,
+    commands: &mut Vec<Command>,
+    large: bool,
+) {
+    let template = &flower.templates[index];
+    let name = template.name.as_str();
+    let Some(draft) = state.drafts.get(name).cloned() else {
+        return;
     };
-    ui.strong("Sketched petal").on_hover_text(
-        "Draw with the mouse on the canvas: the two margins and the primary vein (any order, any \
-         direction), then cross-sections across the petal. The petal is a B-spline surface \
-         whose control points are spread evenly inside the outline; Apply meshes it at the \
-         remesh edge above.",
-    );
+    ui.horizontal_wrapped(|ui| {
+        ui.strong("Sketched petal").on_hover_text(
+            "Draw with the mouse on the canvas: the two margins and the primary vein (any \
+             order, any direction), then cross-sections across the petal. The petal is a \
+             B-spline surface whose control points are spread evenly inside the outline; Apply \
+             meshes it at the remesh edge above.",
+        );
+        large_button(ui, "Large sketch canvas", &mut state.large);
+    });
     ui.horizontal_wrapped(|ui| {
         ui.label("draw");
         for (tool, label, hover) in TOOLS {
@@ -245,7 +356,17 @@ pub fn sketch_ui(
     let built = sketch.build();
     let before = sketch.clone();
 
-    canvas(ui, template, &mut sketch, built.as_ref().ok(), state);
+    // In the large canvas, the rows under it (messages, side view,
+    // preview, Apply) keep about this much room.
+    let height = canvas_height(ui, CANVAS_HEIGHT, 260.0, large);
+    canvas(
+        ui,
+        template,
+        &mut sketch,
+        built.as_ref().ok(),
+        state,
+        height,
+    );
     let built = if sketch == before {
         built
     } else {
@@ -328,7 +449,7 @@ fn sync_draft(state: &mut SketchState, name: &str, saved: &Option<PetalSketch>) 
 /// `sketch`; whether the last stroke was taken back.
 fn stroke_row(ui: &mut egui::Ui, draft: &Draft, sketch: &mut PetalSketch) -> bool {
     let mut undone = false;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if ui
             .add_enabled(!draft.undo.is_empty(), egui::Button::new("Undo stroke"))
             .on_hover_text("Take back the last stroke (or Clear strokes, or Remove cross-sections)")
@@ -475,39 +596,39 @@ fn canvas(
     sketch: &mut PetalSketch,
     petal: Option<&SketchedPetal>,
     state: &mut SketchState,
+    height: f32,
 ) {
-    let size = egui::vec2(ui.available_width().max(160.0), CANVAS_HEIGHT);
+    let size = egui::vec2(ui.available_width().max(160.0), height);
     let (response, painter) = ui.allocate_painter(size, egui::Sense::drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "sketch canvas"));
     let rect = response.rect;
-    // The map: kept while drawing, else fitted to what there is to show.
+    // The map: kept while drawing, else fitted to what there is to show
+    // (zoomed by Ctrl+wheel).
     let view = match (state.view, &state.drawing) {
         (Some(view), Some(_)) if view.centre_on_screen == rect.center() => view,
-        _ => {
-            let (mut low, mut high) = (DEFAULT_VIEW[0], DEFAULT_VIEW[1]);
-            let strokes = [&sketch.left, &sketch.right, &sketch.vein]
-                .into_iter()
-                .chain(&sketch.sections);
-            for p in strokes.flatten() {
-                low = low.min(*p);
-                high = high.max(*p);
+        (_, drawing) => {
+            let fitted = fitted_view(rect, template, sketch);
+            if drawing.is_none() {
+                zoom_on_wheel(ui, &response, fitted, state);
             }
-            for p in &template.mesh.positions {
-                low = low.min(p.truncate());
-                high = high.max(p.truncate());
-            }
-            let inner = rect.shrink(12.0);
-            let extent = (high - low).max(DVec2::splat(1e-6));
-            let scale =
-                (f64::from(inner.width()) / extent.x).min(f64::from(inner.height()) / extent.y);
-            View {
-                centre_on_screen: rect.center(),
-                centre: (low + high) * 0.5,
-                scale,
+            match state.zoom {
+                Some((zoom, centre)) => View {
+                    centre,
+                    scale: fitted.scale * zoom,
+                    ..fitted
+                },
+                None => fitted,
             }
         }
     };
     painter.rect_filled(rect, 4.0, ui.visuals().extreme_bg_color);
+    painter.text(
+        rect.left_bottom() + egui::vec2(6.0, -4.0),
+        egui::Align2::LEFT_BOTTOM,
+        "Ctrl+wheel zooms (the wheel scrolls the panel)",
+        egui::FontId::proportional(11.0),
+        ui.visuals().weak_text_color(),
+    );
     let faint = Stroke::new(1.0, ui.visuals().weak_text_color().gamma_multiply(0.35));
     // The template's mesh seen from its inner side's back (x, y).
     for t in &template.mesh.triangles {
@@ -578,6 +699,59 @@ fn canvas(
     }
     state.view = Some(view);
 }
+
+/// The map that fits the default view, the strokes and the template's
+/// mesh into `rect` (less 12 points a side).
+fn fitted_view(
+    rect: egui::Rect,
+    template: &anthesis_flower::Template,
+    sketch: &PetalSketch,
+) -> View {
+    let (mut low, mut high) = (DEFAULT_VIEW[0], DEFAULT_VIEW[1]);
+    let strokes = [&sketch.left, &sketch.right, &sketch.vein]
+        .into_iter()
+        .chain(&sketch.sections);
+    for p in strokes.flatten() {
+        low = low.min(*p);
+        high = high.max(*p);
+    }
+    for p in &template.mesh.positions {
+        low = low.min(p.truncate());
+        high = high.max(p.truncate());
+    }
+    let inner = rect.shrink(12.0);
+    let extent = (high - low).max(DVec2::splat(1e-6));
+    let scale = (f64::from(inner.width()) / extent.x).min(f64::from(inner.height()) / extent.y);
+    View {
+        centre_on_screen: rect.center(),
+        centre: (low + high) * 0.5,
+        scale,
+    }
+}
+
+/// Ctrl+wheel over the canvas (egui's zoom modifier; the wheel alone
+/// scrolls the panel): zooms the view about the pointer, from the fitted
+/// view (1) to [`MAX_ZOOM`] times it.
+fn zoom_on_wheel(ui: &egui::Ui, response: &egui::Response, fitted: View, state: &mut SketchState) {
+    let factor = f64::from(ui.input(egui::InputState::zoom_delta));
+    let Some(pointer) = response.hover_pos().filter(|_| factor != 1.0) else {
+        return;
+    };
+    let (zoom, centre) = state.zoom.unwrap_or((1.0, fitted.centre));
+    let now = View {
+        centre,
+        scale: fitted.scale * zoom,
+        ..fitted
+    };
+    let under = now.to_sketch(pointer);
+    let zoom = (zoom * factor).clamp(1.0, MAX_ZOOM);
+    let d = pointer - fitted.centre_on_screen;
+    let offset = DVec2::new(f64::from(d.x), -f64::from(d.y)) / (fitted.scale * zoom);
+    state.zoom = (zoom > 1.0).then_some((zoom, under - offset));
+}
+
+/// How far Ctrl+wheel zooms the sketch canvas in, times the fitted view.
+const MAX_ZOOM: f64 = 20.0;
 
 /// The sketched petal over the canvas: its control net and its outline.
 fn draw_petal(painter: &egui::Painter, view: View, petal: &SketchedPetal) {

@@ -20,17 +20,16 @@ impl PaintState {
         let (rect, response) = ui.allocate_exact_size(Vec2::splat(side), Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "UV paint canvas"));
-        if response.hovered() {
-            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            if scroll != 0.0 {
-                let factor = (scroll * 0.003).exp();
-                if let Some(pointer) = response.hover_pos() {
-                    // Zoom about the pointer.
-                    let before = (pointer - rect.min - self.pan) / self.zoom;
-                    self.zoom = (self.zoom * factor).clamp(0.5, 16.0);
-                    self.pan = pointer - rect.min - before * self.zoom;
-                }
-            }
+        // Ctrl+wheel (egui's zoom modifier, Cmd on a Mac) zooms; the wheel
+        // alone scrolls the panel, as over any other widget.
+        let factor = ui.input(egui::InputState::zoom_delta);
+        if factor != 1.0
+            && let Some(pointer) = response.hover_pos()
+        {
+            // Zoom about the pointer.
+            let before = (pointer - rect.min - self.pan) / self.zoom;
+            self.zoom = (self.zoom * factor).clamp(0.5, 16.0);
+            self.pan = pointer - rect.min - before * self.zoom;
         }
         if response.dragged_by(egui::PointerButton::Secondary)
             || response.dragged_by(egui::PointerButton::Middle)

@@ -22,7 +22,7 @@ impl PaintState {
         // The canvas's hint as a line, not a tooltip over the legend.
         ui.label(
             egui::RichText::new(
-                "Drag to paint, click for one dab; Alt+click picks; scroll to zoom; \
+                "Drag to paint, click for one dab; Alt+click picks; Ctrl+wheel zooms; \
                  right- or middle-drag to pan; double-click to reset the view",
             )
             .small()
