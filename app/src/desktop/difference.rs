@@ -103,14 +103,9 @@ pub fn difference_field(input: &FieldInput<'_>) -> FieldShown {
     FieldShown::Field(field)
 }
 
-/// The keyframe time as the timeline says it: a whole keyframe without
-/// decimals.
+/// The keyframe time as the timeline's read-out says it ("54.0").
 fn format_time(time: f64) -> String {
-    if time.fract() == 0.0 {
-        format!("{time:.0}")
-    } else {
-        format!("{time:.2}")
-    }
+    format!("{time:.1}")
 }
 
 /// How far each point of `here` is from the same point of `there` (the
