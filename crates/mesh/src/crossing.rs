@@ -9,7 +9,9 @@
 //! allocates nothing once its buffers have grown. A pair is tested only in
 //! the one cell holding the low corner of the intersection of their boxes,
 //! so it is tested once however many cells the two share, and only when the
-//! boxes overlap. The test itself: each triangle's corners against the
+//! boxes overlap; within a bucket the entries are swept along x (sorted by
+//! their boxes' low x), so pairs apart along x are not visited. The test
+//! itself: each triangle's corners against the
 //! other's plane (all on one side: no crossing), then each edge of either
 //! against the other's interior (Möller & Trumbore 1997), touching at the
 //! very edges not counted.
