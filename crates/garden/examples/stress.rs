@@ -14,7 +14,9 @@
 //! and w_in maps halved), `petal-e-in-x2` (its first petal alone, the same
 //! maps), `lily-maps-x2` (every map value doubled), `eustoma-thin` (the
 //! Eustoma Maite Lady at half its thickness) and `lily-random-SEED` for
-//! seeds 1 to 3 (the lily's e_in maps replaced by smooth random fields).
+//! seeds 1 to 3 (the lily's e_in maps replaced by smooth random fields);
+//! and `lily-petals-e-x0.9`, a modest edit: the lily's petals' e-growth
+//! maps times 0.9 (their margins graze the sepals' from keyframe 33).
 
 use anthesis_flower::Project;
 use anthesis_garden::flowers::{EDGE_SCALE, flower_at_resolution};
@@ -23,7 +25,8 @@ use anthesis_sim::batch::step_through;
 use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::{Selection, Simulation};
 
-const CASES: [&str; 7] = [
+const CASES: [&str; 8] = [
+    "lily-petals-e-x0.9",
     "lily-e-in-x2",
     "petal-e-in-x2",
     "lily-maps-x2",
@@ -64,6 +67,20 @@ fn stress_case(name: &str, scale: f64) -> (Project, Selection) {
             .expect("it builds")
     };
     match name {
+        "lily-petals-e-x0.9" => {
+            let mut project = flower("lily");
+            for t in &mut project.flower.templates {
+                if !t.name.contains("petal") {
+                    continue;
+                }
+                for key in t.maps.keys_mut() {
+                    for v in key.maps.scalar_mut(MapKind::EGrowth).values_mut() {
+                        *v *= 0.9;
+                    }
+                }
+            }
+            (project, Selection::All)
+        }
         "lily-e-in-x2" => (e_in_doubled(flower("lily")), Selection::All),
         "petal-e-in-x2" => (e_in_doubled(flower("lily")), Selection::Only(0)),
         "lily-maps-x2" => {

@@ -9,7 +9,9 @@
 //! allocates nothing once its buffers have grown. A pair is tested only in
 //! the one cell holding the low corner of the intersection of their boxes,
 //! so it is tested once however many cells the two share, and only when the
-//! boxes overlap. The test itself: each triangle's corners against the
+//! boxes overlap; within a bucket the entries are swept along x (sorted by
+//! their boxes' low x), so pairs apart along x are not visited. The test
+//! itself: each triangle's corners against the
 //! other's plane (all on one side: no crossing), then each edge of either
 //! against the other's interior (Möller & Trumbore 1997), touching at the
 //! very edges not counted.
@@ -119,7 +121,8 @@ impl CrossingSearch {
         let entries = self.cover(cell);
         let buckets = self.fill(entries);
         // The buckets in chunks on rayon's threads (sorted after, so the
-        // answer does not depend on them).
+        // answer does not depend on them), each with its own copy of a
+        // bucket's entries to sweep.
         let this = &*self;
         let chunk = buckets.div_ceil(64).max(1024);
         let mut found: Vec<Crossing> = (0..buckets)
@@ -128,8 +131,9 @@ impl CrossingSearch {
             .into_par_iter()
             .flat_map_iter(|first| {
                 let mut out = Vec::new();
+                let mut sweep = Vec::new();
                 for k in first..(first + chunk).min(buckets) {
-                    this.pairs_in(k, bodies.len(), &mut out);
+                    this.pairs_in(k, bodies.len(), &mut sweep, &mut out);
                 }
                 out
             })
@@ -274,27 +278,54 @@ impl CrossingSearch {
 
     /// The crossings among the entries of bucket `k` (of a search over
     /// `count` bodies), each pair in the one cell where its boxes' overlap
-    /// starts.
-    fn pairs_in(&self, k: usize, count: usize, out: &mut Vec<Crossing>) {
+    /// starts. The bucket's entries are copied into `sweep` with their
+    /// boxes (one look-up per entry, not per pair) and sorted by the box's
+    /// low x, so a triangle meets only the entries whose boxes start before
+    /// its own ends along x (sweep and prune within the bucket, Baraff
+    /// 1992).
+    fn pairs_in(&self, k: usize, count: usize, sweep: &mut Vec<Swept>, out: &mut Vec<Crossing>) {
         let list = &self.entries[self.starts[k] as usize..self.starts[k + 1] as usize];
-        for (i, &(s, cs)) in list.iter().enumerate() {
-            let s = s as usize;
-            let (ls, hs) = self.boxes[s];
-            let low_s = self.ranges[s].0;
-            for &(t, ct) in &list[i + 1..] {
-                let t = t as usize;
-                let (lt, ht) = self.boxes[t];
-                // Another cell in the same bucket, boxes apart, or not the
-                // pair's one cell: where the boxes' overlap starts (the
-                // larger of their lowest cells).
-                if cs != ct
-                    || ls.cmpgt(ht).any()
-                    || lt.cmpgt(hs).any()
-                    || low_s.max(self.ranges[t].0) != cs
+        if list.len() < 2 {
+            return;
+        }
+        sweep.clear();
+        sweep.extend(list.iter().map(|&(t, cell)| {
+            let (lo, hi) = self.boxes[t as usize];
+            let low = self.ranges[t as usize].0;
+            Swept {
+                lo,
+                hi,
+                cell,
+                starts: u8::from(low.x == cell.x)
+                    | u8::from(low.y == cell.y) << 1
+                    | u8::from(low.z == cell.z) << 2,
+                triangle: t,
+            }
+        }));
+        sweep.sort_unstable_by(|a, b| a.lo.x.total_cmp(&b.lo.x));
+        for (i, s) in sweep.iter().enumerate() {
+            for t in &sweep[i + 1..] {
+                // Past the box along x: no later entry overlaps it.
+                if t.lo.x > s.hi.x {
+                    break;
+                }
+                // Another cell in the same bucket, not the pair's one cell
+                // (where the boxes' overlap starts, the larger of their
+                // lowest cells: along each axis one of them starts here), or
+                // boxes apart along y or z.
+                if s.starts | t.starts != 0b111
+                    || t.cell != s.cell
+                    || s.lo.y > t.hi.y
+                    || t.lo.y > s.hi.y
+                    || s.lo.z > t.hi.z
+                    || t.lo.z > s.hi.z
                 {
                     continue;
                 }
-                let (s, t) = (s.min(t), s.max(t));
+                let (s, t) = (
+                    s.triangle.min(t.triangle) as usize,
+                    s.triangle.max(t.triangle) as usize,
+                );
                 let (bs, bt) = (self.owner[s] as usize, self.owner[t] as usize);
                 if !self.tested[bs * count + bt] {
                     continue;
@@ -320,6 +351,18 @@ impl CrossingSearch {
             }
         }
     }
+}
+
+/// A bucket's entry as the sweep sees it: the triangle's box, the cell,
+/// along which axes the box starts in that cell (bits x, y, z) and the
+/// triangle.
+#[derive(Debug, Clone, Copy)]
+struct Swept {
+    lo: DVec3,
+    hi: DVec3,
+    cell: IVec3,
+    starts: u8,
+    triangle: u32,
 }
 
 /// The bucket of cell `c` in a table of `mask + 1` buckets.
