@@ -108,23 +108,32 @@ def _smooth(values: np.ndarray, s: np.ndarray, sigma: float) -> np.ndarray:
     return w @ values
 
 
-def ripples(positions: np.ndarray, faces: np.ndarray, uvs: np.ndarray, side: int,
-            sigma_fraction: float = 0.06) -> list[dict[str, float]]:
-    """The ripples of one margin: its out-of-surface wobble about the margin
+def margin_wobble(positions: np.ndarray, faces: np.ndarray, uvs: np.ndarray, side: int,
+                  sigma_fraction: float = 0.06):
+    """One margin's out-of-surface wobble: the margin's offset from itself
     smoothed over `sigma_fraction` of its length (a Gaussian), along the
-    smoothed surface normal. Each full wave between every other zero
-    crossing of the wobble is a ripple: its wavelength w (length of the
-    smoothed margin over the wave), its arc length L (length of the margin
-    itself over the wave) and its amplitude a (half the wobble's peak to
-    peak over the wave). Lengths in project units."""
+    smoothed surface normal. Returns the margin's points [k, 3], their
+    smoothed positions [k, 3], the arc length s [k] and the wobble [k]."""
     chain = margin_chain(faces, uvs, side)
     x = positions[chain]
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(x, axis=0), axis=1))])
-    total = s[-1]
-    smooth = _smooth(x, s, sigma_fraction * total)
-    normals = _smooth(vertex_normals(positions, faces)[chain], s, sigma_fraction * total)
+    sigma = sigma_fraction * s[-1]
+    smooth = _smooth(x, s, sigma)
+    normals = _smooth(vertex_normals(positions, faces)[chain], s, sigma)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    wobble = np.einsum("ij,ij->i", x - smooth, normals)
+    return x, smooth, s, np.einsum("ij,ij->i", x - smooth, normals)
+
+
+def ripples(positions: np.ndarray, faces: np.ndarray, uvs: np.ndarray, side: int,
+            sigma_fraction: float = 0.06) -> list[dict[str, float]]:
+    """The ripples of one margin (see :func:`margin_wobble`): each full wave
+    between every other zero crossing of the wobble, away from the ends
+    (two smoothing widths), is a ripple: its wavelength w (length of the
+    smoothed margin over the wave), its arc length L (length of the margin
+    itself over the wave) and its amplitude a (half the wobble's peak to
+    peak over the wave). Lengths in project units."""
+    x, smooth, s, wobble = margin_wobble(positions, faces, uvs, side, sigma_fraction)
+    total = s[-1]
     # Leave out the ends, where the smoothing window is cut off.
     inside = (s > 2 * sigma_fraction * total) & (s < total - 2 * sigma_fraction * total)
     idx = np.flatnonzero(inside)
@@ -211,8 +220,8 @@ def frames_from_run(mean_edge: float | None, soft_midrib: bool, keyframes: int |
     project = anthesis.load("builtin:lily-edge")
     if soft_midrib:
         for template in project.templates:
-            project.set_map(template, "stretch", np.full((1, 1), project.get_map(template, "stretch").min()))
-            project.set_map(template, "bend", np.full((1, 1), project.get_map(template, "bend").min()))
+            project.set_map(template, "stretch", np.full_like(project.get_map(template, "stretch"), project.get_map(template, "stretch").min()))
+            project.set_map(template, "bend", np.full_like(project.get_map(template, "bend"), project.get_map(template, "bend").min()))
     if mean_edge is not None:
         project.set_parameter("mean_edge", mean_edge)
     result = project.simulate(keyframes=keyframes)
@@ -253,7 +262,9 @@ def report(frames) -> dict[str, object]:
         for side in (0, 1):
             rs = ripples(*frames[last][o], side)
             found += rs
-            print(f"organ {o} margin {side}: {len(rs)} ripples "
+            wobble = margin_wobble(*frames[last][o], side)[3]
+            print(f"organ {o} margin {side}: wobble rms {np.sqrt(np.mean(wobble ** 2)):.3f},"
+                  f" {len(rs)} ripples "
                   + " ".join(f"(w {r['w']:.2f}, L {r['L']:.2f}, a {r['a']:.3f})" for r in rs))
     fit = ripple_fit(found)
     print(f"\nripples found: {int(fit['ripples'])}; a = c sqrt(w (L - w)) with c = {fit['c']:.3f}"

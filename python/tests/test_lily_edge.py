@@ -4,9 +4,10 @@ their plane, more at the margins than along the midrib, and the bud opens,
 each tepal turning from a cup (Gaussian curvature K > 0) into a saddle
 (K < 0); with the midrib no stiffer than the lamina it still opens. The
 ripple measurement of docs/python/lily_edge.py is checked on a margin of
-known ripples. The full measurement (finer mesh, ripples) is the documented
-command of the README's "Edge growth" section; this is its quick check on a
-coarser mesh."""
+known ripples. The full measurement (a four times finer mesh, the ripple
+search) is the documented command of the README's "Edge growth" section;
+this is its quick check at the built-in's resolution (two runs of the whole
+flower, about 20 s each in release)."""
 
 import importlib.util
 import sys
@@ -30,18 +31,12 @@ def edge():
     return module
 
 
-# The CI check's mesh: the paper's own lily edge (Table 1), coarser than
-# the built-in's 0.78.
-COARSE_EDGE = 1.3
-
-
 @pytest.fixture(scope="module")
-def coarse_runs(edge):
-    """Every tenth keyframe of the built-in and of its soft-midrib variant."""
-    return {
-        soft: edge.frames_from_run(COARSE_EDGE, soft, None)
-        for soft in (False, True)
-    }
+def runs(edge):
+    """Every tenth keyframe of the built-in and of its soft-midrib variant,
+    at the built-in's resolution (at the paper's coarser edge, 1.3, the
+    tepals open only to about 54 degrees instead of 84: not converged)."""
+    return {soft: edge.frames_from_run(None, soft, None) for soft in (False, True)}
 
 
 def test_the_tepals_grow_in_their_plane_and_more_at_the_margins():
@@ -61,8 +56,8 @@ def test_the_tepals_grow_in_their_plane_and_more_at_the_margins():
         assert ratio == pytest.approx(1.40, abs=0.01)
 
 
-def test_the_bud_opens_from_cup_to_saddle_and_the_margins_outgrow_the_midrib(edge, coarse_runs):
-    frames = coarse_runs[False]
+def test_the_bud_opens_from_cup_to_saddle_and_the_margins_outgrow_the_midrib(edge, runs):
+    frames = runs[False]
     first, last = min(frames), max(frames)
     assert last == 100
     for organ in frames[last]:
@@ -71,22 +66,24 @@ def test_the_bud_opens_from_cup_to_saddle_and_the_margins_outgrow_the_midrib(edg
         # A cup in the bud, a saddle when open (median over the interior).
         assert bud["median_gaussian"] > 0, (organ, bud)
         assert open_["median_gaussian"] < 0, (organ, open_)
-        # Open: the tip leans out by at least 20 degrees more.
-        assert open_["tip_angle_deg"] - bud["tip_angle_deg"] > 20.0, (organ, bud, open_)
-        # The margin lengthens more than the midrib (the maps ask for 1.40
-        # times; what the shape takes is less where it stays compressed).
+        # Open: the tip turns out from the axis by more than 60 degrees (about
+        # 87 for the petals, 77 for the sepals, from about -2 in the bud).
+        assert open_["tip_angle_deg"] - bud["tip_angle_deg"] > 60.0, (organ, bud, open_)
+        # The margin lengthens more than the midrib: the maps ask for 1.40
+        # times; the shape takes about 1.18 (petals) and 1.13 (sepals), the
+        # rest stays compressed in the margin and is given up at each step.
         margin = open_["margin"] / bud["margin"]
         midrib = open_["midrib"] / bud["midrib"]
-        assert margin / midrib > 1.15, (organ, margin, midrib)
+        assert margin / midrib > 1.1, (organ, margin, midrib)
 
 
-def test_with_the_midrib_no_stiffer_than_the_lamina_it_still_opens(edge, coarse_runs):
-    frames = coarse_runs[True]
+def test_with_the_midrib_no_stiffer_than_the_lamina_it_still_opens(edge, runs):
+    frames = runs[True]
     first, last = min(frames), max(frames)
     for organ in frames[last]:
         bud = edge.organ_summary(*frames[first][organ])
         open_ = edge.organ_summary(*frames[last][organ])
-        assert open_["tip_angle_deg"] - bud["tip_angle_deg"] > 20.0, (organ, bud, open_)
+        assert open_["tip_angle_deg"] - bud["tip_angle_deg"] > 60.0, (organ, bud, open_)
         assert open_["median_gaussian"] < 0, (organ, open_)
 
 

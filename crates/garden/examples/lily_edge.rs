@@ -3,7 +3,10 @@
 //! (positions in the world frame, the template's UVs), for
 //! `docs/python/lily_edge.py --objs FOLDER` to measure.
 //!
-//! `cargo run --release -p anthesis-garden --example lily_edge -- EDGE_SCALE OUT_FOLDER [--soft-midrib] [--every N] [--only ORGAN]`
+//! `cargo run --release -p anthesis-garden --example lily_edge -- EDGE_SCALE OUT_FOLDER [--soft-midrib] [--every N] [--only ORGAN] [--bend-ratio R]`
+//!
+//! `--bend-ratio R` sets each template's bend stiffness `Kb` to `R` times
+//! its stretch stiffness `Ks` (the built-in has them equal).
 //!
 //! `EDGE_SCALE` is the mean edge as a fraction of the paper's (Table 1;
 //! the built-in is 0.6). Prints the particles per organ and the run time.
@@ -22,9 +25,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut edge = LilyEdge::MARGIN;
     let mut every = 10u32;
     let mut selection = Selection::All;
+    let mut bend_ratio: Option<f64> = None;
     while let Some(flag) = args.next() {
         match flag.as_str() {
             "--soft-midrib" => edge = edge.soft_midrib(),
+            "--bend-ratio" => {
+                bend_ratio = Some(args.next().ok_or("--bend-ratio needs a number")?.parse()?);
+            }
             "--every" => every = args.next().ok_or("--every needs a count")?.parse()?,
             "--only" => {
                 selection = Selection::Only(args.next().ok_or("--only needs an organ")?.parse()?);
@@ -32,7 +39,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             other => return Err(format!("unknown flag {other}").into()),
         }
     }
-    let project = lily_edge_of(edge, scale)?;
+    let mut project = lily_edge_of(edge, scale)?;
+    if let Some(ratio) = bend_ratio {
+        for template in &mut project.flower.templates {
+            template.bend_stiffness = template.stretch_stiffness * ratio;
+        }
+    }
     std::fs::create_dir_all(&out)?;
     for (i, organ) in project.flower.organs.iter().enumerate() {
         let mesh = &project.flower.template_of(i).mesh;
