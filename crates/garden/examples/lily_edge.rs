@@ -3,10 +3,14 @@
 //! (positions in the world frame, the template's UVs), for
 //! `docs/python/lily_edge.py --objs FOLDER` to measure.
 //!
-//! `cargo run --release -p anthesis-garden --example lily_edge -- EDGE_SCALE OUT_FOLDER [--soft-midrib] [--every N] [--only ORGAN] [--bend-ratio R]`
+//! `cargo run --release -p anthesis-garden --example lily_edge -- EDGE_SCALE OUT_FOLDER [--soft-midrib] [--every N] [--only ORGAN] [--bend-ratio R] [--keyframes N] [--profile-power P]`
 //!
 //! `--bend-ratio R` sets each template's bend stiffness `Kb` to `R` times
-//! its stretch stiffness `Ks` (the built-in has them equal).
+//! its stretch stiffness `Ks` (the built-in has them equal); `--keyframes N`
+//! the same opening in `N` steps (`anthesis_garden::retime`: larger steps
+//! of growth, each one's excess at the margin larger); `--profile-power P`
+//! the exponent of the e-growth profile across the width (2 in the
+//! built-in; larger puts the excess nearer the margins).
 //!
 //! `EDGE_SCALE` is the mean edge as a fraction of the paper's (Table 1;
 //! the built-in is 0.6). Prints the particles per organ and the run time.
@@ -26,11 +30,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut every = 10u32;
     let mut selection = Selection::All;
     let mut bend_ratio: Option<f64> = None;
+    let mut keyframes: Option<u32> = None;
     while let Some(flag) = args.next() {
         match flag.as_str() {
             "--soft-midrib" => edge = edge.soft_midrib(),
             "--bend-ratio" => {
                 bend_ratio = Some(args.next().ok_or("--bend-ratio needs a number")?.parse()?);
+            }
+            "--profile-power" => {
+                edge.profile_power = args
+                    .next()
+                    .ok_or("--profile-power needs a number")?
+                    .parse()?;
+            }
+            "--keyframes" => {
+                keyframes = Some(args.next().ok_or("--keyframes needs a count")?.parse()?);
             }
             "--every" => every = args.next().ok_or("--every needs a count")?.parse()?,
             "--only" => {
@@ -40,6 +54,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let mut project = lily_edge_of(edge, scale)?;
+    if let Some(keyframes) = keyframes {
+        project = anthesis_garden::retime::in_keyframes(project, keyframes);
+    }
     if let Some(ratio) = bend_ratio {
         for template in &mut project.flower.templates {
             template.bend_stiffness = template.stretch_stiffness * ratio;
