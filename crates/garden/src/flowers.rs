@@ -43,8 +43,9 @@ pub enum GardenError {
 
 /// The names of the default flowers (folder names under `assets/flowers/`):
 /// the paper's four, the seed's apple flower, the empty five-petal
-/// starting point and the lily's bloom and decay.
-pub const FLOWER_NAMES: [&str; 7] = [
+/// starting point, the lily's bloom and decay and the lily opened by edge
+/// growth.
+pub const FLOWER_NAMES: [&str; 8] = [
     "lily",
     "eustoma-mellow-yellow",
     "eustoma-maite-lady",
@@ -52,6 +53,7 @@ pub const FLOWER_NAMES: [&str; 7] = [
     "apple",
     crate::five_petal::FIVE_PETAL_NAME,
     "lily-decay",
+    crate::edge::LILY_EDGE_NAME,
 ];
 
 /// Builds the default flower called `name` (one of [`FLOWER_NAMES`]).
@@ -81,6 +83,9 @@ pub fn flower_at_resolution(name: &str, edge_scale: f64) -> Option<Result<Projec
         crate::five_petal::FIVE_PETAL_NAME => crate::five_petal::five_petal_at(edge_scale),
         "apple" => crate::apple::apple_at(edge_scale / EDGE_SCALE),
         "lily-decay" => crate::decay::lily_decay_at(edge_scale),
+        crate::edge::LILY_EDGE_NAME => {
+            crate::edge::lily_edge_of(crate::edge::LilyEdge::MARGIN, edge_scale)
+        }
         _ => return None,
     })
 }

@@ -12,6 +12,8 @@
 //! - [`apple`]: the apple flower of Qin and Chen 2006 §3–§4, placed
 //!   by the seed's own L-system;
 //! - [`decay`]: the lily, bloom and decay (negative growth in late keys);
+//! - [`edge`]: the lily opened by excess growth at its tepals' margins
+//!   (Liang and Mahadevan 2011), `lily-edge`;
 //! - [`five_petal`]: the empty starting point, one whorl of five simple
 //!   petals with uniform maps;
 //! - [`retime`]: the same opening in another number of keyframes (the
@@ -32,6 +34,7 @@ pub use anthesis_flower::structure::whorl as arrangement;
 pub mod apple;
 pub mod buds;
 pub mod decay;
+pub mod edge;
 pub mod five_petal;
 pub mod flowers;
 pub mod paint;
