@@ -171,6 +171,14 @@ fn first_frame_shows_the_flower_opening_and_the_timeline() {
         "follows new keyframes"
     );
     harness.get_by_label_contains("simulating keyframe 9/20");
+    // The status line says how long the run took: fixed, so the picture
+    // does not depend on the machine's load.
+    harness
+        .state_mut()
+        .session_mut()
+        .freeze_elapsed(Duration::from_millis(2400));
+    harness.run();
+    harness.get_by_label_contains("2.4 s elapsed");
     harness.snapshot("app_simulating");
 
     feed(&mut harness, None);

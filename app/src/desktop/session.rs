@@ -139,6 +139,8 @@ pub struct SimSession {
     stash: Option<Stash>,
     status: RunStatus,
     started_at: Option<Instant>,
+    /// What `elapsed` answers instead of the clock (`freeze_elapsed`).
+    frozen_elapsed: Option<Duration>,
     /// Newton iteration inside the keyframe being computed.
     iteration: Option<(u32, u32)>,
     /// The first keyframe the current run computes (see `Event::Started`).
@@ -192,6 +194,7 @@ impl SimSession {
             stash: None,
             status: RunStatus::Idle,
             started_at: None,
+            frozen_elapsed: None,
             iteration: None,
             first_computed: 1,
             proxy_running: false,
@@ -524,7 +527,15 @@ impl SimSession {
 
     /// Seconds since the run was asked for.
     pub fn elapsed(&self) -> Option<Duration> {
-        self.started_at.map(|t| t.elapsed())
+        self.started_at
+            .map(|t| self.frozen_elapsed.unwrap_or_else(|| t.elapsed()))
+    }
+
+    /// Makes `elapsed` answer `elapsed` from now on, whatever the clock
+    /// says: for pictures of the window (snapshots) that must not depend on
+    /// how fast the machine drew them.
+    pub fn freeze_elapsed(&mut self, elapsed: Duration) {
+        self.frozen_elapsed = Some(elapsed);
     }
 
     /// Estimated seconds left, from the mean time per keyframe so far.
