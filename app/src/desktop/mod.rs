@@ -505,7 +505,21 @@ impl AnthesisApp {
         }
         for failure in drained.failures {
             // A value the user chose at the end of its range is named.
-            let suspects = checked_field::values_at_limits(self.doc.project());
+            // And the values outside the range runs settle in (a failure
+            // that is not the solver's, as a petal passing through itself,
+            // does not say them), not again when the failure names them.
+            let project = self.doc.project();
+            let mut suspects: Vec<String> = project
+                .flower
+                .templates
+                .iter()
+                .flat_map(anthesis_sim::values_out_of_range)
+                .collect();
+            suspects.extend(checked_field::values_at_limits(project));
+            suspects.retain(|s| !s.split(" of ").next().is_some_and(|v| failure.contains(v)));
+            // One line per value and template ("thickness 0.001 of petal").
+            let mut seen = std::collections::HashSet::new();
+            suspects.retain(|s| seen.insert(s.split(" is ").next().map(|v| v.replace('`', ""))));
             let suspects = if suspects.is_empty() {
                 String::new()
             } else {

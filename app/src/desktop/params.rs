@@ -8,7 +8,9 @@
 
 use anthesis_flower::resolution::predicted_size;
 use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOR, JointRamp, Project, Resolution, Template};
-use eframe::egui::{self, DragValue};
+use eframe::egui;
+
+use super::checked_field::checked_with;
 
 use super::command::{Command, ProjectEdit};
 use super::two_state::{ViewedOrgan, two_state_ui};
@@ -126,18 +128,16 @@ pub fn parameters_ui_viewing(
             );
             // A checked field, as the others: a typed count out of range or
             // not a number is marked and logged, not silently clamped.
-            let mut count = f64::from(keyframes);
-            let changed = super::checked_field::checked_number(
+            let changed = checked_with(
                 ui,
                 "keyframes",
-                &mut count,
-                1.0,
-                1.0..=10_000.0,
+                &mut keyframes,
+                1..=anthesis_flower::MAX_KEYFRAMES,
+                |d| d.speed(1.0),
             )
             .labelled_by(label.id)
             .on_hover_text("Simulation steps after the bud, one keyframe each (whole project).")
             .changed();
-            keyframes = count.round() as u32;
             mark(changed, "keyframes");
             ui.end_row();
         });
@@ -238,26 +238,34 @@ fn joint_schedule_ui(
             ui.end_row();
             for (i, ramp) in draft.joint_schedule.iter_mut().enumerate() {
                 mark(
-                    ui.add(DragValue::new(&mut ramp.from_step).range(0..=100_000))
+                    checked_with(ui, "from step", &mut ramp.from_step, 0..=100_000, |d| d)
                         .labelled_by(from_label)
                         .on_hover_text("The ramp starts after this step")
                         .changed(),
                     "joint from",
                 );
                 mark(
-                    ui.add(DragValue::new(&mut ramp.to_step).range(0..=100_000))
-                        .labelled_by(to_label)
-                        .on_hover_text("The ramp has added all its degrees at this step")
-                        .changed(),
+                    {
+                        let to = checked_with(ui, "to step", &mut ramp.to_step, 0..=100_000, |d| d);
+                        // A ramp that ends before it starts adds nothing.
+                        let backwards = (ramp.to_step < ramp.from_step).then(|| {
+                            format!(
+                                "to step {} is before from step {}: this ramp adds no degrees \
+                                 (set to step at or after from step)",
+                                ramp.to_step, ramp.from_step
+                            )
+                        });
+                        super::checked_field::flagged(ui, to, backwards)
+                    }
+                    .labelled_by(to_label)
+                    .on_hover_text("The ramp has added all its degrees at this step")
+                    .changed(),
                     "joint to",
                 );
                 mark(
-                    ui.add(
-                        DragValue::new(&mut ramp.angle_deg)
-                            .speed(0.1)
-                            .range(-180.0..=180.0)
-                            .suffix("°"),
-                    )
+                    checked_with(ui, "degrees", &mut ramp.angle_deg, -180.0..=180.0, |d| {
+                        d.speed(0.1).suffix("°")
+                    })
                     .labelled_by(degrees_label)
                     .on_hover_text("Degrees added; positive tilts the organ outwards")
                     .changed(),
@@ -425,18 +433,21 @@ fn resolution_ui(
             match current.mean_edge() {
                 Some(edge) => {
                     let mut value = dragged_edge.unwrap_or(edge);
-                    let response = ui
-                        .add(
-                            DragValue::new(&mut value)
-                                .speed(0.01 * edge)
-                                .range(1e-3 * built_edge..=1e3 * built_edge)
+                    let response = checked_with(
+                        ui,
+                        "mean edge",
+                        &mut value,
+                        1e-3 * built_edge..=1e3 * built_edge,
+                        |d| {
+                            d.speed(0.01 * edge)
                                 .max_decimals(4)
                                 // A typed edge counts when entered: on the
                                 // way to 0.5, "0" would be the smallest
                                 // edge, remeshed (or refused) at once.
-                                .update_while_editing(false),
-                        )
-                        .on_hover_text(RESOLUTION_TOOLTIP);
+                                .update_while_editing(false)
+                        },
+                    )
+                    .on_hover_text(RESOLUTION_TOOLTIP);
                     if response.dragged() {
                         ui.data_mut(|d| d.insert_temp(draft_id, value));
                     } else {
