@@ -347,6 +347,37 @@ mod tests {
     }
 
     #[test]
+    fn a_fraction_in_a_whole_number_field_is_refused_and_a_loaded_value_outside_is_noted() {
+        let range = 1.0..=10_000.0;
+        assert_eq!(read_typed_whole("7", &range), Typed::Taken(7.0));
+        assert_eq!(
+            read_typed_whole("2.5", &range),
+            Typed::NotWhole("2.5".into())
+        );
+        assert_eq!(
+            read_typed_whole("20000", &range),
+            Typed::Clamped {
+                typed: 20_000.0,
+                to: 10_000.0
+            }
+        );
+        assert_eq!(
+            notice("keyframes", &read_typed_whole("2.5", &range), &range).as_deref(),
+            Some(
+                "`2.5` is not a whole number; keyframes kept its value (keyframes accepts 1 to 10000, whole numbers)"
+            )
+        );
+        assert_eq!(outside_note("thickness", 0.2, &THICKNESS_RANGE), None);
+        assert_eq!(
+            outside_note("thickness", 150.0, &THICKNESS_RANGE).as_deref(),
+            Some(
+                "thickness 150 is outside what the field accepts (0.001 to 100); it is kept as \
+                 it is until you type or drag a new value"
+            )
+        );
+    }
+
+    #[test]
     fn a_value_at_the_end_of_its_range_is_named() {
         let mut project = anthesis_garden::five_petal::five_petal().expect("the five-petal start");
         assert_eq!(values_at_limits(&project), Vec::<String>::new());
