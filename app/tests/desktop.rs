@@ -19,6 +19,9 @@ use egui_kittest::kittest::Queryable;
 
 mod common;
 
+#[path = "desktop/refusals.rs"]
+mod refusals;
+
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {
     let mut project = anthesis_sim::fixtures::whorl(6, 8, 14, 20);
