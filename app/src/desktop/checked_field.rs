@@ -223,22 +223,23 @@ pub fn checked_slider<N: egui::emath::Numeric>(
 /// Outlines `response`'s field and gives it `problem` as its tooltip
 /// while there is one (a value that is in range but does not work with
 /// another, as a ramp ending before it starts); the problem goes to the log
-/// when the field changes into it.
+/// once when the values come to it.
 pub fn flagged(
     ui: &mut egui::Ui,
     response: egui::Response,
     problem: Option<String>,
 ) -> egui::Response {
+    let id = response.id.with("flagged");
     let Some(problem) = problem else {
+        ui.data_mut(|d| d.remove::<String>(id));
         return response;
     };
-    if response.changed() || response.lost_focus() {
-        let id = response.id.with("flagged");
-        let said: Option<String> = ui.data(|d| d.get_temp(id));
-        if said.as_ref() != Some(&problem) {
-            ui.data_mut(|d| d.insert_temp(id, problem.clone()));
-            push_notice(ui.ctx(), problem.clone());
-        }
+    // Said once each time the values come to it (either field's edit, or
+    // a project opened with it).
+    let said: Option<String> = ui.data(|d| d.get_temp(id));
+    if said.as_ref() != Some(&problem) {
+        ui.data_mut(|d| d.insert_temp(id, problem.clone()));
+        push_notice(ui.ctx(), problem.clone());
     }
     ui.painter().rect_stroke(
         response.rect.expand(1.0),
