@@ -157,14 +157,22 @@ fn mark_typed(
     outside: Option<String>,
 ) -> egui::Response {
     let id = response.id.with("checked field notice");
+    let said_id = response.id.with("checked field said");
     let now = ui.input(|i| i.time);
+    if response.gained_focus() {
+        // A new edit: what it refuses is said again.
+        ui.data_mut(|d| d.remove::<String>(said_id));
+    }
     if let Some(message) = typed.and_then(|typed| notice(label, &typed, range)) {
-        // egui may read the typed text more than once as the edit ends:
-        // the same notice within a second is one.
-        let before: Option<(String, f64)> = ui.data(|d| d.get_temp(id));
-        let repeated = before.is_some_and(|(said, at)| said == message && now - at < 1.0);
-        ui.data_mut(|d| d.insert_temp(id, (message.clone(), now)));
-        if !repeated {
+        // egui reads the typed text more than once as an edit ends (at
+        // Enter and as the field lets go, frames apart in a slow window):
+        // the same notice within one edit is said once.
+        let said: Option<String> = ui.data(|d| d.get_temp(said_id));
+        ui.data_mut(|d| {
+            d.insert_temp(id, (message.clone(), now));
+            d.insert_temp(said_id, message.clone());
+        });
+        if said.as_ref() != Some(&message) {
             push_notice(ui.ctx(), message);
         }
     }

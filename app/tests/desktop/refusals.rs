@@ -57,6 +57,13 @@ fn thickness_minus_one_is_marked_and_logged_and_the_failed_run_names_it() {
             "{said:?} once in {lines:?}"
         );
     }
+    // The same refusal in a new edit is said again.
+    type_into(&mut harness, "thickness", 0, "abc");
+    let again = log_lines(&harness)
+        .iter()
+        .filter(|l| l.starts_with("`abc` is not a number; thickness"))
+        .count();
+    assert_eq!(again, 2);
     let petal = &harness.state().project().flower.templates[0];
     assert_eq!(petal.thickness, 0.001);
     let length = anthesis_flower::scale::organ_length(&petal.mesh);
