@@ -158,15 +158,26 @@ fn mark_typed(
 ) -> egui::Response {
     let id = response.id.with("checked field notice");
     let said_id = response.id.with("checked field said");
+    let pending_id = response.id.with("checked field pending");
     let now = ui.input(|i| i.time);
     if response.gained_focus() {
         // A new edit: what it refuses is said again.
         ui.data_mut(|d| d.remove::<String>(said_id));
     }
-    if let Some(message) = typed.and_then(|typed| notice(label, &typed, range)) {
-        // egui reads the typed text more than once as an edit ends (at
-        // Enter and as the field lets go, frames apart in a slow window):
-        // the same notice within one edit is said once.
+    // What the text typed so far makes; egui reads it at every keystroke
+    // ("-" on the way to "-1") and again as the edit ends, so only what
+    // the last reading made is said, once the field lets go.
+    if let Some(typed) = typed {
+        match notice(label, &typed, range) {
+            Some(message) => ui.data_mut(|d| {
+                d.insert_temp(pending_id, message);
+            }),
+            None => ui.data_mut(|d| d.remove::<String>(pending_id)),
+        }
+    }
+    if !response.has_focus()
+        && let Some(message) = ui.data_mut(|d| d.remove_temp::<String>(pending_id))
+    {
         let said: Option<String> = ui.data(|d| d.get_temp(said_id));
         ui.data_mut(|d| {
             d.insert_temp(id, (message.clone(), now));
@@ -383,6 +394,40 @@ mod tests {
                 "thickness 150 is outside what the field accepts (0.001 to 100); it is kept as \
                  it is until you type or drag a new value"
             )
+        );
+    }
+
+    #[test]
+    fn only_what_the_finished_edit_makes_is_said_not_each_keystroke() {
+        use egui_kittest::Harness;
+        use egui_kittest::kittest::Queryable;
+        let mut harness = Harness::new_ui_state(
+            |ui, state: &mut (f64, Vec<String>)| {
+                let label = ui.label("dg");
+                checked_number(ui, "dg", &mut state.0, 0.0001, DG_RANGE).labelled_by(label.id);
+                state.1.extend(take_notices(ui.ctx()));
+            },
+            (0.003, Vec::new()),
+        );
+        harness.get_by_label("dg").focus();
+        harness.run();
+        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+        // "-" alone is not a number, but the edit goes on to "-1".
+        for key in ["-", "1"] {
+            harness.get_by_label("dg").type_text(key);
+            harness.run();
+        }
+        assert_eq!(
+            harness.state().1,
+            Vec::<String>::new(),
+            "nothing while typing"
+        );
+        harness.key_press(egui::Key::Enter);
+        harness.run();
+        harness.run();
+        assert_eq!(
+            harness.state().1,
+            ["dg -1 is out of range (dg accepts -0.5 to 0.5); set to -0.5"]
         );
     }
 
