@@ -856,6 +856,39 @@ fn catalogue() -> Vec<Case> {
             ),
             "coordinates must be finite and within ±1e6"
         ),
+        // ------------------------------ issue 38 leftovers, issue 40 item 3
+        case!(
+            "pde-blossom with an edge of 1e-9 (a saturated vertex count once)",
+            |d| pde_pair(d, same, &["--edge", "1e-9"]),
+            "--edge 0.000000001 would mesh the bud (area 510.0258) into about 5.89e20 vertices; a \
+             mesh may have at most 200,000 (the largest organ the solver and the exports handle, \
+             as `anthesis info` lists): use --edge 0.0554 or longer"
+        ),
+        case!(
+            "a thickness of 0.001 on a petal 18.2 long (issue 40: the run stopped without a word about it)",
+            |d| {
+                replace(d, PROJECT, "thickness = 0.2", "thickness = 0.001");
+                simulate(d, &[])
+            },
+            "its mesh is 18.2 long, 18200 times its thickness 0.001, but organs are 10 to 2000 \
+             thicknesses long"
+        ),
+        case!(
+            "a stretch stiffness 20,000 times below the bend stiffness",
+            |d| {
+                replace(
+                    d,
+                    PROJECT,
+                    "stretch_stiffness = 20.0",
+                    "stretch_stiffness = 0.001",
+                );
+                replace(d, PROJECT, "keyframes = 3", "keyframes = 20");
+                simulate(d, &[])
+            },
+            "; Kb 20 of `petal` is 20,000 times its Ks 0.001, above the range where the solver \
+             converges (Kb up to 3,000 times Ks; the shipped flowers have Kb = Ks): raise Ks or \
+             lower Kb"
+        ),
         case!(
             "a solver that does not converge",
             |d| {

@@ -27,6 +27,9 @@ mod difference;
 #[path = "desktop/measure.rs"]
 mod measure;
 
+#[path = "desktop/refusals.rs"]
+mod refusals;
+
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {
     let mut project = anthesis_sim::fixtures::whorl(6, 8, 14, 20);

@@ -187,11 +187,58 @@ fn read_states(args: &PdeBlossomArgs, keyframes: usize) -> Result<(PdeSweep, Pde
         .point(DVec2::new(0.5, 1.0))
         .distance(bud.point(DVec2::new(0.5, 0.0)));
     let edge = args.edge.unwrap_or(length / 40.0);
+    check_edge(&bud, edge)?;
     let mesh = build_organ(&bud, &RemeshOptions::new(edge))
         .with_context(|| format!("cannot mesh the bud {}", args.bud.display()))?
         .mesh;
     super::check_positions(mesh.vertex_count(), keyframes as u32)?;
     Ok((bud, open, mesh))
+}
+
+/// Refuses a mean edge that would mesh `bud` into more vertices than a
+/// mesh may have, before any meshing (a tiny `--edge` once reported
+/// capped, meaningless figures): the count is estimated from the bud's
+/// area as an equilateral lattice has it, one vertex per √3/2·edge².
+fn check_edge(bud: &PdeSweep, edge: f64) -> Result<()> {
+    let limit = RemeshOptions::new(edge).max_vertices;
+    let area = surface_area(bud);
+    let per_vertex = 3f64.sqrt() / 2.0 * edge * edge;
+    let estimated = area / per_vertex;
+    if !estimated.is_finite() || estimated > limit as f64 {
+        // The shortest edge within the limit, rounded up to 3 digits.
+        let shortest = (area / (3f64.sqrt() / 2.0 * limit as f64)).sqrt();
+        let magnitude = shortest.log10().floor();
+        let unit = 10f64.powf(magnitude - 2.0);
+        let decimals = (2.0 - magnitude).max(0.0) as usize;
+        // (2 % above: the remesher counts a little more than the area.)
+        let suggested = format!("{:.decimals$}", (1.02 * shortest / unit).ceil() * unit);
+        bail!(
+            "--edge {} would mesh the bud (area {area:.4}) into about {estimated:.2e} vertices; \
+             a mesh may have at most {} (the largest organ the solver and the exports handle, as \
+             `anthesis info` lists): use --edge {} or longer",
+            anthesis_files::short_number(edge),
+            crate::desktop::params::grouped(limit as u64),
+            suggested,
+        );
+    }
+    Ok(())
+}
+
+/// The area of `surface`, from a 64 × 64 grid of its points (two
+/// triangles per cell): within a fraction of a percent for a smooth bud,
+/// enough for a limit check.
+fn surface_area(surface: &PdeSweep) -> f64 {
+    const N: usize = 64;
+    let at =
+        |i: usize, j: usize| surface.point(DVec2::new(i as f64 / N as f64, j as f64 / N as f64));
+    let mut area = 0.0;
+    for i in 0..N {
+        for j in 0..N {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            area += 0.5 * (b - a).cross(c - a).length() + 0.5 * (c - a).cross(d - a).length();
+        }
+    }
+    area
 }
 
 /// Solves the in-betweening of `bud` and `open` (Chaudhry et al. §V).

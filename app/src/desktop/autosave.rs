@@ -4,7 +4,10 @@
 //! files) at most every interval (60 s unless the settings say otherwise),
 //! written on the thread `anthesis-autosave` so the window never waits for
 //! the disk. A save, a discard or a clean exit removes it; after a crash or
-//! a `kill -9` the next launch finds it and offers the work back.
+//! a `kill -9` the next launch finds it and offers the work back. A
+//! recovery that cannot be read is set aside as `damaged-*`; at launch the
+//! newest three of those are kept and any set aside over 30 days ago are
+//! removed, each removal said in the log.
 
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, TrySendError, sync_channel};
@@ -176,6 +179,23 @@ impl AnthesisApp {
                 aside.folder.display()
             ));
             readable = readable.or(aside.recovery);
+        }
+        // Damaged recoveries do not pile up: the newest few are kept, none
+        // older than a month, and the log says what went.
+        for pruned in folder.prune_damaged(unix_seconds_now()) {
+            let when = age_in_words(pruned.set_aside_unix_seconds, unix_seconds_now());
+            match pruned.error {
+                None => self.log.info(format!(
+                    "removed the damaged recovery {} (set aside {when}; {})",
+                    pruned.folder.display(),
+                    pruned.why
+                )),
+                Some(error) => self.log.warn(format!(
+                    "cannot remove the damaged recovery {} ({}): {error}",
+                    pruned.folder.display(),
+                    pruned.why
+                )),
+            }
         }
         self.recovery_offer = folder.find().or(readable);
         match Autosave::start(folder, interval) {

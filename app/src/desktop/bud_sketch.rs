@@ -416,7 +416,7 @@ fn option_rows(ui: &mut egui::Ui, flower: &Flower, index: usize, state: &mut Bud
     if state.spiral && !state.opening {
         ui.horizontal(|ui| {
             let label = ui.label("petals").id;
-            ui.add(egui::DragValue::new(&mut state.count).range(1..=40))
+            super::checked_field::checked_with(ui, "petals", &mut state.count, 1..=40, |d| d)
                 .labelled_by(label);
         });
     }

@@ -29,6 +29,9 @@ pub enum Typed {
     },
     /// Not a number: the field keeps its value.
     Refused(String),
+    /// A number with a fraction in a field of whole numbers (a count, a
+    /// step): the field keeps its value.
+    NotWhole(String),
 }
 
 /// Reads `text` typed into a field accepting `range` (what `DragValue`
@@ -45,10 +48,22 @@ pub fn read_typed(text: &str, range: &RangeInclusive<f64>) -> Typed {
     }
 }
 
+/// [`read_typed`] for a field of whole numbers: a fraction is refused
+/// (`DragValue` would silently cut "2.5" to 2).
+pub fn read_typed_whole(text: &str, range: &RangeInclusive<f64>) -> Typed {
+    match read_typed(text, range) {
+        Typed::Taken(value) | Typed::Clamped { typed: value, .. } if value.fract() != 0.0 => {
+            Typed::NotWhole(text.to_owned())
+        }
+        read => read,
+    }
+}
+
 /// The log line for `typed` into the field `label`, or none when it was
 /// taken as typed.
 pub fn notice(label: &str, typed: &Typed, range: &RangeInclusive<f64>) -> Option<String> {
     let accepted = format!("{label} accepts {} to {}", range.start(), range.end());
+    let shown = |text: &str| text.chars().take(40).collect::<String>();
     match typed {
         Typed::Taken(_) => None,
         Typed::Clamped { typed, to } => Some(format!(
@@ -56,9 +71,26 @@ pub fn notice(label: &str, typed: &Typed, range: &RangeInclusive<f64>) -> Option
         )),
         Typed::Refused(text) => Some(format!(
             "`{}` is not a number; {label} kept its value ({accepted})",
-            text.chars().take(40).collect::<String>()
+            shown(text)
+        )),
+        Typed::NotWhole(text) => Some(format!(
+            "`{}` is not a whole number; {label} kept its value ({accepted}, whole numbers)",
+            shown(text)
         )),
     }
+}
+
+/// The tooltip of a field holding `value` outside its `range` (as loaded
+/// from a file or set by a command; the field does not change it).
+pub fn outside_note(label: &str, value: f64, range: &RangeInclusive<f64>) -> Option<String> {
+    (!range.contains(&value)).then(|| {
+        format!(
+            "{label} {value} is outside what the field accepts ({} to {}); it is kept as it \
+             is until you type or drag a new value",
+            range.start(),
+            range.end()
+        )
+    })
 }
 
 /// A number field like `DragValue::new(value).speed(speed).range(range)`
@@ -71,55 +103,176 @@ pub fn checked_number(
     speed: f64,
     range: RangeInclusive<f64>,
 ) -> egui::Response {
+    checked_with(ui, label, value, range, |drag| {
+        drag.speed(speed).max_decimals(5)
+    })
+}
+
+/// A `DragValue` over `value` (any number type) with `range`, styled by
+/// `style` (speed, suffix, decimals), that marks and logs a typed value
+/// it refuses (not a number, or a fraction for a whole-number field) or
+/// clamps into `range`, and marks without changing it a value already
+/// outside `range` (egui would clamp it silently when drawn). Returns the
+/// response.
+pub fn checked_with<N: egui::emath::Numeric>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut N,
+    range: RangeInclusive<N>,
+    style: impl FnOnce(DragValue<'_>) -> DragValue<'_>,
+) -> egui::Response {
+    let range_f64 = range.start().to_f64()..=range.end().to_f64();
     let typed: RefCell<Option<Typed>> = RefCell::new(None);
-    let parse_range = range.clone();
-    let mut response = ui.add(
+    let parse_range = range_f64.clone();
+    let response = ui.add(style(
         DragValue::new(value)
-            .speed(speed)
-            .range(range.clone())
-            .max_decimals(5)
+            .range(range)
+            .clamp_existing_to_range(false)
             .custom_parser(|text| {
-                let read = read_typed(text, &parse_range);
+                let read = if N::INTEGRAL {
+                    read_typed_whole(text, &parse_range)
+                } else {
+                    read_typed(text, &parse_range)
+                };
                 let value = match read {
                     Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
-                    Typed::Refused(_) => None,
+                    Typed::Refused(_) | Typed::NotWhole(_) => None,
                 };
                 *typed.borrow_mut() = Some(read);
                 value
             }),
-    );
+    ));
+    let outside = outside_note(label, value.to_f64(), &range_f64);
+    mark_typed(ui, response, label, typed.into_inner(), &range_f64, outside)
+}
+
+/// Logs what became of a typed value (once), and marks the field while
+/// that is recent or while its value is `outside` its range.
+fn mark_typed(
+    ui: &mut egui::Ui,
+    mut response: egui::Response,
+    label: &str,
+    typed: Option<Typed>,
+    range: &RangeInclusive<f64>,
+    outside: Option<String>,
+) -> egui::Response {
     let id = response.id.with("checked field notice");
+    let said_id = response.id.with("checked field said");
+    let pending_id = response.id.with("checked field pending");
     let now = ui.input(|i| i.time);
-    if let Some(message) = typed
-        .into_inner()
-        .and_then(|typed| notice(label, &typed, &range))
+    if response.gained_focus() {
+        // A new edit: what it refuses is said again.
+        ui.data_mut(|d| d.remove::<String>(said_id));
+    }
+    // What the text typed so far makes; egui reads it at every keystroke
+    // ("-" on the way to "-1") and again as the edit ends, so only what
+    // the last reading made is said, once the field lets go.
+    if let Some(typed) = typed {
+        match notice(label, &typed, range) {
+            Some(message) => ui.data_mut(|d| {
+                d.insert_temp(pending_id, message);
+            }),
+            None => ui.data_mut(|d| d.remove::<String>(pending_id)),
+        }
+    }
+    if !response.has_focus()
+        && let Some(message) = ui.data_mut(|d| d.remove_temp::<String>(pending_id))
     {
-        // egui may read the typed text more than once as the edit ends:
-        // the same notice within a second is one.
-        let before: Option<(String, f64)> = ui.data(|d| d.get_temp(id));
-        let repeated = before.is_some_and(|(said, at)| said == message && now - at < 1.0);
-        ui.data_mut(|d| d.insert_temp(id, (message.clone(), now)));
-        if !repeated {
+        let said: Option<String> = ui.data(|d| d.get_temp(said_id));
+        ui.data_mut(|d| {
+            d.insert_temp(id, (message.clone(), now));
+            d.insert_temp(said_id, message.clone());
+        });
+        if said.as_ref() != Some(&message) {
             push_notice(ui.ctx(), message);
         }
     }
     let marked: Option<(String, f64)> = ui.data(|d| d.get_temp(id));
-    if let Some((message, since)) = marked {
-        if now - since < MARK_SECONDS {
-            ui.painter().rect_stroke(
-                response.rect.expand(1.0),
-                2.0,
-                egui::Stroke::new(1.5, ui.visuals().error_fg_color),
-                egui::StrokeKind::Outside,
-            );
-            response = response.on_hover_text(message);
+    let recent = match marked {
+        Some((message, since)) if now - since < MARK_SECONDS => {
             ui.ctx()
                 .request_repaint_after(std::time::Duration::from_secs_f64(MARK_SECONDS));
-        } else {
-            ui.data_mut(|d| d.remove::<(String, f64)>(id));
+            Some(message)
         }
+        Some(_) => {
+            ui.data_mut(|d| d.remove::<(String, f64)>(id));
+            None
+        }
+        None => None,
+    };
+    if let Some(message) = recent.or(outside) {
+        ui.painter().rect_stroke(
+            response.rect.expand(1.0),
+            2.0,
+            egui::Stroke::new(1.5, ui.visuals().error_fg_color),
+            egui::StrokeKind::Outside,
+        );
+        response = response.on_hover_text(message);
     }
     response
+}
+
+/// A slider like `Slider::new(value, range)` whose number box marks and
+/// logs a typed value it refuses or clamps into `range` (the slider
+/// itself never leaves it). Returns the response.
+pub fn checked_slider<N: egui::emath::Numeric>(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut N,
+    range: RangeInclusive<N>,
+    style: impl FnOnce(egui::Slider<'_>) -> egui::Slider<'_>,
+) -> egui::Response {
+    let range_f64 = range.start().to_f64()..=range.end().to_f64();
+    let typed: RefCell<Option<Typed>> = RefCell::new(None);
+    let parse_range = range_f64.clone();
+    let response = ui.add(style(egui::Slider::new(value, range).custom_parser(
+        |text| {
+            let read = read_typed(text, &parse_range);
+            let value = match read {
+                Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
+                Typed::Refused(_) | Typed::NotWhole(_) => None,
+            };
+            *typed.borrow_mut() = Some(read);
+            value
+        },
+    )));
+    mark_typed(ui, response, label, typed.into_inner(), &range_f64, None)
+}
+
+/// Outlines `response`'s field and gives it `problem` as its tooltip
+/// while there is one (a value that is in range but does not work with
+/// another, as a ramp ending before it starts); the problem goes to the log
+/// once when the values come to it.
+pub fn flagged(
+    ui: &mut egui::Ui,
+    response: egui::Response,
+    problem: Option<String>,
+) -> egui::Response {
+    let id = response.id.with("flagged");
+    let Some(problem) = problem else {
+        ui.data_mut(|d| d.remove::<String>(id));
+        return response;
+    };
+    // Said once each time the values come to it (either field's edit, or
+    // a project opened with it).
+    let said: Option<String> = ui.data(|d| d.get_temp(id));
+    if said.as_ref() != Some(&problem) {
+        ui.data_mut(|d| d.insert_temp(id, problem.clone()));
+        push_notice(ui.ctx(), problem.clone());
+    }
+    ui.painter().rect_stroke(
+        response.rect.expand(1.0),
+        2.0,
+        egui::Stroke::new(1.5, ui.visuals().error_fg_color),
+        egui::StrokeKind::Outside,
+    );
+    response.on_hover_text(problem)
+}
+
+/// Says `message` in the log with the refused and clamped values (a value
+/// a panel changed on its own, as a ramp's end moved up to its start).
+pub fn say(ctx: &egui::Context, message: String) {
+    push_notice(ctx, message);
 }
 
 fn notices_id() -> egui::Id {
@@ -210,6 +363,71 @@ mod tests {
         assert_eq!(
             notice("dg", &read_typed("abc", &DG_RANGE), &DG_RANGE).as_deref(),
             Some("`abc` is not a number; dg kept its value (dg accepts -0.5 to 0.5)")
+        );
+    }
+
+    #[test]
+    fn a_fraction_in_a_whole_number_field_is_refused_and_a_loaded_value_outside_is_noted() {
+        let range = 1.0..=10_000.0;
+        assert_eq!(read_typed_whole("7", &range), Typed::Taken(7.0));
+        assert_eq!(
+            read_typed_whole("2.5", &range),
+            Typed::NotWhole("2.5".into())
+        );
+        assert_eq!(
+            read_typed_whole("20000", &range),
+            Typed::Clamped {
+                typed: 20_000.0,
+                to: 10_000.0
+            }
+        );
+        assert_eq!(
+            notice("keyframes", &read_typed_whole("2.5", &range), &range).as_deref(),
+            Some(
+                "`2.5` is not a whole number; keyframes kept its value (keyframes accepts 1 to 10000, whole numbers)"
+            )
+        );
+        assert_eq!(outside_note("thickness", 0.2, &THICKNESS_RANGE), None);
+        assert_eq!(
+            outside_note("thickness", 150.0, &THICKNESS_RANGE).as_deref(),
+            Some(
+                "thickness 150 is outside what the field accepts (0.001 to 100); it is kept as \
+                 it is until you type or drag a new value"
+            )
+        );
+    }
+
+    #[test]
+    fn only_what_the_finished_edit_makes_is_said_not_each_keystroke() {
+        use egui_kittest::Harness;
+        use egui_kittest::kittest::Queryable;
+        let mut harness = Harness::new_ui_state(
+            |ui, state: &mut (f64, Vec<String>)| {
+                let label = ui.label("dg");
+                checked_number(ui, "dg", &mut state.0, 0.0001, DG_RANGE).labelled_by(label.id);
+                state.1.extend(take_notices(ui.ctx()));
+            },
+            (0.003, Vec::new()),
+        );
+        harness.get_by_label("dg").focus();
+        harness.run();
+        harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+        // "-" alone is not a number, but the edit goes on to "-1".
+        for key in ["-", "1"] {
+            harness.get_by_label("dg").type_text(key);
+            harness.run();
+        }
+        assert_eq!(
+            harness.state().1,
+            Vec::<String>::new(),
+            "nothing while typing"
+        );
+        harness.key_press(egui::Key::Enter);
+        harness.run();
+        harness.run();
+        assert_eq!(
+            harness.state().1,
+            ["dg -1 is out of range (dg accepts -0.5 to 0.5); set to -0.5"]
         );
     }
 

@@ -349,8 +349,14 @@ impl FitDialog {
                         .labelled_by(label);
                         ui.end_row();
                         let label = ui.label("Time keys").id;
-                        ui.add(egui::DragValue::new(&mut self.keys).range(1..=5))
-                            .labelled_by(label);
+                        super::checked_field::checked_with(
+                            ui,
+                            "time keys",
+                            &mut self.keys,
+                            1..=5,
+                            |d| d,
+                        )
+                        .labelled_by(label);
                         ui.end_row();
                         ui.label("");
                         ui.checkbox(&mut self.register, "Register the target on the organ first")

@@ -17,9 +17,10 @@ use anthesis_flower::edit::{RuleOrigin, lsystem_like, spiral_like, whorls_like};
 use anthesis_flower::structure::lsystem::LSystemError;
 use anthesis_flower::structure::{Spiral, Structure, StructureError, Whorl};
 use anthesis_flower::{Flower, Project};
-use eframe::egui::{self, Color32, DragValue, RichText};
+use eframe::egui::{self, Color32, RichText};
 
 use super::bud_sketch::{BudSketchState, bud_sketch_ui};
+use super::checked_field::checked_with;
 use super::command::{Command, ProjectEdit};
 use super::parts_panel;
 use super::shape_panel::{ShapeState, shape_ui};

@@ -520,6 +520,36 @@ impl AnthesisApp {
         }
     }
 
+    /// Logs a run's failure as an error, adding the values the user chose
+    /// that it may come from.
+    pub fn report_run_failure(&mut self, failure: &str) {
+        // A value the user chose at the end of its range is named.
+        // And the values outside the range runs settle in (a failure
+        // that is not the solver's, as a petal passing through itself,
+        // does not say them), not again when the failure names them.
+        let project = self.doc.project();
+        let mut suspects: Vec<String> = project
+            .flower
+            .templates
+            .iter()
+            .flat_map(anthesis_sim::values_out_of_range)
+            .collect();
+        suspects.extend(checked_field::values_at_limits(project));
+        suspects.retain(|s| !s.split(" of ").next().is_some_and(|v| failure.contains(v)));
+        // One line per value and template ("thickness 0.001 of petal").
+        let mut seen = std::collections::HashSet::new();
+        suspects.retain(|s| seen.insert(s.split(" is ").next().map(|v| v.replace('`', ""))));
+        let suspects = if suspects.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", suspects.join("; "))
+        };
+        self.log.error_about(
+            Topic::Simulation,
+            format!("the simulation stopped: {failure}{suspects}"),
+        );
+    }
+
     fn drain_worker(&mut self) {
         let drained = self.session.drain(DRAIN_BUDGET);
         if drained.finished {
@@ -532,17 +562,7 @@ impl AnthesisApp {
             self.log.warn(warning);
         }
         for failure in drained.failures {
-            // A value the user chose at the end of its range is named.
-            let suspects = checked_field::values_at_limits(self.doc.project());
-            let suspects = if suspects.is_empty() {
-                String::new()
-            } else {
-                format!(" ({})", suspects.join("; "))
-            };
-            self.log.error_about(
-                Topic::Simulation,
-                format!("the simulation stopped: {failure}{suspects}"),
-            );
+            self.report_run_failure(&failure);
         }
         if let Some(end) = self.export.poll() {
             match end {

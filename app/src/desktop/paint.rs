@@ -9,6 +9,7 @@ use anthesis_maps::{Blend, MapKey, MapKind};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke, Vec2};
 use glam::DVec2;
 
+use super::checked_field::{checked_slider, checked_with};
 use super::command::{Command, ProjectEdit};
 use super::panels::section;
 use super::words;
@@ -398,13 +399,12 @@ impl PaintState {
                 )
                 .changed();
             let dragged = ui
-                .add_enabled(
-                    own,
-                    egui::DragValue::new(&mut dg)
-                        .speed(0.0001)
-                        .range(-0.5..=0.5)
-                        .max_decimals(4),
-                )
+                .add_enabled_ui(own, |ui| {
+                    checked_with(ui, "dg", &mut dg, -0.5..=0.5, |d| {
+                        d.speed(0.0001).max_decimals(4)
+                    })
+                })
+                .inner
                 .labelled_by(label)
                 .changed();
             if toggled || dragged {
@@ -435,9 +435,15 @@ impl PaintState {
     ) {
         let label = ui.label("New key").id;
         ui.horizontal(|ui| {
-            ui.add(egui::DragValue::new(&mut self.new_key_step).range(0..=100_000))
-                .labelled_by(label)
-                .on_hover_text("Step of the key to add");
+            checked_with(
+                ui,
+                "new key step",
+                &mut self.new_key_step,
+                0..=100_000,
+                |d| d,
+            )
+            .labelled_by(label)
+            .on_hover_text("Step of the key to add");
             let exists = current
                 .maps
                 .keys()
@@ -509,15 +515,18 @@ impl PaintState {
             };
             let slider = |ui: &mut egui::Ui, symbol: &str, value: &mut f32| {
                 let label = name(ui, symbol);
-                ui.add(egui::Slider::new(value, 0.0..=1.0))
+                checked_slider(ui, &words::label(symbol), value, 0.0..=1.0, |s| s)
                     .labelled_by(label)
                     .on_hover_text(words::tooltip(symbol));
                 ui.end_row();
             };
             let label = name(ui, "radius");
-            ui.add(
-                egui::Slider::new(&mut brush.radius_in_uv, MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV)
-                    .logarithmic(true),
+            checked_slider(
+                ui,
+                &words::label("radius"),
+                &mut brush.radius_in_uv,
+                MIN_RADIUS_IN_UV..=MAX_RADIUS_IN_UV,
+                |s| s.logarithmic(true),
             )
             .labelled_by(label)
             .on_hover_text(words::tooltip("radius"));

@@ -8,7 +8,9 @@
 
 use anthesis_flower::resolution::predicted_size;
 use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOR, JointRamp, Project, Resolution, Template};
-use eframe::egui::{self, DragValue};
+use eframe::egui;
+
+use super::checked_field::checked_with;
 
 use super::command::{Command, ProjectEdit};
 use super::panels::section;
@@ -93,18 +95,16 @@ pub fn parameters_ui_viewing(
             let label = ui.label(words::label("keyframes")).on_hover_text(&tooltip);
             // A checked field, as the others: a typed count out of range or
             // not a number is marked and logged, not silently clamped.
-            let mut count = f64::from(keyframes);
-            let changed = super::checked_field::checked_number(
+            let changed = checked_with(
                 ui,
                 &words::label("keyframes"),
-                &mut count,
-                1.0,
-                1.0..=10_000.0,
+                &mut keyframes,
+                1..=anthesis_flower::MAX_KEYFRAMES,
+                |d| d.speed(1.0),
             )
             .labelled_by(label.id)
             .on_hover_text(tooltip)
             .changed();
-            keyframes = count.round() as u32;
             mark(changed, "keyframes");
             ui.end_row();
         });
@@ -200,26 +200,34 @@ fn joint_ramps_ui(
             ui.end_row();
             for (i, ramp) in draft.joint_schedule.iter_mut().enumerate() {
                 mark(
-                    ui.add(DragValue::new(&mut ramp.from_step).range(0..=100_000))
+                    checked_with(ui, "from step", &mut ramp.from_step, 0..=100_000, |d| d)
                         .labelled_by(from_label)
                         .on_hover_text(words::tooltip("from step"))
                         .changed(),
                     "joint from",
                 );
                 mark(
-                    ui.add(DragValue::new(&mut ramp.to_step).range(0..=100_000))
-                        .labelled_by(to_label)
-                        .on_hover_text(words::tooltip("to step"))
-                        .changed(),
+                    {
+                        let to = checked_with(ui, "to step", &mut ramp.to_step, 0..=100_000, |d| d);
+                        // A ramp that ends before it starts adds nothing.
+                        let backwards = (ramp.to_step < ramp.from_step).then(|| {
+                            format!(
+                                "to step {} is before from step {}: this ramp adds no degrees \
+                                 (set to step at or after from step)",
+                                ramp.to_step, ramp.from_step
+                            )
+                        });
+                        super::checked_field::flagged(ui, to, backwards)
+                    }
+                    .labelled_by(to_label)
+                    .on_hover_text(words::tooltip("to step"))
+                    .changed(),
                     "joint to",
                 );
                 mark(
-                    ui.add(
-                        DragValue::new(&mut ramp.angle_deg)
-                            .speed(0.1)
-                            .range(-180.0..=180.0)
-                            .suffix("°"),
-                    )
+                    checked_with(ui, "degrees", &mut ramp.angle_deg, -180.0..=180.0, |d| {
+                        d.speed(0.1).suffix("°")
+                    })
                     .labelled_by(degrees_label)
                     .on_hover_text(words::tooltip("degrees"))
                     .changed(),
@@ -401,18 +409,21 @@ fn resolution_rows(
             match current.mean_edge() {
                 Some(edge) => {
                     let mut value = dragged_edge.unwrap_or(edge);
-                    let response = ui
-                        .add(
-                            DragValue::new(&mut value)
-                                .speed(0.01 * edge)
-                                .range(1e-3 * built_edge..=1e3 * built_edge)
+                    let response = checked_with(
+                        ui,
+                        "mean edge",
+                        &mut value,
+                        1e-3 * built_edge..=1e3 * built_edge,
+                        |d| {
+                            d.speed(0.01 * edge)
                                 .max_decimals(4)
                                 // A typed edge counts when entered: on the
                                 // way to 0.5, "0" would be the smallest
                                 // edge, remeshed (or refused) at once.
-                                .update_while_editing(false),
-                        )
-                        .on_hover_text(&tooltip);
+                                .update_while_editing(false)
+                        },
+                    )
+                    .on_hover_text(&tooltip);
                     if response.dragged() {
                         ui.data_mut(|d| d.insert_temp(draft_id, value));
                     } else {

@@ -7,7 +7,9 @@
 
 use anthesis_flower::parts::{Part, PartShape, Tube, default_colors, instance_name};
 use anthesis_flower::{JointRamp, Project};
-use eframe::egui::{self, DragValue, Rgba};
+use eframe::egui::{self, Rgba};
+
+use super::checked_field::{self, checked_with};
 
 use super::command::{Command, ProjectEdit};
 
@@ -19,15 +21,10 @@ pub(super) fn row(
     value: &mut f64,
     range: std::ops::RangeInclusive<f64>,
 ) -> bool {
+    let name = label;
     let label = ui.label(label).on_hover_text(tooltip);
     let speed = (0.01 * (*range.end() - *range.start()).abs()).clamp(1e-3, 1.0);
-    let changed = ui
-        .add(
-            DragValue::new(value)
-                .speed(speed)
-                .range(range)
-                .max_decimals(3),
-        )
+    let changed = checked_with(ui, name, value, range, |d| d.speed(speed).max_decimals(3))
         .labelled_by(label.id)
         .on_hover_text(tooltip)
         .changed();
@@ -96,9 +93,15 @@ fn part_rows(ui: &mut egui::Ui, part: &mut Part) -> Option<&'static str> {
         let mut count = part.count;
         let label = ui.label("count").on_hover_text("How many around the axis.");
         mark(
-            ui.add(DragValue::new(&mut count).range(1..=anthesis_flower::parts::MAX_PART_COUNT))
-                .labelled_by(label.id)
-                .changed(),
+            checked_with(
+                ui,
+                "count",
+                &mut count,
+                1..=anthesis_flower::parts::MAX_PART_COUNT,
+                |d| d,
+            )
+            .labelled_by(label.id)
+            .changed(),
             "count",
         );
         part.count = count;
@@ -228,9 +231,12 @@ fn shape_fields(
             );
             let label = ui.label("stigma lobes");
             mark(
-                ui.add(
-                    DragValue::new(stigma_lobes)
-                        .range(1..=anthesis_flower::parts::MAX_STIGMA_LOBES),
+                checked_with(
+                    ui,
+                    "stigma lobes",
+                    stigma_lobes,
+                    1..=anthesis_flower::parts::MAX_STIGMA_LOBES,
+                    |d| d,
                 )
                 .labelled_by(label.id)
                 .changed(),
@@ -286,29 +292,23 @@ fn schedule_rows(ui: &mut egui::Ui, part: &mut Part, id: usize) -> Option<&'stat
         .num_columns(4)
         .show(ui, |ui| {
             for (i, ramp) in part.schedule.iter_mut().enumerate() {
-                if ui
-                    .add(DragValue::new(&mut ramp.from_step).range(0..=100_000))
+                if checked_with(ui, "from step", &mut ramp.from_step, 0..=100_000, |d| d)
                     .on_hover_text("The turn starts after this step")
                     .changed()
                 {
                     changed = Some("schedule");
                 }
-                if ui
-                    .add(DragValue::new(&mut ramp.to_step).range(0..=100_000))
+                if checked_with(ui, "to step", &mut ramp.to_step, 0..=100_000, |d| d)
                     .on_hover_text("The turn is done at this step")
                     .changed()
                 {
                     changed = Some("schedule");
                 }
-                if ui
-                    .add(
-                        DragValue::new(&mut ramp.angle_deg)
-                            .speed(0.1)
-                            .range(-180.0..=180.0)
-                            .suffix("°"),
-                    )
-                    .on_hover_text("Degrees it turns outwards")
-                    .changed()
+                if checked_with(ui, "degrees", &mut ramp.angle_deg, -180.0..=180.0, |d| {
+                    d.speed(0.1).suffix("°")
+                })
+                .on_hover_text("Degrees it turns outwards")
+                .changed()
                 {
                     changed = Some("schedule");
                 }
@@ -316,7 +316,17 @@ fn schedule_rows(ui: &mut egui::Ui, part: &mut Part, id: usize) -> Option<&'stat
                     remove = Some(i);
                 }
                 ui.end_row();
-                ramp.to_step = ramp.to_step.max(ramp.from_step);
+                if ramp.to_step < ramp.from_step {
+                    // A ramp goes forwards: said, not done silently.
+                    checked_field::say(
+                        ui.ctx(),
+                        format!(
+                            "to step {} is before from step {}; set to {} (a ramp goes forwards)",
+                            ramp.to_step, ramp.from_step, ramp.from_step
+                        ),
+                    );
+                    ramp.to_step = ramp.from_step;
+                }
             }
         });
     if let Some(i) = remove {

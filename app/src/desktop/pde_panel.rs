@@ -22,9 +22,10 @@ use std::collections::BTreeMap;
 
 use anthesis_bud::{Bud, PdeSweep, RemeshOptions, Surface, SweepCurve};
 use anthesis_flower::{Flower, TemplateSource};
-use eframe::egui::{self, Color32, DragValue, RichText};
+use eframe::egui::{self, Color32, RichText};
 use glam::{DVec2, DVec3};
 
+use super::checked_field::{checked_slider, checked_with};
 use super::command::{Command, ProjectEdit};
 use super::scan_panel::ScanReview;
 use super::sketch_panel::{canvas_height, in_room, large_button};
@@ -208,10 +209,12 @@ fn editor(
     ui.horizontal(|ui| {
         for (axis, value) in [("x", &mut p.x), ("y", &mut p.y), ("z", &mut p.z)] {
             let label = ui.label(axis).id;
-            typed |= ui
-                .add(DragValue::new(value).speed(0.05).max_decimals(3))
-                .labelled_by(label)
-                .changed();
+            let limit = anthesis_mesh::validate::MAX_COORDINATE;
+            typed |= checked_with(ui, axis, value, -limit..=limit, |d| {
+                d.speed(0.05).max_decimals(3)
+            })
+            .labelled_by(label)
+            .changed();
         }
     })
     .response
@@ -233,14 +236,15 @@ fn editor(
                  of eq. 12, larger values pull it taut between the margins",
             )
             .id;
-        if ui
-            .add(
-                egui::Slider::new(&mut lambda, 0.0..=anthesis_bud::MAX_STRETCH_TO_BEND)
-                    .logarithmic(true)
-                    .smallest_positive(0.01),
-            )
-            .labelled_by(label)
-            .changed()
+        if checked_slider(
+            ui,
+            "k_s/k_b",
+            &mut lambda,
+            0.0..=anthesis_bud::MAX_STRETCH_TO_BEND,
+            |slider| slider.logarithmic(true).smallest_positive(0.01),
+        )
+        .labelled_by(label)
+        .changed()
         {
             sweep = sweep.with_stretch_to_bend(lambda);
         }

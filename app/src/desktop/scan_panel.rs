@@ -18,7 +18,7 @@ use anthesis_bud::{
 };
 use anthesis_flower::{Flower, TemplateSource};
 use anthesis_mesh::Mesh;
-use eframe::egui::{self, Color32, DragValue, RichText};
+use eframe::egui::{self, Color32, RichText};
 use glam::{DVec2, DVec3};
 
 use super::background::Background;
@@ -228,15 +228,11 @@ pub fn scan_ui(
             }
             let label = ui.label("edge").id;
             let speed = (review.edge * 0.01).max(1e-4);
-            if ui
-                .add(
-                    DragValue::new(&mut review.edge)
-                        .range(1e-4..=1e4)
-                        .speed(speed)
-                        .max_decimals(4),
-                )
-                .labelled_by(label)
-                .changed()
+            if super::checked_field::checked_with(ui, "edge", &mut review.edge, 1e-4..=1e4, |d| {
+                d.speed(speed).max_decimals(4)
+            })
+            .labelled_by(label)
+            .changed()
             {
                 review.edge_set = true;
                 review.built = None;

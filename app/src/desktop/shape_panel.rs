@@ -13,10 +13,11 @@ use std::collections::BTreeMap;
 use anthesis_bud::{BezierPatch, Bud, BudError, MeshQuality, RemeshOptions};
 use anthesis_flower::{Flower, TemplateSource};
 use anthesis_mesh::Mesh;
-use eframe::egui::{self, Color32, DragValue, RichText};
+use eframe::egui::{self, Color32, RichText};
 use glam::DVec3;
 
 use super::background::Background;
+use super::checked_field::checked_with;
 use super::command::{Command, ProjectEdit};
 use super::widgets::{quality_text, view_point};
 
@@ -195,15 +196,11 @@ fn shape_rows(
             .label("remesh edge")
             .on_hover_text("The mean edge length to remesh at, in project units");
         let speed = (edge * 0.01).max(1e-4);
-        if ui
-            .add(
-                DragValue::new(&mut edge)
-                    .range(1e-4..=1e4)
-                    .speed(speed)
-                    .max_decimals(4),
-            )
-            .labelled_by(label.id)
-            .changed()
+        if checked_with(ui, "remesh edge", &mut edge, 1e-4..=1e4, |d| {
+            d.speed(speed).max_decimals(4)
+        })
+        .labelled_by(label.id)
+        .changed()
         {
             state.edge = Some(edge);
         }
@@ -391,10 +388,12 @@ fn bezier_ui(
     ui.horizontal(|ui| {
         for (axis, value) in [("x", &mut p.x), ("y", &mut p.y), ("z", &mut p.z)] {
             let label = ui.label(axis).id;
-            typed |= ui
-                .add(DragValue::new(value).speed(0.05).max_decimals(3))
-                .labelled_by(label)
-                .changed();
+            let limit = anthesis_mesh::validate::MAX_COORDINATE;
+            typed |= checked_with(ui, axis, value, -limit..=limit, |d| {
+                d.speed(0.05).max_decimals(3)
+            })
+            .labelled_by(label)
+            .changed();
         }
     });
     if typed {

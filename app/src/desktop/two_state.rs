@@ -7,9 +7,10 @@
 
 use anthesis_flower::{Project, Template, TwoStateAnimation, joint_angle_after};
 use anthesis_twostate::VelocityCurve;
-use eframe::egui::{self, DragValue, Stroke};
+use eframe::egui::{self, Stroke};
 use glam::DVec3;
 
+use super::checked_field::checked_with;
 use super::command::Command;
 
 /// The selected organ's shape at the keyframe the viewport shows, when
@@ -181,12 +182,9 @@ fn timing_grid(
             let tip = super::words::tooltip("g");
             let label = ui.label(super::words::label("g")).on_hover_text(&tip);
             mark(
-                ui.add(
-                    DragValue::new(&mut animation.growth.g)
-                        .speed(0.05)
-                        .range(0.01..=60.0)
-                        .max_decimals(3),
-                )
+                checked_with(ui, "g", &mut animation.growth.g, 0.01..=60.0, |d| {
+                    d.speed(0.05).max_decimals(3)
+                })
                 .labelled_by(label.id)
                 .on_hover_text(&tip)
                 .changed(),
@@ -196,11 +194,12 @@ fn timing_grid(
             let tip = super::words::tooltip("T");
             let label = ui.label(super::words::label("T")).on_hover_text(&tip);
             mark(
-                ui.add(
-                    DragValue::new(&mut animation.growth.duration)
-                        .speed(0.5)
-                        .range(0.5..=f64::from(anthesis_flower::MAX_KEYFRAMES))
-                        .max_decimals(2),
+                checked_with(
+                    ui,
+                    "T",
+                    &mut animation.growth.duration,
+                    0.5..=f64::from(anthesis_flower::MAX_KEYFRAMES),
+                    |d| d.speed(0.5).max_decimals(2),
                 )
                 .labelled_by(label.id)
                 .on_hover_text(&tip)
@@ -234,23 +233,17 @@ fn velocity_points_ui(
                 };
                 let point = &mut points[i];
                 mark(
-                    ui.add(
-                        DragValue::new(&mut point[0])
-                            .speed(0.01)
-                            .range(low..=high.max(low))
-                            .max_decimals(3),
-                    )
+                    checked_with(ui, "time / T", &mut point[0], low..=high.max(low), |d| {
+                        d.speed(0.01).max_decimals(3)
+                    })
                     .labelled_by(time_label)
                     .changed(),
                     "velocity point",
                 );
                 mark(
-                    ui.add(
-                        DragValue::new(&mut point[1])
-                            .speed(0.01)
-                            .range(-1.0..=2.0)
-                            .max_decimals(3),
-                    )
+                    checked_with(ui, "fraction", &mut point[1], -1.0..=2.0, |d| {
+                        d.speed(0.01).max_decimals(3)
+                    })
                     .labelled_by(fraction_label)
                     .changed(),
                     "velocity point",

@@ -42,7 +42,9 @@ use crate::organ::{OrganSim, OrganState};
 use crate::resume::{Edit, edit_between};
 use crate::step::search::free_pairs;
 
-pub use crate::error::{SimError, held_against_note, panic_message};
+pub use crate::error::{
+    SimError, held_against_note, panic_message, values_note, values_out_of_range,
+};
 pub use crate::keyframe::{Keyframe, KeyframeStats, Selection};
 
 /// Progress inside a keyframe, reported after every iteration.
@@ -118,11 +120,30 @@ pub struct Simulation {
     /// Particles held off their own organ by a self-contact while the
     /// organs settled, summed over the keyframes computed.
     self_pressed: u64,
+    /// Per organ, its template's values outside the range the solver is
+    /// made for, named when a run stops at it (see
+    /// [`error::values_out_of_range`]).
+    out_of_range: Vec<Vec<String>>,
     #[cfg(any(test, feature = "fault-hook"))]
     fault: Option<fault::Fault>,
 }
 
+/// Per organ of `chosen`, its template's values outside the range the
+/// solver is made for.
+fn out_of_range(project: &Project, chosen: &[usize]) -> Vec<Vec<String>> {
+    chosen
+        .iter()
+        .map(|&i| error::values_out_of_range(project.flower.template_of(i)))
+        .collect()
+}
+
 impl Simulation {
+    /// The values of organ `organ`'s template outside the range the
+    /// solver is made for, for a failure at it.
+    pub(crate) fn values_out_of_range(&self, organ: usize) -> Vec<String> {
+        self.out_of_range.get(organ).cloned().unwrap_or_default()
+    }
+
     /// Sets up a run of `project` (all organs or one, per `selection`) at
     /// the bud: validates every template and builds its solver. Fails with
     /// [`SimError::BadMesh`], [`SimError::BadTemplate`] or
@@ -155,6 +176,7 @@ impl Simulation {
             })
             .collect::<Vec<_>>();
         let previous_energy = vec![0.0; organs.len()];
+        let out_of_range = out_of_range(project, &chosen);
         let free = free_pairs(&organs, &overlaps);
         let obstacles = anthesis_flower::parts::obstacles(flower)
             .into_iter()
@@ -177,6 +199,7 @@ impl Simulation {
             crossings: Vec::new(),
             two_sided: false,
             self_pressed: 0,
+            out_of_range,
             #[cfg(all(feature = "fault-hook", not(test)))]
             fault: fault::Fault::from_env(),
             #[cfg(test)]
@@ -246,6 +269,7 @@ impl Simulation {
             }
             return Ok(1);
         }
+        self.out_of_range = out_of_range(after, &self.chosen);
         for (organ, &index) in self.organs.iter_mut().zip(&self.chosen) {
             organ.take_maps(
                 before.flower.template_of(index),

@@ -274,3 +274,40 @@ fn keyframe_statistics_report_convergence() {
         assert!(s.seconds.is_finite() && s.seconds >= 0.0);
     }
 }
+
+#[test]
+fn a_run_that_fails_for_a_thin_petal_or_a_soft_stretch_names_the_value() {
+    // The ranges `values_out_of_range` says are where runs settle: just
+    // inside them the test whorl runs to the end, far outside it stops and
+    // the message names the value.
+    let base = whorl(1, 8, 14, 20);
+    let length = anthesis_flower::scale::organ_length(&base.flower.templates[0].mesh);
+    let run = |change: &dyn Fn(&mut anthesis_flower::Template)| {
+        let mut project = base.clone();
+        change(&mut project.flower.templates[0]);
+        run_all(&project, &Selection::All)
+    };
+    let (keyframes, error) = run(&|t| t.thickness = length / 1990.0);
+    assert_eq!(
+        (keyframes.len(), error),
+        (21, None),
+        "1,990 thicknesses long"
+    );
+    let (_, error) = run(&|t| t.thickness = length / 100_000.0);
+    let message = error
+        .expect("a petal 100,000 thicknesses long stops")
+        .to_string();
+    assert!(
+        message.contains("; thickness 0.000182 of `petal` is below the range where the solver converges (0.0091 to 1.82"),
+        "{message}"
+    );
+    let kb = base.flower.templates[0].bend_stiffness;
+    let (keyframes, error) = run(&|t| t.stretch_stiffness = kb / 3000.0);
+    assert_eq!((keyframes.len(), error), (21, None), "Kb = 3,000 Ks");
+    let (_, error) = run(&|t| t.stretch_stiffness = kb / 20_000.0);
+    let message = error.expect("Kb = 20,000 Ks stops").to_string();
+    assert!(
+        message.contains("not converged") && message.contains("is 20,000 times its Ks"),
+        "{message}"
+    );
+}

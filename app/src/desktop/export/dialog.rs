@@ -15,19 +15,14 @@ use super::{
     edge_text, run_note, shown_edge, target_format,
 };
 use crate::animation;
-use crate::desktop::checked_field::checked_number;
+use crate::desktop::checked_field::{checked_number, checked_with};
 
 /// A labelled row editing an angle in degrees within `[-limit, limit]`;
 /// returns the editor's response.
 fn angle_row(ui: &mut egui::Ui, name: &str, degrees: &mut f64, limit: f64) -> egui::Response {
     let label = ui.label(name).id;
-    let response = ui
-        .add(
-            egui::DragValue::new(degrees)
-                .range(-limit..=limit)
-                .suffix("°"),
-        )
-        .labelled_by(label);
+    let response =
+        checked_with(ui, name, degrees, -limit..=limit, |d| d.suffix("°")).labelled_by(label);
     ui.end_row();
     response
 }
@@ -93,24 +88,26 @@ impl ExportDialog {
         let a = &mut self.animation;
         let label = ui.label("GIF size").id;
         ui.horizontal(|ui| {
-            ui.add(
-                egui::DragValue::new(&mut a.width)
-                    .range(16..=4096)
-                    .suffix(" px"),
-            )
+            checked_with(ui, "GIF width", &mut a.width, 16..=4096, |d| {
+                d.suffix(" px")
+            })
             .labelled_by(label);
             ui.label("×");
-            ui.add(
-                egui::DragValue::new(&mut a.height)
-                    .range(16..=4096)
-                    .suffix(" px"),
-            )
+            checked_with(ui, "GIF height", &mut a.height, 16..=4096, |d| {
+                d.suffix(" px")
+            })
             .labelled_by(label);
         });
         ui.end_row();
         let label = ui.label("Every Nth keyframe").id;
-        ui.add(egui::DragValue::new(&mut self.animation_step).range(1..=1000))
-            .labelled_by(label);
+        checked_with(
+            ui,
+            "Every Nth keyframe",
+            &mut self.animation_step,
+            1..=1000,
+            |d| d,
+        )
+        .labelled_by(label);
         ui.end_row();
         angle_row(ui, "Camera azimuth", &mut a.azimuth_deg, 360.0);
         angle_row(ui, "Camera elevation", &mut a.elevation_deg, 90.0);
@@ -170,13 +167,13 @@ impl ExportDialog {
             ui.checkbox(&mut self.resimulate, "run again at mean edge");
             let shown = shown_edge(project);
             let speed = 0.01 * self.resimulate_edge;
-            ui.add_enabled(
-                self.resimulate,
-                egui::DragValue::new(&mut self.resimulate_edge)
-                    .speed(speed)
-                    .range(1e-3 * shown..=1e3 * shown)
-                    .max_decimals(4),
-            )
+            let edge = &mut self.resimulate_edge;
+            ui.add_enabled_ui(self.resimulate, |ui| {
+                checked_with(ui, "mean edge", edge, 1e-3 * shown..=1e3 * shown, |d| {
+                    d.speed(speed).max_decimals(4)
+                })
+            })
+            .inner
             .labelled_by(label);
         });
         ui.end_row();
@@ -237,11 +234,12 @@ impl ExportDialog {
                          level (0 = the simulated mesh as it is)",
                     )
                     .id;
-                ui.add(
-                    egui::DragValue::new(&mut self.render_level)
-                        .range(0..=MAX_DIALOG_RENDER_LEVEL)
-                        .prefix("subdivide ")
-                        .suffix(" ×"),
+                checked_with(
+                    ui,
+                    "Smooth mesh",
+                    &mut self.render_level,
+                    0..=MAX_DIALOG_RENDER_LEVEL,
+                    |d| d.prefix("subdivide ").suffix(" ×"),
                 )
                 .labelled_by(label);
                 ui.end_row();
@@ -296,8 +294,14 @@ impl ExportDialog {
                              (clients slow down with very many targets)",
                         )
                         .id;
-                    ui.add(egui::DragValue::new(&mut self.max_morph_targets).range(2..=2000))
-                        .labelled_by(label);
+                    checked_with(
+                        ui,
+                        "Most morph targets",
+                        &mut self.max_morph_targets,
+                        2..=2000,
+                        |d| d,
+                    )
+                    .labelled_by(label);
                     ui.end_row();
                 }
                 ui.label("Normals");

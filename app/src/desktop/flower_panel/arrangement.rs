@@ -30,7 +30,7 @@ fn whorl_rows(
             let label = ui.label("count").on_hover_text("How many organs around the axis.");
             let mut count = whorl.count as u32;
             mark(
-                ui.add(DragValue::new(&mut count).range(1..=64))
+                checked_with(ui, "count", &mut count, 1..=64, |d| d)
                     .labelled_by(label.id)
                     .changed(),
                 "count",
@@ -91,7 +91,7 @@ fn spiral_rows(ui: &mut egui::Ui, flower: &Flower, spiral: &mut Spiral) -> Optio
                 .on_hover_text("How many organs along the spiral.");
             let mut count = spiral.count as u32;
             mark(
-                ui.add(DragValue::new(&mut count).range(1..=256))
+                checked_with(ui, "count", &mut count, 1..=256, |d| d)
                     .labelled_by(label.id)
                     .changed(),
                 "count",

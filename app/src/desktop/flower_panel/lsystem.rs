@@ -183,13 +183,15 @@ impl FlowerPanelState {
         let mut label = None;
         ui.horizontal(|ui| {
             let l = ui.label("derivation steps");
-            if ui
-                .add(
-                    DragValue::new(&mut steps_now)
-                        .range(0..=anthesis_flower::structure::lsystem::MAX_STEPS),
-                )
-                .labelled_by(l.id)
-                .changed()
+            if crate::desktop::checked_field::checked_with(
+                ui,
+                "derivation steps",
+                &mut steps_now,
+                0..=anthesis_flower::structure::lsystem::MAX_STEPS,
+                |d| d,
+            )
+            .labelled_by(l.id)
+            .changed()
             {
                 label = Some("derivation steps".to_string());
             }

@@ -25,6 +25,28 @@ const PROJECT_FILE: &str = "recovered.anthesis.toml";
 const ABOUT_FILE: &str = "recovery.toml";
 const DAMAGED_PREFIX: &str = "damaged-";
 
+/// How many damaged recoveries are kept at most: the newest ones. A
+/// recovery set aside at this launch is always among them.
+pub const KEEP_DAMAGED: usize = 3;
+
+/// How old a damaged recovery may get before it is removed, in days (30:
+/// long enough for a user told at launch to have looked at it).
+pub const KEEP_DAMAGED_DAYS: u64 = 30;
+
+/// A damaged recovery [`RecoveryFolder::prune_damaged`] removed, for the
+/// log.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Pruned {
+    /// Where it was.
+    pub folder: PathBuf,
+    /// When it was set aside (Unix seconds).
+    pub set_aside_unix_seconds: u64,
+    /// Why it was removed ("older than 30 days", "more than the 3 kept").
+    pub why: String,
+    /// The error, if it could not be removed (it is then still there).
+    pub error: Option<String>,
+}
+
 /// A recovery that could not be read whole, moved out of the way of the
 /// next autosave (renamed `damaged-*` in the recovery folder, which
 /// [`RecoveryFolder::write`] and [`RecoveryFolder::discard`] never touch).
@@ -203,6 +225,51 @@ impl RecoveryFolder {
         })
     }
 
+    /// Removes the damaged recoveries set aside longer than
+    /// [`KEEP_DAMAGED_DAYS`] before `now_unix_seconds`, and all but the
+    /// newest [`KEEP_DAMAGED`], so `damaged-*` folders do not pile up
+    /// launch after launch. Only `damaged-*` folders are touched; each
+    /// removal (or failed removal) is returned for the log. Call after
+    /// [`Self::set_aside_damaged`], so a recovery set aside now is the
+    /// newest and kept.
+    pub fn prune_damaged(&self, now_unix_seconds: u64) -> Vec<Pruned> {
+        let Ok(entries) = fs::read_dir(&self.dir) else {
+            return Vec::new();
+        };
+        let mut damaged: Vec<(u64, PathBuf)> = entries
+            .filter_map(Result::ok)
+            .filter(|entry| {
+                entry
+                    .file_name()
+                    .to_string_lossy()
+                    .starts_with(DAMAGED_PREFIX)
+                    && entry.file_type().is_ok_and(|t| t.is_dir())
+            })
+            .map(|entry| (set_aside_at(&entry.path()), entry.path()))
+            .collect();
+        // Newest first; equal stamps by name, for a stable order.
+        damaged.sort_by(|a, b| b.0.cmp(&a.0).then_with(|| b.1.cmp(&a.1)));
+        let max_age = KEEP_DAMAGED_DAYS * 86_400;
+        let mut pruned = Vec::new();
+        for (rank, (at, folder)) in damaged.into_iter().enumerate() {
+            let why = if now_unix_seconds.saturating_sub(at) > max_age {
+                format!("set aside more than {KEEP_DAMAGED_DAYS} days ago")
+            } else if rank >= KEEP_DAMAGED {
+                format!("only the newest {KEEP_DAMAGED} damaged recoveries are kept")
+            } else {
+                continue;
+            };
+            let error = fs::remove_dir_all(&folder).err().map(|e| e.to_string());
+            pruned.push(Pruned {
+                folder,
+                set_aside_unix_seconds: at,
+                why,
+                error,
+            });
+        }
+        pruned
+    }
+
     /// Removes every recovery (after a save, a clean exit, or when the user
     /// discards it).
     pub fn discard(&self) -> std::io::Result<()> {
@@ -220,6 +287,25 @@ impl RecoveryFolder {
         }
         Ok(())
     }
+}
+
+/// When the damaged recovery `folder` was set aside: the Unix seconds in
+/// its name (`damaged-<seconds>[-<n>]`), else its modification time, else
+/// 0 (the oldest).
+fn set_aside_at(folder: &Path) -> u64 {
+    let stamp = folder
+        .file_name()
+        .and_then(|name| name.to_str())
+        .and_then(|name| name.strip_prefix(DAMAGED_PREFIX))
+        .and_then(|rest| rest.split('-').next())
+        .and_then(|seconds| seconds.parse::<u64>().ok());
+    stamp.unwrap_or_else(|| {
+        fs::metadata(folder)
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+            .map_or(0, |d| d.as_secs())
+    })
 }
 
 /// The recovery in `folder`, or what is wrong with it.
@@ -414,5 +500,67 @@ mod tests {
         let aside = folder.set_aside_damaged();
         assert!(aside[0].problem.contains("is missing"), "{aside:?}");
         assert_eq!(aside[0].recovery, None);
+    }
+
+    #[test]
+    fn damaged_recoveries_older_than_the_limit_or_beyond_the_newest_few_are_removed() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let folder = RecoveryFolder::new(dir.path());
+        let day = 86_400;
+        let now = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .expect("after 1970")
+            .as_secs();
+        // Five set aside 1, 2, 3 and 4 days ago and one 31 days ago; and a
+        // folder that is not a damaged recovery, and a file named like one.
+        let ages = [1, 2, 3, 4, 31];
+        for age in ages {
+            let aside = dir
+                .path()
+                .join(format!("{DAMAGED_PREFIX}{}", now - age * day));
+            fs::create_dir_all(&aside).expect("mkdir");
+            fs::write(aside.join(PROJECT_FILE), "x").expect("write");
+        }
+        fs::create_dir_all(dir.path().join(LATEST)).expect("mkdir");
+        fs::write(dir.path().join(format!("{DAMAGED_PREFIX}note")), "x").expect("write");
+        let pruned = folder.prune_damaged(now);
+        let mut removed: Vec<(u64, &str)> = pruned
+            .iter()
+            .map(|p| ((now - p.set_aside_unix_seconds) / day, p.why.as_str()))
+            .collect();
+        removed.sort();
+        assert_eq!(
+            removed,
+            [
+                (4, "only the newest 3 damaged recoveries are kept"),
+                (31, "set aside more than 30 days ago"),
+            ]
+        );
+        assert!(
+            pruned
+                .iter()
+                .all(|p| p.error.is_none() && !p.folder.exists())
+        );
+        let mut left: Vec<String> = fs::read_dir(dir.path())
+            .expect("list")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        let mut expected: Vec<String> = [1, 2, 3]
+            .iter()
+            .map(|age| format!("{DAMAGED_PREFIX}{}", now - age * day))
+            .chain([format!("{DAMAGED_PREFIX}note"), LATEST.to_string()])
+            .collect();
+        expected.sort();
+        assert_eq!(left, expected);
+        // Nothing more to remove the next time.
+        assert_eq!(folder.prune_damaged(now), Vec::new());
+        // A recovery set aside now is the newest, and kept.
+        folder.write(&project("work"), None, 1).expect("write");
+        fs::write(dir.path().join(LATEST).join(ABOUT_FILE), "x = \"").expect("damage");
+        let aside = folder.set_aside_damaged();
+        let pruned = folder.prune_damaged(set_aside_at(&aside[0].folder));
+        assert!(aside[0].folder.exists(), "{pruned:?}");
+        assert_eq!(pruned.len(), 1, "{pruned:?}");
     }
 }

@@ -29,6 +29,7 @@ impl Simulation {
                     energy: e,
                     previous: self.previous_energy[i],
                     held_against: self.held_against(found, i),
+                    values: self.values_out_of_range(i),
                 });
             }
             self.previous_energy[i] = e;

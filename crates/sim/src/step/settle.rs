@@ -118,6 +118,7 @@ impl Simulation {
                 organ: self.organs[organ].name.clone(),
                 error: error.clone(),
                 held_against: self.held_against(found, organ),
+                values: self.values_out_of_range(organ),
             });
         }
         if not_converged {
@@ -128,6 +129,7 @@ impl Simulation {
                 iterations: iterations + solver.max_iterations,
                 relative_gradient,
                 held_against: self.held_against(found, organ),
+                values: self.values_out_of_range(organ),
             });
         }
         Ok((
