@@ -18,6 +18,8 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
 mod common;
+#[path = "desktop/units.rs"]
+mod units;
 
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {
