@@ -350,7 +350,7 @@ impl LSystem {
                                 line: p.line,
                             });
                         }
-                        // At most MAX_MODULES productions fit on the lines.
+                        // One production per line of text: far fewer than u32::MAX.
                         let index = index as u32;
                         let child = Origin {
                             producer: Some(index),
