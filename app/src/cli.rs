@@ -420,12 +420,28 @@ fn load_with_warnings(path: &Path) -> Result<(Project, Vec<String>)> {
         };
     }
     // The project error names the file itself.
-    let loaded = load_project_with_warnings(path).context("cannot open project")?;
+    let mut loaded = load_project_with_warnings(path).context("cannot open project")?;
     for warning in &loaded.warnings {
         say!("warning: {warning}");
     }
     check_units(&loaded.project)?;
+    if let Some(note) = unit_note(&loaded.project) {
+        say!("{note}");
+        loaded.warnings.push(note);
+    }
     Ok((loaded.project, loaded.warnings))
+}
+
+/// The note a project file that states no unit (made before format
+/// version 9) is opened with, on the terminal and in the window's log: it
+/// keeps its old meaning, one unit one metre, and the note says so and how
+/// to state one. None when the project states its unit.
+pub fn unit_note(project: &Project) -> Option<String> {
+    project
+        .flower
+        .unit
+        .is_none()
+        .then(|| format!("note: {}", anthesis_flower::unit::unstated_note()))
 }
 
 /// The project the window opens at `path`, the file it saves to (none for

@@ -43,6 +43,42 @@ fn info_prints_one_line_per_organ_with_counts() {
 }
 
 #[test]
+fn a_project_without_a_unit_loads_as_before_with_a_note_on_stderr() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = saved_whorl(dir.path(), 1, 3);
+    let note = "note: the project does not say what its unit is, so one unit is taken as one metre";
+    let how = "add e.g. `unit = \"1 mm\"` after its `name = …` line in the project file";
+    let out = anthesis(&["info", path.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stderr = text(&out.stderr);
+    assert_eq!(
+        stderr.lines().filter(|l| l.starts_with(note)).count(),
+        1,
+        "{stderr}"
+    );
+    assert!(stderr.contains(how), "{stderr}");
+    // Sizes stay in units: the old meaning.
+    assert!(
+        text(&out.stdout).contains(" units tall"),
+        "{}",
+        text(&out.stdout)
+    );
+    // A project that states its unit opens without it.
+    let mut project = anthesis_flower::project::load_project(&path).expect("loads");
+    project.flower.unit = anthesis_flower::Unit::millimetres(1.0);
+    anthesis_flower::project::save_project(&project, &path).expect("save");
+    let out = anthesis(&["info", path.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stderr = text(&out.stderr);
+    assert!(!stderr.contains("note:"), "{stderr}");
+    assert!(
+        text(&out.stdout).contains("(one unit is 1 mm)"),
+        "{}",
+        text(&out.stdout)
+    );
+}
+
+#[test]
 fn what_loading_reads_past_is_said_and_the_command_goes_on() {
     // A mesh from another tool with Blender's loose edges (`l`): read
     // past with a warning naming the file and line, which the command line

@@ -26,9 +26,10 @@ mod panels;
 mod difference;
 #[path = "desktop/measure.rs"]
 mod measure;
-
 #[path = "desktop/refusals.rs"]
 mod refusals;
+#[path = "desktop/units.rs"]
+mod units;
 
 /// A small flower (six organs, coarse meshes) with 20 keyframes.
 fn small_flower() -> Project {

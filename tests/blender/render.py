@@ -1,12 +1,13 @@
-"""Renders an exported .glb in Blender, headless, for the end-to-end test
-app/tests/blender.rs: the file goes through Blender's own glTF importer,
+"""Renders an exported .glb (or a USD layer) in Blender, headless, for the
+end-to-end test app/tests/blender.rs and the README's pictures: the file
+goes through Blender's own glTF (or USD) importer,
 its animation is played to chosen times and each time is drawn by the
 Workbench engine, seen by the camera `anthesis render` wrote to
 camera.json.
 
     tests/blender/.venv/bin/python tests/blender/render.py JOB.json
 
-JOB.json: { "file": "/abs/lily.glb", "width": W, "height": H,
+JOB.json: { "file": "/abs/lily.glb" (or .usdc, .usda, .usd), "width": W, "height": H,
   "times": [seconds, ...], "fps": keyframes per second of the file,
   "camera": { "eye": [x,y,z], "target": [x,y,z], "up": [x,y,z],
               "vertical_fov_deg": F, "near": N } (glTF axes, Y up),
@@ -17,7 +18,7 @@ For time I it writes OUT/blender-I-LOOK.png:
 - albedo: every material's base colour as Blender shows it (its base-colour
   texture, or its colour where it has none), unlit ("Flat" lighting,
   "Texture" colour), on a transparent background;
-- ids: mesh i of the file (in file order) in a flat colour of full green,
+- ids (a .glb only): mesh i of the file (in file order) in a flat colour of full green,
   n = i + 1 in its red and blue (red = 8 (n mod 32), blue = 8 (n div 32)),
   on a transparent background;
 - studio: Workbench's studio lighting over the same colours, on a
@@ -121,10 +122,20 @@ def main():
     # Whole frames per keyframe: the importer keys time t at frame t * fps.
     scene.render.fps = round(fps)
     scene.render.fps_base = round(fps) / fps
-    if "FINISHED" not in bpy.ops.import_scene.gltf(filepath=job["file"]):
-        fail(3, f"Blender's glTF importer did not import {job['file']}")
-
-    names = meshes_in_file_order(job["file"])
+    if job["file"].endswith((".usd", ".usda", ".usdc")):
+        # Blender's USD importer: time code k at frame k, the layer's Y up
+        # turned to Blender's Z up as the glTF importer does (so the same
+        # camera), its UsdPreviewSurface and UsdUVTexture as a Principled
+        # BSDF fed by an Image Texture.
+        if "FINISHED" not in bpy.ops.wm.usd_import(filepath=job["file"]):
+            fail(3, f"Blender's USD importer did not import {job['file']}")
+        names = sorted(o.name for o in scene.objects if o.type == "MESH")
+        if "ids" in looks:
+            fail(2, "the ids look needs a .glb (its meshes in file order)")
+    else:
+        if "FINISHED" not in bpy.ops.import_scene.gltf(filepath=job["file"]):
+            fail(3, f"Blender's glTF importer did not import {job['file']}")
+        names = meshes_in_file_order(job["file"])
     objects = []
     for name in names:
         found = [o for o in scene.objects if o.type == "MESH" and o.name in (name, name.replace(" ", "_"))]

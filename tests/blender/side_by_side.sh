@@ -33,10 +33,20 @@ mkdir "$work/anthesis" "$work/three" "$work/blender"
     --elevation 35 --background "$background" --out "$work/anthesis"
 
 # The jobs of the two checks, with anthesis render's camera.
+"$anthesis" info "builtin:$flower" >"$work/info.txt"
 /usr/bin/python3 - "$work" "$keyframe" "$width" "$height" <<'EOF'
-import json, sys
+import json, re, sys
 work, keyframe, width, height = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 camera = json.load(open(f"{work}/anthesis/camera.json"))
+info = open(f"{work}/info.txt").read()
+# anthesis render's camera is in project units, the exports in metres:
+# one unit is what `anthesis info` says (one metre when the project does
+# not say).
+unit = re.search(r"one unit is ([0-9.]+) ?(µm|mm|cm|m)\)", info)
+metres = float(unit.group(1)) * {"µm": 1e-6, "mm": 1e-3, "cm": 1e-2, "m": 1.0}[unit.group(2)] if unit else 1.0
+for key in ("eye", "target"):
+    camera[key] = [x * metres for x in camera[key]]
+camera["near"] *= metres
 time = keyframe / 24
 json.dump({"width": width, "height": height, "times": [time], "camera": camera, "hide": [],
            "files": [{"name": "flower", "path": f"{work}/flower.glb"}], "out": f"{work}/three"},

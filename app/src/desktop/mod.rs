@@ -299,7 +299,8 @@ impl AnthesisApp {
             None => match &settings.last_project {
                 Some(path) => match load_project_with_warnings(path) {
                     Ok(loaded) => {
-                        for warning in loaded.warnings {
+                        let note = crate::cli::unit_note(&loaded.project);
+                        for warning in loaded.warnings.into_iter().chain(note) {
                             log.warn(warning);
                         }
                         (loaded.project, Some(path.clone()))

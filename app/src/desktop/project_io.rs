@@ -28,7 +28,11 @@ impl AnthesisApp {
         let resolved = anthesis_flower::project::project_file(path);
         let path = resolved.as_deref().unwrap_or(path);
         match load_project_with_warnings(path) {
-            Ok(LoadedProject { project, warnings }) => {
+            Ok(LoadedProject {
+                project,
+                mut warnings,
+            }) => {
+                warnings.extend(crate::cli::unit_note(&project));
                 self.settings.remember(path);
                 // The work open before was saved or thrown away (the
                 // "save changes?" prompt came first).

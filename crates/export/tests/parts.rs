@@ -171,3 +171,51 @@ fn the_node_animation_reproduces_every_keyframe() {
         }
     }
 }
+
+/// An L-system's tubes reach every export under the names of what drew
+/// them: glTF node names as they are, USD prims as valid identifiers.
+#[test]
+fn lsystem_tubes_are_exported_under_the_names_of_what_drew_them() {
+    let flower = Flower {
+        templates: Vec::new(),
+        organs: Vec::new(),
+        overlaps: Vec::new(),
+        structure: Some(anthesis_flower::structure::Structure::LSystem {
+            text: "name A = stem\nname S = stamen\naxiom: A [S] [S]\nA -> F(3)\nS -> F(1)[+F(1)]"
+                .to_string(),
+            steps: 1,
+            surfaces: Default::default(),
+            units: 1.0,
+        }),
+        parts: Vec::new(),
+        unit: None,
+    };
+    let keyframes: Vec<Vec<Vec<DVec3>>> = vec![Vec::new(); 2];
+    let tracks =
+        anthesis_export::flower_tracks(&flower, &[], keyframes.iter().map(Vec::as_slice), 0)
+            .expect("tracks");
+    let names: Vec<&str> = tracks.iter().map(|t| t.name.as_str()).collect();
+    let expected = [
+        "receptacle",
+        "stem",
+        "stamen-1",
+        "stamen-2",
+        "stamen-3",
+        "stamen-4",
+    ];
+    assert_eq!(names, expected);
+    let bytes = glb_bytes(&tracks, &GlbOptions::default(), &mut |_| {}).expect("glb");
+    let gltf = gltf::Gltf::from_slice(&bytes).expect("parse");
+    let nodes: Vec<&str> = gltf.nodes().filter_map(|n| n.name()).collect();
+    for name in expected {
+        assert!(nodes.contains(&name), "{name} in {nodes:?}");
+    }
+    let usda = String::from_utf8(
+        anthesis_export::usd_bytes(&tracks, &Default::default(), &mut |_| {}).expect("usd"),
+    )
+    .expect("text");
+    for prim in ["stem", "stamen_1", "stamen_4"] {
+        assert!(usda.contains(&format!("\"{prim}\"")), "{prim}");
+    }
+    assert!(!usda.contains("segment"), "no segment-N left");
+}

@@ -541,18 +541,37 @@ pub fn part_lines(flower: &Flower) -> Vec<String> {
 }
 
 /// The tubes the flower's L-system draws with `F` (see
-/// [`crate::structure::Structure::segments`]), named `segment-1`, … in the
-/// word's order, in the colour `;` set (the stem's colour by default);
-/// they do not move.
+/// [`crate::structure::Structure::tubes`]), named after what drew them
+/// (`stem`, `stamen-3`, …; a name an organ or a part already has gets
+/// `-2`, `-3`, … until it is free), in the word's order, in the colour `;`
+/// set (the stem's colour by default); they do not move.
 fn segment_pieces(flower: &Flower) -> Vec<PartPiece> {
     let Some(structure) = &flower.structure else {
         return Vec::new();
     };
+    let mut taken: std::collections::BTreeSet<String> =
+        flower.organs.iter().map(|o| o.name.clone()).collect();
+    taken.insert("receptacle".to_owned());
+    for part in &flower.parts {
+        let suffixes: Vec<&str> = part.meshes().into_iter().map(|(_, _, s)| s).collect();
+        for k in 0..part.placements().len() {
+            let name = part.instance_name(k as u32);
+            for suffix in &suffixes {
+                taken.insert(format!("{name}{suffix}"));
+            }
+        }
+    }
     structure
-        .segments()
-        .iter()
-        .enumerate()
-        .map(|(k, segment)| {
+        .tubes()
+        .into_iter()
+        .map(|(name, segment)| {
+            let mut unique = name.clone();
+            let mut n = 2;
+            while taken.contains(&unique) {
+                unique = format!("{name}-{n}");
+                n += 1;
+            }
+            taken.insert(unique.clone());
             let along = segment.end - segment.start;
             let tube = Tube {
                 length: along.length(),
@@ -560,7 +579,7 @@ fn segment_pieces(flower: &Flower) -> Vec<PartPiece> {
                 curvature_deg: 0.0,
             };
             PartPiece {
-                name: format!("segment-{}", k + 1),
+                name: unique,
                 mesh: tube_mesh(&tube, (0.0, 1.0)),
                 color: segment.color.unwrap_or(RECEPTACLE_COLOR),
                 placement: Placement {

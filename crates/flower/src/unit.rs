@@ -200,7 +200,8 @@ impl std::str::FromStr for Unit {
 /// projects made before units existed keep their meaning.
 pub fn unstated_note() -> &'static str {
     "the project does not say what its unit is, so one unit is taken as one metre, as \
-     before; add e.g. `unit = \"1 mm\"` after its name to export it at its real size"
+     before; to export it at its real size, add e.g. `unit = \"1 mm\"` after its \
+     `name = …` line in the project file (a number and µm, mm, cm or m)"
 }
 
 /// How large `flower` is, as `anthesis info` prints it: one line for the

@@ -96,7 +96,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|&i| project.flower.template_of(i).mesh.clone())
         .collect();
     // Each organ's colour, or white times its template's colour map (as the
-    // app and `anthesis render` draw it).
+    // app and `anthesis render` draw it): both sides' maps side by side when
+    // they differ (the lily's spots are inside only).
     let looks: Vec<_> = simulated
         .iter()
         .map(|&i| {
@@ -111,10 +112,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         .iter()
                         .map(|uv| uv.as_vec2().to_array())
                         .collect();
-                    (
-                        [1.0; 4],
-                        Some((uvs, std::sync::Arc::new(template.colour_image(w, h)))),
-                    )
+                    let two_sided = template.is_two_sided();
+                    let image = if two_sided {
+                        template.colour_atlas(w, h)
+                    } else {
+                        template.colour_image(w, h)
+                    };
+                    ([1.0; 4], Some((uvs, std::sync::Arc::new(image), two_sided)))
                 }
             }
         })
@@ -185,7 +189,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let (colour, texture) = &looks[i];
                     let mesh = OrganMesh::from_positions(p, &meshes[i].triangles, *colour);
                     match texture {
-                        Some((uvs, image)) => mesh.with_texture(uvs.clone(), image.clone()),
+                        Some((uvs, image, true)) => {
+                            mesh.with_two_sided_texture(uvs.clone(), image.clone())
+                        }
+                        Some((uvs, image, false)) => mesh.with_texture(uvs.clone(), image.clone()),
                         None => mesh,
                     }
                 })

@@ -38,9 +38,10 @@ use glam::{DVec2, DVec3};
 use crate::flowers::{GardenError, base_region, keyed};
 use crate::paint::{Painting, above_base, colour_map, midrib_band, smoothstep};
 
-/// The seed's L-system (3), without the axiom's viewing turns and with a
+/// The seed's L-system (3), without the axiom's viewing turns, with a
 /// colour for the lines drawn after the stem (see the module
-/// documentation).
+/// documentation) and names for the tubes `A` and `S` draw (`stem`,
+/// `stamen-1` … `stamen-18` in the exports and `anthesis info`).
 pub const APPLE_LSYSTEM: &str = "\
 initial line width = 20
 line width increment = 5
@@ -53,6 +54,8 @@ p3: A → F(lenA)
 p4: C → ~c
 p5: P → ~p
 p6: S → F(lenF)[-(18)F(lenF)][+(18)F(lenF)]
+name A = stem
+name S = stamen
 ";
 
 /// Derivation steps: three rewrite the axiom down to `~c`, `~p` and `F`.

@@ -381,3 +381,30 @@ fn an_lsystems_f_segments_are_tubes_of_its_width_from_start_to_end() {
     );
     assert_eq!(obstacles(&flower).len(), 3, "the tubes keep organs out");
 }
+
+#[test]
+fn a_tube_named_like_a_part_gets_a_free_name() {
+    use crate::structure::Structure;
+    let mut stem = part(
+        PartShape::Pedicel {
+            stalk: tube(4.0, 0.2, 0.0),
+        },
+        1,
+    );
+    stem.name = "stem".to_owned();
+    let flower = Flower {
+        templates: Vec::new(),
+        organs: Vec::new(),
+        overlaps: Vec::new(),
+        structure: Some(Structure::LSystem {
+            text: "name A = stem\naxiom: A\nA -> F(2)".to_string(),
+            steps: 1,
+            surfaces: Default::default(),
+            units: 1.0,
+        }),
+        parts: vec![stem],
+        unit: None,
+    };
+    let names: Vec<String> = part_pieces(&flower).into_iter().map(|p| p.name).collect();
+    assert_eq!(names, ["receptacle", "stem", "stem-2"]);
+}

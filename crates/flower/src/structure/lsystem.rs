@@ -10,6 +10,7 @@
 //! axiom: /(154) &(72) #A!B       (or `ω:`)
 //! p1: B -> D/(60)D/(60)D         (an optional label, `->` or `→`)
 //! A(x) -> F(x) A(x * 0.9)        (formal parameters, used in expressions)
+//! name A = stem                  (what the tubes module A writes are called)
 //! ```
 //!
 //! A module is one character (a letter, or a turtle symbol
@@ -21,6 +22,15 @@
 //! the turtle's defaults are the constants `angle` (degrees, default 90),
 //! `step` (1), `initial line width` or `width` (1), `line width increment`
 //! or `width increment` (1) and `scale` (1).
+//!
+//! `name X = word` (a module letter, then a name of ASCII letters, digits
+//! and `_` starting with a letter) names the tubes the `F`s derived from
+//! module `X` draw: each `F` of the derived word remembers the modules it
+//! was rewritten from ([`LSystem::derive_with_origins`]), and its tube is
+//! called after the nearest of them that has a name (`name S = stamen`
+//! with `S → F[-F][+F]`: three stamens per `S`). Without one, after the
+//! letter of the module whose production wrote it; an `F` of the axiom is a
+//! `segment`. See [`super::Structure::tubes`] for the numbering.
 
 use std::collections::BTreeMap;
 
@@ -193,11 +203,25 @@ struct Production {
     line: usize,
 }
 
+/// Where a module of a derived word comes from
+/// ([`LSystem::derive_with_origins`]): indices into the productions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Origin {
+    /// The production that wrote the module (`None`: it is the axiom's).
+    producer: Option<u32>,
+    /// The production of the nearest module it was rewritten from that has
+    /// a `name` (the producer's predecessor, or that module's, …).
+    named: Option<u32>,
+}
+
 /// A parsed L-system.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LSystem {
     /// Constants by name (lower case, single spaces).
     pub constants: BTreeMap<String, f64>,
+    /// What the tubes derived from a module are called, by the module's
+    /// letter (`name S = stamen`).
+    pub names: BTreeMap<String, String>,
     /// The axiom, its parameters evaluated.
     pub axiom: Vec<Module>,
     productions: Vec<Production>,
@@ -207,6 +231,7 @@ impl LSystem {
     /// Parses the text (see the module documentation).
     pub fn parse(text: &str) -> Result<LSystem, LSystemError> {
         let mut constants = BTreeMap::new();
+        let mut names = BTreeMap::new();
         let mut axiom: Option<(usize, &str)> = None;
         let mut production_lines = Vec::new();
         for (index, line) in text.lines().enumerate() {
@@ -215,7 +240,21 @@ impl LSystem {
             if trimmed.is_empty() {
                 continue;
             }
-            if let Some((name, value)) = constant(trimmed) {
+            if let Some((letter, name)) = name_statement(trimmed) {
+                if !valid_name(name) {
+                    return Err(syntax(
+                        number,
+                        column_of(line, name),
+                        "a name of ASCII letters, digits and `_` starting with a letter (at most 64)",
+                        first_char(name),
+                    ));
+                }
+                if names.insert(letter.to_string(), name.to_owned()).is_some() {
+                    return Err(LSystemError::Statement(format!(
+                        "module {letter} is named a second time on line {number}"
+                    )));
+                }
+            } else if let Some((name, value)) = constant(trimmed) {
                 let column = column_of(line, value.trim());
                 let value = value
                     .trim()
@@ -266,6 +305,7 @@ impl LSystem {
         }
         Ok(LSystem {
             constants,
+            names,
             axiom,
             productions,
         })
@@ -276,15 +316,32 @@ impl LSystem {
     /// replaced by its successor, evaluated with the module's parameters;
     /// the others are kept.
     pub fn derive(&self, steps: u32) -> Result<Vec<Module>, LSystemError> {
+        self.derive_with_origins(steps).map(|(word, _)| word)
+    }
+
+    /// [`LSystem::derive`], and for each module of the word where it comes
+    /// from: the production that wrote it and the nearest module it was
+    /// rewritten from that has a `name` ([`LSystem::name_of`]).
+    pub fn derive_with_origins(
+        &self,
+        steps: u32,
+    ) -> Result<(Vec<Module>, Vec<Origin>), LSystemError> {
         if steps > MAX_STEPS {
             return Err(LSystemError::TooManySteps(steps));
         }
         let mut word = self.axiom.clone();
+        let mut origins = vec![Origin::default(); word.len()];
         for step in 1..=steps {
             let mut next = Vec::with_capacity(word.len());
-            for module in &word {
-                match self.productions.iter().find(|p| p.symbol == module.symbol) {
-                    Some(p) => {
+            let mut next_origins = Vec::with_capacity(word.len());
+            for (module, origin) in word.iter().zip(&origins) {
+                let found = self
+                    .productions
+                    .iter()
+                    .enumerate()
+                    .find(|(_, p)| p.symbol == module.symbol);
+                match found {
+                    Some((index, p)) => {
                         if module.params.len() < p.formals.len() {
                             return Err(LSystemError::Arity {
                                 symbol: module.symbol.clone(),
@@ -293,6 +350,16 @@ impl LSystem {
                                 line: p.line,
                             });
                         }
+                        // One production per line of text: far fewer than u32::MAX.
+                        let index = index as u32;
+                        let child = Origin {
+                            producer: Some(index),
+                            named: if self.names.contains_key(&p.symbol) {
+                                Some(index)
+                            } else {
+                                origin.named
+                            },
+                        };
                         for t in &p.successor {
                             let params: Vec<f64> =
                                 t.params.iter().map(|e| e.eval(&module.params)).collect();
@@ -308,17 +375,38 @@ impl LSystem {
                                 symbol: t.symbol.clone(),
                                 params,
                             });
+                            next_origins.push(child);
                         }
                     }
-                    None => next.push(module.clone()),
+                    None => {
+                        next.push(module.clone());
+                        next_origins.push(*origin);
+                    }
                 }
                 if next.len() > MAX_MODULES {
                     return Err(LSystemError::TooLong { step });
                 }
             }
             word = next;
+            origins = next_origins;
         }
-        Ok(word)
+        Ok((word, origins))
+    }
+
+    /// What a module that came from `origin` draws is called: the `name` of
+    /// the nearest module it was rewritten from that has one, else the
+    /// letter of the module whose production wrote it, else (a module of
+    /// the axiom) `segment`.
+    pub fn name_of(&self, origin: Origin) -> &str {
+        let symbol = |index: Option<u32>| {
+            index
+                .and_then(|i| self.productions.get(i as usize))
+                .map(|p| p.symbol.as_str())
+        };
+        if let Some(name) = symbol(origin.named).and_then(|s| self.names.get(s)) {
+            return name;
+        }
+        symbol(origin.producer).unwrap_or("segment")
     }
 
     /// A constant by name (case and spacing as in [`constant_key`]).
@@ -347,6 +435,31 @@ fn constant(line: &str) -> Option<(String, &str)> {
             .chars()
             .all(|c| c.is_alphanumeric() || c == '_' || c == ' ');
     ok.then(|| (constant_key(name), value))
+}
+
+/// `name X = word`: a module letter and the name its tubes get (checked
+/// by [`valid_name`]); the value is what follows `=`, trimmed.
+fn name_statement(line: &str) -> Option<(char, &str)> {
+    let rest = line.strip_prefix("name")?;
+    let (letter, value) = rest.split_once('=')?;
+    let mut letters = letter.trim().chars();
+    let (Some(letter), None) = (letters.next(), letters.next()) else {
+        return None;
+    };
+    let value = value.trim();
+    // `name x = 2` is a constant called "name x".
+    (rest.starts_with(char::is_whitespace)
+        && letter.is_alphabetic()
+        && value.parse::<f64>().is_err())
+    .then_some((letter, value))
+}
+
+/// A name a tube may get: ASCII letters, digits and `_`, starting with a
+/// letter, at most 64 characters (a valid identifier in every export).
+fn valid_name(name: &str) -> bool {
+    name.len() <= 64
+        && name.starts_with(|c: char| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
 fn strip_label<'a>(line: &'a str, labels: &[&str]) -> Option<&'a str> {

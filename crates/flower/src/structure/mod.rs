@@ -192,6 +192,15 @@ impl Structure {
     /// its diameter. None for whorls and spirals, or an L-system that does
     /// not derive (loading refuses those).
     pub fn segments(&self) -> Vec<turtle::Segment> {
+        self.tubes().into_iter().map(|(_, s)| s).collect()
+    }
+
+    /// [`Structure::segments`] with their names: after what drew them
+    /// ([`LSystem::name_of`]: `stem`, `stamen`, or a module's letter), a
+    /// name that several tubes share numbered in the word's order
+    /// (`stamen-1`, `stamen-2`, …), one that only one tube has left as it
+    /// is (`stem`). The same text and steps always give the same names.
+    pub fn tubes(&self) -> Vec<(String, turtle::Segment)> {
         let Structure::LSystem {
             text, steps, units, ..
         } = self
@@ -201,19 +210,42 @@ impl Structure {
         let Ok(system) = LSystem::parse(text) else {
             return Vec::new();
         };
-        let Ok(word) = system.derive(*steps) else {
+        let Ok((word, origins)) = system.derive_with_origins(*steps) else {
             return Vec::new();
         };
-        interpret(&word, &Defaults::of(&system))
+        let segments: Vec<turtle::Segment> = interpret(&word, &Defaults::of(&system))
             .segments
             .into_iter()
             .map(|s| turtle::Segment {
                 start: s.start * *units,
                 end: s.end * *units,
                 width: s.width * *units,
-                color: s.color,
+                ..s
             })
             .filter(|s| s.width > 0.0 && s.width.is_finite() && s.start.distance(s.end) > 1e-9)
+            .collect();
+        let bases: Vec<&str> = segments
+            .iter()
+            .map(|s| system.name_of(origins.get(s.module).copied().unwrap_or_default()))
+            .collect();
+        let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+        for base in &bases {
+            *counts.entry(base).or_default() += 1;
+        }
+        let mut seen: BTreeMap<&str, usize> = BTreeMap::new();
+        bases
+            .iter()
+            .zip(segments)
+            .map(|(base, segment)| {
+                let k = seen.entry(base).or_default();
+                *k += 1;
+                let name = if counts[base] == 1 {
+                    (*base).to_owned()
+                } else {
+                    format!("{base}-{k}")
+                };
+                (name, segment)
+            })
             .collect()
     }
 }

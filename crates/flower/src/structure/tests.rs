@@ -489,3 +489,80 @@ fn a_deeply_nested_expression_is_refused_not_a_stack_overflow() {
         Err(LSystemError::TooComplex { .. })
     ));
 }
+
+fn tube_names(text: &str, steps: u32) -> Vec<String> {
+    let structure = super::Structure::LSystem {
+        text: text.to_owned(),
+        steps,
+        surfaces: Default::default(),
+        units: 1.0,
+    };
+    structure
+        .tubes()
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect()
+}
+
+#[test]
+fn tubes_are_named_after_the_nearest_named_module_they_derive_from() {
+    // The apple's stem and stamens, named: a name one tube has stays bare,
+    // one several share is numbered in the word's order.
+    let named = format!("{APPLE}name A = stem\nname S = stamen\n");
+    let names = tube_names(&named, 3);
+    let mut expected = vec!["stem".to_owned()];
+    expected.extend((1..=18).map(|k| format!("stamen-{k}")));
+    assert_eq!(names, expected);
+    // The same text gives the same names every time.
+    assert_eq!(tube_names(&named, 3), names);
+    // Without names: the letter of the module whose production wrote the
+    // `F`; the axiom's own `F` is a segment.
+    assert_eq!(
+        tube_names("axiom: F(1) A B\nA -> F(1)\nB -> F(1) F(1)", 1),
+        ["segment", "A", "B-1", "B-2"]
+    );
+    // The nearest named module counts, not the last production: `F → F F`
+    // rewrites every `F`, but the stem's pieces are still the stem's, and
+    // those of the `F` an unnamed `S` inside a named `D` wrote the `D`'s.
+    assert_eq!(
+        tube_names(
+            "name A = stem\nname D = whorl\naxiom: A D\nA -> F(1)\nF -> F(1) F(1)\nD -> S\nS -> F(1)",
+            3
+        ),
+        ["stem-1", "stem-2", "stem-3", "stem-4", "whorl-1", "whorl-2"]
+    );
+    // A stamen's `F` named inside a named flower: the nearer name wins.
+    assert_eq!(
+        tube_names(
+            "name B = flower\nname S = stamen\naxiom: B\nB -> F(1) S\nS -> F(1)",
+            2
+        ),
+        ["flower", "stamen"]
+    );
+}
+
+#[test]
+fn a_name_statement_is_checked() {
+    let err = LSystem::parse("name S = 3stamen\naxiom: S").unwrap_err();
+    assert!(
+        matches!(
+            &err,
+            LSystemError::Syntax {
+                line: 1,
+                column: 10,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("ASCII letters"), "{err}");
+    let err = LSystem::parse("name S = stamen\nname S = filament\naxiom: S").unwrap_err();
+    assert_eq!(
+        err,
+        LSystemError::Statement("module S is named a second time on line 2".to_owned())
+    );
+    // A number after `=` makes a constant called "name x", as before.
+    let system = LSystem::parse("name x = 2\naxiom: F(name_x)").unwrap();
+    assert_eq!(system.constant("name x"), Some(2.0));
+    assert!(system.names.is_empty());
+}

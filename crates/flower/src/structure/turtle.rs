@@ -49,6 +49,8 @@ pub struct Segment {
     /// The colour `;(r, g, b)` set (linear RGBA, opaque), or `None` for the
     /// default.
     pub color: Option<[f32; 4]>,
+    /// Where its `F` is in the word (an index), to tell what drew it.
+    pub module: usize,
 }
 
 /// What a word draws.
@@ -167,7 +169,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
     };
     let mut stack = Vec::new();
     let mut drawing = Drawing::default();
-    for module in word {
+    for (index, module) in word.iter().enumerate() {
         let first = module.params.first().copied();
         let angle = || first.unwrap_or(defaults.angle_deg).to_radians();
         // [H' L' U'] = [H L U] R (eq. 1.1).
@@ -180,6 +182,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
                     end,
                     width: state.width,
                     color: state.color,
+                    module: index,
                 });
                 state.position = end;
             }
