@@ -39,7 +39,7 @@ struct Frame {
 
 struct Organ {
     // Linear RGB; alpha is written but blending is off.
-    color_linear: vec4<f32>,
+    colour_linear: vec4<f32>,
     // x: how much the per-vertex overlay ramp replaces the organ colour
     // (0 = overlay off, 1 = overlay only). y: 1 when the texture holds the
     // two sides, the inner (front) side on its left half and the outer
@@ -161,7 +161,7 @@ fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0
     let halfway = normalize(light + to_eye);
     let sheen = 0.04 * pow(max(dot(normal, halfway), 0.0), 16.0);
 
-    var base = organ.color_linear.rgb * painted.rgb;
+    var base = organ.colour_linear.rgb * painted.rgb;
     base = mix(base, overlay_ramp(in.overlay), clamp(organ.overlay_mix.x, 0.0, 1.0));
 
     let reflected = base * (0.42 * ambient + 0.6 * key);
@@ -169,7 +169,7 @@ fn fs_organ(in: VertexOut, @builtin(front_facing) is_front: bool) -> @location(0
     // squared): more saturated than the reflected colour.
     let transmitted = 0.5 * through * base * base;
     let lit = (reflected + transmitted + vec3<f32>(sheen)) * side_brightness;
-    return vec4<f32>(to_target(lit), organ.color_linear.a * painted.a);
+    return vec4<f32>(to_target(lit), organ.colour_linear.a * painted.a);
 }
 
 struct BackgroundOut {

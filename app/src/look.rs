@@ -27,7 +27,7 @@ pub struct Texture {
 /// colour.
 pub fn template_look(template: &Template) -> Look {
     if template.colouring.is_none() {
-        return (template.color, None);
+        return (template.colour, None);
     }
     let (width, height) = template.colour_image_size();
     let two_sided = template.is_two_sided();
@@ -61,8 +61,8 @@ pub fn track_texture(track: &anthesis_export::Track) -> Option<Texture> {
             .ok()
             .map(|image| image.into_rgba8())
     };
-    let inner = decode(track.base_color_png.as_deref()?)?;
-    let Some(outer) = &track.outer_color_png else {
+    let inner = decode(track.base_colour_png.as_deref()?)?;
+    let Some(outer) = &track.outer_colour_png else {
         return Some(Texture {
             image: Arc::new(inner),
             two_sided: false,

@@ -36,7 +36,7 @@ pub fn piece_mesh(piece: &PartPiece, time_in_keyframes: f64) -> OrganMesh {
         Some(blend) => piece.positions_at(blend.below as u32),
         None => piece.positions_at(0),
     };
-    OrganMesh::from_positions(&positions, &piece.mesh.triangles, piece.color)
+    OrganMesh::from_positions(&positions, &piece.mesh.triangles, piece.colour)
 }
 
 #[cfg(test)]
@@ -67,8 +67,8 @@ mod tests {
                 to_step: 10,
                 angle_deg: 20.0,
             }],
-            color: [0.2, 0.5, 0.2, 1.0],
-            head_color: [0.2, 0.5, 0.2, 1.0],
+            colour: [0.2, 0.5, 0.2, 1.0],
+            head_colour: [0.2, 0.5, 0.2, 1.0],
         }];
         let at = |t: f64| {
             part_meshes(&project.flower, t)[1]

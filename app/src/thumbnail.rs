@@ -27,8 +27,8 @@ pub fn bud_meshes(project: &Project) -> Vec<OrganMesh> {
                 .iter()
                 .map(|p| organ.placement.world_from_template(*p, 0.0))
                 .collect();
-            let (color, texture) = crate::look::template_look(template);
-            let mesh = OrganMesh::from_positions(&positions, &template.mesh.triangles, color);
+            let (colour, texture) = crate::look::template_look(template);
+            let mesh = OrganMesh::from_positions(&positions, &template.mesh.triangles, colour);
             Some(crate::look::with_texture(
                 mesh,
                 &template.mesh.uvs,

@@ -18,16 +18,16 @@ use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
 mod common;
-#[path = "desktop/sketch_room.rs"]
-mod sketch_room;
-#[path = "desktop/panels.rs"]
-mod panels;
 #[path = "desktop/difference.rs"]
 mod difference;
 #[path = "desktop/measure.rs"]
 mod measure;
+#[path = "desktop/panels.rs"]
+mod panels;
 #[path = "desktop/refusals.rs"]
 mod refusals;
+#[path = "desktop/sketch_room.rs"]
+mod sketch_room;
 #[path = "desktop/units.rs"]
 mod units;
 
@@ -1339,7 +1339,7 @@ fn the_window_and_anthesis_render_show_an_organ_in_the_same_colour() {
     // which encodes once. A saturated orange, where a missing or a double
     // conversion shows most.
     let mut project = anthesis_sim::fixtures::whorl(2, 8, 14, 4);
-    project.flower.templates[0].color = [0.8, 0.3, 0.05, 1.0];
+    project.flower.templates[0].colour = [0.8, 0.3, 0.05, 1.0];
     let (azimuth_deg, elevation_deg) = (project.flower.organs[0].placement.azimuth_deg, 20.0);
     let bud = anthesis_sim::Simulation::new(&project, &Selection::All)
         .expect("simulation")
@@ -2309,8 +2309,8 @@ fn painting_the_colour_target_paints_the_colour_map_shows_its_colours_and_undoes
         .as_ref()
         .expect("the stroke made a colour map");
     assert_eq!(
-        colouring.second_color,
-        anthesis_flower::DEFAULT_SECOND_COLOR
+        colouring.second_colour,
+        anthesis_flower::DEFAULT_SECOND_COLOUR
     );
     assert_eq!(
         colouring.mix.size(),
@@ -2347,7 +2347,7 @@ fn painting_the_colour_target_paints_the_colour_map_shows_its_colours_and_undoes
 fn the_parameters_panel_picks_the_base_and_second_colours() {
     let mut project = small_flower();
     project.flower.templates[0].colouring = Some(anthesis_flower::Colouring {
-        second_color: [0.45, 0.02, 0.06, 1.0],
+        second_colour: [0.45, 0.02, 0.06, 1.0],
         mix: anthesis_maps::ScalarMap::from_fn(16, 16, |uv| uv.y as f32),
         layers: Vec::new(),
     });

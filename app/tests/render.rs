@@ -366,9 +366,9 @@ fn render_shows_a_two_colour_template_in_both_colours_where_its_mix_map_says() {
     // A red organ painted blue over its right half (u > 0.5).
     let mut project = anthesis_sim::fixtures::whorl(1, 8, 14, 2);
     let template = &mut project.flower.templates[0];
-    template.color = [0.8, 0.05, 0.03, 1.0];
+    template.colour = [0.8, 0.05, 0.03, 1.0];
     template.colouring = Some(Colouring {
-        second_color: [0.03, 0.08, 0.8, 1.0],
+        second_colour: [0.03, 0.08, 0.8, 1.0],
         mix: anthesis_maps::ScalarMap::from_fn(32, 32, |uv| if uv.x > 0.5 { 1.0 } else { 0.0 }),
         layers: Vec::new(),
     });

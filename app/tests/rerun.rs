@@ -123,7 +123,7 @@ fn a_stroke_its_undo_and_redo_give_the_keyframes_of_runs_from_the_bud() {
 
     // A colour is not simulated: every keyframe is kept.
     let mut recoloured = harness.state().project().flower.templates[1].clone();
-    recoloured.color = [0.2, 0.4, 0.9, 1.0];
+    recoloured.colour = [0.2, 0.4, 0.9, 1.0];
     let edit = Command::Edit {
         label: "colour".into(),
         edit: ProjectEdit::Template {

@@ -1586,7 +1586,7 @@ fn render(
                 return anthesis_render::OrganMesh::from_positions(
                     positions,
                     &template.mesh.triangles,
-                    template.color,
+                    template.colour,
                 );
             }
             let mesh = anthesis_render::OrganMesh::from_positions(
@@ -1613,7 +1613,7 @@ fn render(
         organs.push(anthesis_render::OrganMesh::from_positions(
             &piece.positions_at(step),
             &piece.mesh.triangles,
-            piece.color,
+            piece.colour,
         ));
     }
     // Framed as `anthesis render --frames KEYFRAME` frames it.

@@ -136,7 +136,7 @@ pub(super) fn blossom(args: &BlossomArgs) -> Result<()> {
             name,
             triangles: bud.triangles.clone(),
             uvs: bud.uvs.clone(),
-            base_color: [0.95, 0.6, 0.3, 1.0],
+            base_colour: [0.95, 0.6, 0.3, 1.0],
             keyframes: shapes,
             ..Track::default()
         };

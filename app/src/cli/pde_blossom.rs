@@ -108,7 +108,7 @@ pub(super) fn pde_blossom(args: &PdeBlossomArgs) -> Result<()> {
             name,
             triangles: mesh.triangles.clone(),
             uvs: mesh.uvs.clone(),
-            base_color: [0.95, 0.93, 0.88, 1.0],
+            base_colour: [0.95, 0.93, 0.88, 1.0],
             keyframes,
             ..Track::default()
         };

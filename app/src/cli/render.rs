@@ -167,7 +167,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         }
         _ => None,
     };
-    let background = args.background.as_deref().map(parse_color).transpose()?;
+    let background = args.background.as_deref().map(parse_colour).transpose()?;
     anthesis_export::check_render_level(
         &project.flower,
         &selection.organs(project.flower.organs.len()),
@@ -285,7 +285,7 @@ fn write_camera(path: &Path, camera: &Camera, width: u32, height: u32) -> Result
 
 /// `RRGGBB` hexadecimal sRGB (a leading `#` allowed) as components in
 /// `[0, 1]`.
-fn parse_color(hex: &str) -> Result<[f32; 3]> {
+fn parse_colour(hex: &str) -> Result<[f32; 3]> {
     let digits = hex.trim().trim_start_matches('#');
     let channel = |i: usize| {
         digits
@@ -345,8 +345,8 @@ fn simulate_scenes(
             .iter()
             .zip(&subdivisions)
             .zip(&looks)
-            .map(|((p, s), (color, texture))| {
-                let mesh = OrganMesh::from_positions(&s.apply(p), s.triangles(), *color);
+            .map(|((p, s), (colour, texture))| {
+                let mesh = OrganMesh::from_positions(&s.apply(p), s.triangles(), *colour);
                 crate::look::with_texture(mesh, s.uvs(), texture.as_ref())
             })
             .collect()
@@ -477,12 +477,12 @@ mod tests {
     #[test]
     fn background_colours_parse_as_hexadecimal_srgb() {
         assert_eq!(
-            parse_color("ff0080").expect("valid"),
+            parse_colour("ff0080").expect("valid"),
             [1.0, 0.0, 128.0 / 255.0]
         );
-        assert_eq!(parse_color("#FFFFFF").expect("valid"), [1.0; 3]);
+        assert_eq!(parse_colour("#FFFFFF").expect("valid"), [1.0; 3]);
         for bad in ["fff", "white", "ff00zz", "ff00ff00", "é00000"] {
-            assert!(parse_color(bad).is_err(), "{bad}");
+            assert!(parse_colour(bad).is_err(), "{bad}");
         }
     }
 

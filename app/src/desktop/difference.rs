@@ -30,7 +30,7 @@ pub const BEFORE_KEY: egui::Key = egui::Key::B;
 
 /// The badge's colour while the result before the last edit is shown (a
 /// violet no other badge uses).
-pub const BEFORE_COLOR: Color32 = Color32::from_rgb(120, 70, 170);
+pub const BEFORE_COLOUR: Color32 = Color32::from_rgb(120, 70, 170);
 
 /// What the badge says while the result before the last edit is shown.
 pub const BEFORE_BADGE: &str = "BEFORE THE LAST EDIT";
@@ -191,14 +191,14 @@ impl AnthesisApp {
         let mut rows = 0;
         if key.before {
             if self.session.before().is_some() {
-                viewport::badge(ui, rect, row, BEFORE_BADGE, BEFORE_COLOR);
+                viewport::badge(ui, rect, row, BEFORE_BADGE, BEFORE_COLOUR);
             } else {
                 viewport::badge(
                     ui,
                     rect,
                     row,
                     "NO EARLIER RESULT TO SHOW: the current one is shown",
-                    BEFORE_COLOR,
+                    BEFORE_COLOUR,
                 );
             }
             rows += 1;

@@ -172,7 +172,7 @@ fn write_gif(
                 .filter_map(|(t, texture)| {
                     // A still track (one keyframe) shows it throughout.
                     let positions = t.keyframes.get(k as usize).or(t.keyframes.last())?;
-                    let mesh = OrganMesh::from_positions(positions, &t.triangles, t.base_color);
+                    let mesh = OrganMesh::from_positions(positions, &t.triangles, t.base_colour);
                     Some(crate::look::with_texture(mesh, &t.uvs, texture.as_ref()))
                 })
                 .collect()
@@ -635,13 +635,13 @@ mod tests {
         assert_eq!(tracks[0].name, project.flower.organs[1].name);
         assert_eq!(tracks[0].triangles, template.mesh.triangles);
         assert_eq!(tracks[0].uvs, template.mesh.uvs);
-        assert_eq!(tracks[0].base_color, template.color);
+        assert_eq!(tracks[0].base_colour, template.colour);
         assert_eq!(tracks[0].keyframes, bud.positions_in_world);
         // The receptacle, as `anthesis simulate --out` exports it too.
         let receptacle = anthesis_flower::receptacle_for(&project.flower);
         assert_eq!(tracks[1].name, "receptacle");
         assert_eq!(tracks[1].keyframes, vec![receptacle.positions]);
-        assert_eq!(tracks[1].base_color, anthesis_flower::RECEPTACLE_COLOR);
+        assert_eq!(tracks[1].base_colour, anthesis_flower::RECEPTACLE_COLOUR);
         // Before the first keyframe there is nothing to export.
         assert!(
             super::tracks(&project, &[1], &[], 0)

@@ -118,13 +118,13 @@ impl Log {
             .auto_shrink([false, false])
             .show(ui, |ui| {
                 for entry in &self.entries {
-                    let (tag, color) = match entry.level {
+                    let (tag, colour) = match entry.level {
                         Level::Info => ("info", ui.visuals().weak_text_color()),
                         Level::Warning => ("warning", Color32::from_rgb(200, 140, 0)),
                         Level::Error => ("error", Color32::from_rgb(210, 50, 40)),
                     };
                     ui.horizontal_wrapped(|ui| {
-                        ui.label(RichText::new(tag).color(color).monospace());
+                        ui.label(RichText::new(tag).color(colour).monospace());
                         ui.label(&entry.message);
                     });
                 }

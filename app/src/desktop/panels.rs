@@ -237,16 +237,16 @@ impl AnthesisApp {
         );
         self.measure_window(ui.ctx());
         let mut row = self.difference_ui(ui, viewport_rect, &key, 0);
-        if let Some((badge, color)) =
+        if let Some((badge, colour)) =
             timeline::viewport_badge(&self.session, key.time_in_keyframes).filter(|_| !key.before)
         {
-            viewport::badge(ui, viewport_rect, row, badge, color);
+            viewport::badge(ui, viewport_rect, row, badge, colour);
             row += 1;
         }
         if let Some(warning) =
             timeline::crossing_badge(&self.session, key.time_in_keyframes).filter(|_| !key.before)
         {
-            viewport::badge(ui, viewport_rect, row, &warning, timeline::CROSSING_COLOR);
+            viewport::badge(ui, viewport_rect, row, &warning, timeline::CROSSING_COLOUR);
         }
         let template = self.selected_template();
         // Alt, or the eyedropper, picks the value under the pointer on the

@@ -7,7 +7,7 @@
 //! undoable and restarts the simulation.
 
 use anthesis_flower::resolution::predicted_size;
-use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOR, JointRamp, Project, Resolution, Template};
+use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOUR, JointRamp, Project, Resolution, Template};
 use eframe::egui;
 
 use super::checked_field::checked_with;
@@ -283,16 +283,16 @@ fn colour_rows(ui: &mut egui::Ui, draft: &mut Template, mark: &mut dyn FnMut(boo
                 ui,
                 "base colour",
                 "The organ's colour where the colour map is 0 (everywhere without one).",
-                draft.color,
+                draft.colour,
             );
             if changed {
-                draft.color = base;
+                draft.colour = base;
                 mark(true, "base colour");
             }
             let second = draft
                 .colouring
                 .as_ref()
-                .map_or(DEFAULT_SECOND_COLOR, |c| c.second_color);
+                .map_or(DEFAULT_SECOND_COLOUR, |c| c.second_colour);
             let (second, changed) = colour_row(
                 ui,
                 "second colour",
@@ -304,11 +304,11 @@ fn colour_rows(ui: &mut egui::Ui, draft: &mut Template, mark: &mut dyn FnMut(boo
                 draft
                     .colouring
                     .get_or_insert_with(|| Colouring {
-                        second_color: second,
+                        second_colour: second,
                         mix: anthesis_maps::ScalarMap::constant(0.0),
                         layers: Vec::new(),
                     })
-                    .second_color = second;
+                    .second_colour = second;
                 mark(true, "second colour");
             }
         });

@@ -5,7 +5,7 @@
 //! [`ProjectEdit::Parts`] (the whole list, which is small), so it is
 //! undoable and re-simulates like any other edit.
 
-use anthesis_flower::parts::{Part, PartShape, Tube, default_colors, instance_name};
+use anthesis_flower::parts::{Part, PartShape, Tube, default_colours, instance_name};
 use anthesis_flower::{JointRamp, Project};
 use eframe::egui::{self, Rgba};
 
@@ -60,9 +60,9 @@ fn tube_rows(ui: &mut egui::Ui, what: &str, tube: &mut Tube) -> bool {
 }
 
 /// A colour row; returns whether it changed.
-fn color_row(ui: &mut egui::Ui, label: &str, color: &mut [f32; 4]) -> bool {
+fn colour_row(ui: &mut egui::Ui, label: &str, colour: &mut [f32; 4]) -> bool {
     ui.label(label);
-    let mut rgba = Rgba::from_rgba_unmultiplied(color[0], color[1], color[2], color[3]);
+    let mut rgba = Rgba::from_rgba_unmultiplied(colour[0], colour[1], colour[2], colour[3]);
     let changed = egui::color_picker::color_edit_button_rgba(
         ui,
         &mut rgba,
@@ -72,8 +72,8 @@ fn color_row(ui: &mut egui::Ui, label: &str, color: &mut [f32; 4]) -> bool {
     .changed();
     ui.end_row();
     if changed {
-        *color = rgba.to_rgba_unmultiplied();
-        for c in color.iter_mut() {
+        *colour = rgba.to_rgba_unmultiplied();
+        for c in colour.iter_mut() {
             *c = c.clamp(0.0, 1.0);
         }
     }
@@ -148,17 +148,17 @@ fn part_rows(ui: &mut egui::Ui, part: &mut Part) -> Option<&'static str> {
         "height",
     );
     shape_fields(ui, &mut part.shape, &mut mark);
-    mark(color_row(ui, "colour", &mut part.color), "colour");
+    mark(colour_row(ui, "colour", &mut part.colour), "colour");
     if matches!(
         part.shape,
         PartShape::Stamen { .. } | PartShape::Pistil { .. }
     ) {
         mark(
-            color_row(ui, "head colour", &mut part.head_color),
+            colour_row(ui, "head colour", &mut part.head_colour),
             "head colour",
         );
     } else {
-        part.head_color = part.color;
+        part.head_colour = part.colour;
     }
     changed
 }
@@ -436,7 +436,7 @@ pub fn new_part(project: &Project, kind: &str) -> Part {
         name = format!("{base}{n}");
         n += 1;
     }
-    let (color, head_color) = default_colors(&shape);
+    let (colour, head_colour) = default_colours(&shape);
     Part {
         name,
         shape,
@@ -452,8 +452,8 @@ pub fn new_part(project: &Project, kind: &str) -> Part {
         offset_deg: 0.0,
         angle_deg: if kind == "stamen" { 3.0 } else { 0.0 },
         schedule: Vec::new(),
-        color,
-        head_color,
+        colour,
+        head_colour,
     }
 }
 

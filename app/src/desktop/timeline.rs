@@ -257,8 +257,8 @@ pub fn stale_line(session: &SimSession, time: f64) -> Option<String> {
 pub fn viewport_badge(session: &SimSession, time: f64) -> Option<(&'static str, Color32)> {
     match session.state_at(time)? {
         FrameState::Converged => None,
-        FrameState::Proxy => Some(("PROXY", PROXY_COLOR)),
-        FrameState::Stale => Some(("STALE", STALE_COLOR)),
+        FrameState::Proxy => Some(("PROXY", PROXY_COLOUR)),
+        FrameState::Stale => Some(("STALE", STALE_COLOUR)),
     }
 }
 
@@ -275,16 +275,16 @@ pub fn crossing_badge(session: &SimSession, time: f64) -> Option<String> {
 }
 
 /// Colour of keyframes where organs cross.
-pub const CROSSING_COLOR: Color32 = Color32::from_rgb(200, 50, 50);
+pub const CROSSING_COLOUR: Color32 = Color32::from_rgb(200, 50, 50);
 /// Colour of the current run's computed keyframes.
-const COMPUTED_COLOR: Color32 = Color32::from_rgb(90, 140, 90);
+const COMPUTED_COLOUR: Color32 = Color32::from_rgb(90, 140, 90);
 /// Colour of the current run's proxy keyframes (the converged ones are
 /// coming).
-pub const PROXY_COLOR: Color32 = Color32::from_rgb(70, 130, 170);
+pub const PROXY_COLOUR: Color32 = Color32::from_rgb(70, 130, 170);
 /// Colour of stale keyframes (an earlier run's, still shown).
-const STALE_COLOR: Color32 = Color32::from_rgb(150, 125, 70);
+const STALE_COLOUR: Color32 = Color32::from_rgb(150, 125, 70);
 /// Colour of the playhead and of the key being painted.
-const PLAYHEAD_COLOR: Color32 = Color32::from_rgb(230, 120, 40);
+const PLAYHEAD_COLOUR: Color32 = Color32::from_rgb(230, 120, 40);
 
 /// The timeline panel: the scrubber moves `playback` directly; the
 /// buttons' commands are returned.
@@ -352,7 +352,8 @@ pub fn timeline_ui(
             && reached < 0.95 * playback.wanted_keyframes_per_second()
         {
             ui.label(
-                egui::RichText::new(format!("{reached:.0} keyframes/s reached")).color(STALE_COLOR),
+                egui::RichText::new(format!("{reached:.0} keyframes/s reached"))
+                    .color(STALE_COLOUR),
             )
             .on_hover_text(format!(
                 "Playback reaches {reached:.1} of the {:.0} keyframes per second the speed \
@@ -370,10 +371,10 @@ pub fn timeline_ui(
         ui.separator();
         ui.label(status_line(session));
         if let Some(stale) = stale_line(session, playback.time_in_keyframes) {
-            let color =
-                viewport_badge(session, playback.time_in_keyframes).map_or(STALE_COLOR, |(_, c)| c);
+            let colour = viewport_badge(session, playback.time_in_keyframes)
+                .map_or(STALE_COLOUR, |(_, c)| c);
             ui.separator();
-            ui.label(egui::RichText::new(stale).color(color))
+            ui.label(egui::RichText::new(stale).color(colour))
                 .on_hover_text(
                     "The edit started a new run. The viewed keyframe shows a coarse proxy of \
                      the edited flower (blue), computed first, or the result from before the \
@@ -446,10 +447,10 @@ fn scrubber(
     painter.rect_filled(rect, 3.0, visuals.extreme_bg_color);
     // Runs of cells in one state, each a rectangle from the keyframe
     // before the run to its last one.
-    let color_of = |state: FrameState| match state {
-        FrameState::Converged => COMPUTED_COLOR,
-        FrameState::Proxy => PROXY_COLOR,
-        FrameState::Stale => STALE_COLOR,
+    let colour_of = |state: FrameState| match state {
+        FrameState::Converged => COMPUTED_COLOUR,
+        FrameState::Proxy => PROXY_COLOUR,
+        FrameState::Stale => STALE_COLOUR,
     };
     let end = shown.unwrap_or(0);
     let mut k = 1;
@@ -465,7 +466,7 @@ fn scrubber(
             Pos2::new(x_of(f64::from(k - 1)), rect.top()),
             Pos2::new(x_of(f64::from(last)), rect.bottom()),
         );
-        painter.rect_filled(cells, 0.0, color_of(state));
+        painter.rect_filled(cells, 0.0, colour_of(state));
         k = last + 1;
     }
     // Keyframes where organs cross: a red bar along the cell's bottom.
@@ -477,7 +478,7 @@ fn scrubber(
                 rect.bottom(),
             ),
         );
-        painter.rect_filled(bar, 0.0, CROSSING_COLOR);
+        painter.rect_filled(bar, 0.0, CROSSING_COLOUR);
     }
     // Keyframe ticks: every keyframe when they are far enough apart,
     // otherwise every 10th.
@@ -511,7 +512,7 @@ fn scrubber(
             Pos2::new(x, rect.top() + 7.0),
         ];
         let fill = if keys.painted == Some(i) {
-            PLAYHEAD_COLOR
+            PLAYHEAD_COLOUR
         } else {
             Color32::from_gray(235)
         };
@@ -524,7 +525,7 @@ fn scrubber(
     let x = x_of(playback.time_in_keyframes);
     painter.line_segment(
         [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
-        Stroke::new(2.5, PLAYHEAD_COLOR),
+        Stroke::new(2.5, PLAYHEAD_COLOUR),
     );
 }
 
@@ -575,7 +576,7 @@ fn stats_plot(ui: &mut egui::Ui, session: &SimSession, time: f64) {
     let x = rect.left() + (time / f64::from(total)) as f32 * rect.width();
     painter.line_segment(
         [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
-        Stroke::new(1.0, PLAYHEAD_COLOR),
+        Stroke::new(1.0, PLAYHEAD_COLOUR),
     );
     painter.text(
         rect.left_top() + Vec2::new(4.0, 2.0),

@@ -63,9 +63,9 @@ pub(crate) fn paint_tracks(
             pngs[index] = Some((colour_png(template)?, outer));
         }
         if let Some((Some(png), outer)) = &pngs[index] {
-            track.base_color_png = Some(png.clone());
-            track.outer_color_png = outer.clone();
-            track.base_color = [1.0; 4];
+            track.base_colour_png = Some(png.clone());
+            track.outer_colour_png = outer.clone();
+            track.base_colour = [1.0; 4];
         }
     }
     Ok(())
@@ -76,7 +76,7 @@ pub(crate) fn paint_tracks(
 /// in linear light, clamped at the edges, `v = 0` the bottom row, as the
 /// renderer and glTF clients sample it); `None` without a texture.
 pub(crate) fn vertex_colours(track: &Track) -> Result<Option<Vec<[f32; 4]>>, TrackProblem> {
-    let Some(png) = &track.base_color_png else {
+    let Some(png) = &track.base_colour_png else {
         return Ok(None);
     };
     let image = image::load_from_memory_with_format(png, image::ImageFormat::Png)
@@ -120,7 +120,7 @@ pub(crate) fn vertex_colours(track: &Track) -> Result<Option<Vec<[f32; 4]>>, Tra
             .iter()
             .map(|&uv| {
                 let t = sample(uv);
-                std::array::from_fn(|i| track.base_color[i] * t[i])
+                std::array::from_fn(|i| track.base_colour[i] * t[i])
             })
             .collect(),
     ))
@@ -150,8 +150,8 @@ mod tests {
                 DVec2::new(1.0, 1.0),
                 DVec2::new(0.5, 0.5),
             ],
-            base_color: [1.0, 1.0, 0.5, 1.0],
-            base_color_png: Some(png),
+            base_colour: [1.0, 1.0, 0.5, 1.0],
+            base_colour_png: Some(png),
             ..Track::default()
         };
         let colours = vertex_colours(&track).expect("decodes").expect("textured");
@@ -162,7 +162,7 @@ mod tests {
         let plain = Track::default();
         assert_eq!(vertex_colours(&plain), Ok(None));
         let broken = Track {
-            base_color_png: Some(b"\x89PNG\r\n\x1a\nbroken".to_vec()),
+            base_colour_png: Some(b"\x89PNG\r\n\x1a\nbroken".to_vec()),
             ..Track::default()
         };
         assert!(matches!(

@@ -154,11 +154,11 @@ pub enum TrackProblem {
         /// The vertex.
         vertex: usize,
     },
-    #[error("its base colour {color:?} is not four numbers in [0, 1]")]
+    #[error("its base colour {colour:?} is not four numbers in [0, 1]")]
     /// The base colour is outside `[0, 1]`.
-    BaseColor {
+    BaseColour {
         /// The colour given.
-        color: [f32; 4],
+        colour: [f32; 4],
     },
     #[error(
         "its rigid motion does not match its keyframes ({local} local positions for {vertices} \

@@ -97,13 +97,13 @@ pub struct Track {
     /// One UV per vertex (Anthesis convention: `v = 0` at the base).
     pub uvs: Vec<DVec2>,
     /// Linear RGBA in `[0, 1]`; an alpha below 1 makes the material blended.
-    pub base_color: [f32; 4],
+    pub base_colour: [f32; 4],
     /// Positions per keyframe: `keyframes[0]` is the bud (keyframe 0); a
     /// static mesh such as the receptacle has exactly one keyframe.
     pub keyframes: Vec<Vec<DVec3>>,
     /// Optional base-colour texture as the bytes of a PNG file, multiplied
     /// by `base_color` (so use white there to show the texture as it is).
-    pub base_color_png: Option<Vec<u8>>,
+    pub base_colour_png: Option<Vec<u8>>,
     /// Set when the track moves as a rigid body (a part turned by its
     /// schedule): `keyframes[k][i]` is `poses[k]` applied to `local[i]`.
     /// The .glb then animates the node's translation and rotation instead
@@ -121,7 +121,7 @@ pub struct Track {
     /// mesh a second primitive of the same triangles wound the other way
     /// with this texture, the USD layer a second mesh `<name>_outer`, each
     /// side single-sided, so every client shows each side its own colours.
-    pub outer_color_png: Option<Vec<u8>>,
+    pub outer_colour_png: Option<Vec<u8>>,
 }
 
 /// A rigid track's mesh in its own frame and its pose at every keyframe.

@@ -61,20 +61,20 @@ fn check_track(track: &Track) -> Result<(), TrackProblem> {
         return Err(TrackProblem::NonFiniteUv { vertex });
     }
     if !track
-        .base_color
+        .base_colour
         .iter()
         .all(|c| c.is_finite() && (0.0..=1.0).contains(c))
     {
-        return Err(TrackProblem::BaseColor {
-            color: track.base_color,
+        return Err(TrackProblem::BaseColour {
+            colour: track.base_colour,
         });
     }
-    if let Some(png) = &track.base_color_png
+    if let Some(png) = &track.base_colour_png
         && !png.starts_with(&PNG_SIGNATURE)
     {
         return Err(TrackProblem::TextureNotPng);
     }
-    if let Some(png) = &track.outer_color_png
+    if let Some(png) = &track.outer_colour_png
         && !png.starts_with(&PNG_SIGNATURE)
     {
         return Err(TrackProblem::TextureNotPng);
@@ -249,12 +249,12 @@ mod tests {
             name: "t".to_owned(),
             triangles: vec![[0, 1, 2]],
             uvs: vec![DVec2::ZERO, DVec2::X, DVec2::Y],
-            base_color: [1.0, 1.0, 1.0, 1.0],
+            base_colour: [1.0, 1.0, 1.0, 1.0],
             keyframes,
-            base_color_png: None,
+            base_colour_png: None,
             rigid: None,
             unit: anthesis_flower::Unit::METRE,
-            outer_color_png: None,
+            outer_colour_png: None,
         }
     }
 
@@ -338,10 +338,10 @@ mod tests {
         t.uvs[1].x = f64::INFINITY;
         assert_eq!(problem(&[t]), TrackProblem::NonFiniteUv { vertex: 1 });
         let mut t = triangle_track(vec![frame(0.0)]);
-        t.base_color = [1.2, 0.0, 0.0, 1.0];
-        assert!(matches!(problem(&[t]), TrackProblem::BaseColor { .. }));
+        t.base_colour = [1.2, 0.0, 0.0, 1.0];
+        assert!(matches!(problem(&[t]), TrackProblem::BaseColour { .. }));
         let mut t = triangle_track(vec![frame(0.0)]);
-        t.base_color_png = Some(b"GIF89a".to_vec());
+        t.base_colour_png = Some(b"GIF89a".to_vec());
         assert_eq!(problem(&[t]), TrackProblem::TextureNotPng);
     }
 

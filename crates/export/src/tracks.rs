@@ -25,7 +25,7 @@ pub struct TrackLook<'a> {
     /// One UV per vertex.
     pub uvs: &'a [DVec2],
     /// Linear RGBA in `[0, 1]`.
-    pub base_color: [f32; 4],
+    pub base_colour: [f32; 4],
 }
 
 impl<'a> TrackLook<'a> {
@@ -34,13 +34,13 @@ impl<'a> TrackLook<'a> {
         name: &'a str,
         triangles: &'a [[u32; 3]],
         uvs: &'a [DVec2],
-        base_color: [f32; 4],
+        base_colour: [f32; 4],
     ) -> TrackLook<'a> {
         TrackLook {
             name,
             triangles,
             uvs,
-            base_color,
+            base_colour,
         }
     }
 }
@@ -48,17 +48,17 @@ impl<'a> TrackLook<'a> {
 impl Track {
     /// A track that does not move (the receptacle): `mesh` as it is, as the
     /// only keyframe.
-    pub fn still(name: impl Into<String>, mesh: Mesh, base_color: [f32; 4]) -> Track {
+    pub fn still(name: impl Into<String>, mesh: Mesh, base_colour: [f32; 4]) -> Track {
         Track {
             name: name.into(),
             triangles: mesh.triangles,
             uvs: mesh.uvs,
-            base_color,
+            base_colour,
             keyframes: vec![mesh.positions],
-            base_color_png: None,
+            base_colour_png: None,
             rigid: None,
             unit: anthesis_flower::Unit::METRE,
-            outer_color_png: None,
+            outer_colour_png: None,
         }
     }
 }
@@ -78,12 +78,12 @@ pub fn organ_tracks<'a, 'k>(
             name: look.name.to_string(),
             triangles: look.triangles.to_vec(),
             uvs: look.uvs.to_vec(),
-            base_color: look.base_color,
+            base_colour: look.base_colour,
             keyframes: Vec::new(),
-            base_color_png: None,
+            base_colour_png: None,
             rigid: None,
             unit: anthesis_flower::Unit::METRE,
-            outer_color_png: None,
+            outer_colour_png: None,
         })
         .collect();
     for organs in keyframes {
@@ -195,7 +195,7 @@ pub fn flower_tracks<'k>(
             &flower.organs[organ].name,
             &template.mesh.triangles,
             &template.mesh.uvs,
-            template.color,
+            template.colour,
         )
     });
     let count = keyframes.len();
@@ -238,7 +238,7 @@ pub fn part_track(piece: &PartPiece, keyframe_count: usize) -> Track {
             positions: piece.positions_at(0),
             ..piece.mesh.clone()
         };
-        return Track::still(piece.name.clone(), mesh, piece.color);
+        return Track::still(piece.name.clone(), mesh, piece.colour);
     }
     let poses: Vec<Pose> = (0..keyframe_count as u32)
         .map(|step| {
@@ -264,15 +264,15 @@ pub fn part_track(piece: &PartPiece, keyframe_count: usize) -> Track {
         name: piece.name.clone(),
         triangles: piece.mesh.triangles.clone(),
         uvs: piece.mesh.uvs.clone(),
-        base_color: piece.color,
+        base_colour: piece.colour,
         keyframes,
-        base_color_png: None,
+        base_colour_png: None,
         rigid: Some(RigidMotion {
             local: piece.mesh.positions.clone(),
             poses,
         }),
         unit: anthesis_flower::Unit::METRE,
-        outer_color_png: None,
+        outer_colour_png: None,
     }
 }
 
@@ -319,12 +319,12 @@ impl Track {
             name: self.name.clone(),
             triangles: subdivision.triangles().to_vec(),
             uvs: subdivision.uvs().to_vec(),
-            base_color: self.base_color,
+            base_colour: self.base_colour,
             keyframes,
-            base_color_png: self.base_color_png.clone(),
+            base_colour_png: self.base_colour_png.clone(),
             rigid: None,
             unit: self.unit,
-            outer_color_png: self.outer_color_png.clone(),
+            outer_colour_png: self.outer_colour_png.clone(),
         })
     }
 }
@@ -351,8 +351,8 @@ mod tests {
         assert_eq!(tracks[1].name, "petal");
         assert_eq!(tracks[1].triangles, triangle);
         assert_eq!(tracks[1].uvs, uvs);
-        assert_eq!(tracks[1].base_color, [0.0, 0.0, 1.0, 1.0]);
-        assert_eq!(tracks[1].base_color_png, None);
+        assert_eq!(tracks[1].base_colour, [0.0, 0.0, 1.0, 1.0]);
+        assert_eq!(tracks[1].base_colour_png, None);
         assert_eq!(tracks[0].keyframes, vec![at(0, 0), at(1, 0), at(2, 0)]);
         assert_eq!(tracks[1].keyframes, vec![at(0, 1), at(1, 1), at(2, 1)]);
     }
@@ -365,7 +365,7 @@ mod tests {
         assert_eq!(track.triangles, mesh.triangles);
         assert_eq!(track.uvs, mesh.uvs);
         assert_eq!(track.keyframes, vec![mesh.positions]);
-        assert_eq!(track.base_color, [0.5; 4]);
+        assert_eq!(track.base_colour, [0.5; 4]);
     }
 
     /// A petal bending outwards over three keyframes.
@@ -385,12 +385,12 @@ mod tests {
             name: "petal".into(),
             triangles: petal.triangles,
             uvs: petal.uvs,
-            base_color: [0.9, 0.8, 0.9, 1.0],
+            base_colour: [0.9, 0.8, 0.9, 1.0],
             keyframes,
-            base_color_png: None,
+            base_colour_png: None,
             rigid: None,
             unit: anthesis_flower::Unit::METRE,
-            outer_color_png: None,
+            outer_colour_png: None,
         }
     }
 
@@ -406,7 +406,7 @@ mod tests {
         };
         let subdivision = Subdivision::new(&bud, 2).expect("subdivides");
         assert_eq!(fine.name, track.name);
-        assert_eq!(fine.base_color, track.base_color);
+        assert_eq!(fine.base_colour, track.base_colour);
         assert_eq!(fine.triangles, subdivision.triangles());
         assert_eq!(fine.uvs, subdivision.uvs());
         assert_eq!(fine.triangles.len(), 16 * track.triangles.len());

@@ -202,13 +202,13 @@ fn build_layer(
     let mut textures = TextureFiles::new();
     for (index, (track, name)) in tracks.iter().zip(&names).enumerate() {
         let mut sides = vec![(track.clone(), name.clone())];
-        if let Some(outer) = &track.outer_color_png {
+        if let Some(outer) = &track.outer_colour_png {
             // The outer side: the same surface wound the other way, with
             // the outer texture (each side's mesh single-sided).
             sides.push((
                 Track {
                     triangles: track.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
-                    base_color_png: Some(outer.clone()),
+                    base_colour_png: Some(outer.clone()),
                     ..track.clone()
                 },
                 format!("{name}_outer"),
@@ -224,14 +224,14 @@ fn build_layer(
                 }
             })?;
             let texture = side
-                .base_color_png
+                .base_colour_png
                 .as_ref()
                 .map(|png| texture_file(&mut textures, texture_folder, name, png));
             let material = write_material(
                 &mut layer,
                 &materials,
                 name,
-                side.base_color,
+                side.base_colour,
                 texture.as_deref(),
             )?;
             let mesh = layer.prim(&flower, name, "Mesh")?;
@@ -301,14 +301,14 @@ fn write_outer_mesh(
             .iter()
             .map(|c| gf::vec3f(c[0], c[1], c[2]))
             .collect();
-        let color = layer.attribute(
+        let colour = layer.attribute(
             mesh,
             "primvars:displayColor",
             "color3f[]",
             None,
             Value::Vec3fVec(rgb),
         )?;
-        layer.set_field(&color, "interpolation", Value::Token("vertex".into()))?;
+        layer.set_field(&colour, "interpolation", Value::Token("vertex".into()))?;
     }
     layer.relationship(mesh, "material:binding", material)
 }
@@ -474,7 +474,7 @@ fn write_mesh(
     )?;
     let uniform = Some(Variability::Uniform);
     // A track whose sides look different is two single-sided meshes.
-    let double_sided = track.outer_color_png.is_none();
+    let double_sided = track.outer_colour_png.is_none();
     layer.attribute(
         mesh,
         "doubleSided",
@@ -552,7 +552,7 @@ fn write_mesh(
     // One colour, or one per vertex from the colour map.
     let (rgb, alpha, interpolation) = match colours {
         None => {
-            let [r, g, b, a] = track.base_color;
+            let [r, g, b, a] = track.base_colour;
             (vec![gf::vec3f(r, g, b)], vec![a], "constant")
         }
         Some(colours) => (
@@ -564,14 +564,14 @@ fn write_mesh(
             "vertex",
         ),
     };
-    let color = layer.attribute(
+    let colour = layer.attribute(
         mesh,
         "primvars:displayColor",
         "color3f[]",
         None,
         Value::Vec3fVec(rgb),
     )?;
-    layer.set_field(&color, "interpolation", Value::Token(interpolation.into()))?;
+    layer.set_field(&colour, "interpolation", Value::Token(interpolation.into()))?;
     let opacity = layer.attribute(
         mesh,
         "primvars:displayOpacity",
@@ -600,13 +600,13 @@ fn write_material(
     layer: &mut LayerBuilder,
     scope: &sdf::Path,
     name: &str,
-    color: [f32; 4],
+    colour: [f32; 4],
     texture: Option<&str>,
 ) -> Result<sdf::Path, ExportError> {
     let material = layer.prim(scope, name, "Material")?;
     let shader = layer.prim(&material, "surface", "Shader")?;
     layer.shader_id(&shader, "UsdPreviewSurface")?;
-    let [r, g, b, a] = color;
+    let [r, g, b, a] = colour;
     let diffuse = layer.attribute(
         &shader,
         "inputs:diffuseColor",
@@ -615,7 +615,7 @@ fn write_material(
         Value::Vec3f(gf::vec3f(r, g, b)),
     )?;
     if let Some(file) = texture {
-        let rgb = write_texture(layer, &material, file, color)?;
+        let rgb = write_texture(layer, &material, file, colour)?;
         layer.set_field(
             &diffuse,
             FieldKey::ConnectionPaths,
@@ -648,7 +648,7 @@ fn write_texture(
     layer: &mut LayerBuilder,
     material: &sdf::Path,
     file: &str,
-    color: [f32; 4],
+    colour: [f32; 4],
 ) -> Result<sdf::Path, ExportError> {
     let reader = layer.prim(material, "stReader", "Shader")?;
     layer.shader_id(&reader, "UsdPrimvarReader_float2")?;
@@ -685,7 +685,7 @@ fn write_texture(
     )?;
     layer.attribute(&texture, "inputs:wrapS", "token", None, token("clamp"))?;
     layer.attribute(&texture, "inputs:wrapT", "token", None, token("clamp"))?;
-    let [r, g, b, a] = color;
+    let [r, g, b, a] = colour;
     layer.attribute(
         &texture,
         "inputs:scale",

@@ -16,7 +16,7 @@ const RED: [f32; 4] = [0.8, 0.05, 0.05, 1.0];
 const BLUE: [f32; 4] = [0.05, 0.1, 0.9, 1.0];
 const GREEN: [f32; 4] = [0.2, 0.6, 0.1, 1.0];
 
-fn template(name: &str, color: [f32; 4], colouring: Option<Colouring>) -> Template {
+fn template(name: &str, colour: [f32; 4], colouring: Option<Colouring>) -> Template {
     Template {
         name: name.to_owned(),
         mesh: test_petal(4.0, 2.0, 6, 9),
@@ -27,7 +27,7 @@ fn template(name: &str, color: [f32; 4], colouring: Option<Colouring>) -> Templa
         bend_stiffness: 20.0,
         base_region: BaseRegion::default(),
         joint_schedule: Vec::new(),
-        color,
+        colour,
         colouring,
         two_state: None,
         source: None,
@@ -54,7 +54,7 @@ fn flower() -> Flower {
                 "petal",
                 RED,
                 Some(Colouring {
-                    second_color: BLUE,
+                    second_colour: BLUE,
                     mix: ScalarMap::from_fn(16, 8, |uv| if uv.x > 0.5 { 1.0 } else { 0.0 }),
                     layers: Vec::new(),
                 }),
@@ -94,8 +94,8 @@ fn a_colour_map_becomes_the_tracks_texture_with_a_white_base_colour() {
     let tracks = tracks();
     assert_eq!(tracks.len(), 3, "two organs and the receptacle");
     let petal = &tracks[0];
-    assert_eq!(petal.base_color, [1.0; 4]);
-    let png = petal.base_color_png.as_ref().expect("a texture");
+    assert_eq!(petal.base_colour, [1.0; 4]);
+    let png = petal.base_colour_png.as_ref().expect("a texture");
     let image = image::load_from_memory(png).expect("a PNG").into_rgba8();
     assert_eq!(image.dimensions(), (16, 8));
     let linear = |x: u32, y: u32| {
@@ -110,9 +110,9 @@ fn a_colour_map_becomes_the_tracks_texture_with_a_white_base_colour() {
     assert!(close(linear(2, 4), RED, 0.01), "{:?}", linear(2, 4));
     assert!(close(linear(13, 4), BLUE, 0.01), "{:?}", linear(13, 4));
     // The plain sepal keeps its colour, without a texture.
-    assert_eq!(tracks[1].base_color, GREEN);
-    assert_eq!(tracks[1].base_color_png, None);
-    assert_eq!(tracks[2].base_color_png, None);
+    assert_eq!(tracks[1].base_colour, GREEN);
+    assert_eq!(tracks[1].base_colour_png, None);
+    assert_eq!(tracks[2].base_colour_png, None);
     // Render meshes keep the texture.
     let flower = flower();
     let keyframe: Vec<Vec<DVec3>> = flower
@@ -121,7 +121,7 @@ fn a_colour_map_becomes_the_tracks_texture_with_a_white_base_colour() {
         .map(|o| flower.templates[o.template].mesh.positions.clone())
         .collect();
     let fine = flower_tracks(&flower, &[0, 1], [keyframe.as_slice()], 1).expect("subdivided");
-    assert_eq!(fine[0].base_color_png, petal.base_color_png);
+    assert_eq!(fine[0].base_colour_png, petal.base_colour_png);
 }
 
 #[test]

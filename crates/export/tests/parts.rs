@@ -37,8 +37,8 @@ fn tracks() -> Vec<Track> {
             to_step: 15,
             angle_deg: 30.0,
         }],
-        color: [0.8, 0.8, 0.6, 1.0],
-        head_color: [0.6, 0.2, 0.05, 1.0],
+        colour: [0.8, 0.8, 0.6, 1.0],
+        head_colour: [0.6, 0.2, 0.05, 1.0],
     };
     let flower = Flower {
         templates: Vec::new(),

@@ -215,13 +215,13 @@ fn meshes_name_their_targets_and_carry_materials() {
         let material = &json["materials"][mesh["primitives"][0]["material"]
             .as_u64()
             .expect("material") as usize];
-        let color: Vec<f32> = material["pbrMetallicRoughness"]["baseColorFactor"]
+        let colour: Vec<f32> = material["pbrMetallicRoughness"]["baseColorFactor"]
             .as_array()
             .expect("base colour")
             .iter()
             .map(|c| c.as_f64().expect("number") as f32)
             .collect();
-        assert_eq!(color, track.base_color.to_vec());
+        assert_eq!(colour, track.base_colour.to_vec());
         assert_eq!(material["doubleSided"], true);
         if track.keyframes.len() == 1 {
             assert!(mesh.get("extras").is_none() && mesh["primitives"][0].get("targets").is_none());
@@ -666,17 +666,17 @@ fn meshopt_steps_do_not_accumulate_rounding() {
         name: "creeping".into(),
         triangles: sheet.triangles.clone(),
         uvs: sheet.uvs.clone(),
-        base_color: [1.0; 4],
+        base_colour: [1.0; 4],
         keyframes: (0..keyframes)
             .map(|k| {
                 let shift = DVec3::new(0.0, 0.0, k as f64 * step / 3.0);
                 sheet.positions.iter().map(|p| *p + shift).collect()
             })
             .collect(),
-        base_color_png: None,
+        base_colour_png: None,
         rigid: None,
         unit: anthesis_flower::Unit::METRE,
-        outer_color_png: None,
+        outer_colour_png: None,
     };
     let options = GlbOptions {
         encoding: Encoding::Meshopt,
@@ -787,8 +787,8 @@ fn a_two_sided_track_shares_its_data_between_its_two_primitives() {
         png
     };
     let mut tracks = fixture(KEYFRAMES);
-    tracks[0].base_color_png = Some(png([230, 20, 20, 255]));
-    tracks[0].outer_color_png = Some(png([20, 40, 220, 255]));
+    tracks[0].base_colour_png = Some(png([230, 20, 20, 255]));
+    tracks[0].outer_colour_png = Some(png([20, 40, 220, 255]));
     for encoding in Encoding::ALL {
         let bytes = export(
             &tracks,

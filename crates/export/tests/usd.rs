@@ -211,7 +211,7 @@ fn layers_read_back_in_pixars_usd_with_every_keyframe() {
                 track.uvs.iter().map(|uv| uv.as_vec2().to_array()).collect();
             assert_eq!(st["value"], serde_json::json!(expected_st), "{what}");
 
-            let [r, g, b, a] = track.base_color;
+            let [r, g, b, a] = track.base_colour;
             assert_eq!(mesh["display_color"]["interpolation"], "constant");
             assert_eq!(
                 mesh["display_color"]["value"],
@@ -382,8 +382,8 @@ fn a_textured_track_gets_its_colour_map_as_a_texture_and_per_vertex() {
     image::DynamicImage::ImageRgba8(image)
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .expect("encode");
-    tracks[0].base_color_png = Some(png);
-    tracks[0].base_color = [1.0; 4];
+    tracks[0].base_colour_png = Some(png);
+    tracks[0].base_colour = [1.0; 4];
     let report = write_and_read(&tracks, &UsdOptions::default(), "coloured.usda");
     assert_eq!(report["validation_findings"], serde_json::json!([]));
     let mesh = &report["meshes"][0];
@@ -430,7 +430,7 @@ fn a_textured_track_gets_its_colour_map_as_a_texture_and_per_vertex() {
         &mut |_| {},
     )
     .expect("export");
-    let png = tracks[0].base_color_png.clone().expect("textured");
+    let png = tracks[0].base_colour_png.clone().expect("textured");
     assert_eq!(
         files.textures,
         [("coloured_textures/petal.png".to_owned(), png)]
@@ -494,9 +494,9 @@ fn plain_png(rgba: [u8; 4]) -> Vec<u8> {
 #[test]
 fn a_two_sided_track_gets_an_outer_mesh_over_the_same_points() {
     let mut tracks = fixture(3);
-    tracks[0].base_color_png = Some(plain_png([230, 20, 20, 255]));
-    tracks[0].outer_color_png = Some(plain_png([20, 40, 220, 255]));
-    tracks[0].base_color = [1.0; 4];
+    tracks[0].base_colour_png = Some(plain_png([230, 20, 20, 255]));
+    tracks[0].outer_colour_png = Some(plain_png([20, 40, 220, 255]));
+    tracks[0].base_colour = [1.0; 4];
     for file in ["two.usda", "two.usdc"] {
         let report = write_and_read(&tracks, &UsdOptions::default(), file);
         assert_eq!(

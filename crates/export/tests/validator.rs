@@ -106,10 +106,10 @@ fn png(width: u32, height: u32) -> Vec<u8> {
 #[test]
 fn a_textured_export_passes_the_validator() {
     let mut tracks = fixture(5);
-    tracks[0].base_color_png = Some(png(64, 128));
-    tracks[0].base_color = [1.0, 1.0, 1.0, 1.0];
-    tracks[1].base_color_png = Some(png(32, 32));
-    tracks[1].base_color = [1.0, 1.0, 1.0, 0.5];
+    tracks[0].base_colour_png = Some(png(64, 128));
+    tracks[0].base_colour = [1.0, 1.0, 1.0, 1.0];
+    tracks[1].base_colour_png = Some(png(32, 32));
+    tracks[1].base_colour = [1.0, 1.0, 1.0, 0.5];
     for encoding in Encoding::ALL {
         let bytes = glb_bytes(&tracks, &options(encoding, true), &mut |_| {}).expect("export");
         let report = assert_valid_glb(&bytes, &format!("textured-{encoding}"));

@@ -14,7 +14,7 @@ use crate::Template;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Colouring {
     /// Linear RGBA in `[0, 1]` (as [`Template::color`]).
-    pub second_color: [f32; 4],
+    pub second_colour: [f32; 4],
     /// How much of the second colour shows, over the mesh's UV square
     /// (`v = 0` on the bottom row, as growth maps); values in `[0, 1]`.
     /// Its size is its own: it need not match the growth maps'.
@@ -30,7 +30,7 @@ pub struct Colouring {
 #[derive(Debug, Clone, PartialEq)]
 pub struct ColourLayer {
     /// Linear RGBA in `[0, 1]`.
-    pub color: [f32; 4],
+    pub colour: [f32; 4],
     /// How much of `color` shows, values in `[0, 1]`, any size.
     pub mix: ScalarMap,
     /// The side of the organ it is painted on (the lily's spots are on the
@@ -67,7 +67,7 @@ fn blend(under: [f32; 4], over: [f32; 4], t: f64) -> [f32; 4] {
 
 /// The second colour a template gets when its colour map is first painted
 /// or its second colour first picked (a deep crimson, linear RGBA).
-pub const DEFAULT_SECOND_COLOR: [f32; 4] = [0.45, 0.02, 0.06, 1.0];
+pub const DEFAULT_SECOND_COLOUR: [f32; 4] = [0.45, 0.02, 0.06, 1.0];
 
 /// The size a colour map is painted at when it is first painted (finer than
 /// growth maps: spots and veins are small).
@@ -94,15 +94,19 @@ impl Template {
     /// with only the layers painted on that side.
     pub fn colour_on(&self, side: Side, uv: DVec2) -> [f32; 4] {
         match &self.colouring {
-            None => self.color,
+            None => self.colour,
             Some(colouring) => {
-                let second = blend(self.color, colouring.second_color, colouring.mix.sample(uv));
+                let second = blend(
+                    self.colour,
+                    colouring.second_colour,
+                    colouring.mix.sample(uv),
+                );
                 colouring
                     .layers
                     .iter()
                     .filter(|layer| layer.side.shows_on(side))
                     .fold(second, |under, layer| {
-                        blend(under, layer.color, layer.mix.sample(uv))
+                        blend(under, layer.colour, layer.mix.sample(uv))
                     })
             }
         }
@@ -121,7 +125,7 @@ impl Template {
     /// made a raster of [`COLOUR_PAINT_SIZE`] holding the same value.
     pub fn colouring_to_paint(&mut self) -> &mut Colouring {
         let colouring = self.colouring.get_or_insert_with(|| Colouring {
-            second_color: DEFAULT_SECOND_COLOR,
+            second_colour: DEFAULT_SECOND_COLOUR,
             mix: ScalarMap::constant(0.0),
             layers: Vec::new(),
         });
@@ -230,7 +234,7 @@ mod tests {
             bend_stiffness: 1.0,
             base_region: crate::BaseRegion::default(),
             joint_schedule: Vec::new(),
-            color: [1.0, 0.0, 0.0, 1.0],
+            colour: [1.0, 0.0, 0.0, 1.0],
             colouring,
             two_state: None,
             source: None,
@@ -251,7 +255,7 @@ mod tests {
         // Mix 0 at the base (v = 0), 1 at the tip: red to blue.
         let mix = ScalarMap::from_fn(8, 8, |uv| uv.y as f32);
         let t = template(Some(Colouring {
-            second_color: [0.0, 0.0, 1.0, 1.0],
+            second_colour: [0.0, 0.0, 1.0, 1.0],
             mix,
             layers: Vec::new(),
         }));
@@ -276,10 +280,10 @@ mod tests {
         // Green over the left half of the red base, then blue over the
         // bottom half of everything.
         let t = template(Some(Colouring {
-            second_color: [0.0, 1.0, 0.0, 1.0],
+            second_colour: [0.0, 1.0, 0.0, 1.0],
             mix: ScalarMap::from_fn(8, 8, |uv| if uv.x < 0.5 { 1.0 } else { 0.0 }),
             layers: vec![ColourLayer {
-                color: [0.0, 0.0, 1.0, 1.0],
+                colour: [0.0, 0.0, 1.0, 1.0],
                 mix: ScalarMap::from_fn(4, 16, |uv| if uv.y < 0.5 { 1.0 } else { 0.0 }),
                 side: Side::Both,
             }],
@@ -297,10 +301,10 @@ mod tests {
         // Blue spots over the bottom half of the inner side; green over the
         // left half of both sides.
         let t = template(Some(Colouring {
-            second_color: [0.0, 1.0, 0.0, 1.0],
+            second_colour: [0.0, 1.0, 0.0, 1.0],
             mix: ScalarMap::from_fn(8, 8, |uv| if uv.x < 0.5 { 1.0 } else { 0.0 }),
             layers: vec![ColourLayer {
-                color: [0.0, 0.0, 1.0, 1.0],
+                colour: [0.0, 0.0, 1.0, 1.0],
                 mix: ScalarMap::from_fn(4, 16, |uv| if uv.y < 0.5 { 1.0 } else { 0.0 }),
                 side: Side::Inner,
             }],

@@ -17,10 +17,10 @@ pub mod structure;
 pub mod unit;
 
 pub use colour::{
-    COLOUR_PAINT_SIZE, ColourLayer, Colouring, DEFAULT_SECOND_COLOR, MAX_BAKED_SIDE, Side, srgb8,
+    COLOUR_PAINT_SIZE, ColourLayer, Colouring, DEFAULT_SECOND_COLOUR, MAX_BAKED_SIDE, Side, srgb8,
     srgb8_to_linear,
 };
-pub use receptacle::{RECEPTACLE_COLOR, receptacle_for, receptacle_mesh};
+pub use receptacle::{RECEPTACLE_COLOUR, receptacle_for, receptacle_mesh};
 pub use resolution::Resolution;
 pub use unit::{Unit, UnitError};
 
@@ -58,7 +58,7 @@ pub struct Template {
     pub joint_schedule: Vec<JointRamp>,
     /// Display and export colour, linear RGBA in [0, 1]: the base colour
     /// when the template has a [`Colouring`].
-    pub color: [f32; 4],
+    pub colour: [f32; 4],
     /// A second colour painted over `color` with a mix map ([`Colouring`]);
     /// `None`: the organ is `color` all over.
     pub colouring: Option<Colouring>,
@@ -425,7 +425,7 @@ pub(crate) fn test_template(name: &str, mesh: Mesh) -> Template {
         bend_stiffness: 20.0,
         base_region: BaseRegion::default(),
         joint_schedule: Vec::new(),
-        color: [1.0; 4],
+        colour: [1.0; 4],
         colouring: None,
         two_state: None,
         source: None,

@@ -19,7 +19,7 @@ use std::f64::consts::{PI, TAU};
 use anthesis_mesh::Mesh;
 use glam::{DQuat, DVec2, DVec3};
 
-use crate::{Flower, JointRamp, Placement, RECEPTACLE_COLOR, joint_angle_after, receptacle_for};
+use crate::{Flower, JointRamp, Placement, RECEPTACLE_COLOUR, joint_angle_after, receptacle_for};
 
 /// Vertices around a tube or a head.
 const AROUND: usize = 10;
@@ -148,9 +148,9 @@ pub struct Part {
     /// schedule).
     pub schedule: Vec<JointRamp>,
     /// Colour of the tube (filament, style, stem, receptacle), linear RGBA.
-    pub color: [f32; 4],
+    pub colour: [f32; 4],
     /// Colour of the head (anther, stigma), linear RGBA.
-    pub head_color: [f32; 4],
+    pub head_colour: [f32; 4],
 }
 
 /// The name of instance `k` (from 0) of a part named `name` repeated
@@ -166,7 +166,7 @@ pub fn instance_name(name: &str, count: u32, k: u32) -> String {
 /// The colours a part of this shape gets unless told otherwise (linear
 /// RGBA, body and head): a pale filament with a pollen-orange anther, a
 /// pale green style and stigma, a stem green.
-pub fn default_colors(shape: &PartShape) -> ([f32; 4], [f32; 4]) {
+pub fn default_colours(shape: &PartShape) -> ([f32; 4], [f32; 4]) {
     const PALE: [f32; 4] = [0.80, 0.82, 0.60, 1.0];
     const POLLEN: [f32; 4] = [0.55, 0.18, 0.03, 1.0];
     const STYLE: [f32; 4] = [0.62, 0.72, 0.40, 1.0];
@@ -174,7 +174,7 @@ pub fn default_colors(shape: &PartShape) -> ([f32; 4], [f32; 4]) {
         PartShape::Stamen { .. } => (PALE, POLLEN),
         PartShape::Pistil { .. } => (STYLE, STYLE),
         PartShape::Pedicel { .. } | PartShape::Receptacle { .. } => {
-            (RECEPTACLE_COLOR, RECEPTACLE_COLOR)
+            (RECEPTACLE_COLOUR, RECEPTACLE_COLOUR)
         }
     }
 }
@@ -189,7 +189,7 @@ pub struct PartPiece {
     /// The mesh in the part's own frame.
     pub mesh: Mesh,
     /// Linear RGBA.
-    pub color: [f32; 4],
+    pub colour: [f32; 4],
     /// Where the instance sits.
     pub placement: Placement,
     /// Its schedule (empty: it does not move).
@@ -296,8 +296,8 @@ impl Part {
                     (HEAD_V, 1.0),
                 );
                 vec![
-                    (tube_mesh(&filament, (0.0, HEAD_V)), self.color, ""),
-                    (anther, self.head_color, "-anther"),
+                    (tube_mesh(&filament, (0.0, HEAD_V)), self.colour, ""),
+                    (anther, self.head_colour, "-anther"),
                 ]
             }
             PartShape::Pistil {
@@ -350,11 +350,14 @@ impl Part {
                         );
                     }
                 }
-                vec![(body, self.color, ""), (stigma, self.head_color, "-stigma")]
+                vec![
+                    (body, self.colour, ""),
+                    (stigma, self.head_colour, "-stigma"),
+                ]
             }
-            PartShape::Pedicel { stalk } => vec![(tube_mesh(&stalk, (0.0, 1.0)), self.color, "")],
+            PartShape::Pedicel { stalk } => vec![(tube_mesh(&stalk, (0.0, 1.0)), self.colour, "")],
             PartShape::Receptacle { radius, depth } => {
-                vec![(crate::receptacle_mesh(radius, depth), self.color, "")]
+                vec![(crate::receptacle_mesh(radius, depth), self.colour, "")]
             }
         }
     }
@@ -470,10 +473,10 @@ impl Part {
                 ));
             }
         }
-        for (what, color) in [("color", self.color), ("head_color", self.head_color)] {
-            if color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+        for (what, colour) in [("color", self.colour), ("head_color", self.head_colour)] {
+            if colour.iter().any(|c| !(0.0..=1.0).contains(c)) {
                 return Err(format!(
-                    "{kind} \"{name}\": {what} components must be between 0 and 1, not {color:?}"
+                    "{kind} \"{name}\": {what} components must be between 0 and 1, not {colour:?}"
                 ));
             }
         }
@@ -495,7 +498,7 @@ pub fn part_pieces(flower: &Flower) -> Vec<PartPiece> {
         pieces.push(PartPiece {
             name: "receptacle".to_string(),
             mesh: receptacle_for(flower),
-            color: RECEPTACLE_COLOR,
+            colour: RECEPTACLE_COLOUR,
             placement: Placement {
                 position: DVec3::ZERO,
                 azimuth_deg: 0.0,
@@ -509,11 +512,11 @@ pub fn part_pieces(flower: &Flower) -> Vec<PartPiece> {
         let meshes = part.meshes();
         for (k, placement) in part.placements().into_iter().enumerate() {
             let name = part.instance_name(k as u32);
-            for (mesh, color, suffix) in &meshes {
+            for (mesh, colour, suffix) in &meshes {
                 pieces.push(PartPiece {
                     name: format!("{name}{suffix}"),
                     mesh: mesh.clone(),
-                    color: *color,
+                    colour: *colour,
                     placement,
                     schedule: part.schedule.clone(),
                 });
@@ -581,7 +584,7 @@ fn segment_pieces(flower: &Flower) -> Vec<PartPiece> {
             PartPiece {
                 name: unique,
                 mesh: tube_mesh(&tube, (0.0, 1.0)),
-                color: segment.color.unwrap_or(RECEPTACLE_COLOR),
+                colour: segment.colour.unwrap_or(RECEPTACLE_COLOUR),
                 placement: Placement {
                     position: segment.start,
                     azimuth_deg: 0.0,
@@ -612,7 +615,7 @@ pub fn obstacles(flower: &Flower) -> Vec<PartPiece> {
                 out.push(PartPiece {
                     name: part.instance_name(k as u32),
                     mesh: mesh.clone(),
-                    color: part.color,
+                    colour: part.colour,
                     placement,
                     schedule: part.schedule.clone(),
                 });

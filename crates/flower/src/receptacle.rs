@@ -14,7 +14,7 @@ const SEGMENTS: usize = 32;
 const RINGS: usize = 12;
 
 /// The receptacle's colour in exports (linear RGBA): a stem green.
-pub const RECEPTACLE_COLOR: [f32; 4] = [0.36, 0.55, 0.24, 1.0];
+pub const RECEPTACLE_COLOUR: [f32; 4] = [0.36, 0.55, 0.24, 1.0];
 
 /// The receptacle of `flower` ([`receptacle_mesh`]), sized to the ring its
 /// organs sit on: with the organs' bases at most `ring` from the axis

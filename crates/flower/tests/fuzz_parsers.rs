@@ -581,7 +581,7 @@ fn generated_png() -> impl Strategy<Value = Vec<u8>> {
         (C::Rgb16, 6),
         (C::Rgba16, 8),
     ]);
-    (kind, 1u32..24, 1u32..24, any::<u64>()).prop_map(|((color, bytes_per_pixel), w, h, seed)| {
+    (kind, 1u32..24, 1u32..24, any::<u64>()).prop_map(|((colour, bytes_per_pixel), w, h, seed)| {
         use image::ImageEncoder;
         let mut state = seed;
         let pixels: Vec<u8> = (0..(w * h) as usize * bytes_per_pixel)
@@ -595,7 +595,7 @@ fn generated_png() -> impl Strategy<Value = Vec<u8>> {
             .collect();
         let mut png = Vec::new();
         image::codecs::png::PngEncoder::new(&mut png)
-            .write_image(&pixels, w, h, color)
+            .write_image(&pixels, w, h, colour)
             .expect("the encoder writes what it offers");
         png
     })

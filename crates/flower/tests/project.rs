@@ -106,7 +106,7 @@ fn petal_template() -> Template {
                 angle_deg: -4.5,
             },
         ],
-        color: [0.98, 0.62, 0.32, 1.0],
+        colour: [0.98, 0.62, 0.32, 1.0],
         colouring: None,
         two_state: None,
         source: None,
@@ -136,7 +136,7 @@ fn sepal_template() -> Template {
         bend_stiffness: 25.0,
         base_region: BaseRegion::default(),
         joint_schedule: Vec::new(),
-        color: [0.3, 0.55, 0.2, 0.9],
+        colour: [0.3, 0.55, 0.2, 0.9],
         colouring: None,
         two_state: None,
         source: None,
@@ -245,7 +245,7 @@ fn a_project_states_its_unit_or_keeps_the_old_meaning() {
     // A colour layer on one side is saved with its side.
     let mut colouring = project.flower.templates[0].colouring_to_paint().clone();
     colouring.layers.push(ColourLayer {
-        color: [0.5, 0.0, 0.1, 1.0],
+        colour: [0.5, 0.0, 0.1, 1.0],
         mix: exact_raster(4, 4, |uv| uv.y),
         side: anthesis_flower::Side::Inner,
     });
@@ -881,7 +881,7 @@ template = "petal"
     let template = &project.flower.templates[0];
     assert_eq!(template.mesh, mesh);
     assert_eq!(template.thickness, 1.0);
-    assert_eq!(template.color, [1.0; 4]);
+    assert_eq!(template.colour, [1.0; 4]);
     assert_eq!(
         template.base_region,
         BaseRegion {
@@ -1799,8 +1799,8 @@ fn lily_parts() -> Vec<anthesis_flower::parts::Part> {
         offset_deg: 0.0,
         angle_deg: 0.0,
         schedule: Vec::new(),
-        color: [0.3, 0.5, 0.2, 1.0],
-        head_color: [0.3, 0.5, 0.2, 1.0],
+        colour: [0.3, 0.5, 0.2, 1.0],
+        head_colour: [0.3, 0.5, 0.2, 1.0],
     };
     let mut stamen = part(
         "stamen",
@@ -1819,7 +1819,7 @@ fn lily_parts() -> Vec<anthesis_flower::parts::Part> {
     stamen.ring_radius = 0.6;
     stamen.offset_deg = 30.0;
     stamen.angle_deg = 5.0;
-    stamen.head_color = [0.6, 0.2, 0.05, 1.0];
+    stamen.head_colour = [0.6, 0.2, 0.05, 1.0];
     stamen.schedule = vec![JointRamp {
         from_step: 20,
         to_step: 80,
@@ -1941,7 +1941,7 @@ fn broken_parts_are_refused_naming_the_part_and_the_key() {
 fn coloured_lily() -> Project {
     let mut project = lily();
     project.flower.templates[0].colouring = Some(Colouring {
-        second_color: [0.6, 0.02, 0.08, 1.0],
+        second_colour: [0.6, 0.02, 0.08, 1.0],
         mix: exact_raster(16, 16, |uv| 1.0 - uv.y),
         layers: Vec::new(),
     });
@@ -1972,9 +1972,9 @@ fn a_colour_map_survives_saving_and_loading() {
         base[0] < 0.7 && base[1] < 0.1,
         "crimson at the base: {base:?}"
     );
-    let color = loaded.flower.templates[0].color;
+    let colour = loaded.flower.templates[0].colour;
     assert!(
-        (0..4).all(|i| (tip[i] - color[i]).abs() < 0.05),
+        (0..4).all(|i| (tip[i] - colour[i]).abs() < 0.05),
         "nearly the base colour at the tip: {tip:?}"
     );
 }
@@ -1997,10 +1997,10 @@ fn a_constant_colour_map_is_a_number_and_layers_are_saved() {
     let path = folder.path().join("lily.anthesis.toml");
     let mut project = lily();
     project.flower.templates[1].colouring = Some(Colouring {
-        second_color: [0.1, 0.2, 0.3, 1.0],
+        second_colour: [0.1, 0.2, 0.3, 1.0],
         mix: ScalarMap::constant(0.5),
         layers: vec![ColourLayer {
-            color: [0.9, 0.9, 0.1, 1.0],
+            colour: [0.9, 0.9, 0.1, 1.0],
             mix: exact_raster(4, 4, |uv| uv.x),
             side: anthesis_flower::Side::Both,
         }],
@@ -2055,7 +2055,7 @@ fn half_a_colour_map_or_colours_out_of_range_are_refused() {
     );
     let mut project = coloured_lily();
     if let Some(colouring) = &mut project.flower.templates[0].colouring {
-        colouring.second_color = [1.5, 0.0, 0.0, 1.0];
+        colouring.second_colour = [1.5, 0.0, 0.0, 1.0];
     }
     let error = save_project(&project, &path).expect_err("second colour out of range");
     assert!(error.to_string().contains("second_color"), "{error}");

@@ -29,7 +29,7 @@ fn template(name: &str) -> Template {
             ..BaseRegion::default()
         },
         joint_schedule: Vec::new(),
-        color: [0.9, 0.5, 0.6, 1.0],
+        colour: [0.9, 0.5, 0.6, 1.0],
         colouring: None,
         source: None,
         vein: None,

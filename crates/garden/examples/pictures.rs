@@ -103,7 +103,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|&i| {
             let template = project.flower.template_of(i);
             match &template.colouring {
-                None => (template.color, None),
+                None => (template.colour, None),
                 Some(_) => {
                     let (w, h) = template.colour_image_size();
                     let uvs: Vec<[f32; 2]> = template
@@ -203,7 +203,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     OrganMesh::from_positions(
                         &piece.positions_at(*index),
                         &piece.mesh.triangles,
-                        piece.color,
+                        piece.colour,
                     )
                 }));
             }

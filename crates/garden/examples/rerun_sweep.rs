@@ -273,13 +273,13 @@ fn cases(base: &Project, selection: &Selection) -> Vec<Case> {
     edit("12 more keyframes".into(), &|p| p.settings.keyframes += 12);
     edit("15 fewer keyframes".into(), &|p| p.settings.keyframes -= 15);
     edit("template colour".into(), &|p| {
-        p.flower.templates[template].color = [0.9, 0.1, 0.5, 1.0];
+        p.flower.templates[template].colour = [0.9, 0.1, 0.5, 1.0];
     });
     if !flower.parts.is_empty() {
         edit("every part's colours".into(), &|p| {
             for part in &mut p.flower.parts {
-                part.color = [0.1, 0.9, 0.2, 1.0];
-                part.head_color = [0.9, 0.9, 0.1, 1.0];
+                part.colour = [0.1, 0.9, 0.2, 1.0];
+                part.head_colour = [0.9, 0.9, 0.1, 1.0];
             }
         });
     }

@@ -260,7 +260,7 @@ fn apple_template(
         stretch_stiffness: APPLE_STIFFNESS,
         bend_stiffness: APPLE_STIFFNESS,
         joint_schedule: Vec::new(),
-        color: colour,
+        colour: colour,
         colouring: None,
         two_state: None,
         source: None,
@@ -276,7 +276,7 @@ pub fn apple_petal_template(edge: f64) -> Result<Template, GardenError> {
     let maps = apple_petal_maps().map_err(|error| GardenError::Maps { organ, error })?;
     let mut petal = apple_template("petal", bud.mesh, maps, APPLE_WHITE);
     petal.colouring = Some(Colouring {
-        second_color: APPLE_PINK,
+        second_colour: APPLE_PINK,
         mix: colour_map(apple_blush),
         layers: Vec::new(),
     });

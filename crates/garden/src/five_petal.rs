@@ -104,7 +104,7 @@ pub fn simple_template_of_mesh(name: &str, mesh: anthesis_mesh::Mesh) -> Templat
         stretch_stiffness: crate::flowers::EUSTOMA_STIFFNESS,
         bend_stiffness: crate::flowers::EUSTOMA_STIFFNESS,
         joint_schedule: vec![SIMPLE_JOINT],
-        color: SIMPLE_PINK,
+        colour: SIMPLE_PINK,
         colouring: None,
         two_state: None,
         source: None,

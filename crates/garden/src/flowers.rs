@@ -319,7 +319,7 @@ fn template(
         stretch_stiffness: spec.stiffness,
         bend_stiffness: spec.stiffness,
         joint_schedule: vec![spec.joint],
-        color: spec.colour,
+        colour: spec.colour,
         colouring: None,
         two_state: None,
         source: None,
@@ -389,10 +389,10 @@ fn lily_colouring(seed: u64, count: usize) -> Colouring {
     // wider in u than in v are round on it.
     let spotted = spots(seed, count, (0.14, 0.5), 0.2, 0.011, 3.0);
     Colouring {
-        second_color: LILY_THROAT,
+        second_colour: LILY_THROAT,
         mix: colour_map(lily_throat),
         layers: vec![ColourLayer {
-            color: LILY_CRIMSON,
+            colour: LILY_CRIMSON,
             mix: colour_map(spotted),
             // The spots are inside the flower only.
             side: anthesis_flower::Side::Inner,
@@ -525,19 +525,19 @@ impl Cultivar {
         match self {
             Cultivar::MellowYellow => Colouring {
                 // sRGB about 165, 200, 60.
-                second_color: [0.376, 0.578, 0.045, 1.0],
+                second_colour: [0.376, 0.578, 0.045, 1.0],
                 mix: colour_map(|uv| 0.85 * (1.0 - smoothstep(0.05, 0.4, uv.y))),
                 layers: Vec::new(),
             },
             Cultivar::MaiteLady => Colouring {
                 // sRGB about 150, 40, 140.
-                second_color: [0.305, 0.021, 0.262, 1.0],
+                second_colour: [0.305, 0.021, 0.262, 1.0],
                 mix: colour_map(eustoma_picotee),
                 layers: Vec::new(),
             },
             Cultivar::Pinocchio => Colouring {
                 // sRGB about 80, 20, 110.
-                second_color: [0.08, 0.007, 0.155, 1.0],
+                second_colour: [0.08, 0.007, 0.155, 1.0],
                 mix: colour_map(|uv| 1.0 - smoothstep(0.04, 0.45, uv.y)),
                 layers: Vec::new(),
             },

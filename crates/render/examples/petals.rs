@@ -15,7 +15,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let petal = test_petal(10.0, 5.0, 14, 28);
     // Linear RGBA (pale pink, white, pink).
-    let colors = [
+    let colours = [
         [0.96, 0.6, 0.71, 1.0],
         [0.93, 0.93, 0.89, 1.0],
         [0.89, 0.34, 0.52, 1.0],
@@ -36,7 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .iter()
                 .map(|&p| turn * (tilt * p + DVec3::new(0.0, 0.0, receptacle_radius)))
                 .collect();
-            OrganMesh::from_positions(&positions, &petal.triangles, colors[i as usize])
+            OrganMesh::from_positions(&positions, &petal.triangles, colours[i as usize])
         })
         .collect();
     let (lo, hi) = organs_bounds_in_world(&organs).ok_or("no vertices")?;

@@ -13,7 +13,7 @@ pub const BLIT_SHADER_SOURCE: &str = include_str!("../../../shaders/viewport_bli
 /// decodes them for an sRGB destination); multisampled 4x, resolved by
 /// the [`RenderTarget`].
 pub const BLIT_SOURCE_FORMAT: TargetFormat = TargetFormat {
-    color: wgpu::TextureFormat::Rgba8Unorm,
+    colour: wgpu::TextureFormat::Rgba8Unorm,
     depth: wgpu::TextureFormat::Depth32Float,
     sample_count: 4,
 };

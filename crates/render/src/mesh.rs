@@ -19,7 +19,7 @@ pub struct OrganMesh {
     pub triangles: Vec<[u32; 3]>,
     /// Linear RGBA in `[0, 1]`, as project files and exports hold colours;
     /// the renderer encodes for the target once, at the end of its shader.
-    pub color_linear: [f32; 4],
+    pub colour_linear: [f32; 4],
     /// An optional scalar per vertex in `[0, 1]` (e.g. a growth-map value)
     /// shown with a blue–yellow–red ramp instead of the organ colour.
     pub overlay: Option<Vec<f32>>,
@@ -51,7 +51,7 @@ impl OrganMesh {
     pub fn from_positions(
         positions_in_world: &[DVec3],
         triangles: &[[u32; 3]],
-        color_linear: [f32; 4],
+        colour_linear: [f32; 4],
     ) -> OrganMesh {
         let normals = anthesis_mesh::vertex_normals(positions_in_world, triangles);
         OrganMesh {
@@ -61,7 +61,7 @@ impl OrganMesh {
                 .collect(),
             normals_in_world: normals.iter().map(|n| n.as_vec3().to_array()).collect(),
             triangles: triangles.to_vec(),
-            color_linear,
+            colour_linear,
             overlay: None,
             texture: None,
         }

@@ -80,7 +80,7 @@ impl OffscreenRenderer {
                 .flags
                 .sample_count_supported(format.sample_count)
         };
-        if !(supports(format.color) && supports(format.depth)) {
+        if !(supports(format.colour) && supports(format.depth)) {
             format.sample_count = 1;
         }
         let pipeline = OrganPipeline::new(&device, &queue, format);

@@ -64,7 +64,7 @@ pub struct TargetFormat {
     /// Any renderable colour format. For `…Srgb` formats the hardware
     /// encodes; for others the shader writes sRGB-encoded values itself, so
     /// the image looks the same either way.
-    pub color: wgpu::TextureFormat,
+    pub colour: wgpu::TextureFormat,
     /// A depth format (`Depth32Float` recommended: depth is reversed).
     pub depth: wgpu::TextureFormat,
     /// 1 (no MSAA) or a count the device supports for both formats (4 is
@@ -75,7 +75,7 @@ pub struct TargetFormat {
 impl TargetFormat {
     /// `Rgba8UnormSrgb` colour, `Depth32Float` depth, 4x MSAA.
     pub const DEFAULT: TargetFormat = TargetFormat {
-        color: wgpu::TextureFormat::Rgba8UnormSrgb,
+        colour: wgpu::TextureFormat::Rgba8UnormSrgb,
         depth: wgpu::TextureFormat::Depth32Float,
         sample_count: 4,
     };
@@ -143,7 +143,7 @@ struct FrameUniform {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 struct OrganUniform {
-    color_linear: [f32; 4],
+    colour_linear: [f32; 4],
     overlay_mix: [f32; 4],
 }
 
@@ -274,9 +274,9 @@ fn organ_layouts(device: &wgpu::Device) -> OrganLayouts {
 }
 
 /// The one colour attachment both pipelines write, unblended.
-fn color_targets(format: TargetFormat) -> [Option<wgpu::ColorTargetState>; 1] {
+fn colour_targets(format: TargetFormat) -> [Option<wgpu::ColorTargetState>; 1] {
     [Some(wgpu::ColorTargetState {
-        format: format.color,
+        format: format.colour,
         blend: None,
         write_mask: wgpu::ColorWrites::ALL,
     })]
@@ -299,7 +299,7 @@ fn create_organ_pipeline(
     layout: &wgpu::PipelineLayout,
     format: TargetFormat,
 ) -> wgpu::RenderPipeline {
-    let color_targets = color_targets(format);
+    let colour_targets = colour_targets(format);
     let vertex_buffers = [Some(wgpu::VertexBufferLayout {
         array_stride: size_of::<Vertex>() as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
@@ -333,7 +333,7 @@ fn create_organ_pipeline(
             module: shader,
             entry_point: Some("fs_organ"),
             compilation_options: Default::default(),
-            targets: &color_targets,
+            targets: &colour_targets,
         }),
         multiview_mask: None,
         cache: None,
@@ -348,7 +348,7 @@ fn create_background_pipeline(
     layout: &wgpu::PipelineLayout,
     format: TargetFormat,
 ) -> wgpu::RenderPipeline {
-    let color_targets = color_targets(format);
+    let colour_targets = colour_targets(format);
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("anthesis background"),
         layout: Some(layout),
@@ -371,7 +371,7 @@ fn create_background_pipeline(
             module: shader,
             entry_point: Some("fs_background"),
             compilation_options: Default::default(),
-            targets: &color_targets,
+            targets: &colour_targets,
         }),
         multiview_mask: None,
         cache: None,
@@ -556,7 +556,7 @@ impl OrganPipeline {
         let flag = |on: bool| if on { 1.0 } else { 0.0 };
         for (i, mesh) in organs.iter().enumerate() {
             let uniform = OrganUniform {
-                color_linear: mesh.color_linear,
+                colour_linear: mesh.colour_linear,
                 overlay_mix: [
                     flag(mesh.overlay.is_some()),
                     flag(mesh.texture.as_ref().is_some_and(|t| t.two_sided)),
@@ -696,7 +696,7 @@ impl OrganPipeline {
             background_top_srgb: [tr, tg, tb, 1.0],
             background_bottom_srgb: [br, bg, bb, 1.0],
             output_flags: [
-                if self.format.color.is_srgb() {
+                if self.format.colour.is_srgb() {
                     0.0
                 } else {
                     1.0
@@ -754,14 +754,14 @@ impl OrganPipeline {
     pub fn render(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        color_view: &wgpu::TextureView,
+        colour_view: &wgpu::TextureView,
         resolve_view: Option<&wgpu::TextureView>,
         depth_view: &wgpu::TextureView,
     ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("anthesis organs"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color_view,
+                view: colour_view,
                 depth_slice: None,
                 resolve_target: resolve_view,
                 ops: wgpu::Operations {

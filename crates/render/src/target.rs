@@ -41,7 +41,7 @@ impl RenderTarget {
         let resolved = texture(
             "anthesis colour",
             1,
-            format.color,
+            format.colour,
             wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
@@ -50,7 +50,7 @@ impl RenderTarget {
             texture(
                 "anthesis colour (multisampled)",
                 format.sample_count,
-                format.color,
+                format.colour,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
             )
             .create_view(&Default::default())

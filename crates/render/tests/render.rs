@@ -24,14 +24,14 @@ fn renderer() -> OffscreenRenderer {
 
 /// A square `[-h, h]^2` in the plane z = `z`, wound counter-clockwise seen
 /// from +Z, so its normal (the front side) faces +Z.
-fn square(half: f64, z: f64, color_linear: [f32; 4]) -> OrganMesh {
+fn square(half: f64, z: f64, colour_linear: [f32; 4]) -> OrganMesh {
     let positions = [
         DVec3::new(-half, -half, z),
         DVec3::new(half, -half, z),
         DVec3::new(half, half, z),
         DVec3::new(-half, half, z),
     ];
-    OrganMesh::from_positions(&positions, &[[0, 1, 2], [0, 2, 3]], color_linear)
+    OrganMesh::from_positions(&positions, &[[0, 1, 2], [0, 2, 3]], colour_linear)
 }
 
 /// Looks at the origin from +Z (`from_front`) or -Z, 5 units away, with a

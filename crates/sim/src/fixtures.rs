@@ -114,7 +114,7 @@ fn template_with_mesh(name: &str, mesh: Mesh, rows: usize) -> Template {
             to_step: 60,
             angle_deg: 23.0,
         }],
-        color: [0.95, 0.55, 0.35, 1.0],
+        colour: [0.95, 0.55, 0.35, 1.0],
         colouring: None,
         two_state: None,
         source: None,
@@ -140,7 +140,7 @@ pub fn whorl(organs: usize, columns: usize, rows: usize, keyframes: u32) -> Proj
     let mut templates = vec![ring_petal_template("petal", columns, rows, inner_radius)];
     if organs >= 2 {
         let mut sepal = ring_petal_template("sepal", columns, rows, outer_radius);
-        sepal.color = [0.6, 0.75, 0.35, 1.0];
+        sepal.colour = [0.6, 0.75, 0.35, 1.0];
         templates.push(sepal);
     }
     let organs_list: Vec<Organ> = (0..organs)

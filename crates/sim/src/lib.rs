@@ -360,8 +360,8 @@ impl Simulation {
     }
 
     /// Display colour of simulated organ `i`.
-    pub fn color(&self, i: usize) -> [f32; 4] {
-        self.organs[i].color
+    pub fn colour(&self, i: usize) -> [f32; 4] {
+        self.organs[i].colour
     }
 
     /// Numeric Hessian factorisations done so far, over all organs (the

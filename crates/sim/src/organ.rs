@@ -122,7 +122,7 @@ pub(crate) struct Settled {
 
 pub(crate) struct OrganSim {
     pub name: String,
-    pub color: [f32; 4],
+    pub colour: [f32; 4],
     /// Bud mesh in the template frame (UVs and triangles are used as is).
     pub mesh: Mesh,
     topology: Topology,
@@ -264,7 +264,7 @@ impl OrganSim {
         let mut sim = OrganSim {
             two_state,
             name: organ.name.clone(),
-            color: template.color,
+            colour: template.colour,
             mesh: template.mesh.clone(),
             positions: initial.clone(),
             initial,
@@ -643,7 +643,7 @@ impl OrganSim {
         self.key_dg = key_growth_scales(new);
         self.key_schedule = new.maps.schedule();
         self.schedule.clone_from(&new.joint_schedule);
-        self.color = new.color;
+        self.colour = new.colour;
     }
 
     /// The state a later run can go on from (see [`OrganState`]).

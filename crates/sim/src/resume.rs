@@ -284,8 +284,8 @@ mod tests {
                 to_step: 20,
                 angle_deg: 10.0,
             }],
-            color: [0.8, 0.8, 0.6, 1.0],
-            head_color: [0.6, 0.2, 0.0, 1.0],
+            colour: [0.8, 0.8, 0.6, 1.0],
+            head_colour: [0.6, 0.2, 0.0, 1.0],
         });
         project
     }
@@ -310,8 +310,8 @@ mod tests {
         faster.flower.parts[0].schedule[0].to_step = 10;
         assert_eq!(edit_between(&before, &faster, &ALL), Edit::Everything);
         let mut recoloured = before.clone();
-        recoloured.flower.parts[0].color = [0.1, 0.2, 0.3, 1.0];
-        recoloured.flower.parts[0].head_color = [0.9, 0.2, 0.3, 1.0];
+        recoloured.flower.parts[0].colour = [0.1, 0.2, 0.3, 1.0];
+        recoloured.flower.parts[0].head_colour = [0.9, 0.2, 0.3, 1.0];
         recoloured.flower.parts[0].name = "filament".to_string();
         assert_eq!(edit_between(&before, &recoloured, &ALL), Edit::Nothing);
         // Its shape or place acts from the bud on.
@@ -338,7 +338,7 @@ mod tests {
     fn what_acts_from_the_bud_starts_over_and_a_colour_changes_nothing() {
         let before = lily_like();
         let mut colour = before.clone();
-        colour.flower.templates[0].color = [0.1, 0.2, 0.3, 1.0];
+        colour.flower.templates[0].colour = [0.1, 0.2, 0.3, 1.0];
         assert_eq!(edit_between(&before, &colour, &ALL), Edit::Nothing);
         assert_eq!(edit_between(&before, &before.clone(), &ALL), Edit::Nothing);
 

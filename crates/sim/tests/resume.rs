@@ -132,11 +132,11 @@ fn without_checkpoints_an_edit_starts_over_and_an_edit_that_changes_nothing_keep
     assert_resumes_exactly(sim, &kept, &before, &after, 13);
     // A colour is not simulated.
     let mut recoloured = before.clone();
-    recoloured.flower.templates[0].color = [0.2, 0.3, 0.9, 1.0];
+    recoloured.flower.templates[0].colour = [0.2, 0.3, 0.9, 1.0];
     let (mut sim, _) = full_run(&before);
     assert_eq!(sim.edit(&before, &recoloured).expect("valid"), 13);
     assert!(sim.finished());
-    assert_eq!(sim.color(0), [0.2, 0.3, 0.9, 1.0]);
+    assert_eq!(sim.colour(0), [0.2, 0.3, 0.9, 1.0]);
 }
 
 #[test]
@@ -186,7 +186,7 @@ fn a_part_turned_from_a_later_step_goes_on_from_there_bit_for_bit() {
     assert_resumes_exactly(sim, &kept, &before, &after, 9);
 
     let mut recoloured = before.clone();
-    recoloured.flower.parts[0].color = [0.9, 0.1, 0.1, 1.0];
+    recoloured.flower.parts[0].colour = [0.9, 0.1, 0.1, 1.0];
     let (mut sim, _) = full_run(&before);
     assert_eq!(sim.edit(&before, &recoloured).expect("valid"), 15);
 }

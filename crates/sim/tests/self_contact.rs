@@ -54,7 +54,7 @@ fn folded(rows: usize, keyframes: u32, band: (f64, f64), dg: f64) -> Project {
             ..BaseRegion::default()
         },
         joint_schedule: Vec::new(),
-        color: [1.0; 4],
+        colour: [1.0; 4],
         colouring: None,
         two_state: None,
         source: None,

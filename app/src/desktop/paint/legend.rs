@@ -32,8 +32,8 @@ impl PaintState {
             let second = current
                 .colouring
                 .as_ref()
-                .map_or(anthesis_flower::DEFAULT_SECOND_COLOR, |c| c.second_color);
-            (current.color, second)
+                .map_or(anthesis_flower::DEFAULT_SECOND_COLOUR, |c| c.second_colour);
+            (current.colour, second)
         });
         match self.target {
             PaintTarget::Scalar(_) | PaintTarget::Colour => {

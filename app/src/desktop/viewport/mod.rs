@@ -93,7 +93,7 @@ pub struct ViewportResponse {
 /// A badge in the top-left corner of the viewport `rect` saying what the
 /// view shows when it is not the converged result ("PROXY", "STALE") or is
 /// wrong ("CROSSING: …"): white text on `color`, `row` badges down.
-pub fn badge(ui: &egui::Ui, rect: egui::Rect, row: usize, text: &str, color: egui::Color32) {
+pub fn badge(ui: &egui::Ui, rect: egui::Rect, row: usize, text: &str, colour: egui::Color32) {
     let font = egui::FontId::proportional(13.0);
     let galley = ui
         .painter()
@@ -101,7 +101,7 @@ pub fn badge(ui: &egui::Ui, rect: egui::Rect, row: usize, text: &str, color: egu
     let at = rect.left_top() + Vec2::new(10.0, 10.0 + 26.0 * row as f32);
     let frame = egui::Rect::from_min_size(at, galley.size() + Vec2::new(12.0, 6.0));
     let painter = ui.painter_at(rect);
-    painter.rect_filled(frame, 4.0, color);
+    painter.rect_filled(frame, 4.0, colour);
     painter.galley(at + Vec2::new(6.0, 3.0), galley, egui::Color32::WHITE);
     // Said to screen readers (and found by tests) as a label.
     ui.interact(

@@ -130,19 +130,20 @@ pub fn scene_meshes(
         .map(|(in_scene, o)| {
             let template = project.flower.template_of(o.organ);
             let index = project.flower.organs[o.organ].template;
-            let (mut color_linear, texture) = looks[index]
+            let (mut colour_linear, texture) = looks[index]
                 .get_or_insert_with(|| crate::look::template_look(template))
                 .clone();
             if selected == Some(o.organ) {
-                for (c, h) in color_linear.iter_mut().zip(HIGHLIGHT_LINEAR) {
+                for (c, h) in colour_linear.iter_mut().zip(HIGHLIGHT_LINEAR) {
                     *c += 0.45 * (h - *c);
                 }
             } else if !o.simulated {
-                for c in color_linear.iter_mut().take(3) {
+                for c in colour_linear.iter_mut().take(3) {
                     *c = 0.26 + 0.43 * *c;
                 }
             }
-            let mesh = OrganMesh::from_positions(&o.positions_in_world, &o.triangles, color_linear);
+            let mesh =
+                OrganMesh::from_positions(&o.positions_in_world, &o.triangles, colour_linear);
             let mesh = crate::look::with_texture(mesh, &o.uvs, texture.as_ref());
             if let Some(field) = field {
                 return match field.ramp_values(in_scene) {

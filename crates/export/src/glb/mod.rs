@@ -178,7 +178,7 @@ impl<'a> Scene<'a> {
 
         // A two-sided track's outer primitive shares every accessor whose
         // data is the same as the inner one's (all but normals and indices).
-        self.gltf.share_accessors(track.outer_color_png.is_some());
+        self.gltf.share_accessors(track.outer_colour_png.is_some());
         let encoded = encode_mesh(&mut self.gltf, track, frames, options, &mut || work.tick());
 
         let mut primitive = json!({
@@ -195,7 +195,7 @@ impl<'a> Scene<'a> {
             self.animated_nodes.push(self.nodes.len());
         }
         let mut primitives = vec![primitive];
-        if track.outer_color_png.is_some() {
+        if track.outer_colour_png.is_some() {
             let outer_material = self.materials.len();
             self.materials.push(material(
                 &mut self.gltf,
@@ -420,7 +420,7 @@ fn material<'a>(
     track: &'a Track,
     face: Face,
 ) -> Value {
-    let two_sided = track.outer_color_png.is_none();
+    let two_sided = track.outer_colour_png.is_none();
     let name = match face {
         Face::Inner => track.name.clone(),
         Face::Outer => format!("{} outer", track.name),
@@ -428,18 +428,18 @@ fn material<'a>(
     let mut material = json!({
         "name": name,
         "pbrMetallicRoughness": {
-            "baseColorFactor": track.base_color.map(f32_json),
+            "baseColorFactor": track.base_colour.map(f32_json),
             "metallicFactor": 0.0,
             "roughnessFactor": 0.7,
         },
         "doubleSided": two_sided,
     });
-    if track.base_color[3] < 1.0 {
+    if track.base_colour[3] < 1.0 {
         material["alphaMode"] = json!("BLEND");
     }
     let png = match face {
-        Face::Inner => &track.base_color_png,
-        Face::Outer => &track.outer_color_png,
+        Face::Inner => &track.base_colour_png,
+        Face::Outer => &track.outer_colour_png,
     };
     if let Some(png) = png {
         // Organs of one template share its colour map: one image and

@@ -54,20 +54,20 @@ pub fn organ_track(
     template: &Mesh,
     placement: Placement,
     keyframes: usize,
-    color: [f32; 4],
+    colour: [f32; 4],
 ) -> Track {
     Track {
         name: name.to_owned(),
         triangles: template.triangles.clone(),
         uvs: template.uvs.clone(),
-        base_color: color,
+        base_colour: colour,
         keyframes: (0..keyframes)
             .map(|k| organ_at(template, placement, k as f64 / (keyframes - 1) as f64))
             .collect(),
-        base_color_png: None,
+        base_colour_png: None,
         rigid: None,
         unit: anthesis_flower::Unit::METRE,
-        outer_color_png: None,
+        outer_colour_png: None,
     }
 }
 

@@ -20,8 +20,8 @@ fn part(shape: PartShape, count: u32) -> Part {
         offset_deg: 30.0,
         angle_deg: 10.0,
         schedule: Vec::new(),
-        color: [0.9, 0.9, 0.7, 1.0],
-        head_color: [0.6, 0.2, 0.05, 1.0],
+        colour: [0.9, 0.9, 0.7, 1.0],
+        head_colour: [0.6, 0.2, 0.05, 1.0],
     }
 }
 
@@ -99,9 +99,9 @@ fn every_part_mesh_is_closed_and_wound_outwards() {
         }
     }
     // The receptacle keeps its seam (its own convention) but faces out.
-    let (mesh, color, _) = part(receptacle, 1).meshes().remove(0);
+    let (mesh, colour, _) = part(receptacle, 1).meshes().remove(0);
     assert!(volume(&mesh) > 0.0);
-    assert_eq!(color, [0.9, 0.9, 0.7, 1.0]);
+    assert_eq!(colour, [0.9, 0.9, 0.7, 1.0]);
 }
 
 #[test]
@@ -318,7 +318,7 @@ fn bad_parameters_are_refused_naming_the_part() {
     );
     assert!(receptacle.check().unwrap_err().contains("one receptacle"));
     receptacle.count = 1;
-    receptacle.color = [1.5, 0.0, 0.0, 1.0];
+    receptacle.colour = [1.5, 0.0, 0.0, 1.0];
     assert!(receptacle.check().unwrap_err().contains("color components"));
 }
 
@@ -374,10 +374,10 @@ fn an_lsystems_f_segments_are_tubes_of_its_width_from_start_to_end() {
         assert!(!piece.moves());
     }
     // The branch is drawn in the colour `;` set, the others in the stem's.
-    let colours: Vec<[f32; 4]> = pieces[1..].iter().map(|p| p.color).collect();
+    let colours: Vec<[f32; 4]> = pieces[1..].iter().map(|p| p.colour).collect();
     assert_eq!(
         colours,
-        [RECEPTACLE_COLOR, [1.0, 1.0, 0.0, 1.0], RECEPTACLE_COLOR]
+        [RECEPTACLE_COLOUR, [1.0, 1.0, 0.0, 1.0], RECEPTACLE_COLOUR]
     );
     assert_eq!(obstacles(&flower).len(), 3, "the tubes keep organs out");
 }

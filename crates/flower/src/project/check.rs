@@ -425,31 +425,31 @@ fn base_region_problem(template: &Template) -> Option<String> {
 /// The colours and the colour maps: every component and every mix value
 /// in [0, 1].
 fn colour_problem(template: &Template) -> Option<String> {
-    if template.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+    if template.colour.iter().any(|c| !(0.0..=1.0).contains(c)) {
         return Some(format!(
             "color components must lie in [0, 1], found {:?}",
-            template.color
+            template.colour
         ));
     }
     if let Some(colouring) = &template.colouring {
         if colouring
-            .second_color
+            .second_colour
             .iter()
             .any(|c| !(0.0..=1.0).contains(c))
         {
             return Some(format!(
                 "second_color components must lie in [0, 1], found {:?}",
-                colouring.second_color
+                colouring.second_colour
             ));
         }
         if let Some(layer) = colouring
             .layers
             .iter()
-            .find(|l| l.color.iter().any(|c| !(0.0..=1.0).contains(c)))
+            .find(|l| l.colour.iter().any(|c| !(0.0..=1.0).contains(c)))
         {
             return Some(format!(
                 "colour layer components must lie in [0, 1], found {:?}",
-                layer.color
+                layer.colour
             ));
         }
         let maps = std::iter::once(&colouring.mix).chain(colouring.layers.iter().map(|l| &l.mix));

@@ -363,13 +363,13 @@ impl Loader<'_> {
     fn colouring(
         &self,
         name: &str,
-        second_color: Option<[f32; 4]>,
+        second_colour: Option<[f32; 4]>,
         colour_map: Option<ScalarEntry>,
         colour_layers: Vec<ColourLayerFile>,
     ) -> Result<Option<Colouring>, ProjectError> {
-        match (second_color, colour_map) {
+        match (second_colour, colour_map) {
             (None, None) if colour_layers.is_empty() => Ok(None),
-            (Some(second_color), Some(entry)) => {
+            (Some(second_colour), Some(entry)) => {
                 // Colour maps have sizes of their own (they are not simulated).
                 let mix = self.scalar_map(
                     entry,
@@ -379,7 +379,7 @@ impl Loader<'_> {
                 let mut layers = Vec::with_capacity(colour_layers.len());
                 for (i, layer) in colour_layers.into_iter().enumerate() {
                     layers.push(ColourLayer {
-                        color: layer.color,
+                        colour: layer.colour,
                         mix: self.scalar_map(
                             layer.map,
                             &format!("template \"{name}\": colour layer {}", i + 1),
@@ -389,7 +389,7 @@ impl Loader<'_> {
                     });
                 }
                 Ok(Some(Colouring {
-                    second_color,
+                    second_colour,
                     mix,
                     layers,
                 }))
@@ -418,8 +418,12 @@ impl Loader<'_> {
         }
         let mesh = self.mesh(&file.mesh, name)?;
         let maps = self.keyed_maps(name, file.keys, &file.blend)?;
-        let colouring =
-            self.colouring(name, file.second_color, file.colour_map, file.colour_layers)?;
+        let colouring = self.colouring(
+            name,
+            file.second_colour,
+            file.colour_map,
+            file.colour_layers,
+        )?;
         let two_state = match file.two_state {
             None => None,
             Some(two) => Some(self.two_state(two, &mesh, name)?),
@@ -442,7 +446,7 @@ impl Loader<'_> {
                 u_max: file.base_region.u_max,
             },
             joint_schedule: file.joint_schedule.iter().map(JointRamp::from).collect(),
-            color: file.color,
+            colour: file.colour,
             colouring,
             source,
         };

@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::schema::JointRampFile;
-use crate::parts::{Part, PartShape, Tube, default_colors};
+use crate::parts::{Part, PartShape, Tube, default_colours};
 
 /// One `[[parts]]` entry.
 #[derive(Serialize, Deserialize, Default)]
@@ -44,10 +44,14 @@ pub(super) struct PartFile {
     pub(super) ovary_radius: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(super) depth: Option<f64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub(super) color: Option<[f32; 4]>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub(super) head_color: Option<[f32; 4]>,
+    #[serde(rename = "color", default, skip_serializing_if = "Option::is_none")]
+    pub(super) colour: Option<[f32; 4]>,
+    #[serde(
+        rename = "head_color",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub(super) head_colour: Option<[f32; 4]>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub(super) schedule: Vec<JointRampFile>,
 }
@@ -103,7 +107,7 @@ impl PartFile {
                 ));
             }
         }
-        if self.head_color.is_some() && !matches!(kind, "stamen" | "pistil") {
+        if self.head_colour.is_some() && !matches!(kind, "stamen" | "pistil") {
             return Err(format!(
                 "{kind} \"{name}\": `head_color` is for the anther of a stamen or the stigma of a pistil"
             ));
@@ -138,14 +142,14 @@ impl PartFile {
                 depth: need("depth", self.depth)?,
             },
         };
-        let (color, head_color) = default_colors(&shape);
-        let color = self.color.unwrap_or(color);
+        let (colour, head_colour) = default_colours(&shape);
+        let colour = self.colour.unwrap_or(colour);
         // A part without a head keeps its one colour there too.
-        let head_color = match shape {
+        let head_colour = match shape {
             PartShape::Stamen { .. } | PartShape::Pistil { .. } => {
-                self.head_color.unwrap_or(head_color)
+                self.head_colour.unwrap_or(head_colour)
             }
-            _ => color,
+            _ => colour,
         };
         let part = Part {
             name: name.clone(),
@@ -156,8 +160,8 @@ impl PartFile {
             offset_deg: self.offset_deg,
             angle_deg: self.angle_deg,
             schedule: self.schedule.iter().map(Into::into).collect(),
-            color,
-            head_color,
+            colour,
+            head_colour,
         };
         part.check()?;
         Ok(part)
@@ -174,7 +178,7 @@ impl From<&Part> for PartFile {
             height: part.height,
             offset_deg: part.offset_deg,
             angle_deg: part.angle_deg,
-            color: Some(part.color),
+            colour: Some(part.colour),
             schedule: part.schedule.iter().map(Into::into).collect(),
             ..PartFile::default()
         };
@@ -194,7 +198,7 @@ impl From<&Part> for PartFile {
                 file.anther_length = Some(anther_length);
                 file.anther_radius = Some(anther_radius);
                 file.anther_tilt_deg = Some(anther_tilt_deg);
-                file.head_color = Some(part.head_color);
+                file.head_colour = Some(part.head_colour);
             }
             PartShape::Pistil {
                 style,
@@ -208,7 +212,7 @@ impl From<&Part> for PartFile {
                 file.stigma_lobes = Some(stigma_lobes);
                 file.ovary_length = Some(ovary_length);
                 file.ovary_radius = Some(ovary_radius);
-                file.head_color = Some(part.head_color);
+                file.head_colour = Some(part.head_colour);
             }
             PartShape::Pedicel { stalk } => tube(&stalk),
             PartShape::Receptacle { radius, depth } => {

@@ -358,7 +358,7 @@ mod tests {
                 u_max: 1.0,
             },
             joint_schedule: Vec::new(),
-            color: [1.0, 0.5, 0.5, 1.0],
+            colour: [1.0, 0.5, 0.5, 1.0],
             colouring: None,
             two_state: None,
             source: None,

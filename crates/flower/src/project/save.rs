@@ -158,7 +158,7 @@ fn colouring_entries(
     let mut layers = Vec::with_capacity(colouring.layers.len());
     for (i, layer) in colouring.layers.iter().enumerate() {
         layers.push(ColourLayerFile {
-            color: layer.color,
+            colour: layer.colour,
             map: colour_map_entry(
                 &layer.mix,
                 &format!("{stem}-colour-{}", i + 2),
@@ -169,7 +169,7 @@ fn colouring_entries(
         });
     }
     Ok((
-        Some(colouring.second_color),
+        Some(colouring.second_colour),
         Some(colour_map_entry(
             &colouring.mix,
             &format!("{stem}-colour"),
@@ -201,7 +201,7 @@ pub(super) fn template_file(
     ));
 
     let keys = key_files(template, stem, folder, files)?;
-    let (second_color, colour_map, colour_layers) =
+    let (second_colour, colour_map, colour_layers) =
         colouring_entries(template, stem, folder, files)?;
 
     let two_state = two_state_file(template, stem, files);
@@ -213,8 +213,8 @@ pub(super) fn template_file(
         thickness: template.thickness,
         stretch_stiffness: template.stretch_stiffness,
         bend_stiffness: template.bend_stiffness,
-        color: template.color,
-        second_color,
+        colour: template.colour,
+        second_colour,
         colour_map,
         colour_layers,
         blend: BlendFile::from(template.maps.blend),

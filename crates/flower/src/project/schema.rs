@@ -164,12 +164,16 @@ pub(super) struct TemplateFile {
     pub(super) thickness: f64,
     pub(super) stretch_stiffness: f64,
     pub(super) bend_stiffness: f64,
-    #[serde(default = "opaque_white")]
-    pub(super) color: [f32; 4],
+    #[serde(rename = "color", default = "opaque_white")]
+    pub(super) colour: [f32; 4],
     /// Version 5: the colour a colour map paints over `color`; with
     /// `colour_map`, or neither.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub(super) second_color: Option<[f32; 4]>,
+    #[serde(
+        rename = "second_color",
+        default,
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub(super) second_colour: Option<[f32; 4]>,
     /// Version 5: how much of `second_color` shows (a PNG like the growth
     /// maps, or a number).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -266,7 +270,8 @@ fn default_g() -> f64 {
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct ColourLayerFile {
-    pub(super) color: [f32; 4],
+    #[serde(rename = "color")]
+    pub(super) colour: [f32; 4],
     pub(super) map: ScalarEntry,
     /// Version 9: the side it is painted on (absent: both).
     #[serde(default, skip_serializing_if = "SideFile::is_both")]

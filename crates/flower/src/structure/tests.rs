@@ -139,7 +139,7 @@ fn a_semicolon_sets_the_line_colour_and_brackets_restore_it() {
         "red = 1\naxiom: F ;(red, 0, 0) F [ ;(0, 2, -1) F ] F ; F ;(0.5) F",
         0,
     );
-    let colours: Vec<Option<[f32; 4]>> = d.segments.iter().map(|s| s.color).collect();
+    let colours: Vec<Option<[f32; 4]>> = d.segments.iter().map(|s| s.colour).collect();
     assert_eq!(
         colours,
         [

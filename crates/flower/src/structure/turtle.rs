@@ -48,7 +48,7 @@ pub struct Segment {
     pub width: f64,
     /// The colour `;(r, g, b)` set (linear RGBA, opaque), or `None` for the
     /// default.
-    pub color: Option<[f32; 4]>,
+    pub colour: Option<[f32; 4]>,
     /// Where its `F` is in the word (an index), to tell what drew it.
     pub module: usize,
 }
@@ -136,12 +136,12 @@ struct State {
     /// Columns H, L, U.
     frame: DMat3,
     width: f64,
-    color: Option<[f32; 4]>,
+    colour: Option<[f32; 4]>,
 }
 
 /// The colour `;(r, g, b)` sets: the three components clamped to `[0, 1]`
 /// (a NaN to 0), opaque; `None` (the default colour) with fewer than three.
-fn line_color(params: &[f64]) -> Option<[f32; 4]> {
+fn line_colour(params: &[f64]) -> Option<[f32; 4]> {
     let channel = |x: f64| {
         if x.is_nan() {
             0.0
@@ -165,7 +165,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
         position: DVec3::ZERO,
         frame: DMat3::from_cols(DVec3::Y, -DVec3::X, DVec3::Z),
         width: defaults.width,
-        color: None,
+        colour: None,
     };
     let mut stack = Vec::new();
     let mut drawing = Drawing::default();
@@ -181,7 +181,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
                     start: state.position,
                     end,
                     width: state.width,
-                    color: state.color,
+                    colour: state.colour,
                     module: index,
                 });
                 state.position = end;
@@ -205,7 +205,7 @@ pub fn interpret(word: &[Module], defaults: &Defaults) -> Drawing {
             "!" => {
                 state.width = first.unwrap_or(state.width - defaults.width_increment);
             }
-            ";" => state.color = line_color(&module.params),
+            ";" => state.colour = line_colour(&module.params),
             symbol => {
                 if let Some(letter) = symbol.strip_prefix('~').and_then(|l| l.chars().next()) {
                     drawing.surfaces.push(PlacedSurface {

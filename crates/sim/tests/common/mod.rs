@@ -274,7 +274,7 @@ pub fn pistil() -> Part {
         offset_deg: 0.0,
         angle_deg: 0.0,
         schedule: Vec::new(),
-        color: [0.5, 0.7, 0.3, 1.0],
-        head_color: [0.5, 0.7, 0.3, 1.0],
+        colour: [0.5, 0.7, 0.3, 1.0],
+        head_colour: [0.5, 0.7, 0.3, 1.0],
     }
 }
