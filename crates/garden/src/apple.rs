@@ -260,7 +260,7 @@ fn apple_template(
         stretch_stiffness: APPLE_STIFFNESS,
         bend_stiffness: APPLE_STIFFNESS,
         joint_schedule: Vec::new(),
-        colour: colour,
+        colour,
         colouring: None,
         two_state: None,
         source: None,

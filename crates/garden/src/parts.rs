@@ -19,7 +19,7 @@ fn part(name: &str, shape: PartShape, count: u32, colour: [f32; 4], head: [f32; 
         offset_deg: 0.0,
         angle_deg: 0.0,
         schedule: Vec::new(),
-        colour: colour,
+        colour,
         head_colour: head,
     }
 }
