@@ -9,11 +9,15 @@ use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
+use anthesis_app::desktop::words;
+
 use super::{AnthesisApp, harness, small_flower};
 
-/// Types `text` into the field labelled `label` (the `nth` of them) and
-/// presses Enter.
-fn type_into(harness: &mut Harness<'_, AnthesisApp>, label: &str, nth: usize, text: &str) {
+/// Types `text` into the field of the parameter `symbol` (the `nth` of
+/// them; labelled with its plain words) and presses Enter.
+fn type_into(harness: &mut Harness<'_, AnthesisApp>, symbol: &str, nth: usize, text: &str) {
+    let label = words::label(symbol);
+    let label = label.as_str();
     harness
         .get_all_by_label(label)
         .nth(nth)
@@ -48,8 +52,8 @@ fn thickness_minus_one_is_marked_and_logged_and_the_failed_run_names_it() {
     type_into(&mut harness, "thickness", 0, "-1");
     let lines = log_lines(&harness);
     for said in [
-        "`abc` is not a number; thickness kept its value (thickness accepts 0.001 to 100)",
-        "thickness -1 is out of range (thickness accepts 0.001 to 100); set to 0.001",
+        "`abc` is not a number; Thickness kept its value (Thickness accepts 0.001 to 100)",
+        "Thickness -1 is out of range (Thickness accepts 0.001 to 100); set to 0.001",
     ] {
         assert_eq!(
             lines.iter().filter(|l| l.as_str() == said).count(),
@@ -61,7 +65,7 @@ fn thickness_minus_one_is_marked_and_logged_and_the_failed_run_names_it() {
     type_into(&mut harness, "thickness", 0, "abc");
     let again = log_lines(&harness)
         .iter()
-        .filter(|l| l.starts_with("`abc` is not a number; thickness"))
+        .filter(|l| l.starts_with("`abc` is not a number; Thickness"))
         .count();
     assert_eq!(again, 2);
     let petal = &harness.state().project().flower.templates[0];
@@ -114,8 +118,8 @@ fn a_fraction_in_a_count_is_refused_and_a_backwards_joint_ramp_is_flagged() {
     assert_eq!(harness.state().project().settings.keyframes, keyframes);
     assert!(
         log_lines(&harness).contains(
-            &"`2.5` is not a whole number; keyframes kept its value (keyframes accepts 1 to \
-              10000, whole numbers)"
+            &"`2.5` is not a whole number; Steps (keyframes) kept its value (Steps (keyframes) \
+              accepts 1 to 10000, whole numbers)"
                 .to_string()
         ),
         "{:?}",
