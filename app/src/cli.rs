@@ -208,7 +208,16 @@ pub fn main() -> ExitCode {
         install_remesh_cache();
     }
     let command = cli.command.is_some();
-    match run(cli) {
+    // `info` says the unit in its size lines already.
+    let says_its_unit = matches!(cli.command, Some(Command::Info { .. }));
+    let result = run(cli);
+    let notes = stream::take_notes();
+    if result.is_ok() && !says_its_unit {
+        for note in notes {
+            say!("{note}");
+        }
+    }
+    match result {
         // A command that could not say what it did on standard error
         // (`2>/dev/full`) has still written its files; it ends non-zero.
         Ok(()) if command && stream::stderr_failure().is_some() => ExitCode::FAILURE,
@@ -425,23 +434,11 @@ fn load_with_warnings(path: &Path) -> Result<(Project, Vec<String>)> {
         say!("warning: {warning}");
     }
     check_units(&loaded.project)?;
-    if let Some(note) = unit_note(&loaded.project) {
-        say!("{note}");
+    if let Some(note) = anthesis_flower::unit::note_if_unstated(&loaded.project) {
+        stream::note_at_end(note.clone());
         loaded.warnings.push(note);
     }
     Ok((loaded.project, loaded.warnings))
-}
-
-/// The note a project file that states no unit (made before format
-/// version 9) is opened with, on the terminal and in the window's log: it
-/// keeps its old meaning, one unit one metre, and the note says so and how
-/// to state one. None when the project states its unit.
-pub fn unit_note(project: &Project) -> Option<String> {
-    project
-        .flower
-        .unit
-        .is_none()
-        .then(|| format!("note: {}", anthesis_flower::unit::unstated_note()))
 }
 
 /// The project the window opens at `path`, the file it saves to (none for

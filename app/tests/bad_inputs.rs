@@ -740,7 +740,7 @@ fn catalogue() -> Vec<Case> {
         case!(
             "an unknown subcommand",
             |_| vec!["grow".to_string()],
-            "`grow` is not a subcommand (they are: info, simulate, render, bud, import-scan, blossom, pde-blossom, fit, new)"
+            "`grow` is not a subcommand (they are: info, simulate, render, bud, import-scan, blossom, pde-blossom, fit, measure, new)"
         ),
         case!(
             "blossom with a billion keyframes",

@@ -2207,7 +2207,7 @@ fn the_in_app_file_browser_navigates_filters_and_opens_saves_and_exports() {
     harness.get_by_label("Save").click();
     harness.run();
     // The name the export dialog's field proposed, from the project's name.
-    let named = anthesis_app::desktop::export::default_file_name(&harness.state().project().name);
+    let named = anthesis_app::desktop::files::default_file_name(&harness.state().project().name);
     assert_eq!(
         harness.state().export_dialog().path,
         sub.join(&named).display().to_string()

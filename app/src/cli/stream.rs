@@ -99,6 +99,27 @@ pub fn stderr_failure() -> Option<String> {
     STDERR_FAILURE.lock().ok().and_then(|kept| kept.clone())
 }
 
+/// Notes said once a command has succeeded (a project that states no
+/// unit): a command that fails says only its error, in one line.
+static NOTES_AT_END: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+/// Keeps `note` to say when the command has succeeded (`take_notes`).
+pub fn note_at_end(note: String) {
+    if let Ok(mut notes) = NOTES_AT_END.lock() {
+        if !notes.contains(&note) {
+            notes.push(note);
+        }
+    }
+}
+
+/// The notes kept by `note_at_end`, emptied.
+pub fn take_notes() -> Vec<String> {
+    NOTES_AT_END
+        .lock()
+        .map(|mut notes| std::mem::take(&mut *notes))
+        .unwrap_or_default()
+}
+
 /// Whether standard output was closed when the program started.
 pub fn stdout_closed() -> bool {
     STDOUT_CLOSED.load(Ordering::Relaxed)

@@ -22,30 +22,6 @@ use crate::animation::{self, AnimationOptions, AnimationTarget};
 
 mod dialog;
 
-/// The file name an export of a project named `project_name` is offered
-/// under, by the export dialog's field and by the file dialog alike: the
-/// name with every character but ASCII letters, digits and `-` made `_`,
-/// as a .glb ("Asiatic lily" → "Asiatic_lily.glb"); "flower.glb" for a
-/// project without a name.
-pub fn default_file_name(project_name: &str) -> String {
-    let stem: String = project_name
-        .trim()
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    if stem.is_empty() {
-        "flower.glb".to_owned()
-    } else {
-        format!("{stem}.glb")
-    }
-}
-
 /// How the dialog asks for the animation's timing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TimingMode {
@@ -575,13 +551,6 @@ impl ExportDialog {
 mod tests {
     use super::*;
 
-    #[test]
-    fn the_export_is_named_after_the_project() {
-        assert_eq!(default_file_name("Asiatic lily"), "Asiatic_lily.glb");
-        assert_eq!(default_file_name("five-petal"), "five-petal.glb");
-        assert_eq!(default_file_name("Lys/été"), "Lys__t_.glb");
-        assert_eq!(default_file_name("  "), "flower.glb");
-    }
     use anthesis_flower::resolution::resolve;
     use std::time::{Duration, Instant};
 

@@ -50,7 +50,7 @@ impl DialogPurpose {
 
     /// The file name offered when saving, for a project named
     /// `project_name`: an export is named as the export dialog names it
-    /// ([`super::export::default_file_name`]).
+    /// ([`default_file_name`]).
     pub fn suggested_name(self, project_name: &str) -> Option<String> {
         match self {
             DialogPurpose::OpenProject
@@ -58,7 +58,7 @@ impl DialogPurpose {
             | DialogPurpose::ImportScan
             | DialogPurpose::OpenShape(_) => None,
             DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml".to_owned()),
-            DialogPurpose::ExportGlb => Some(super::export::default_file_name(project_name)),
+            DialogPurpose::ExportGlb => Some(default_file_name(project_name)),
         }
     }
 
@@ -319,9 +319,41 @@ fn native_dialog(
     }
 }
 
+/// The file name an export of a project named `project_name` is offered
+/// under, by the export dialog's field and by the file dialog alike: the
+/// name with every character but ASCII letters, digits and `-` made `_`,
+/// as a .glb ("Asiatic lily" → "Asiatic_lily.glb"); "flower.glb" for a
+/// project without a name.
+pub fn default_file_name(project_name: &str) -> String {
+    let stem: String = project_name
+        .trim()
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if stem.is_empty() {
+        "flower.glb".to_owned()
+    } else {
+        format!("{stem}.glb")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_export_is_named_after_the_project() {
+        assert_eq!(default_file_name("Asiatic lily"), "Asiatic_lily.glb");
+        assert_eq!(default_file_name("five-petal"), "five-petal.glb");
+        assert_eq!(default_file_name("Lys/été"), "Lys__t_.glb");
+        assert_eq!(default_file_name("  "), "flower.glb");
+    }
 
     #[test]
     fn a_program_is_found_on_path_only_where_it_is_and_executable() {

@@ -23,57 +23,28 @@ use super::AnthesisApp;
 use super::command::Command;
 use super::session::SimSession;
 use super::viewport::field::FieldInput;
+pub use super::viewport::field::MeasureField;
 use super::viewport::{FieldShown, Quantity, ScalarField, SceneOrgan, ViewField};
 
-/// A per-vertex measurement the viewport can colour the organs by.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum MeasureField {
-    MeanCurvature,
-    GaussianCurvature,
-    StretchMajor,
-    StretchMinor,
-    Contact,
-}
-
-impl MeasureField {
-    pub const ALL: [MeasureField; 5] = [
-        MeasureField::MeanCurvature,
-        MeasureField::GaussianCurvature,
-        MeasureField::StretchMajor,
-        MeasureField::StretchMinor,
-        MeasureField::Contact,
-    ];
-
-    /// The name menus and the legend give it.
-    pub fn label(self) -> &'static str {
-        match self {
-            MeasureField::MeanCurvature => "Mean curvature H",
-            MeasureField::GaussianCurvature => "Gaussian curvature K",
-            MeasureField::StretchMajor => "Larger principal stretch",
-            MeasureField::StretchMinor => "Smaller principal stretch",
-            MeasureField::Contact => "Contact with other organs",
-        }
-    }
-
-    fn explain(self) -> &'static str {
-        match self {
-            MeasureField::MeanCurvature => {
-                "Half the cotangent Laplacian along the normal of the inner side (Meyer et al. \
+/// What the legend says of a field, besides its numbers.
+fn explain(field: MeasureField) -> &'static str {
+    match field {
+        MeasureField::MeanCurvature => {
+            "Half the cotangent Laplacian along the normal of the inner side (Meyer et al. \
                  2003); a sphere of radius R has 1/R. Rim points have none (drawn at the low end)."
-            }
-            MeasureField::GaussianCurvature => {
-                "The angle defect over the mixed Voronoi area: positive on a cup, negative on a \
+        }
+        MeasureField::GaussianCurvature => {
+            "The angle defect over the mixed Voronoi area: positive on a cup, negative on a \
                  saddle, 0 where the surface unrolls flat. Rim points have none (drawn at the \
                  low end)."
-            }
-            MeasureField::StretchMajor | MeasureField::StretchMinor => {
-                "Against the bud (keyframe 0): 1 unchanged, 1.4 forty per cent longer; each \
+        }
+        MeasureField::StretchMajor | MeasureField::StretchMinor => {
+            "Against the bud (keyframe 0): 1 unchanged, 1.4 forty per cent longer; each \
                  point the mean of its triangles weighted by their area in the bud."
-            }
-            MeasureField::Contact => {
-                "Points within twice the collision offset of another organ or a part \
+        }
+        MeasureField::Contact => {
+            "Points within twice the collision offset of another organ or a part \
                  (receptacle, stamens, pistil): 100 %; the contact area is their Voronoi area."
-            }
         }
     }
 }
@@ -210,7 +181,7 @@ pub(crate) fn measure_field(field: MeasureField, input: &FieldInput<'_>) -> Fiel
         MeasureField::StretchMajor | MeasureField::StretchMinor => Quantity::Plain("×"),
         MeasureField::Contact => Quantity::Plain("%"),
     };
-    let mut notes = vec![field.explain().to_string()];
+    let mut notes = vec![explain(field).to_string()];
     if buds.iter().any(Option::is_none)
         && matches!(
             field,

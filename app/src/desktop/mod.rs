@@ -299,7 +299,7 @@ impl AnthesisApp {
             None => match &settings.last_project {
                 Some(path) => match load_project_with_warnings(path) {
                     Ok(loaded) => {
-                        let note = crate::cli::unit_note(&loaded.project);
+                        let note = anthesis_flower::unit::note_if_unstated(&loaded.project);
                         for warning in loaded.warnings.into_iter().chain(note) {
                             log.warn(warning);
                         }

@@ -11,7 +11,7 @@ use glam::DVec2;
 
 use super::checked_field::{checked_slider, checked_with};
 use super::command::{Command, ProjectEdit};
-use super::panels::section;
+use super::widgets::section;
 use super::words;
 use anthesis_maps::brush::{Brush, BrushMode, PaintTarget, StrokeDab, StrokeSpacing};
 
@@ -377,7 +377,7 @@ impl PaintState {
             });
     }
 
-    /// The "Key dg" row of the paint grid: the chosen time key's own growth
+    /// The "Key growth (dg)" row of the paint grid: the chosen time key's own growth
     /// scale, or the template's.
     fn key_dg_row(
         &mut self,
@@ -385,7 +385,13 @@ impl PaintState {
         (project, template, current): (&Project, usize, &Template),
         chosen: &mut Vec<Command>,
     ) {
-        let label = ui.label("Key dg").id;
+        let label = ui
+            .label("Key growth (dg)")
+            .on_hover_text(format!(
+                "This time key's own growth per step, in place of the template's.\n{}",
+                words::tooltip("dg")
+            ))
+            .id;
         ui.horizontal(|ui| {
             let key = &current.maps.keys()[self.key];
             let mut own = key.dg.is_some();

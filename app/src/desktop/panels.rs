@@ -10,24 +10,6 @@ use super::timeline;
 use super::viewport;
 use super::{AnthesisApp, LeftTab, flower_panel};
 
-/// A section of a side panel that the user can fold away: its title with
-/// `tooltip`, open at first; egui remembers (and eframe saves between
-/// launches) whether it is open. Returns what `add_contents` returned
-/// when the section is open.
-pub(super) fn section<R>(
-    ui: &mut egui::Ui,
-    title: &str,
-    tooltip: &str,
-    add_contents: impl FnOnce(&mut egui::Ui) -> R,
-) -> Option<R> {
-    let shown = egui::CollapsingHeader::new(egui::RichText::new(title).strong())
-        .id_salt(("section", title))
-        .default_open(true)
-        .show(ui, add_contents);
-    shown.header_response.on_hover_text(tooltip);
-    shown.body_returned
-}
-
 /// The scroll area a whole side panel scrolls in (the wheel over the
 /// panel scrolls it; widgets that take the wheel themselves say so).
 pub(super) fn panel_scroll(id: &str) -> egui::ScrollArea {

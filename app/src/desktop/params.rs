@@ -13,8 +13,8 @@ use eframe::egui;
 use super::checked_field::checked_with;
 
 use super::command::{Command, ProjectEdit};
-use super::panels::section;
 use super::two_state::{ViewedOrgan, two_state_ui};
+use super::widgets::section;
 use super::words;
 
 /// A labelled number row of the parameter `symbol`, named and explained

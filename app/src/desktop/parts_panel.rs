@@ -13,7 +13,23 @@ use super::checked_field::{self, checked_with};
 
 use super::command::{Command, ProjectEdit};
 
-/// A labelled number row; returns whether it changed.
+/// The unit of a part's or an arrangement's row, from the last word of its
+/// label (the rows are lengths or angles), in the words of
+/// [`super::words`].
+fn unit_of(label: &str) -> Option<&'static str> {
+    match label.rsplit(' ').next()? {
+        "length" | "radius" | "size" | "depth" | "height" | "distance" | "step" => {
+            Some("project units (lengths)")
+        }
+        "curvature" | "tilt" | "offset" | "angle" | "span" | "divergence" | "azimuth" => {
+            Some("degrees")
+        }
+        _ => None,
+    }
+}
+
+/// A labelled number row; returns whether it changed. Its tooltip ends
+/// with the row's unit.
 pub(super) fn row(
     ui: &mut egui::Ui,
     label: &str,
@@ -22,6 +38,11 @@ pub(super) fn row(
     range: std::ops::RangeInclusive<f64>,
 ) -> bool {
     let name = label;
+    let tooltip = match unit_of(label) {
+        Some(unit) => format!("{tooltip}\nUnit: {unit}."),
+        None => tooltip.to_owned(),
+    };
+    let tooltip = tooltip.as_str();
     let label = ui.label(label).on_hover_text(tooltip);
     let speed = (0.01 * (*range.end() - *range.start()).abs()).clamp(1e-3, 1.0);
     let changed = checked_with(ui, name, value, range, |d| d.speed(speed).max_decimals(3))
@@ -37,7 +58,7 @@ fn tube_rows(ui: &mut egui::Ui, what: &str, tube: &mut Tube) -> bool {
     let mut changed = row(
         ui,
         &format!("{what} length"),
-        "Length along its centre line, in project units.",
+        "Length along its centre line.",
         &mut tube.length,
         0.01..=1000.0,
     );
@@ -52,7 +73,7 @@ fn tube_rows(ui: &mut egui::Ui, what: &str, tube: &mut Tube) -> bool {
     changed |= row(
         ui,
         &format!("{what} curvature"),
-        "How far it turns outwards over its length, in degrees (negative: inwards).",
+        "How far it turns outwards over its length (negative: inwards).",
         &mut tube.curvature_deg,
         -360.0..=360.0,
     );
@@ -307,7 +328,7 @@ fn schedule_rows(ui: &mut egui::Ui, part: &mut Part, id: usize) -> Option<&'stat
                 if checked_with(ui, "degrees", &mut ramp.angle_deg, -180.0..=180.0, |d| {
                     d.speed(0.1).suffix("°")
                 })
-                .on_hover_text("Degrees it turns outwards")
+                .on_hover_text("Degrees it turns outwards (unit: degrees)")
                 .changed()
                 {
                     changed = Some("schedule");
@@ -537,4 +558,18 @@ pub fn parts_ui(ui: &mut egui::Ui, project: &Project) -> Option<Command> {
         label,
         edit: ProjectEdit::Parts(draft),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::unit_of;
+
+    #[test]
+    fn rows_say_their_unit_from_their_last_word() {
+        assert_eq!(unit_of("filament length"), Some("project units (lengths)"));
+        assert_eq!(unit_of("radius step"), Some("project units (lengths)"));
+        assert_eq!(unit_of("anther tilt"), Some("degrees"));
+        assert_eq!(unit_of("divergence"), Some("degrees"));
+        assert_eq!(unit_of("count"), None);
+    }
 }

@@ -32,7 +32,7 @@ impl AnthesisApp {
                 project,
                 mut warnings,
             }) => {
-                warnings.extend(crate::cli::unit_note(&project));
+                warnings.extend(anthesis_flower::unit::note_if_unstated(&project));
                 self.settings.remember(path);
                 // The work open before was saved or thrown away (the
                 // "save changes?" prompt came first).
@@ -469,7 +469,7 @@ impl AnthesisApp {
         self.export.open = true;
         if self.export.path.trim().is_empty() {
             let folder = self.project_folder().unwrap_or_default();
-            let name = export::default_file_name(&self.project().name);
+            let name = super::files::default_file_name(&self.project().name);
             self.export.path = folder.join(name).display().to_string();
         }
     }

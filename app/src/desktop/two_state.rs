@@ -64,7 +64,7 @@ pub fn two_state_ui(
     viewed: Option<&ViewedOrgan>,
     mark: &mut dyn FnMut(bool, &'static str),
 ) -> Option<Command> {
-    super::panels::section(
+    super::widgets::section(
         ui,
         "Two-state opening",
         "Animate this template's organs from the bud to an open shape (the two-state blossom) \

@@ -44,3 +44,21 @@ pub fn view_point(
     });
     (hit.clicked() || hit.drag_started(), shift)
 }
+
+/// A section of a side panel that the user can fold away: its title with
+/// `tooltip`, open at first; egui remembers (and eframe saves between
+/// launches) whether it is open. Returns what `add_contents` returned
+/// when the section is open.
+pub(super) fn section<R>(
+    ui: &mut egui::Ui,
+    title: &str,
+    tooltip: &str,
+    add_contents: impl FnOnce(&mut egui::Ui) -> R,
+) -> Option<R> {
+    let shown = egui::CollapsingHeader::new(egui::RichText::new(title).strong())
+        .id_salt(("section", title))
+        .default_open(true)
+        .show(ui, add_contents);
+    shown.header_response.on_hover_text(tooltip);
+    shown.body_returned
+}

@@ -204,6 +204,18 @@ pub fn unstated_note() -> &'static str {
      `name = …` line in the project file (a number and µm, mm, cm or m)"
 }
 
+/// The note a project that states no unit (made before format version 9)
+/// is opened with, on the terminal and in the window's log: it keeps its
+/// old meaning, one unit one metre, and the note says so and how to state
+/// one. None when the project states its unit.
+pub fn note_if_unstated(project: &crate::Project) -> Option<String> {
+    project
+        .flower
+        .unit
+        .is_none()
+        .then(|| format!("note: {}", unstated_note()))
+}
+
 /// How large `flower` is, as `anthesis info` prints it: one line for the
 /// bud (its organs placed as in keyframe 0 and its parts: height along the
 /// axis and width across) and one per template (its mesh's length along

@@ -15,7 +15,7 @@ use anthesis_flower::Project;
 use anthesis_flower::unit::Unit;
 use eframe::egui::{self, Color32, Pos2, Rect, Stroke, Vec2};
 
-use super::scene::SceneOrgan;
+use super::organ::SceneOrgan;
 use crate::desktop::session::SimSession;
 
 /// The fields the viewport can draw on the organs (at most one at a time;
@@ -27,18 +27,18 @@ pub enum ViewField {
     Difference,
     /// A measurement of the organs at the time shown
     /// (`crate::desktop::measure_panel`).
-    Measure(crate::desktop::measure_panel::MeasureField),
+    Measure(MeasureField),
 }
 
 impl ViewField {
     /// Every field, in the order menus list them.
     pub const ALL: [ViewField; 6] = [
         ViewField::Difference,
-        ViewField::Measure(crate::desktop::measure_panel::MeasureField::MeanCurvature),
-        ViewField::Measure(crate::desktop::measure_panel::MeasureField::GaussianCurvature),
-        ViewField::Measure(crate::desktop::measure_panel::MeasureField::StretchMajor),
-        ViewField::Measure(crate::desktop::measure_panel::MeasureField::StretchMinor),
-        ViewField::Measure(crate::desktop::measure_panel::MeasureField::Contact),
+        ViewField::Measure(MeasureField::MeanCurvature),
+        ViewField::Measure(MeasureField::GaussianCurvature),
+        ViewField::Measure(MeasureField::StretchMajor),
+        ViewField::Measure(MeasureField::StretchMinor),
+        ViewField::Measure(MeasureField::Contact),
     ];
 
     /// The field's name, as menus and the legend say it.
@@ -68,15 +68,6 @@ pub struct FieldInput<'a> {
     /// The scene shows the result before the last edit (the key is held),
     /// not the current one.
     pub before: bool,
-}
-
-/// The field `field` on the scene of `input`; `None` when there is
-/// nothing to draw (the legend then says why, see [`FieldShown`]).
-pub fn compute(field: ViewField, input: &FieldInput<'_>) -> FieldShown {
-    match field {
-        ViewField::Difference => crate::desktop::difference::difference_field(input),
-        ViewField::Measure(field) => crate::desktop::measure_panel::measure_field(field, input),
-    }
 }
 
 /// What a field's numbers are, so the legend can say them in words people
@@ -328,6 +319,37 @@ fn field_legend(ui: &mut egui::Ui, field: &ScalarField) {
     }
     for note in &field.notes {
         ui.label(egui::RichText::new(note.as_str()).small());
+    }
+}
+
+/// A per-vertex measurement the viewport can colour the organs by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum MeasureField {
+    MeanCurvature,
+    GaussianCurvature,
+    StretchMajor,
+    StretchMinor,
+    Contact,
+}
+
+impl MeasureField {
+    pub const ALL: [MeasureField; 5] = [
+        MeasureField::MeanCurvature,
+        MeasureField::GaussianCurvature,
+        MeasureField::StretchMajor,
+        MeasureField::StretchMinor,
+        MeasureField::Contact,
+    ];
+
+    /// The name menus and the legend give it.
+    pub fn label(self) -> &'static str {
+        match self {
+            MeasureField::MeanCurvature => "Mean curvature H",
+            MeasureField::GaussianCurvature => "Gaussian curvature K",
+            MeasureField::StretchMajor => "Larger principal stretch",
+            MeasureField::StretchMinor => "Smaller principal stretch",
+            MeasureField::Contact => "Contact with other organs",
+        }
     }
 }
 

@@ -6,6 +6,7 @@
 
 pub mod field;
 pub mod gpu;
+pub mod organ;
 pub mod overlays;
 pub mod scene;
 

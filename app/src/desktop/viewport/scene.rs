@@ -11,24 +11,13 @@ use anthesis_flower::Project;
 use anthesis_flower::parts::{PartPiece, part_pieces};
 use anthesis_maps::MapKind;
 use anthesis_render::OrganMesh;
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 use anthesis_sim::worker::RunId;
 
-use super::field::{self, FieldInput, FieldShown, ScalarField, ViewField};
+use super::field::{FieldInput, FieldShown, ScalarField, ViewField};
+pub use super::organ::SceneOrgan;
 use crate::desktop::session::{ShownAt, SimSession};
-
-/// One organ as displayed.
-#[derive(Debug, Clone)]
-pub struct SceneOrgan {
-    /// Index into the project's organs.
-    pub organ: usize,
-    pub positions_in_world: Vec<DVec3>,
-    pub triangles: Vec<[u32; 3]>,
-    pub uvs: Vec<DVec2>,
-    /// Simulated in the current run (false: shown in its bud state).
-    pub simulated: bool,
-}
 
 /// The organs at keyframe time `time`: simulated organs from the run (on
 /// the meshes of the frame shown: a proxy's are coarser), the others (when
@@ -289,7 +278,7 @@ impl SceneCache {
             let scene = build_scene_of(project, shown.as_ref(), session.organs(), key.show_others);
             let field = key.field.map(|chosen| {
                 let meshes = shown.as_ref().map_or(&**project, |s| &*s.meshes);
-                field::compute(
+                compute_field(
                     chosen,
                     &FieldInput {
                         project,
@@ -362,6 +351,15 @@ impl SceneCache {
     /// How many times the scene has been built.
     pub fn builds(&self) -> u64 {
         self.revision
+    }
+}
+
+/// The field `field` on the scene of `input`; `None` when there is
+/// nothing to draw (the legend then says why, see [`FieldShown`]).
+fn compute_field(field: ViewField, input: &FieldInput<'_>) -> FieldShown {
+    match field {
+        ViewField::Difference => crate::desktop::difference::difference_field(input),
+        ViewField::Measure(field) => crate::desktop::measure_panel::measure_field(field, input),
     }
 }
 
