@@ -105,10 +105,10 @@ static NOTES_AT_END: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::
 
 /// Keeps `note` to say when the command has succeeded (`take_notes`).
 pub fn note_at_end(note: String) {
-    if let Ok(mut notes) = NOTES_AT_END.lock() {
-        if !notes.contains(&note) {
-            notes.push(note);
-        }
+    if let Ok(mut notes) = NOTES_AT_END.lock()
+        && !notes.contains(&note)
+    {
+        notes.push(note);
     }
 }
 
