@@ -48,7 +48,28 @@ fn a_project_without_a_unit_loads_as_before_with_a_note_on_stderr() {
     let path = saved_whorl(dir.path(), 1, 3);
     let note = "note: the project does not say what its unit is, so one unit is taken as one metre";
     let how = "add e.g. `unit = \"1 mm\"` after its `name = …` line in the project file";
+    // `info` says it in its size line (not again on stderr) ...
     let out = anthesis(&["info", path.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        !text(&out.stderr).contains("note:"),
+        "{}",
+        text(&out.stderr)
+    );
+    // Sizes stay in units: the old meaning.
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains(" units tall") && stdout.contains(how),
+        "{stdout}"
+    );
+    // ... other commands once they have succeeded, on stderr.
+    let glb = dir.path().join("flower.glb");
+    let out = anthesis(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--out",
+        glb.to_str().expect("utf-8"),
+    ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stderr = text(&out.stderr);
     assert_eq!(
@@ -57,11 +78,19 @@ fn a_project_without_a_unit_loads_as_before_with_a_note_on_stderr() {
         "{stderr}"
     );
     assert!(stderr.contains(how), "{stderr}");
-    // Sizes stay in units: the old meaning.
-    assert!(
-        text(&out.stdout).contains(" units tall"),
+    // A command that fails says only its error, in one line.
+    let out = anthesis(&[
+        "simulate",
+        path.to_str().expect("utf-8"),
+        "--organ",
+        "nobody",
+    ]);
+    assert!(!out.status.success());
+    assert_eq!(
+        text(&out.stderr).lines().count(),
+        1,
         "{}",
-        text(&out.stdout)
+        text(&out.stderr)
     );
     // A project that states its unit opens without it.
     let mut project = anthesis_flower::project::load_project(&path).expect("loads");
