@@ -311,7 +311,32 @@ fn rows(
         ));
     }
 
-    // Drawing.
+    track_stroke(state, &response, frame, rect);
+    let drawn: Vec<egui::Pos2> = state.stroke.iter().map(|p| to_screen(*p)).collect();
+    painter.add(egui::Shape::line(
+        drawn,
+        egui::Stroke::new(1.5, ui.visuals().strong_text_color()),
+    ));
+
+    make_from_stroke(
+        state,
+        (flower, keyframes),
+        index,
+        extent,
+        response.dragged(),
+    );
+    draw_results(ui, &painter, (frame, rect), index, state);
+    apply_row(ui, flower, index, state, commands);
+}
+
+/// The stroke being drawn on the side view: a press starts a new one (and
+/// forgets the last result), a drag adds points at least 1.5 px apart.
+fn track_stroke(
+    state: &mut BudSketchState,
+    response: &egui::Response,
+    frame: Frame,
+    rect: egui::Rect,
+) {
     if response.drag_started() {
         state.stroke.clear();
         state.result = None;
@@ -331,21 +356,6 @@ fn rows(
             state.stroke.push(q);
         }
     }
-    let drawn: Vec<egui::Pos2> = state.stroke.iter().map(|p| to_screen(*p)).collect();
-    painter.add(egui::Shape::line(
-        drawn,
-        egui::Stroke::new(1.5, ui.visuals().strong_text_color()),
-    ));
-
-    make_from_stroke(
-        state,
-        (flower, keyframes),
-        index,
-        extent,
-        response.dragged(),
-    );
-    draw_results(ui, &painter, (frame, rect), index, state);
-    apply_row(ui, flower, index, state, commands);
 }
 
 /// The rows of what to draw: the bud or its opening, the spiral or the
