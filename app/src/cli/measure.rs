@@ -11,7 +11,6 @@ use std::path::PathBuf;
 
 use anthesis_flower::Resolution;
 use anthesis_sim::batch;
-use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::measure::{
     OrganLayout, QUANTITIES, Surface, default_contact_distance, measure_keyframe, real_scale,
 };
@@ -20,7 +19,7 @@ use anthesis_sim::{Keyframe, Selection};
 use anyhow::{Result, bail};
 use clap::Args;
 
-use super::simulate::{Progress, set_keyframes};
+use super::simulate::{run_with_progress, set_keyframes};
 use super::stream::{out, say};
 use super::{check_count, check_particle_limit, load, parse_edge, warn_about_the_cache};
 
@@ -133,20 +132,7 @@ pub(super) fn measure(args: &MeasureArgs) -> Result<()> {
     warn_about_the_cache();
     let project = prepared?;
 
-    let on_crossing = if args.allow_crossings {
-        OnCrossing::Warn
-    } else {
-        OnCrossing::Stop
-    };
-    let mut progress = Progress::new();
-    let mut run = batch::simulate(
-        &project,
-        &selection,
-        on_crossing,
-        &|| false,
-        &mut |sim, k| progress.show(sim, k.index, sim.keyframe_count()),
-    )?;
-    let run_result = progress.finish(&run.simulation, run.stepped.failure.take());
+    let (run, run_result) = run_with_progress(&project, &selection, args.allow_crossings)?;
 
     let table = table(
         &project,

@@ -104,20 +104,7 @@ pub(super) fn simulate(
     warn_about_the_cache();
     let project = prepared?;
 
-    let on_crossing = if allow_crossings {
-        OnCrossing::Warn
-    } else {
-        OnCrossing::Stop
-    };
-    let mut progress = Progress::new();
-    let mut run = batch::simulate(
-        &project,
-        &selection,
-        on_crossing,
-        &|| false,
-        &mut |sim, k| progress.show(sim, k.index, sim.keyframe_count()),
-    )?;
-    let run_result = progress.finish(&run.simulation, run.stepped.failure.take());
+    let (run, run_result) = run_with_progress(&project, &selection, allow_crossings)?;
     let done = run.stepped.done;
 
     if let Some(stats_path) = stats_path {
@@ -176,6 +163,26 @@ pub(super) fn set_keyframes(
         project.settings.keyframes = n;
     }
     Ok(())
+}
+/// Runs `project` to the end with the terminal's progress line, stopping at
+/// a crossing unless `allow_crossings`: the run, and what `Progress::finish`
+/// made of it (the seconds, or the failure that ended it early).
+pub(super) fn run_with_progress(
+    project: &anthesis_flower::Project,
+    selection: &anthesis_sim::Selection,
+    allow_crossings: bool,
+) -> Result<(batch::BatchRun, Result<f64>)> {
+    let on_crossing = if allow_crossings {
+        OnCrossing::Warn
+    } else {
+        OnCrossing::Stop
+    };
+    let mut progress = Progress::new();
+    let mut run = batch::simulate(project, selection, on_crossing, &|| false, &mut |sim, k| {
+        progress.show(sim, k.index, sim.keyframe_count())
+    })?;
+    let finished = progress.finish(&run.simulation, run.stepped.failure.take());
+    Ok((run, finished))
 }
 
 /// The progress of a run on stderr: the keyframe and the time left while

@@ -282,19 +282,7 @@ fn write_outer_mesh(
         FieldKey::References,
         Value::ReferenceListOp(ListOp::prepended([reference])),
     )?;
-    let indices: Vec<i32> = outer
-        .triangles
-        .iter()
-        .flatten()
-        .map(|&i| i32::try_from(i).unwrap_or(i32::MAX))
-        .collect();
-    layer.attribute(
-        mesh,
-        "faceVertexIndices",
-        "int[]",
-        None,
-        Value::IntVec(indices),
-    )?;
+    face_vertex_indices(layer, mesh, &outer.triangles)?;
     layer.attribute(mesh, "normals", "normal3f[]", None, Value::ValueBlock)?;
     if let Some(colours) = colours {
         let rgb = colours
@@ -503,19 +491,7 @@ fn write_mesh(
         None,
         Value::IntVec(vec![3; track.triangles.len()]),
     )?;
-    let indices: Vec<i32> = track
-        .triangles
-        .iter()
-        .flatten()
-        .map(|&i| i32::try_from(i).unwrap_or(i32::MAX))
-        .collect();
-    layer.attribute(
-        mesh,
-        "faceVertexIndices",
-        "int[]",
-        None,
-        Value::IntVec(indices),
-    )?;
+    face_vertex_indices(layer, mesh, &track.triangles)?;
 
     let frames = &track.keyframes;
     let metres = track.unit.metres();
@@ -882,4 +858,25 @@ fn bracket_single_api_schemas(text: &str) -> String {
         fixed.push('\n');
     }
     fixed
+}
+
+/// A mesh prim's `faceVertexIndices`: its triangles' corners in order.
+fn face_vertex_indices(
+    layer: &mut LayerBuilder,
+    mesh: &sdf::Path,
+    triangles: &[[u32; 3]],
+) -> Result<(), ExportError> {
+    let indices: Vec<i32> = triangles
+        .iter()
+        .flatten()
+        .map(|&i| i32::try_from(i).unwrap_or(i32::MAX))
+        .collect();
+    layer.attribute(
+        mesh,
+        "faceVertexIndices",
+        "int[]",
+        None,
+        Value::IntVec(indices),
+    )?;
+    Ok(())
 }
