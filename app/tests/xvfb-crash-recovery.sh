@@ -26,20 +26,8 @@
 # sizes (xvfb-window.sh).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-binary=""
-out=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --binary) binary="$2"; shift 2 ;;
-    -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
-    -*) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
-    *) out="$1"; shift ;;
-  esac
-done
-out="${out:-target/screenshots}"
-mkdir -p "$out"
-out="$(realpath "$out")"
 . app/tests/xvfb-window.sh
+parse_arguments "$@"
 binary="$(anthesis_binary "$binary")"
 
 data="$(mktemp -d)"

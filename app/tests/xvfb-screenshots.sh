@@ -15,19 +15,8 @@
 # xvfb-crash-recovery.sh and xvfb-sketch-petal.sh).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-binary=""
-out=""
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --binary) binary="$2"; shift 2 ;;
-    -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
-    -*) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
-    *) out="$1"; shift ;;
-  esac
-done
-out="${out:-target/screenshots}"
-mkdir -p "$out"
 . app/tests/xvfb-window.sh
+parse_arguments "$@"
 binary="$(anthesis_binary "$binary")"
 
 config="$(mktemp -d)"

@@ -2,6 +2,25 @@
 # and inside their xvfb-run shell): what each of them needs to drive the
 # real Anthesis window.
 
+# The scripts' arguments, `[--binary PATH] [OUT_DIR]` (`--help` prints the
+# calling script's header): sets `binary` (empty: build one) and `out`,
+# made and absolute (target/screenshots by default).
+parse_arguments() {
+  binary=""
+  out=""
+  while [ $# -gt 0 ]; do
+    case "$1" in
+      --binary) binary="$2"; shift 2 ;;
+      -h | --help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+      -*) echo "unknown option $1 (see --help)" >&2; exit 2 ;;
+      *) out="$1"; shift ;;
+    esac
+  done
+  out="${out:-target/screenshots}"
+  mkdir -p "$out"
+  out="$(realpath "$out")"
+}
+
 # Builds the release binary and prints its absolute path (under
 # CARGO_TARGET_DIR when that is set, absolute or relative).
 release_binary() {
