@@ -22,6 +22,8 @@
 //! and edge scale in their first line; older dumps take `DIGEST_FLOWER` at
 //! the default scale).
 //! `DIGEST_FLOWER=NAME` runs another default flower than the lily.
+//! `DIGEST_TWO_SIDED=1` (or `0`) turns two-sided contact on (off) whatever
+//! the default (`Simulation::two_sided_contact`).
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::time::Instant;
 
@@ -57,6 +59,9 @@ fn main() {
         Selection::Only(0)
     };
     let mut sim = Simulation::new(&project, &selection).expect("the lily simulates");
+    if let Ok(on) = std::env::var("DIGEST_TWO_SIDED") {
+        sim.two_sided_contact(on == "1");
+    }
     if stroke {
         sim.keep_checkpoints();
     }
