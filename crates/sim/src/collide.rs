@@ -668,6 +668,41 @@ pub fn reactions(
     }
 }
 
+/// `list`, reactions on one organ (at `positions`), as one contact per
+/// particle (ascending): where several contacts press a particle (a
+/// corner shared by the triangles under several of the presser's
+/// particles), one holds it with their summed stiffness along their
+/// summed force, violated so that it pushes as hard as they did together
+/// where the particle is. Held by several one-sided planes a little apart,
+/// a corner left some and met others as it moved, and each change of
+/// which held it cost Newton an iteration (with reactions from 0.01 mean
+/// edges deep, the whole lily took 270 iterations with them apart and 167
+/// merged, Maite Lady 448 and 426).
+pub fn merge_reactions(mut list: Vec<Contact>, positions: &[DVec3]) -> Vec<Contact> {
+    list.sort_by_key(|c| c.particle);
+    let mut merged: Vec<Contact> = Vec::new();
+    for group in list.chunk_by(|a, b| a.particle == b.particle) {
+        let x = positions[group[0].particle as usize];
+        let (force, weight) = group.iter().fold((DVec3::ZERO, 0.0), |(f, w), c| {
+            (f + c.normal * (c.weight * c.violation(x)), w + c.weight)
+        });
+        let length = force.length();
+        if length <= 0.0 || weight <= 0.0 {
+            continue;
+        }
+        let normal = force / length;
+        let offset = group[0].offset;
+        merged.push(Contact {
+            particle: group[0].particle,
+            point: x - normal * (offset - length / weight),
+            normal,
+            offset,
+            weight,
+        });
+    }
+    merged
+}
+
 /// The point of an organ's surface nearest a particle.
 struct Nearest {
     /// On the Phong surface.
@@ -1183,5 +1218,76 @@ mod tests {
         let mut none = Vec::new();
         reactions(&contact, &held, point + normal * 0.5, &corners, &mut none);
         assert!(none.is_empty());
+    }
+
+    #[test]
+    fn merged_reactions_push_each_particle_as_hard_as_they_did_apart() {
+        // Two presser particles over triangles sharing corners 1 and 2,
+        // along slightly different normals and depths.
+        let corners = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.1),
+            DVec3::new(0.0, 2.0, -0.1),
+            DVec3::new(2.0, 2.0, 0.0),
+        ];
+        let k = 1000.0;
+        let pressing = [
+            (
+                DVec3::new(0.1, 0.0, 1.0).normalize(),
+                0.2,
+                [0, 1, 2],
+                [0.2, 0.5, 0.3],
+            ),
+            (
+                DVec3::new(0.0, -0.1, 1.0).normalize(),
+                0.1,
+                [1, 3, 2],
+                [0.4, 0.4, 0.2],
+            ),
+        ];
+        let mut apart = Vec::new();
+        for (n, (normal, depth, triangle, weights)) in pressing.into_iter().enumerate() {
+            let point: DVec3 = (0..3).map(|i| corners[triangle[i]] * weights[i]).sum();
+            let contact = Contact {
+                particle: n as u32,
+                point,
+                normal,
+                offset: 0.01,
+                weight: 1.0,
+            };
+            let held = Held {
+                contact: 0,
+                corners: triangle.map(|i| i as u32),
+                weights,
+            };
+            reactions(
+                &contact,
+                &held,
+                point - normal * depth,
+                &corners,
+                &mut apart,
+            );
+        }
+        let force = |list: &[Contact], particle: u32| -> DVec3 {
+            list.iter()
+                .filter(|c| c.particle == particle)
+                .map(|c| c.normal * (k * c.weight * c.violation(corners[particle as usize])))
+                .sum()
+        };
+        let merged = merge_reactions(apart.clone(), &corners);
+        // One per particle, in order.
+        let particles: Vec<u32> = merged.iter().map(|c| c.particle).collect();
+        assert_eq!(particles, vec![0, 1, 2, 3]);
+        for p in 0..4 {
+            let (a, m) = (force(&apart, p), force(&merged, p));
+            assert!(a.length() > 1.0);
+            assert!(
+                (a - m).length() < 1e-12 * a.length(),
+                "{p}: {a} against {m}"
+            );
+        }
+        // The stiffness is the sum of the merged ones': corner 1 got
+        // 0.5 of one contact's and 0.4 of the other's.
+        assert!((merged[1].weight - 0.9).abs() < 1e-15);
     }
 }
