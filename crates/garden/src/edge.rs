@@ -1,13 +1,13 @@
 //! The lily opened by edge growth (issue 41 item 4, after Liang and
 //! Mahadevan, "Growth, geometry, and mechanics of a blooming lily", PNAS
-//! 2011): the built-in lily's bud, organs and material, but tepals that
+//! 2011): the built-in lily's bud, organs and stretch stiffness, but tepals that
 //! grow only in their plane (the inner and the base growth maps are equal,
 //! so no hinge is told to bend) and faster at the margins than along the
 //! midrib. A tepal that is cup-shaped in the bud (positive Gaussian
 //! curvature) and whose margins outgrow its midrib cannot stay a cup: its
 //! margins get longer than the cup has room for, so it turns into a saddle
-//! (negative Gaussian curvature) and bends out, and the excess length at
-//! the margin may ripple.
+//! (negative Gaussian curvature) and bends out, and the excess length
+//! stored at the margin ripples it.
 //!
 //! Decided here (the paper's measurements, our reading):
 //!
