@@ -173,16 +173,24 @@ def organ_summary(positions: np.ndarray, faces: np.ndarray, uvs: np.ndarray) -> 
 
 def ripple_fit(found: list[dict[str, float]]) -> dict[str, float]:
     """Least-squares c of a = c·√(w(L − w)) through the origin over the
-    ripples found, with the correlation of a against √(w(L − w)) and the
-    relative rms misfit (a sinusoid has c = 1/π ≈ 0.318)."""
+    ripples found, with the correlation r of a against √(w(L − w)), the
+    relative rms misfit, the spread of the ripples' own c = a/√(w(L − w))
+    (c_mean, c_std) and of their wavelengths (w_mean, w_std); a sinusoid
+    has c = 1/π ≈ 0.318."""
     a = np.array([r["a"] for r in found])
     x = np.sqrt(np.maximum([r["w"] * (r["L"] - r["w"]) for r in found], 0.0))
+    w = np.array([r["w"] for r in found])
+    nan = float("nan")
     if len(a) < 2 or not np.any(x > 0):
-        return {"ripples": float(len(a)), "c": float("nan"), "r": float("nan"), "misfit": float("nan")}
+        return {"ripples": float(len(a)), "c": nan, "r": nan, "misfit": nan,
+                "c_mean": nan, "c_std": nan, "w_mean": nan, "w_std": nan}
     c = float(a @ x / (x @ x))
-    r = float(np.corrcoef(a, x)[0, 1]) if len(a) > 2 else float("nan")
+    r = float(np.corrcoef(a, x)[0, 1]) if len(a) > 2 else nan
     misfit = float(np.sqrt(np.mean((a - c * x) ** 2)) / np.mean(a))
-    return {"ripples": float(len(a)), "c": c, "r": r, "misfit": misfit}
+    own = a[x > 0] / x[x > 0]
+    return {"ripples": float(len(a)), "c": c, "r": r, "misfit": misfit,
+            "c_mean": float(own.mean()), "c_std": float(own.std()),
+            "w_mean": float(w.mean()), "w_std": float(w.std())}
 
 
 # ---------------------------------------------------------------------------
@@ -269,7 +277,8 @@ def report(frames) -> dict[str, object]:
     fit = ripple_fit(found)
     print(f"\nripples found: {int(fit['ripples'])}; a = c sqrt(w (L - w)) with c = {fit['c']:.3f}"
           f" (sinusoid 1/pi = {1 / np.pi:.3f}), correlation r = {fit['r']:.3f},"
-          f" relative rms misfit {fit['misfit']:.2f}")
+          f" relative rms misfit {fit['misfit']:.2f}; each ripple's c {fit['c_mean']:.3f}"
+          f" ± {fit['c_std']:.3f}; wavelength w {fit['w_mean']:.2f} ± {fit['w_std']:.2f}")
     return {"summary": summary, "ripples": found, "fit": fit}
 
 

@@ -27,7 +27,7 @@ pub use unit::{Unit, UnitError};
 use anthesis_maps::KeyedMaps;
 use anthesis_mesh::Mesh;
 use anthesis_physics::SolverSettings;
-use anthesis_physics::{BendBase, Model};
+use anthesis_physics::{BendBase, LengthBase, Model};
 use glam::{DQuat, DVec3};
 
 /// Everything an organ type needs: its bud mesh (in the template frame, see
@@ -382,6 +382,10 @@ pub struct SimulationSettings {
     pub model: Model,
     /// Which angle a hinge's growth starts from.
     pub bend_base: BendBase,
+    /// Which triangle grows into the new rest lengths: the current shape
+    /// (the paper; the default) or the rest triangle, so that the rest state
+    /// accumulates the growth (`lengths_from = "rest"` in the file).
+    pub length_base: LengthBase,
     /// The meshes as built, or every template remeshed at one mean edge
     /// ([`resolution`]; the project keeps the meshes as built).
     pub resolution: Resolution,
@@ -395,6 +399,7 @@ impl Default for SimulationSettings {
             collision_offset: 0.01,
             model: Model::default(),
             bend_base: BendBase::default(),
+            length_base: LengthBase::default(),
             resolution: Resolution::AsBuilt,
         }
     }

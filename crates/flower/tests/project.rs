@@ -1408,6 +1408,32 @@ fn the_model_is_read_from_the_file_and_version_1_files_keep_the_papers() {
     assert!(error.to_string().contains("exact"), "{error}");
 }
 
+#[test]
+fn accumulated_rest_lengths_are_saved_as_version_10_and_absent_means_the_shape() {
+    use anthesis_physics::LengthBase;
+    let (_folder, path) = saved_lily();
+    // The default is not written: the file is the version 2 file it was.
+    let text = fs::read_to_string(&path).expect("saved");
+    assert!(text.contains("version = 2\n"), "{text}");
+    assert!(!text.contains("lengths_from"), "{text}");
+    assert_eq!(
+        load_project(&path).expect("loads").settings.length_base,
+        LengthBase::Shape
+    );
+    let mut project = lily();
+    project.settings.length_base = LengthBase::Rest;
+    save_project(&project, &path).expect("saves");
+    let text = fs::read_to_string(&path).expect("read");
+    assert!(text.contains("version = 10\n"), "{text}");
+    assert!(text.contains("lengths_from = \"rest\""), "{text}");
+    assert_eq!(load_project(&path).expect("loads"), project);
+    edit(&path, |t| {
+        replace_once(t, "lengths_from = \"rest\"", "lengths_from = \"target\"")
+    });
+    let error = load_project(&path).expect_err("unknown rule");
+    assert!(error.to_string().contains("target"), "{error}");
+}
+
 /// A project saved by the release that wrote format version 1 (the
 /// Pinocchio asset as it was then, kept byte for byte) still opens, with the
 /// paper's model it was made with.

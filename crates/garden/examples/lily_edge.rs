@@ -3,14 +3,21 @@
 //! (positions in the world frame, the template's UVs), for
 //! `docs/python/lily_edge.py --objs FOLDER` to measure.
 //!
-//! `cargo run --release -p anthesis-garden --example lily_edge -- EDGE_SCALE OUT_FOLDER [--soft-midrib] [--every N] [--only ORGAN] [--bend-ratio R] [--keyframes N] [--profile-power P]`
+//! `cargo run --release -p anthesis-garden --example lily_edge -- EDGE_SCALE OUT_FOLDER [--soft-midrib] [--every N] [--only ORGAN] [--bend-ratio R] [--keyframes N] [--profile-power P] [--layer SHARE POWER] [--lengths-from-shape|--lengths-from-rest] [--bend-from-rest|--bend-from-dihedral] [--max-iterations N] [--no-parts]`
 //!
 //! `--bend-ratio R` sets each template's bend stiffness `Kb` to `R` times
-//! its stretch stiffness `Ks` (the built-in has them equal); `--keyframes N`
+//! its stretch stiffness `Ks` (the built-in: 0.001); `--keyframes N`
 //! the same opening in `N` steps (`anthesis_garden::retime`: larger steps
 //! of growth, each one's excess at the margin larger); `--profile-power P`
 //! the exponent of the e-growth profile across the width (2 in the
-//! built-in; larger puts the excess nearer the margins).
+//! built-in; larger puts the excess nearer the margins); `--layer SHARE
+//! POWER` the share of the excess in the layer along the margin and its
+//! exponent (the built-in: 0.5 and 16); `--lengths-from-shape` the paper's
+//! regrowth of the rest lengths from the current shape instead of the
+//! built-in's accumulated rest state (`--lengths-from-rest`);
+//! `--bend-from-rest` / `--bend-from-dihedral` what a hinge's growth adds
+//! to; `--max-iterations N` Newton's limit per keyframe (the built-in: 200);
+//! `--no-parts` the flower without its stamens and pistil.
 //!
 //! `EDGE_SCALE` is the mean edge as a fraction of the paper's (Table 1;
 //! the built-in is 0.6). Prints the particles per organ and the run time.
@@ -31,6 +38,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut selection = Selection::All;
     let mut bend_ratio: Option<f64> = None;
     let mut keyframes: Option<u32> = None;
+    let mut length_base: Option<anthesis_physics::LengthBase> = None;
+    let mut bend_base: Option<anthesis_physics::BendBase> = None;
+    let mut max_iterations: Option<u32> = None;
+    let mut no_parts = false;
     while let Some(flag) = args.next() {
         match flag.as_str() {
             "--soft-midrib" => edge = edge.soft_midrib(),
@@ -43,9 +54,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .ok_or("--profile-power needs a number")?
                     .parse()?;
             }
+            "--layer" => {
+                edge.layer_share = args.next().ok_or("--layer needs a share")?.parse()?;
+                edge.layer_power = args.next().ok_or("--layer needs a power")?.parse()?;
+            }
             "--keyframes" => {
                 keyframes = Some(args.next().ok_or("--keyframes needs a count")?.parse()?);
             }
+            "--lengths-from-shape" => length_base = Some(anthesis_physics::LengthBase::Shape),
+            "--lengths-from-rest" => length_base = Some(anthesis_physics::LengthBase::Rest),
+            "--bend-from-dihedral" => bend_base = Some(anthesis_physics::BendBase::Dihedral),
+            "--bend-from-rest" => bend_base = Some(anthesis_physics::BendBase::RestAngle),
+            "--max-iterations" => {
+                max_iterations = Some(
+                    args.next()
+                        .ok_or("--max-iterations needs a count")?
+                        .parse()?,
+                );
+            }
+            "--no-parts" => no_parts = true,
             "--every" => every = args.next().ok_or("--every needs a count")?.parse()?,
             "--only" => {
                 selection = Selection::Only(args.next().ok_or("--only needs an organ")?.parse()?);
@@ -61,6 +88,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for template in &mut project.flower.templates {
             template.bend_stiffness = template.stretch_stiffness * ratio;
         }
+    }
+    if let Some(base) = length_base {
+        project.settings.length_base = base;
+    }
+    if let Some(base) = bend_base {
+        project.settings.bend_base = base;
+    }
+    if let Some(iterations) = max_iterations {
+        project.settings.solver.max_iterations = iterations;
+    }
+    if no_parts {
+        project.flower.parts.clear();
     }
     std::fs::create_dir_all(&out)?;
     for (i, organ) in project.flower.organs.iter().enumerate() {

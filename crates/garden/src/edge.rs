@@ -1,13 +1,13 @@
 //! The lily opened by edge growth (issue 41 item 4, after Liang and
 //! Mahadevan, "Growth, geometry, and mechanics of a blooming lily", PNAS
-//! 2011): the built-in lily's bud, organs and material, but tepals that
+//! 2011): the built-in lily's bud, organs and stretch stiffness, but tepals that
 //! grow only in their plane (the inner and the base growth maps are equal,
 //! so no hinge is told to bend) and faster at the margins than along the
 //! midrib. A tepal that is cup-shaped in the bud (positive Gaussian
 //! curvature) and whose margins outgrow its midrib cannot stay a cup: its
 //! margins get longer than the cup has room for, so it turns into a saddle
-//! (negative Gaussian curvature) and bends out, and the excess length at
-//! the margin may ripple.
+//! (negative Gaussian curvature) and bends out, and the excess length
+//! stored at the margin ripples it.
 //!
 //! Decided here (the paper's measurements, our reading):
 //!
@@ -23,10 +23,24 @@
 //!   receptacle (the built-in lily tilts its tepals 23°);
 //! - the midrib band is stiffer than the lamina as in the lily, or, in the
 //!   variant of the paper's experiment with the midribs cut away
-//!   ([`LilyEdge::soft_midrib`]), no stiffer.
+//!   ([`LilyEdge::soft_midrib`]), no stiffer;
+//! - half of the margin's excess lies in a narrow layer along the margin
+//!   ([`LilyEdge::layer_share`], profile `s^16`), the other half rises as
+//!   `s²` across the width: the broad part turns the cup into a saddle and
+//!   opens the bud, the layer is what ripples;
+//! - the rest state keeps the growth ([`LengthBase::Rest`]: the rest
+//!   lengths are the bud's grown by the cumulative growth, not regrown from
+//!   the current shape each step, so the margin's excess length is stored
+//!   rather than forgotten), and the sheet is thin in bending
+//!   ([`LilyEdge::bend_ratio`]: `Kb = Ks / 1000`, against Table 1's
+//!   `Kb = Ks`), so the stored excess buckles the margin into ripples
+//!   several mesh edges long (README, "Edge growth"). The buckling makes
+//!   the Newton iterations slower to settle, so the solver may take up to
+//!   200 per keyframe.
 
 use anthesis_flower::Project;
 use anthesis_maps::{KeyedMaps, MapError};
+use anthesis_physics::LengthBase;
 use glam::DVec2;
 
 use crate::flowers::{
@@ -42,6 +56,11 @@ pub const LILY_EDGE_NAME: &str = "lily-edge";
 /// `1 + 0.006·m` per step).
 pub const LILY_EDGE_DG: f64 = 0.006;
 
+/// The Newton iterations a keyframe of the edge-growth lily may take (the
+/// other flowers: 50): while the margins buckle the iterations settle
+/// slowly (at 4 times the particles, 50 were not enough in keyframe 1).
+pub const LILY_EDGE_MAX_ITERATIONS: u32 = 200;
+
 /// How an edge-growth lily's tepals grow (map values, scaled by
 /// [`LILY_EDGE_DG`] per step).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,11 +74,19 @@ pub struct LilyEdge {
     /// The exponent of the profile across the width (2: a parabola, flat
     /// at the midrib; larger: the excess nearer the margins).
     pub profile_power: f64,
+    /// The share of the margin's excess put in a layer along the margin
+    /// (`s^layer_power`; 0: none, the whole excess follows `s^profile_power`).
+    pub layer_share: f64,
+    /// The exponent of that layer's profile (large: a narrow layer).
+    pub layer_power: f64,
     /// Stretch and bend stiffness of the lamina, relative to the midrib's
     /// 1 (the lily's 0.3).
     pub lamina_stiffness: f64,
     /// The midrib band is no stiffer than the lamina.
     pub soft_midrib: bool,
+    /// Each template's bend stiffness `Kb` over its stretch stiffness `Ks`
+    /// (Table 1: 1; small: a sheet thin in bending).
+    pub bend_ratio: f64,
 }
 
 impl LilyEdge {
@@ -71,8 +98,11 @@ impl LilyEdge {
         e_margin: 0.81,
         w: 0.25,
         profile_power: 2.0,
+        layer_share: 0.5,
+        layer_power: 16.0,
         lamina_stiffness: 0.3,
         soft_midrib: false,
+        bend_ratio: 0.001,
     };
 
     /// The same growth with the midrib band as soft as the lamina (the
@@ -87,7 +117,9 @@ impl LilyEdge {
     /// The e-growth map's value at `uv` (before the base's ramp).
     pub fn e_at(&self, uv: DVec2) -> f64 {
         let s = ((uv.x - 0.5).abs() / 0.5).clamp(0.0, 1.0);
-        self.e_midrib + (self.e_margin - self.e_midrib) * s.powf(self.profile_power)
+        let profile = (1.0 - self.layer_share) * s.powf(self.profile_power)
+            + self.layer_share * s.powf(self.layer_power);
+        self.e_midrib + (self.e_margin - self.e_midrib) * profile
     }
 }
 
@@ -140,7 +172,10 @@ pub fn lily_edge_of(edge: LilyEdge, edge_scale: f64) -> Result<Project, GardenEr
         template.maps = lily_edge_maps(edge).map_err(|error| GardenError::Maps { organ, error })?;
         template.dg = LILY_EDGE_DG;
         template.joint_schedule.clear();
+        template.bend_stiffness = edge.bend_ratio * template.stretch_stiffness;
     }
+    project.settings.length_base = LengthBase::Rest;
+    project.settings.solver.max_iterations = LILY_EDGE_MAX_ITERATIONS;
     Ok(project)
 }
 
@@ -173,12 +208,21 @@ mod tests {
             |u: f64| (1.0 + LILY_EDGE_DG * LilyEdge::MARGIN.e_at(DVec2::new(u, 0.6))).powi(100);
         assert!((exact(0.0) / exact(0.5) - 1.40).abs() < 0.005);
         // The map: its outermost pixel's centre lies 1/128 inside the
-        // margin, where the profile gives 1.383.
+        // margin, where the profile gives 1.340 (the narrow layer falls
+        // steeply there: s^16 is 0.78 at s = 63/64).
         let (midrib, margin) = (stretch(0.5), stretch(0.0));
         assert!((midrib - 1.162).abs() < 0.005, "midrib ×{midrib}");
         assert!(
-            (1.375..1.40).contains(&(margin / midrib)),
+            (1.335..1.345).contains(&(margin / midrib)),
             "margin ×{margin}, midrib ×{midrib}"
+        );
+        // Half the excess in the layer: at nine tenths of the half width the
+        // s² half alone gives 0.405 of the excess, the layer 0.093 more.
+        let at = |s: f64| LilyEdge::MARGIN.e_at(DVec2::new(0.5 - 0.5 * s, 0.6));
+        let share = (at(0.9) - at(0.0)) / (at(1.0) - at(0.0));
+        assert!(
+            (share - 0.5 * (0.81 + 0.9f64.powi(16))).abs() < 1e-12,
+            "{share}"
         );
         // A smooth profile across: rising monotonically from the midrib.
         let across: Vec<f64> = (0..=10)

@@ -43,6 +43,13 @@
 //!
 //! `theta0`, the angle the growth starts from, is the hinge's current
 //! dihedral angle or its current rest angle ([`BendBase`]).
+//!
+//! The triangle that grows is, for its rest lengths, the triangle as it is
+//! now (the paper's rule, [`LengthBase::Shape`]: length the shape could not
+//! take is forgotten at each step) or its rest triangle
+//! ([`LengthBase::Rest`]: the flat triangle of its three rest lengths, so
+//! the rest state is the bud's grown by the cumulative growth and excess
+//! length the shape could not take is kept, as ripples need).
 
 use anthesis_mesh::Topology;
 
@@ -90,6 +97,20 @@ pub enum BendBase {
     RestAngle,
 }
 
+/// The triangle whose growth gives the new rest lengths.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LengthBase {
+    /// The triangle as it is now (the paper, §4): growth the shape could
+    /// not take is forgotten at each step (the tissue yields).
+    #[default]
+    Shape,
+    /// The rest triangle (the flat triangle of its current rest lengths):
+    /// the rest state accumulates the growth, so after steps of rates
+    /// `g1, g2, …` a rest length is the bud's times their product whatever
+    /// shape the sheet took (the tissue keeps its target metric).
+    Rest,
+}
+
 /// The regional-growth parameters of one organ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GrowthModel {
@@ -100,6 +121,8 @@ pub struct GrowthModel {
     pub bend_rule: BendRule,
     /// Which angle a hinge's growth starts from.
     pub bend_base: BendBase,
+    /// Which triangle grows into the new rest lengths.
+    pub length_base: LengthBase,
 }
 
 impl GrowthModel {
@@ -109,6 +132,7 @@ impl GrowthModel {
             thickness,
             bend_rule: BendRule::default(),
             bend_base: BendBase::default(),
+            length_base: LengthBase::default(),
         }
     }
 }
@@ -169,7 +193,14 @@ impl RegionalGrowth {
                     let x = corners(positions, *tri);
                     let rates = &rates[t];
                     let frame = TriangleFrame::new(x, corners(uvs, *tri), rates.direction_in_uv);
-                    let lengths = frame.grown_lengths(x, rates.e, rates.w);
+                    let lengths = match model.length_base {
+                        LengthBase::Shape => frame.grown_lengths(x, rates.e, rates.w),
+                        LengthBase::Rest => grown_rest_lengths(
+                            topology.triangle_edges[t].map(|e| rest_lengths[e as usize]),
+                            corners(uvs, *tri),
+                            rates,
+                        ),
+                    };
                     self.add_lengths(topology.triangle_edges[t], lengths);
                     self.bends.push(TriangleBend {
                         normal: frame.normal,
@@ -220,7 +251,15 @@ impl RegionalGrowth {
                         model.thickness,
                         theta0,
                     );
-                    self.add_lengths(edge_ids, grown.lengths);
+                    let lengths = match model.length_base {
+                        LengthBase::Shape => grown.lengths,
+                        LengthBase::Rest => grown_rest_lengths(
+                            edge_ids.map(|e| rest_lengths[e as usize]),
+                            corners(uvs, *tri),
+                            &rates[t],
+                        ),
+                    };
+                    self.add_lengths(edge_ids, lengths);
                     for k in 0..3 {
                         self.angle_sum[edge_ids[k] as usize] += grown.half_angles[k];
                     }
@@ -249,6 +288,31 @@ impl RegionalGrowth {
     fn mean_length(&self, e: usize) -> f64 {
         self.length_sum[e] / f64::from(self.length_count[e].max(1))
     }
+}
+
+/// The grown lengths of the sides `(t0,t1)`, `(t1,t2)`, `(t2,t0)` of the
+/// rest triangle whose sides are `rest` (in that order; the flat triangle
+/// of those lengths): scaled by `e` along the growth direction (mapped
+/// through the rest triangle's UV→rest Jacobian) and `w` across it. The
+/// layout is the triangle up to a reflection, which maps the growth
+/// direction with it and so changes no length. Lengths that no longer make a triangle
+/// (each edge's rest length is the mean of its two triangles', so they
+/// can drift apart) give a flat one.
+fn grown_rest_lengths(rest: [f64; 3], uv: [DVec2; 3], rates: &GrowthRates) -> [f64; 3] {
+    let [a, b, c] = rest;
+    // Corner 2 at distance c from corner 0 and b from corner 1 (at (a, 0)).
+    let along = if a > 0.0 {
+        (a * a + c * c - b * b) / (2.0 * a)
+    } else {
+        0.0
+    };
+    let height = (c * c - along * along).max(0.0).sqrt();
+    let x = [
+        DVec3::ZERO,
+        DVec3::new(a, 0.0, 0.0),
+        DVec3::new(along, height, 0.0),
+    ];
+    TriangleFrame::new(x, uv, rates.direction_in_uv).grown_lengths(x, rates.e, rates.w)
 }
 
 /// `values` at `indices`.
@@ -712,6 +776,80 @@ mod tests {
             }
         }
         assert_eq!(checked, 800);
+    }
+
+    #[test]
+    fn rest_lengths_accumulate_the_growth_while_shape_lengths_forget_it() {
+        // A sheet held in its bud shape (the solver never moves it) and
+        // grown n steps by e along D and w across: growing from the rest
+        // triangles gives each edge the bud edge scaled by e^n along D and
+        // w^n across; growing from the shape gives the bud scaled once.
+        let mut mesh = anthesis_mesh::generate::flat_sheet(3.0, 4.0, 5, 6);
+        let mut rng = TestRng(7);
+        for (p, uv) in mesh.positions.iter_mut().zip(&mut mesh.uvs) {
+            *p += DVec3::new(rng.centred(), rng.centred(), 0.0) * 0.2;
+            // UVs follow the positions, so D is one direction in every
+            // triangle and the scaled triangles fit together.
+            *uv = DVec2::new(p.x / 3.0 + 0.5, p.y / 4.0);
+        }
+        let topology = Topology::build(&mesh).expect("manifold");
+        let direction = DVec2::new(0.4, 1.0);
+        let (e, w, steps) = (1.05, 0.98, 12);
+        let per_triangle = vec![rates(e, w, e, w, direction); mesh.triangles.len()];
+        let scaled = |e: f64, w: f64| -> Vec<f64> {
+            // Each edge's expected length: the mean over its triangles of
+            // that triangle scaled by (e, w) in its own growth frame.
+            let mut sum = vec![0.0; topology.edges.len()];
+            let mut count = vec![0.0; topology.edges.len()];
+            for (t, tri) in mesh.triangles.iter().enumerate() {
+                let x = corners(&mesh.positions, *tri);
+                let frame = TriangleFrame::new(x, corners(&mesh.uvs, *tri), direction);
+                let lengths = frame.grown_lengths(x, e, w);
+                for k in 0..3 {
+                    let edge = topology.triangle_edges[t][k] as usize;
+                    sum[edge] += lengths[k];
+                    count[edge] += 1.0;
+                }
+            }
+            sum.iter().zip(&count).map(|(s, c)| s / c).collect()
+        };
+        for (base, expected) in [
+            (LengthBase::Rest, scaled(e.powi(steps), w.powi(steps))),
+            (LengthBase::Shape, scaled(e, w)),
+        ] {
+            let model = GrowthModel {
+                length_base: base,
+                ..GrowthModel::new(0.2)
+            };
+            let mut lengths: Vec<f64> = topology
+                .edges
+                .iter()
+                .map(|edge| {
+                    let [a, b] = edge.vertices.map(|v| v as usize);
+                    mesh.positions[a].distance(mesh.positions[b])
+                })
+                .collect();
+            let mut angles = vec![0.0; topology.edges.len()];
+            let mut growth = RegionalGrowth::default();
+            for _ in 0..steps {
+                growth.grow(
+                    &mesh.positions,
+                    &mesh.uvs,
+                    &mesh.triangles,
+                    &topology,
+                    &per_triangle,
+                    &model,
+                    &mut lengths,
+                    &mut angles,
+                );
+            }
+            for (edge, (got, want)) in lengths.iter().zip(&expected).enumerate() {
+                assert!(
+                    (got - want).abs() < 1e-9 * want,
+                    "{base:?}, edge {edge}: {got} vs {want}"
+                );
+            }
+        }
     }
 
     #[test]

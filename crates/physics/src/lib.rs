@@ -17,7 +17,7 @@ pub mod solver;
 mod test_rng;
 
 pub use elastic::{Contact, Elastic};
-pub use growth::{BendBase, BendRule, GrowthModel, GrowthRates, RegionalGrowth};
+pub use growth::{BendBase, BendRule, GrowthModel, GrowthRates, LengthBase, RegionalGrowth};
 pub use model::Model;
 
 pub use solver::{NewtonSolver, SolverError, SolverSettings, StepReport};

@@ -3,7 +3,7 @@
 
 use anthesis_mesh::{Mesh, Topology, generate};
 use anthesis_physics::elastic::edge_areas;
-use anthesis_physics::growth::{BendBase, GrowthModel, GrowthRates, RegionalGrowth};
+use anthesis_physics::growth::{BendBase, GrowthModel, GrowthRates, LengthBase, RegionalGrowth};
 use anthesis_physics::hinge::dihedral_angle;
 use anthesis_physics::membrane::EdgeSmoothedMembrane;
 use anthesis_physics::pattern::BlockPattern;
@@ -322,6 +322,29 @@ fn grow_uniformly(
     settings: SolverSettings,
     model: Model,
 ) -> (Vec<DVec3>, usize) {
+    let per_triangle = vec![rates; mesh.triangles.len()];
+    grow_by(
+        mesh,
+        |_| per_triangle.clone(),
+        thickness,
+        steps,
+        settings,
+        model,
+        LengthBase::Shape,
+    )
+}
+
+/// As [`grow_uniformly`], with each step's rates per triangle from
+/// `rates_at(step)` and the rest lengths grown from `length_base`.
+fn grow_by(
+    mesh: &Mesh,
+    rates_at: impl Fn(usize) -> Vec<GrowthRates>,
+    thickness: f64,
+    steps: usize,
+    settings: SolverSettings,
+    model: Model,
+    length_base: LengthBase,
+) -> (Vec<DVec3>, usize) {
     let topology = Topology::build(mesh).expect("manifold");
     let mut elastic = Elastic::at_rest(&mesh.positions, &topology);
     let mesh_edge = elastic.rest_lengths.iter().sum::<f64>() / elastic.rest_lengths.len() as f64;
@@ -332,14 +355,15 @@ fn grow_uniformly(
         thickness,
         bend_rule: model.bend_rule(),
         bend_base: BendBase::Dihedral,
+        length_base,
     };
     let mut x = mesh.positions.clone();
     let mut growth = RegionalGrowth::default();
     let mut solver = NewtonSolver::new(x.len(), &elastic).expect("analysis");
-    let per_triangle = vec![rates; mesh.triangles.len()];
     let modulus = vec![Model::membrane_modulus(20.0, mesh_edge); topology.edges.len()];
     let mut iterations = 0;
-    for _ in 0..steps {
+    for step in 0..steps {
+        let per_triangle = rates_at(step);
         growth.grow(
             &x,
             &mesh.uvs,
@@ -416,6 +440,125 @@ fn flat_sheet_under_uniform_growth_stays_flat_and_scales() {
                 assert!(angle.abs() < 1e-8, "{model:?}: hinge {h:?} bent by {angle}");
             }
         }
+    }
+}
+
+#[test]
+fn accumulated_growth_scales_a_free_flat_sheet_by_the_product_of_its_rates() {
+    // With the rest state accumulating the growth, an unconstrained flat
+    // sheet under uniform growth g ends exactly g^n times its bud size
+    // (each step's rest lengths come from the last step's rest lengths, not
+    // from the solved shape).
+    for model in [Model::Consistent, Model::Paper] {
+        let mesh = generate::flat_sheet(4.0, 6.0, 9, 13);
+        let (steps, rate) = (40, 1.0 + 0.003);
+        let rates = GrowthRates {
+            e: rate,
+            w: rate,
+            e_in: rate,
+            w_in: rate,
+            direction_in_uv: DVec2::new(0.3, 1.0),
+        };
+        let (x, _) = grow_by(
+            &mesh,
+            |_| vec![rates; mesh.triangles.len()],
+            0.2,
+            steps,
+            SolverSettings {
+                relative_tolerance: 1e-11,
+                ..SolverSettings::default()
+            },
+            model,
+            LengthBase::Rest,
+        );
+        let expected_scale = rate.powi(steps as i32);
+        let topology = Topology::build(&mesh).expect("manifold");
+        for e in &topology.edges {
+            let [a, b] = e.vertices.map(|v| v as usize);
+            let scale = (x[a] - x[b]).length() / (mesh.positions[a] - mesh.positions[b]).length();
+            assert!(
+                (scale - expected_scale).abs() < 1e-9,
+                "{model:?}: edge {a}-{b}: scale {scale}, expected {expected_scale}"
+            );
+        }
+    }
+}
+
+#[test]
+fn accumulated_in_plane_growth_gradient_bends_a_strip_into_the_annulus_it_asks_for() {
+    // A strip of length L along x and height H along y grown along x by a
+    // factor 1 + k y (linear in y, 1 on its lower edge) has the metric of an
+    // annular sector: every line y = const becomes an arc about one centre,
+    // of radius 1/k + y, through the angle k L. The growth comes in steps
+    // whose product is that factor (step i takes (1 + k_i y) / (1 + k_(i−1)
+    // y), k_i = i k / n), each triangle at its centroid's y, so the
+    // accumulated rest state is the annulus whatever shape the strip took
+    // in between.
+    let (length, height) = (8.0, 1.0);
+    // Rows of triangles evaluate the gradient at their centroids, so the
+    // boundary rows are off by a third of a row: 12 rows keep that under 2 %.
+    let (columns, rows) = (49, 13);
+    let mesh = generate::flat_sheet(length, height, columns, rows);
+    let k = 0.2;
+    let steps = 10;
+    let centroid_y: Vec<f64> = mesh
+        .triangles
+        .iter()
+        .map(|t| t.iter().map(|&v| mesh.positions[v as usize].y).sum::<f64>() / 3.0)
+        .collect();
+    let rates_at = |step: usize| -> Vec<GrowthRates> {
+        let k_at = |i: usize| k * i as f64 / steps as f64;
+        centroid_y
+            .iter()
+            .map(|&y| {
+                let e = (1.0 + k_at(step + 1) * y) / (1.0 + k_at(step) * y);
+                GrowthRates {
+                    e,
+                    w: 1.0,
+                    e_in: e,
+                    w_in: 1.0,
+                    direction_in_uv: DVec2::X,
+                }
+            })
+            .collect()
+    };
+    let (x, _) = grow_by(
+        &mesh,
+        rates_at,
+        0.2,
+        steps,
+        SolverSettings::default(),
+        Model::Consistent,
+        LengthBase::Rest,
+    );
+    // The grid's vertex (column c, row r) is at index r * columns + c.
+    let at = |c: usize, r: usize| x[r * columns + c];
+    let in_plane = |v: DVec3| DVec2::new(v.x, v.y);
+    // Still flat (in-plane growth with a flat metric): no particle leaves z = 0.
+    for p in &x {
+        assert!(p.z.abs() < 1e-6, "the strip left its plane: {p}");
+    }
+    // The two end columns, which stay radial, turn by k L between them.
+    let end_direction = |c: usize| in_plane(at(c, rows - 1) - at(c, 0)).normalize();
+    let turned = end_direction(0).angle_to(end_direction(columns - 1)).abs();
+    let expected = k * length;
+
+    assert!(
+        (turned / expected - 1.0).abs() < 0.02,
+        "the ends turn by {turned} rad, the annulus by {expected}"
+    );
+    // Each row's arc: the lower edge keeps its length, the upper one takes
+    // (1 + k H) times it, the rows between their linear share.
+    for r in [0, rows / 2, rows - 1] {
+        let y = height * r as f64 / (rows - 1) as f64;
+        let arc: f64 = (1..columns)
+            .map(|c| (at(c, r) - at(c - 1, r)).length())
+            .sum();
+        let expected = length * (1.0 + k * y);
+        assert!(
+            (arc / expected - 1.0).abs() < 0.01,
+            "row {r} (y {y}): arc {arc}, annulus {expected}"
+        );
     }
 }
 

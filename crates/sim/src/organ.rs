@@ -288,6 +288,7 @@ impl OrganSim {
                 thickness: template.thickness,
                 bend_rule: settings.model.bend_rule(),
                 bend_base: settings.bend_base,
+                length_base: settings.length_base,
             },
             modulus: Vec::new(),
             triangle_areas: Vec::new(),

@@ -22,6 +22,11 @@
 //!                              # read as "paper", the model they were made with
 //! bend_from = "dihedral"       # or "rest_angle": what a hinge's growth adds
 //!                              # to, its current dihedral or its rest angle
+//! lengths_from = "shape"       # or "rest" (version 10): what grows into the
+//!                              # new rest lengths, each triangle as it is now
+//!                              # (growth the shape could not take is
+//!                              # forgotten) or its rest triangle (the rest
+//!                              # state accumulates the growth)
 //! mean_edge = 0.8              # absent: the meshes as built; a length:
 //!                              # every template simulated remeshed at this
 //!                              # mean edge (crate::resolution; the meshes
@@ -227,7 +232,7 @@ use save::{plan_save, write_file};
 pub const FORMAT_NAME: &str = "anthesis-project";
 
 /// The newest file format version this build reads, and the one it writes.
-pub const FORMAT_VERSION: u32 = 9;
+pub const FORMAT_VERSION: u32 = 10;
 
 /// Checks `project` by the rules every loaded or saved project obeys
 /// (names, counts, numbers, parts), as the app does before it takes an

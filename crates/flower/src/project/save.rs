@@ -92,16 +92,20 @@ pub(super) fn plan_save(
 /// `[[parts]]`, colour maps, version 6 a key's own `dg`, version 7
 /// `[templates.two_state]` and `[templates.source]`, version 8
 /// `[templates.vein]` and a sketched or PDE petal's `[templates.source]`,
-/// version 9 the project's `unit` and a colour layer's `side`).
+/// version 9 the project's `unit` and a colour layer's `side`, version 10
+/// `lengths_from`).
 fn file_version(project: &Project) -> u32 {
     let flower = &project.flower;
+    if project.settings.length_base != anthesis_physics::LengthBase::Shape {
+        return FORMAT_VERSION;
+    }
     let one_sided = |t: &Template| {
         t.colouring
             .as_ref()
             .is_some_and(|c| c.layers.iter().any(|l| l.side != crate::Side::Both))
     };
     if flower.unit.is_some() || flower.templates.iter().any(one_sided) {
-        return FORMAT_VERSION;
+        return 9;
     }
     if flower.templates.iter().any(|t| {
         t.vein.is_some()

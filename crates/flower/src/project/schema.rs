@@ -4,7 +4,7 @@
 use std::fmt;
 
 use anthesis_maps::{Blend, MapKind};
-use anthesis_physics::{BendBase, Model, SolverSettings};
+use anthesis_physics::{BendBase, LengthBase, Model, SolverSettings};
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize, Serializer};
 
@@ -123,6 +123,9 @@ pub(super) struct SimulationFile {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(super) model: Option<ModelFile>,
     pub(super) bend_from: BendFromFile,
+    /// Version 10; absent: `shape` (every file before).
+    #[serde(skip_serializing_if = "LengthsFromFile::is_shape")]
+    pub(super) lengths_from: LengthsFromFile,
     /// Absent: the meshes as built (every file before version 3).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(super) mean_edge: Option<f64>,
@@ -143,6 +146,21 @@ pub(super) enum BendFromFile {
     #[default]
     Dihedral,
     RestAngle,
+}
+
+/// [`LengthBase`] in the file.
+#[derive(Serialize, Deserialize, Clone, Copy, Default, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum LengthsFromFile {
+    #[default]
+    Shape,
+    Rest,
+}
+
+impl LengthsFromFile {
+    fn is_shape(&self) -> bool {
+        *self == LengthsFromFile::Shape
+    }
 }
 
 impl Default for SimulationFile {
@@ -535,6 +553,10 @@ impl From<&SimulationSettings> for SimulationFile {
                 BendBase::Dihedral => BendFromFile::Dihedral,
                 BendBase::RestAngle => BendFromFile::RestAngle,
             },
+            lengths_from: match settings.length_base {
+                LengthBase::Shape => LengthsFromFile::Shape,
+                LengthBase::Rest => LengthsFromFile::Rest,
+            },
             mean_edge: settings.resolution.mean_edge(),
         }
     }
@@ -554,6 +576,10 @@ impl SimulationFile {
             bend_base: match self.bend_from {
                 BendFromFile::Dihedral => BendBase::Dihedral,
                 BendFromFile::RestAngle => BendBase::RestAngle,
+            },
+            length_base: match self.lengths_from {
+                LengthsFromFile::Shape => LengthBase::Shape,
+                LengthsFromFile::Rest => LengthBase::Rest,
             },
             ..SimulationSettings::from(self)
         }
