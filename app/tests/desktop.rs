@@ -28,6 +28,8 @@ mod panels;
 mod refusals;
 #[path = "desktop/sketch_room.rs"]
 mod sketch_room;
+#[path = "desktop/sliders.rs"]
+mod sliders;
 #[path = "desktop/units.rs"]
 mod units;
 

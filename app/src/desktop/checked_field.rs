@@ -84,6 +84,7 @@ pub fn notice(label: &str, typed: &Typed, range: &RangeInclusive<f64>) -> Option
 /// from a file or set by a command; the field does not change it).
 pub fn outside_note(label: &str, value: f64, range: &RangeInclusive<f64>) -> Option<String> {
     (!range.contains(&value)).then(|| {
+        let value = shortest(value);
         format!(
             "{label} {value} is outside what the field accepts ({} to {}); it is kept as it \
              is until you type or drag a new value",
@@ -91,6 +92,17 @@ pub fn outside_note(label: &str, value: f64, range: &RangeInclusive<f64>) -> Opt
             range.end()
         )
     })
+}
+
+/// `value` as written for a person: a value that came from an `f32`
+/// field as that field shows it ("1.7", not "1.7000000476837158").
+fn shortest(value: f64) -> String {
+    let single = value as f32;
+    if f64::from(single) == value {
+        single.to_string()
+    } else {
+        value.to_string()
+    }
 }
 
 /// A number field like `DragValue::new(value).speed(speed).range(range)`

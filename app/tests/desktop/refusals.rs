@@ -74,6 +74,12 @@ pub(crate) fn tooltip_of(
     nth: usize,
 ) -> String {
     let label = words::label(symbol);
+    harness
+        .get_all_by_label(&label)
+        .nth(nth)
+        .expect("the field")
+        .scroll_to_me();
+    harness.run();
     let before = texts(harness);
     harness
         .get_all_by_label(&label)
@@ -102,7 +108,7 @@ fn texts(harness: &Harness<'_, AnthesisApp>) -> Vec<String> {
         .collect()
 }
 
-fn log_lines(harness: &Harness<'_, AnthesisApp>) -> Vec<String> {
+pub(crate) fn log_lines(harness: &Harness<'_, AnthesisApp>) -> Vec<String> {
     harness
         .state()
         .log()
