@@ -24,6 +24,8 @@ mod difference;
 mod measure;
 #[path = "desktop/panels.rs"]
 mod panels;
+#[path = "desktop/plain_names.rs"]
+mod plain_names;
 #[path = "desktop/refusals.rs"]
 mod refusals;
 #[path = "desktop/sketch_room.rs"]
