@@ -17,6 +17,8 @@ use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
+#[path = "desktop/browse.rs"]
+mod browse;
 mod common;
 #[path = "desktop/difference.rs"]
 mod difference;
