@@ -166,14 +166,15 @@ fn base_region_ui(
 /// The largest step a joint ramp's fields accept.
 const STEP_MAX: u32 = 100_000;
 
-/// What is wrong with a ramp that ends before it starts (it adds no
-/// degrees), with the range each of its step fields accepts given the
+/// What is wrong with a ramp that ends before it starts (a run refuses
+/// it), with the range each of its step fields accepts given the
 /// other; `None` for a ramp that runs forwards.
 fn backwards_ramp(ramp: &JointRamp) -> Option<String> {
     (ramp.to_step < ramp.from_step).then(|| {
         format!(
-            "to step {} is before from step {}: this ramp adds no degrees (to step accepts {} \
-             to {STEP_MAX} with this from step; from step accepts 0 to {} with this to step)",
+            "to step {} is before from step {}: a run stops at a ramp that ends before it \
+             starts (to step accepts {} to {STEP_MAX} with this from step; from step accepts 0 \
+             to {} with this to step)",
             ramp.to_step, ramp.from_step, ramp.from_step, ramp.to_step
         )
     })

@@ -211,8 +211,8 @@ fn a_fraction_in_a_count_is_refused_and_a_backwards_joint_ramp_is_flagged() {
     type_keys(&mut harness, "to step", ramps - 1, &["1", "0"]);
     let ramp = harness.state().project().flower.templates[0].joint_schedule[ramps - 1];
     assert_eq!((ramp.from_step, ramp.to_step), (50, 10));
-    let backwards = "to step 10 is before from step 50: this ramp adds no degrees (to step \
-                     accepts 50 to 100000 with this from step; from step accepts 0 to 10 with \
+    let backwards = "to step 10 is before from step 50: a run stops at a ramp that ends \
+                     before it starts (to step accepts 50 to 100000 with this from step; from step accepts 0 to 10 with \
                      this to step)";
     let lines = log_lines(&harness);
     assert_eq!(
@@ -242,7 +242,7 @@ fn a_fraction_in_a_count_is_refused_and_a_backwards_joint_ramp_is_flagged() {
     );
     // The start moved back before the end: no outline, nothing said.
     type_into(&mut harness, "from step", ramps - 1, "5");
-    assert!(!tooltip_of(&mut harness, "to step", ramps - 1).contains("adds no degrees"));
+    assert!(!tooltip_of(&mut harness, "to step", ramps - 1).contains("ends before it starts"));
     assert!(
         !log_lines(&harness)
             .iter()
