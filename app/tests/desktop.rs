@@ -17,6 +17,8 @@ use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 
+#[path = "desktop/browse.rs"]
+mod browse;
 mod common;
 #[path = "desktop/difference.rs"]
 mod difference;
@@ -24,10 +26,14 @@ mod difference;
 mod measure;
 #[path = "desktop/panels.rs"]
 mod panels;
+#[path = "desktop/plain_names.rs"]
+mod plain_names;
 #[path = "desktop/refusals.rs"]
 mod refusals;
 #[path = "desktop/sketch_room.rs"]
 mod sketch_room;
+#[path = "desktop/sliders.rs"]
+mod sliders;
 #[path = "desktop/units.rs"]
 mod units;
 
@@ -2117,12 +2123,11 @@ fn harness_with_file_browser(path: &std::path::Path) -> Harness<'static, Anthesi
     anthesis_flower::project::save_project(&project, path).expect("saves");
     let path = path.to_path_buf();
     // egui_file titles its window and its icons with characters (📂, 🗀,
-    // ⬆) that egui's bundled fonts lack: they draw as boxes; and its path
-    // and file-name fields have no accessible name. Both are egui_file's,
-    // listed as known faults in the issue note.
+    // ⬆) that egui's monochrome emoji font draws (the app enables it): no
+    // missing glyphs are allowed, so an icon drawn as a box fails here. Its
+    // path and file-name fields have no accessible name (egui_file's).
     let mut harness = Harness::builder()
         .with_size(egui::vec2(1280.0, 800.0))
-        .allow_missing_glyphs()
         .with_accessibility_check(false)
         .wgpu()
         .build_eframe(move |cc| {

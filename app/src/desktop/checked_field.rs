@@ -84,6 +84,7 @@ pub fn notice(label: &str, typed: &Typed, range: &RangeInclusive<f64>) -> Option
 /// from a file or set by a command; the field does not change it).
 pub fn outside_note(label: &str, value: f64, range: &RangeInclusive<f64>) -> Option<String> {
     (!range.contains(&value)).then(|| {
+        let value = shortest(value);
         format!(
             "{label} {value} is outside what the field accepts ({} to {}); it is kept as it \
              is until you type or drag a new value",
@@ -91,6 +92,17 @@ pub fn outside_note(label: &str, value: f64, range: &RangeInclusive<f64>) -> Opt
             range.end()
         )
     })
+}
+
+/// `value` as written for a person: a value that came from an `f32`
+/// field as that field shows it ("1.7", not "1.7000000476837158").
+fn shortest(value: f64) -> String {
+    let single = value as f32;
+    if f64::from(single) == value {
+        single.to_string()
+    } else {
+        value.to_string()
+    }
 }
 
 /// A number field like `DragValue::new(value).speed(speed).range(range)`
@@ -124,6 +136,9 @@ pub fn checked_with<N: egui::emath::Numeric>(
     let range_f64 = range.start().to_f64()..=range.end().to_f64();
     let typed: RefCell<Option<Typed>> = RefCell::new(None);
     let parse_range = range_f64.clone();
+    // The same each frame (a slider's response is its number box's while
+    // that has focus, its rail's otherwise).
+    let key = ui.next_auto_id();
     let response = ui.add(style(
         DragValue::new(value)
             .range(range)
@@ -143,14 +158,22 @@ pub fn checked_with<N: egui::emath::Numeric>(
             }),
     ));
     let outside = outside_note(label, value.to_f64(), &range_f64);
-    mark_typed(ui, response, label, typed.into_inner(), &range_f64, outside)
+    mark_typed(
+        ui,
+        (key, response),
+        label,
+        typed.into_inner(),
+        &range_f64,
+        outside,
+    )
 }
 
 /// Logs what became of a typed value (once), and marks the field while
-/// that is recent or while its value is `outside` its range.
+/// that is recent or while its value is `outside` its range (said once
+/// in the log too).
 fn mark_typed(
     ui: &mut egui::Ui,
-    mut response: egui::Response,
+    (key, mut response): (egui::Id, egui::Response),
     label: &str,
     typed: Option<Typed>,
     range: &RangeInclusive<f64>,
@@ -187,6 +210,20 @@ fn mark_typed(
             push_notice(ui.ctx(), message);
         }
     }
+    // A value outside the range that no edit made (loaded from a file,
+    // picked by the eyedropper) is said once, when the field first shows
+    // it.
+    let outside_said_id = key.with("checked field outside said");
+    match &outside {
+        Some(message) => {
+            let said: Option<String> = ui.data(|d| d.get_temp(outside_said_id));
+            if said.as_ref() != Some(message) {
+                ui.data_mut(|d| d.insert_temp(outside_said_id, message.clone()));
+                push_notice(ui.ctx(), message.clone());
+            }
+        }
+        None => ui.data_mut(|d| d.remove::<String>(outside_said_id)),
+    }
     let marked: Option<(String, f64)> = ui.data(|d| d.get_temp(id));
     let recent = match marked {
         Some((message, since)) if now - since < MARK_SECONDS => {
@@ -213,8 +250,10 @@ fn mark_typed(
 }
 
 /// A slider like `Slider::new(value, range)` whose number box marks and
-/// logs a typed value it refuses or clamps into `range` (the slider
-/// itself never leaves it). Returns the response.
+/// logs a typed value it refuses or clamps into `range` (a drag never
+/// leaves it), and that keeps, marks and logs once a value already outside
+/// `range` (egui's slider would clamp it silently when drawn). Returns the
+/// response.
 pub fn checked_slider<N: egui::emath::Numeric>(
     ui: &mut egui::Ui,
     label: &str,
@@ -225,48 +264,74 @@ pub fn checked_slider<N: egui::emath::Numeric>(
     let range_f64 = range.start().to_f64()..=range.end().to_f64();
     let typed: RefCell<Option<Typed>> = RefCell::new(None);
     let parse_range = range_f64.clone();
-    let response = ui.add(style(egui::Slider::new(value, range).custom_parser(
-        |text| {
-            let read = read_typed(text, &parse_range);
-            let value = match read {
-                Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
-                Typed::Refused(_) | Typed::NotWhole(_) => None,
-            };
-            *typed.borrow_mut() = Some(read);
-            value
-        },
-    )));
-    mark_typed(ui, response, label, typed.into_inner(), &range_f64, None)
+    // The same each frame (a slider's response is its number box's while
+    // that has focus, its rail's otherwise).
+    let key = ui.next_auto_id();
+    let response = ui.add(
+        style(egui::Slider::new(value, range))
+            // egui's default clamps a value outside the range as it is
+            // drawn: a value loaded or picked outside it is kept instead
+            // (and marked below); a drag or a typed value stays inside.
+            .clamping(egui::SliderClamping::Edits)
+            .custom_parser(|text| {
+                let read = read_typed(text, &parse_range);
+                let value = match read {
+                    Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
+                    Typed::Refused(_) | Typed::NotWhole(_) => None,
+                };
+                *typed.borrow_mut() = Some(read);
+                value
+            }),
+    );
+    let outside = outside_note(label, value.to_f64(), &range_f64);
+    mark_typed(
+        ui,
+        (key, response),
+        label,
+        typed.into_inner(),
+        &range_f64,
+        outside,
+    )
 }
 
-/// Outlines `response`'s field and gives it `problem` as its tooltip
-/// while there is one (a value that is in range but does not work with
-/// another, as a ramp ending before it starts); the problem goes to the log
-/// once when the values come to it.
-pub fn flagged(
+/// Outlines the fields of `responses` and gives each `problem` as its
+/// tooltip while there is one (values that are each in range but do not
+/// work together, as a ramp ending before it starts: every field that
+/// makes it so is outlined). The problem goes to the log once per edit,
+/// when it ends (not at each keystroke or drag step on the way), and once
+/// when a project is opened with it.
+pub fn flagged<const N: usize>(
     ui: &mut egui::Ui,
-    response: egui::Response,
+    responses: [egui::Response; N],
     problem: Option<String>,
-) -> egui::Response {
-    let id = response.id.with("flagged");
-    let Some(problem) = problem else {
-        ui.data_mut(|d| d.remove::<String>(id));
-        return response;
+) -> [egui::Response; N] {
+    let Some(first) = responses.first() else {
+        return responses;
     };
-    // Said once each time the values come to it (either field's edit, or
-    // a project opened with it).
-    let said: Option<String> = ui.data(|d| d.get_temp(id));
-    if said.as_ref() != Some(&problem) {
-        ui.data_mut(|d| d.insert_temp(id, problem.clone()));
+    let said_id = first.id.with("flagged");
+    if responses.iter().any(egui::Response::changed) {
+        // A new value: what it makes is said again when the edit ends.
+        ui.data_mut(|d| d.remove::<String>(said_id));
+    }
+    let Some(problem) = problem else {
+        ui.data_mut(|d| d.remove::<String>(said_id));
+        return responses;
+    };
+    let editing = responses.iter().any(|r| r.has_focus() || r.dragged());
+    let said: Option<String> = ui.data(|d| d.get_temp(said_id));
+    if !editing && said.as_ref() != Some(&problem) {
+        ui.data_mut(|d| d.insert_temp(said_id, problem.clone()));
         push_notice(ui.ctx(), problem.clone());
     }
-    ui.painter().rect_stroke(
-        response.rect.expand(1.0),
-        2.0,
-        egui::Stroke::new(1.5, ui.visuals().error_fg_color),
-        egui::StrokeKind::Outside,
-    );
-    response.on_hover_text(problem)
+    responses.map(|response| {
+        ui.painter().rect_stroke(
+            response.rect.expand(1.0),
+            2.0,
+            egui::Stroke::new(1.5, ui.visuals().error_fg_color),
+            egui::StrokeKind::Outside,
+        );
+        response.on_hover_text(problem.as_str())
+    })
 }
 
 /// Says `message` in the log with the refused and clamped values (a value

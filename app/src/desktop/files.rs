@@ -34,6 +34,8 @@ pub enum DialogPurpose {
     ImportScan,
     /// An OBJ as the open shape of this template (two-state).
     OpenShape(usize),
+    /// The target surface (an OBJ) of the growth-map fit.
+    FitTarget,
 }
 
 impl DialogPurpose {
@@ -45,6 +47,7 @@ impl DialogPurpose {
             DialogPurpose::ImportTemplateObj => "Import an OBJ mesh as a new template",
             DialogPurpose::ImportScan => "Import a scanned petal (OBJ) to fit",
             DialogPurpose::OpenShape(_) => "Open shape: an OBJ of the template mesh moved",
+            DialogPurpose::FitTarget => "Fit target: an OBJ surface",
         }
     }
 
@@ -56,7 +59,8 @@ impl DialogPurpose {
             DialogPurpose::OpenProject
             | DialogPurpose::ImportTemplateObj
             | DialogPurpose::ImportScan
-            | DialogPurpose::OpenShape(_) => None,
+            | DialogPurpose::OpenShape(_)
+            | DialogPurpose::FitTarget => None,
             DialogPurpose::SaveProjectAs => Some("flower.anthesis.toml".to_owned()),
             DialogPurpose::ExportGlb => Some(default_file_name(project_name)),
         }
@@ -69,7 +73,7 @@ impl DialogPurpose {
             DialogPurpose::OpenProject | DialogPurpose::SaveProjectAs => vec![PROJECT_EXTENSION],
             DialogPurpose::ExportGlb => Format::file_extensions(),
             DialogPurpose::ImportTemplateObj | DialogPurpose::ImportScan => vec!["obj"],
-            DialogPurpose::OpenShape(_) => vec!["obj"],
+            DialogPurpose::OpenShape(_) | DialogPurpose::FitTarget => vec!["obj"],
         }
     }
 }
@@ -228,7 +232,8 @@ impl Dialogs {
             DialogPurpose::OpenProject
             | DialogPurpose::ImportTemplateObj
             | DialogPurpose::ImportScan
-            | DialogPurpose::OpenShape(_) => egui_file::FileDialog::open_file(),
+            | DialogPurpose::OpenShape(_)
+            | DialogPurpose::FitTarget => egui_file::FileDialog::open_file(),
             DialogPurpose::SaveProjectAs | DialogPurpose::ExportGlb => {
                 egui_file::FileDialog::save_file()
             }
@@ -299,7 +304,7 @@ fn native_dialog(
         DialogPurpose::OpenProject => dialog
             .add_filter("Anthesis project", &purpose.extensions())
             .pick_file(),
-        DialogPurpose::OpenShape(_) => dialog
+        DialogPurpose::OpenShape(_) | DialogPurpose::FitTarget => dialog
             .add_filter("OBJ mesh", &purpose.extensions())
             .pick_file(),
         DialogPurpose::SaveProjectAs => dialog

@@ -97,6 +97,8 @@ impl Default for FitDialog {
 pub struct FitRequests {
     pub start: bool,
     pub apply: bool,
+    /// Choose the target in a file dialog.
+    pub browse: bool,
 }
 
 impl FitDialog {
@@ -341,12 +343,22 @@ impl FitDialog {
                 ui.add_enabled_ui(!running, |ui| {
                     egui::Grid::new("fit-grid").num_columns(2).show(ui, |ui| {
                         let label = ui.label("Target OBJ").id;
-                        ui.add(
-                            egui::TextEdit::singleline(&mut self.target)
-                                .hint_text("/path/to/open.obj")
-                                .desired_width(300.0),
-                        )
-                        .labelled_by(label);
+                        ui.horizontal(|ui| {
+                            ui.add(
+                                egui::TextEdit::singleline(&mut self.target)
+                                    .hint_text("/path/to/open.obj")
+                                    .desired_width(300.0),
+                            )
+                            .labelled_by(label);
+                            // As the export's path: typed, or chosen.
+                            if ui
+                                .button("Browse…")
+                                .on_hover_text("Choose the target OBJ in a file dialog")
+                                .clicked()
+                            {
+                                requests.browse = true;
+                            }
+                        });
                         ui.end_row();
                         let label = ui.label("Time keys").id;
                         super::checked_field::checked_with(
@@ -444,6 +456,9 @@ impl AnthesisApp {
             .get(organ)
             .map_or_else(String::new, |o| o.name.clone());
         let requests = self.fit.ui(ctx, &name);
+        if requests.browse {
+            self.ask_for_path(super::files::DialogPurpose::FitTarget);
+        }
         if requests.start {
             let resolved = self.resolved_project();
             let revision = self.doc.revision();

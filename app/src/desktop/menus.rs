@@ -391,7 +391,7 @@ impl AnthesisApp {
                 if ui
                     .add_enabled(
                         undo.is_some(),
-                        egui::Button::new(undo.unwrap_or_else(|| "Undo".into())),
+                        egui::Button::new(undo.unwrap_or_else(|| with_keys("Undo", "Undo"))),
                     )
                     .clicked()
                 {
@@ -404,7 +404,7 @@ impl AnthesisApp {
                 if ui
                     .add_enabled(
                         redo.is_some(),
-                        egui::Button::new(redo.unwrap_or_else(|| "Redo".into())),
+                        egui::Button::new(redo.unwrap_or_else(|| with_keys("Redo", "Redo"))),
                     )
                     .clicked()
                 {

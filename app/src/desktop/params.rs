@@ -10,7 +10,7 @@ use anthesis_flower::resolution::predicted_size;
 use anthesis_flower::{Colouring, DEFAULT_SECOND_COLOUR, JointRamp, Project, Resolution, Template};
 use eframe::egui;
 
-use super::checked_field::checked_with;
+use super::checked_field::{checked_with, flagged};
 
 use super::command::{Command, ProjectEdit};
 use super::two_state::{ViewedOrgan, two_state_ui};
@@ -163,6 +163,23 @@ fn base_region_ui(
     );
 }
 
+/// The largest step a joint ramp's fields accept.
+const STEP_MAX: u32 = 100_000;
+
+/// What is wrong with a ramp that ends before it starts (a run refuses
+/// it), with the range each of its step fields accepts given the
+/// other; `None` for a ramp that runs forwards.
+fn backwards_ramp(ramp: &JointRamp) -> Option<String> {
+    (ramp.to_step < ramp.from_step).then(|| {
+        format!(
+            "to step {} is before from step {}: a run stops at a ramp that ends before it \
+             starts (to step accepts {} to {STEP_MAX} with this from step; from step accepts 0 \
+             to {} with this to step)",
+            ramp.to_step, ramp.from_step, ramp.from_step, ramp.to_step
+        )
+    })
+}
+
 /// The Joint schedule section: each ramp's steps and degrees, removed or
 /// added.
 fn joint_schedule_ui(
@@ -199,29 +216,21 @@ fn joint_ramps_ui(
             let degrees_label = header(ui, "degrees");
             ui.end_row();
             for (i, ramp) in draft.joint_schedule.iter_mut().enumerate() {
+                let from = checked_with(ui, "from step", &mut ramp.from_step, 0..=STEP_MAX, |d| d);
+                let to = checked_with(ui, "to step", &mut ramp.to_step, 0..=STEP_MAX, |d| d);
+                // A ramp that ends before it starts adds nothing: both
+                // fields are what make it so.
+                let [from, to] = flagged(ui, [from, to], backwards_ramp(ramp));
                 mark(
-                    checked_with(ui, "from step", &mut ramp.from_step, 0..=100_000, |d| d)
-                        .labelled_by(from_label)
+                    from.labelled_by(from_label)
                         .on_hover_text(words::tooltip("from step"))
                         .changed(),
                     "joint from",
                 );
                 mark(
-                    {
-                        let to = checked_with(ui, "to step", &mut ramp.to_step, 0..=100_000, |d| d);
-                        // A ramp that ends before it starts adds nothing.
-                        let backwards = (ramp.to_step < ramp.from_step).then(|| {
-                            format!(
-                                "to step {} is before from step {}: this ramp adds no degrees \
-                                 (set to step at or after from step)",
-                                ramp.to_step, ramp.from_step
-                            )
-                        });
-                        super::checked_field::flagged(ui, to, backwards)
-                    }
-                    .labelled_by(to_label)
-                    .on_hover_text(words::tooltip("to step"))
-                    .changed(),
+                    to.labelled_by(to_label)
+                        .on_hover_text(words::tooltip("to step"))
+                        .changed(),
                     "joint to",
                 );
                 mark(

@@ -312,15 +312,32 @@ fn schedule_rows(ui: &mut egui::Ui, part: &mut Part, id: usize) -> Option<&'stat
     egui::Grid::new(("part schedule", id))
         .num_columns(4)
         .show(ui, |ui| {
+            if part.schedule.is_empty() {
+                return;
+            }
+            // Named columns, as the joint schedule's: three bare numbers
+            // in a row do not say which is which.
+            const FROM: &str = "The turn starts after this step";
+            const TO: &str = "The turn is done at this step";
+            const TURN: &str = "Degrees it turns outwards (unit: degrees)";
+            let header = |ui: &mut egui::Ui, name: &str, tooltip: &str| {
+                ui.label(name).on_hover_text(tooltip).id
+            };
+            let from_label = header(ui, "From step", FROM);
+            let to_label = header(ui, "To step", TO);
+            let turn_label = header(ui, "Turn (degrees)", TURN);
+            ui.end_row();
             for (i, ramp) in part.schedule.iter_mut().enumerate() {
                 if checked_with(ui, "from step", &mut ramp.from_step, 0..=100_000, |d| d)
-                    .on_hover_text("The turn starts after this step")
+                    .labelled_by(from_label)
+                    .on_hover_text(FROM)
                     .changed()
                 {
                     changed = Some("schedule");
                 }
                 if checked_with(ui, "to step", &mut ramp.to_step, 0..=100_000, |d| d)
-                    .on_hover_text("The turn is done at this step")
+                    .labelled_by(to_label)
+                    .on_hover_text(TO)
                     .changed()
                 {
                     changed = Some("schedule");
@@ -328,12 +345,17 @@ fn schedule_rows(ui: &mut egui::Ui, part: &mut Part, id: usize) -> Option<&'stat
                 if checked_with(ui, "degrees", &mut ramp.angle_deg, -180.0..=180.0, |d| {
                     d.speed(0.1).suffix("°")
                 })
-                .on_hover_text("Degrees it turns outwards (unit: degrees)")
+                .labelled_by(turn_label)
+                .on_hover_text(TURN)
                 .changed()
                 {
                     changed = Some("schedule");
                 }
-                if ui.small_button("Remove").clicked() {
+                if ui
+                    .small_button("Remove")
+                    .on_hover_text("Remove this turn")
+                    .clicked()
+                {
                     remove = Some(i);
                 }
                 ui.end_row();

@@ -306,6 +306,7 @@ impl AnthesisApp {
             DialogPurpose::ImportTemplateObj => self.import_template(&path),
             DialogPurpose::ImportScan => self.import_scan(&path),
             DialogPurpose::OpenShape(template) => self.open_shape_from_obj(template, &path),
+            DialogPurpose::FitTarget => self.fit.target = path.display().to_string(),
         }
     }
 

@@ -7,7 +7,7 @@
 use anthesis_sim::SimError;
 use eframe::egui;
 use egui_kittest::Harness;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 
 use anthesis_app::desktop::words;
 
@@ -34,7 +34,81 @@ fn type_into(harness: &mut Harness<'_, AnthesisApp>, symbol: &str, nth: usize, t
     harness.run();
 }
 
-fn log_lines(harness: &Harness<'_, AnthesisApp>) -> Vec<String> {
+/// Types `keys` into the `nth` field of `symbol`, one frame each, and
+/// presses Enter.
+fn type_keys(harness: &mut Harness<'_, AnthesisApp>, symbol: &str, nth: usize, keys: &[&str]) {
+    let label = words::label(symbol);
+    let field = |harness: &Harness<'_, AnthesisApp>| {
+        harness
+            .get_all_by_label(&label)
+            .nth(nth)
+            .expect("the field")
+            .rect()
+    };
+    let at = field(harness).center();
+    harness
+        .get_all_by_label(&label)
+        .nth(nth)
+        .expect("the field")
+        .focus();
+    harness.run();
+    harness.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    for key in keys {
+        assert_eq!(field(harness).center(), at, "the same field");
+        harness
+            .get_all_by_label(&label)
+            .nth(nth)
+            .expect("the field")
+            .type_text(key);
+        harness.run();
+    }
+    harness.key_press(egui::Key::Enter);
+    harness.run();
+}
+
+/// The tooltip shown while the pointer is over the `nth` field of
+/// `symbol` (all its texts, one per line).
+pub(crate) fn tooltip_of(
+    harness: &mut Harness<'_, AnthesisApp>,
+    symbol: &str,
+    nth: usize,
+) -> String {
+    let label = words::label(symbol);
+    harness
+        .get_all_by_label(&label)
+        .nth(nth)
+        .expect("the field")
+        .scroll_to_me();
+    harness.run();
+    let before = texts(harness);
+    harness
+        .get_all_by_label(&label)
+        .nth(nth)
+        .expect("the field")
+        .hover();
+    harness.run();
+    harness.run();
+    let mut after = texts(harness);
+    for text in before {
+        if let Some(i) = after.iter().position(|t| *t == text) {
+            after.remove(i);
+        }
+    }
+    // The pointer off the panels again.
+    harness.hover_at(egui::pos2(640.0, 300.0));
+    harness.run();
+    after.join("\n")
+}
+
+/// Every text shown in the window.
+fn texts(harness: &Harness<'_, AnthesisApp>) -> Vec<String> {
+    harness
+        .get_all_by(|n| n.label().is_some() || n.value().is_some())
+        .filter_map(|n| n.accesskit_node().label().or_else(|| n.value()))
+        .collect()
+}
+
+pub(crate) fn log_lines(harness: &Harness<'_, AnthesisApp>) -> Vec<String> {
     harness
         .state()
         .log()
@@ -132,17 +206,47 @@ fn a_fraction_in_a_count_is_refused_and_a_backwards_joint_ramp_is_flagged() {
         .joint_schedule
         .len();
     type_into(&mut harness, "from step", ramps - 1, "50");
-    type_into(&mut harness, "to step", ramps - 1, "10");
+    // "10" typed a key at a time: the end passes through 1 on the way, and
+    // only what the finished edit makes is said, once.
+    type_keys(&mut harness, "to step", ramps - 1, &["1", "0"]);
     let ramp = harness.state().project().flower.templates[0].joint_schedule[ramps - 1];
     assert_eq!((ramp.from_step, ramp.to_step), (50, 10));
+    let backwards = "to step 10 is before from step 50: a run stops at a ramp that ends \
+                     before it starts (to step accepts 50 to 100000 with this from step; from step accepts 0 to 10 with \
+                     this to step)";
     let lines = log_lines(&harness);
-    assert!(
-        lines.contains(
-            &"to step 10 is before from step 50: this ramp adds no degrees (set to step at or \
-              after from step)"
-                .to_string()
-        ),
+    assert_eq!(
+        lines.iter().filter(|l| l.as_str() == backwards).count(),
+        1,
         "{lines:?}"
+    );
+    assert!(
+        !lines.iter().any(|l| l.starts_with("to step 1 is before")),
+        "a keystroke on the way is not said: {lines:?}"
+    );
+    // Both fields that make it wrong are outlined with the problem as
+    // their tooltip.
+    for symbol in ["from step", "to step"] {
+        assert!(
+            tooltip_of(&mut harness, symbol, ramps - 1).contains(backwards),
+            "{symbol}"
+        );
+    }
+    // More frames, and hovering, say nothing more.
+    harness.run();
+    let lines = log_lines(&harness);
+    assert_eq!(
+        lines.iter().filter(|l| l.as_str() == backwards).count(),
+        1,
+        "{lines:?}"
+    );
+    // The start moved back before the end: no outline, nothing said.
+    type_into(&mut harness, "from step", ramps - 1, "5");
+    assert!(!tooltip_of(&mut harness, "to step", ramps - 1).contains("ends before it starts"));
+    assert!(
+        !log_lines(&harness)
+            .iter()
+            .any(|l| l.starts_with("to step 10 is before from step 5:"))
     );
     // Out of range: clamped and said.
     type_into(&mut harness, "to step", ramps - 1, "200000");
