@@ -300,6 +300,15 @@ fn an_edit_keeps_the_viewed_frame_stale_until_the_new_run_reaches_it() {
             .width()
             > 0.0
     );
+    // The elapsed time in the status line is fixed, so the picture does not
+    // depend on how fast the machine ran the test (it said "under 0.1 s"
+    // once at load 7).
+    harness
+        .state_mut()
+        .session_mut()
+        .freeze_elapsed(Duration::from_millis(100));
+    harness.run();
+    harness.get_by_label_contains("0.1 s elapsed");
     harness.snapshot("app_stale_after_an_edit");
 
     // It reaches keyframe 12: the new result is shown.
