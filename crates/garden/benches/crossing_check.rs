@@ -1,10 +1,10 @@
 //! The crossing check that ends every keyframe (issue 35), alone: the
 //! default lily is run once from the bud (not timed), keeping every
 //! keyframe's organ positions, then `anthesis_mesh::crossing` searches all
-//! of them, every organ against the others and itself, with the cell the
-//! simulation uses (twice the organs' largest mean edge where they are).
-//! The parts are left out (the simulation's broad phase drops almost all of
-//! their triangles, which lie beside every organ's box).
+//! of them in turn with one search (its hierarchies built once and refitted
+//! to each keyframe, as in a run), every organ against the others and
+//! itself. The parts are left out (their triangles lie beside almost every
+//! organ's box).
 //!
 //! `cargo bench -p anthesis-garden --bench crossing_check`
 
@@ -15,19 +15,6 @@ use anthesis_mesh::crossing::{Body, CrossingSearch};
 use anthesis_sim::Selection;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;
-
-/// The mean edge of `triangles` at `positions`.
-fn mean_edge(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
-    let sum: f64 = triangles
-        .iter()
-        .map(|t| {
-            (0..3)
-                .map(|k| positions[t[k] as usize].distance(positions[t[(k + 1) % 3] as usize]))
-                .sum::<f64>()
-        })
-        .sum();
-    sum / (3 * triangles.len()).max(1) as f64
-}
 
 fn crossing_check(c: &mut Criterion) {
     let project = match flower_at_resolution("lily", EDGE_SCALE) {
@@ -60,12 +47,7 @@ fn crossing_check(c: &mut Criterion) {
                             triangles,
                         })
                         .collect();
-                    let cell = 2.0
-                        * bodies
-                            .iter()
-                            .map(|b| mean_edge(b.positions, b.triangles))
-                            .fold(0.0, f64::max);
-                    found += search.find(black_box(&bodies), cell, &|_, _| true).len();
+                    found += search.find(black_box(&bodies), &|_, _| true).len();
                 }
                 assert_eq!(found, 0, "the default lily crosses");
                 found

@@ -10,9 +10,10 @@
 //! [`OnCrossing::Warn`], goes on and keeps what it found
 //! ([`Simulation::crossings`](crate::Simulation::crossings)).
 //!
-//! The search is `anthesis_mesh::crossing`'s spatial hash over every
-//! triangle of the keyframe: linear in the triangles, parts against parts
-//! not tested (they overlap by design, a stamen's anther on its filament).
+//! The search is `anthesis_mesh::crossing`'s bounding volume hierarchies
+//! over every triangle of the keyframe (built in the run's first check,
+//! refitted after), parts against parts not tested (they overlap by
+//! design, a stamen's anther on its filament).
 
 use std::fmt;
 

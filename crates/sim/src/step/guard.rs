@@ -77,13 +77,10 @@ impl Simulation {
                 }
             }))
             .collect();
-        // Twice the organs' largest mean edge: a cell holds a triangle and
-        // its neighbours.
-        let cell = 2.0 * self.organs.iter().map(|o| o.mean_edge).fold(0.0, f64::max);
         // Parts against parts are not tested: they overlap by design.
         let found = self
             .crossing_search
-            .find(&bodies, cell, &|i, j| i.min(j) < organs);
+            .find(&bodies, &|i, j| i.min(j) < organs);
         if found.is_empty() {
             return None;
         }
