@@ -141,6 +141,8 @@ pub(crate) struct OrganSim {
     rings: TriangleRings,
     /// Whether each particle is on the organ's rim.
     rim: Vec<bool>,
+    /// The organ's rim edges, each `[low, high]` (rim contacts, issue 35).
+    rim_edges: Vec<[u32; 2]>,
     placement: Placement,
     schedule: Vec<anthesis_flower::JointRamp>,
     base: Vec<u32>,
@@ -275,6 +277,7 @@ impl OrganSim {
                 .collect(),
             rings: TriangleRings::new(&template.mesh.triangles, template.mesh.vertex_count()),
             rim: topology.boundary_vertices(template.mesh.vertex_count()),
+            rim_edges: crate::collide::rim_edges(&template.mesh.triangles),
             placement: organ.placement,
             schedule: template.joint_schedule.clone(),
             base_current: Vec::with_capacity(base.len()),
@@ -486,6 +489,11 @@ impl OrganSim {
             rim: &self.rim,
             mean_edge: self.mean_edge,
         }
+    }
+
+    /// The organ's rim edges, each `[low, high]`, sorted.
+    pub fn rim_edges(&self) -> &[[u32; 2]] {
+        &self.rim_edges
     }
 
     /// Which of this organ's particles are each other's neighbourhood,

@@ -22,6 +22,7 @@ mod grow;
 mod guard;
 mod push_back;
 mod record;
+mod rim;
 pub(crate) mod search;
 mod settle;
 

@@ -38,6 +38,7 @@ impl Simulation {
             });
         let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
         let selves = self.self_contacts(&geometry);
+        let rims = self.rim_contacts(&geometry);
         let free = self
             .free
             .par_iter()
@@ -81,6 +82,7 @@ impl Simulation {
             parts,
             sides,
             selves,
+            rims,
             free,
             side_held,
             free_held,
@@ -239,6 +241,12 @@ impl Simulation {
         if selves {
             for ((list, own), organ) in contacts.iter_mut().zip(&found.selves).zip(&self.organs) {
                 list.extend(own.iter().map(|&c| match violated {
+                    Violated::MoveHalf => move_half(c, organ.positions[c.particle as usize]),
+                    Violated::MoveAll => c,
+                }));
+            }
+            for ((list, rims), organ) in contacts.iter_mut().zip(&found.rims).zip(&self.organs) {
+                list.extend(rims.iter().map(|&c| match violated {
                     Violated::MoveHalf => move_half(c, organ.positions[c.particle as usize]),
                     Violated::MoveAll => c,
                 }));
@@ -468,6 +476,9 @@ pub(crate) struct Found {
     pub(crate) sides: Vec<Vec<Contact>>,
     /// Each organ's contacts against itself.
     pub(crate) selves: Vec<Vec<Contact>>,
+    /// Each organ's rim contacts (see `collide::rim`), appended after its
+    /// self-contacts.
+    pub(crate) rims: Vec<Vec<Contact>>,
     /// Each free pair's contacts (`Simulation::free`, same order).
     pub(crate) free: Vec<Vec<Contact>>,
     /// Where the violated contacts of each side press on the other organ

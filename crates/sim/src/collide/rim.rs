@@ -1,0 +1,316 @@
+//! Rim contacts (issue 35): edge–edge proximity between an organ's edges
+//! and the rim (boundary) edges of a neighbour or of itself, the way cloth
+//! simulators keep edges apart (Bridson, Fedkiw and Anderson, "Robust
+//! treatment of collisions, contact and friction for cloth animation",
+//! 2002: point–triangle and edge–edge proximities).
+//!
+//! Particle contacts hold each particle off the neighbour's surface where
+//! it lies over it; a particle beside the neighbour's rim has no point of
+//! its surface under it, so nothing holds it, and an edge from it to a
+//! held particle could pass through the neighbour's rim triangles (a margin
+//! through a margin, rim on rim) while every particle stayed on its side.
+//! Where two surfaces cross, the line they cross along either closes on
+//! itself (then particles of one lie past the other, which the particle
+//! contacts see) or ends on a rim, where an edge of one passes through a
+//! rim edge of the other. So each pair of edges of which one is a rim edge
+//! and which come within reach of each other gets a contact: the nearest
+//! points of the two edges are kept `RIM_OFFSET` of the collision offset
+//! apart, along the line between them, or, where the edges have passed
+//! through each other since the last keyframe ended (the side of one's
+//! line the other lies on changed, and they met on the way), back along
+//! their common normal to the side they were on.
+//!
+//! The contact acts on the moving organ's edge at the point nearest the
+//! other edge, `P(s) = (1 - s) a + s b`: it is given to the two ends as two
+//! particle contacts on one plane moved along with the edge, of weights
+//! `1 - s` and `s`, so their forces sum to the edge point's (the same
+//! gradient; the Hessian leaves out the coupling of the two ends) and the
+//! push-back, moving each end by the edge point's violation, moves the
+//! edge onto its side.
+
+use anthesis_mesh::crossing::segment_through_triangle;
+use anthesis_physics::Contact;
+use glam::DVec3;
+
+use super::{Locality, Surface, Tracker};
+
+/// The distance two edges are kept apart, as a fraction of the collision
+/// offset: less than the particle contacts' whole offset, so that where a
+/// margin rests on a neighbour the particle contacts hold it and these
+/// stay slack.
+pub const RIM_OFFSET: f64 = 0.5;
+
+/// Edge pairs nearer than this, in mean edges (the larger organ's), get a
+/// contact (held fixed, like the particle contacts, while the organs
+/// settle).
+pub const RIM_REACH: f64 = 1.0;
+
+/// One organ as the rim search sees it: where it is, where it was when
+/// the last keyframe ended, its nearest-particle lookup where it is and its
+/// rim edges (each `[low, high]`).
+pub struct RimSide<'a> {
+    /// The organ where it is.
+    pub surface: Surface<'a>,
+    /// Its positions at the end of the last keyframe.
+    pub previous: &'a [DVec3],
+    /// Its nearest-particle lookup where it is.
+    pub tracker: &'a Tracker,
+    /// Its boundary edges, each `[low, high]`.
+    pub rim_edges: &'a [[u32; 2]],
+}
+
+/// The rim contacts of the edges of `moving` against `other` (see the
+/// module): pairs of an edge of `moving` and a rim edge of `other`, and of
+/// a rim edge of `moving` and an edge of `other`. For an organ against
+/// itself (`locality`: its neighbourhood) pairs with an end in each
+/// other's neighbourhood are left out. Particles `skip`ped (the base) get
+/// none. `offset` is the collision offset.
+pub fn rim_contacts(
+    moving: &RimSide,
+    other: &RimSide,
+    locality: Option<&Locality>,
+    skip: &[bool],
+    offset: f64,
+    out: &mut Vec<Contact>,
+) {
+    let reach = RIM_REACH * moving.surface.mean_edge.max(other.surface.mean_edge);
+    let mut pairs: Vec<([u32; 2], [u32; 2])> = Vec::new();
+    let mut near = Vec::new();
+    for &q in other.rim_edges {
+        near.clear();
+        edges_near(moving, other.surface.positions, q, reach, &mut near);
+        pairs.extend(near.iter().map(|&p| (p, q)));
+    }
+    for &p in moving.rim_edges {
+        near.clear();
+        edges_near(other, moving.surface.positions, p, reach, &mut near);
+        pairs.extend(near.iter().map(|&q| (p, q)));
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    for (p, q) in pairs {
+        if p.iter().all(|&k| skip[k as usize]) {
+            continue;
+        }
+        if let Some(locality) = locality
+            && p.iter().any(|&a| {
+                q.iter()
+                    .any(|&c| a == c || locality.near(a as usize, c as usize))
+            })
+        {
+            continue;
+        }
+        edge_contact(moving, other, p, q, reach, RIM_OFFSET * offset, skip, out);
+    }
+}
+
+/// The edges (each `[low, high]`) of `side` that may come within `reach`
+/// of the segment `q` of the organ at `positions`: those with an end
+/// within `reach` and a mean edge and a half of it.
+fn edges_near(
+    side: &RimSide,
+    positions: &[DVec3],
+    q: [u32; 2],
+    reach: f64,
+    out: &mut Vec<[u32; 2]>,
+) {
+    let (c, d) = (positions[q[0] as usize], positions[q[1] as usize]);
+    let tracker = side.tracker;
+    let mid = 0.5 * (c + d);
+    // Nothing of `side` near: one look-up.
+    if let Some(cell) = tracker.flat(tracker.cell_of(mid))
+        && !tracker.near[cell]
+        && (c - d).length() < tracker.cell
+    {
+        return;
+    }
+    let within = reach + 1.5 * side.surface.mean_edge;
+    let lo = tracker.cell_of(c.min(d) - DVec3::splat(within));
+    let hi = tracker.cell_of(c.max(d) + DVec3::splat(within));
+    let clamp = |v: i64, k: usize| v.clamp(0, tracker.dims[k] - 1);
+    if (0..3).any(|k| hi[k] < 0 || lo[k] >= tracker.dims[k]) {
+        return;
+    }
+    let own = side.surface.positions;
+    for z in clamp(lo[2], 2)..=clamp(hi[2], 2) {
+        for y in clamp(lo[1], 1)..=clamp(hi[1], 1) {
+            let (Some(first), Some(last)) = (
+                tracker.flat([clamp(lo[0], 0), y, z]),
+                tracker.flat([clamp(hi[0], 0), y, z]),
+            ) else {
+                continue;
+            };
+            let range = tracker.cell_start[first] as usize..tracker.cell_start[last + 1] as usize;
+            for &i in &tracker.items[range] {
+                let x = own[i as usize];
+                let (_, t) = closest_between_segments(x, x, c, d);
+                if x.distance_squared(c + (d - c) * t) > within * within {
+                    continue;
+                }
+                for &tri in side.surface.rings.around(i) {
+                    for k in side.surface.triangles[tri as usize] {
+                        if k != i {
+                            out.push([i.min(k), i.max(k)]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+}
+
+/// The contact of edge `p` of `moving` against edge `q` of `other`, if
+/// they are within `reach` (see the module), kept `apart` apart.
+#[allow(clippy::too_many_arguments)]
+fn edge_contact(
+    moving: &RimSide,
+    other: &RimSide,
+    p: [u32; 2],
+    q: [u32; 2],
+    reach: f64,
+    apart: f64,
+    skip: &[bool],
+    out: &mut Vec<Contact>,
+) {
+    let ends =
+        |positions: &[DVec3], e: [u32; 2]| (positions[e[0] as usize], positions[e[1] as usize]);
+    let (a, b) = ends(moving.surface.positions, p);
+    let (c, d) = ends(other.surface.positions, q);
+    let (s, t) = closest_between_segments(a, b, c, d);
+    let (on_p, on_q) = (a + (b - a) * s, c + (d - c) * t);
+    let between = on_p - on_q;
+    let distance = between.length();
+    if distance > reach {
+        return;
+    }
+    let through = passes_through(moving, p, other, q) || passes_through(other, q, moving, p);
+    let normal = if through {
+        // Crossed: back to the side of each other's line they were on
+        // when the last keyframe ended, if they were on the other side
+        // then (else this pair is not where they crossed).
+        let (a0, b0) = ends(moving.previous, p);
+        let (c0, d0) = ends(other.previous, q);
+        match side_changed(a0, b0, c0, d0, a, b, c, d) {
+            Some(normal) => normal,
+            None => return,
+        }
+    } else if distance > 1e-9 * reach {
+        between / distance
+    } else {
+        return;
+    };
+    for (k, weight) in [(p[0], 1.0 - s), (p[1], s)] {
+        if weight <= 0.0 || skip[k as usize] {
+            continue;
+        }
+        let x = moving.surface.positions[k as usize];
+        out.push(Contact {
+            particle: k,
+            // The plane through the other edge's point, moved with the
+            // edge: this end is as far past it as the edge's point.
+            point: on_q + normal * (x - on_p).dot(normal),
+            normal,
+            offset: apart,
+            weight,
+        });
+    }
+}
+
+/// Whether edge `p` of `first` passes through a triangle of `second`
+/// with edge `q`.
+fn passes_through(first: &RimSide, p: [u32; 2], second: &RimSide, q: [u32; 2]) -> bool {
+    let (a, b) = (
+        first.surface.positions[p[0] as usize],
+        first.surface.positions[p[1] as usize],
+    );
+    let surface = &second.surface;
+    surface.rings.around(q[0]).iter().any(|&t| {
+        let tri = surface.triangles[t as usize];
+        tri.contains(&q[1])
+            && segment_through_triangle(a, b, &tri.map(|k| surface.positions[k as usize])).is_some()
+    })
+}
+
+/// Whether segment `a b` lies on the other side of segment `c d`'s line
+/// (along their common normal) than `a0 b0` of `c0 d0`'s when the last
+/// keyframe ended. If so, the unit common normal now pointing to the side
+/// `a b` was on (the normals turn little in a keyframe; turned by more
+/// than a right angle, nothing is trusted).
+#[allow(clippy::too_many_arguments)]
+fn side_changed(
+    a0: DVec3,
+    b0: DVec3,
+    c0: DVec3,
+    d0: DVec3,
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    d: DVec3,
+) -> Option<DVec3> {
+    let normal = (b - a).cross(d - c).try_normalize()?;
+    let then = (b0 - a0).cross(d0 - c0);
+    let turned = then.dot(normal);
+    let was = then.dot(a0 - c0) * turned.signum();
+    let is = normal.dot(a - c);
+    (turned != 0.0 && was != 0.0 && was.signum() != is.signum()).then_some(normal * was.signum())
+}
+
+/// The parameters `(s, t)` in `[0, 1]` of the nearest points of segments
+/// `a b` and `c d` (`a + s (b - a)`, `c + t (d - c)`); a segment of no
+/// length is its point.
+pub fn closest_between_segments(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
+    let (u, v, w) = (b - a, d - c, a - c);
+    let (uu, vv) = (u.dot(u), v.dot(v));
+    let (uv, uw, vw) = (u.dot(v), u.dot(w), v.dot(w));
+    let tiny = 1e-300;
+    if uu <= tiny && vv <= tiny {
+        return (0.0, 0.0);
+    }
+    if uu <= tiny {
+        return (0.0, (vw / vv).clamp(0.0, 1.0));
+    }
+    if vv <= tiny {
+        return ((-uw / uu).clamp(0.0, 1.0), 0.0);
+    }
+    let denominator = uu * vv - uv * uv;
+    let mut s = if denominator > 1e-14 * uu * vv {
+        ((uv * vw - vv * uw) / denominator).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (uv * s + vw) / vv;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-uw / uu).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((uv - uw) / uu).clamp(0.0, 1.0);
+    }
+    (s, t)
+}
+
+/// The rim edges of a mesh of `triangles`: those of one triangle only,
+/// each `[low, high]`, sorted.
+pub fn rim_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut all: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[i, j]| [i.min(j), i.max(j)])
+        .collect();
+    all.sort_unstable();
+    let mut rim = Vec::new();
+    let mut k = 0;
+    while k < all.len() {
+        let mut n = k + 1;
+        while n < all.len() && all[n] == all[k] {
+            n += 1;
+        }
+        if n - k == 1 {
+            rim.push(all[k]);
+        }
+        k = n;
+    }
+    rim
+}
