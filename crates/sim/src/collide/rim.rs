@@ -57,19 +57,22 @@ pub struct RimSide<'a> {
     pub tracker: &'a Tracker,
     /// Its boundary edges, each `[low, high]`.
     pub rim_edges: &'a [[u32; 2]],
+    /// Its base particles, which attachment places: no edge from one gets
+    /// a rim contact, nor is held off by one.
+    pub base: &'a [bool],
 }
 
 /// The rim contacts of the edges of `moving` against `other` (see the
 /// module): pairs of an edge of `moving` and a rim edge of `other`, and of
 /// a rim edge of `moving` and an edge of `other`. For an organ against
 /// itself (`locality`: its neighbourhood) pairs with an end in each
-/// other's neighbourhood are left out. Particles `skip`ped (the base) get
-/// none. `offset` is the collision offset.
+/// other's neighbourhood are left out, and so are edges with a base
+/// particle at an end (the bases of organs meet on the receptacle by
+/// design). `offset` is the collision offset.
 pub fn rim_contacts(
     moving: &RimSide,
     other: &RimSide,
     locality: Option<&Locality>,
-    skip: &[bool],
     offset: f64,
     out: &mut Vec<Contact>,
 ) {
@@ -78,18 +81,32 @@ pub fn rim_contacts(
     let mut near = Vec::new();
     for &q in other.rim_edges {
         near.clear();
-        edges_near(moving, other.surface.positions, q, reach, &mut near);
+        edges_near(
+            moving,
+            other.surface.positions,
+            q,
+            reach,
+            locality,
+            &mut near,
+        );
         pairs.extend(near.iter().map(|&p| (p, q)));
     }
     for &p in moving.rim_edges {
         near.clear();
-        edges_near(other, moving.surface.positions, p, reach, &mut near);
+        edges_near(
+            other,
+            moving.surface.positions,
+            p,
+            reach,
+            locality,
+            &mut near,
+        );
         pairs.extend(near.iter().map(|&q| (p, q)));
     }
     pairs.sort_unstable();
     pairs.dedup();
     for (p, q) in pairs {
-        if p.iter().all(|&k| skip[k as usize]) {
+        if p.iter().any(|&k| moving.base[k as usize]) || q.iter().any(|&k| other.base[k as usize]) {
             continue;
         }
         if let Some(locality) = locality
@@ -100,38 +117,46 @@ pub fn rim_contacts(
         {
             continue;
         }
-        edge_contact(moving, other, p, q, reach, RIM_OFFSET * offset, skip, out);
+        edge_contact(moving, other, p, q, reach, RIM_OFFSET * offset, out);
     }
 }
 
-/// The edges (each `[low, high]`) of `side` that may come within `reach`
-/// of the segment `q` of the organ at `positions`: those with an end
-/// within `reach` and a mean edge and a half of it.
+/// The edges (each `[low, high]`, perhaps twice) of `side` within `reach`
+/// of the segment `q` of the organ at `positions`; for an organ against
+/// itself (`locality`), none with an end in the neighbourhood of `q`'s.
 fn edges_near(
     side: &RimSide,
     positions: &[DVec3],
     q: [u32; 2],
     reach: f64,
+    locality: Option<&Locality>,
     out: &mut Vec<[u32; 2]>,
 ) {
     let (c, d) = (positions[q[0] as usize], positions[q[1] as usize]);
     let tracker = side.tracker;
-    let mid = 0.5 * (c + d);
-    // Nothing of `side` near: one look-up.
-    if let Some(cell) = tracker.flat(tracker.cell_of(mid))
-        && !tracker.near[cell]
-        && (c - d).length() < tracker.cell
-    {
+    // Nothing of `side` within a cell or two of the segment: a look-up
+    // per end and the middle.
+    let far = |x: DVec3| {
+        tracker
+            .flat(tracker.cell_of(x))
+            .is_none_or(|cell| !tracker.near[cell])
+    };
+    if far(c) && far(d) && far(0.5 * (c + d)) {
         return;
     }
-    let within = reach + 1.5 * side.surface.mean_edge;
+    // An edge within reach has an end within reach and an edge of it.
+    let within = reach + side.surface.mean_edge;
     let lo = tracker.cell_of(c.min(d) - DVec3::splat(within));
     let hi = tracker.cell_of(c.max(d) + DVec3::splat(within));
-    let clamp = |v: i64, k: usize| v.clamp(0, tracker.dims[k] - 1);
     if (0..3).any(|k| hi[k] < 0 || lo[k] >= tracker.dims[k]) {
         return;
     }
+    let clamp = |v: i64, k: usize| v.clamp(0, tracker.dims[k] - 1);
     let own = side.surface.positions;
+    let local = |i: u32| {
+        locality
+            .is_some_and(|l| l.near(i as usize, q[0] as usize) || l.near(i as usize, q[1] as usize))
+    };
     for z in clamp(lo[2], 2)..=clamp(hi[2], 2) {
         for y in clamp(lo[1], 1)..=clamp(hi[1], 1) {
             let (Some(first), Some(last)) = (
@@ -144,12 +169,20 @@ fn edges_near(
             for &i in &tracker.items[range] {
                 let x = own[i as usize];
                 let (_, t) = closest_between_segments(x, x, c, d);
-                if x.distance_squared(c + (d - c) * t) > within * within {
+                if x.distance_squared(c + (d - c) * t) > within * within || local(i) {
                     continue;
                 }
                 for &tri in side.surface.rings.around(i) {
                     for k in side.surface.triangles[tri as usize] {
-                        if k != i {
+                        // Each edge of the ring once from this end (the
+                        // triangles around `i` share them in pairs).
+                        if k == i || local(k) {
+                            continue;
+                        }
+                        let y = own[k as usize];
+                        let (s, t) = closest_between_segments(x, y, c, d);
+                        let gap = (x + (y - x) * s).distance_squared(c + (d - c) * t);
+                        if gap <= reach * reach {
                             out.push([i.min(k), i.max(k)]);
                         }
                     }
@@ -157,8 +190,6 @@ fn edges_near(
             }
         }
     }
-    out.sort_unstable();
-    out.dedup();
 }
 
 /// The contact of edge `p` of `moving` against edge `q` of `other`, if
@@ -171,7 +202,6 @@ fn edge_contact(
     q: [u32; 2],
     reach: f64,
     apart: f64,
-    skip: &[bool],
     out: &mut Vec<Contact>,
 ) {
     let ends =
@@ -202,7 +232,7 @@ fn edge_contact(
         return;
     };
     for (k, weight) in [(p[0], 1.0 - s), (p[1], s)] {
-        if weight <= 0.0 || skip[k as usize] {
+        if weight <= 0.0 {
             continue;
         }
         let x = moving.surface.positions[k as usize];

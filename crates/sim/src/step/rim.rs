@@ -46,6 +46,7 @@ impl Simulation {
             previous,
             tracker: &geometry[k].tracker,
             rim_edges: self.organs[k].rim_edges(),
+            base: &self.organs[k].is_base,
         };
         let moving = side(i, previous);
         let offset = self.settings.collision_offset;
@@ -57,24 +58,10 @@ impl Simulation {
             else {
                 continue;
             };
-            rim_contacts(
-                &moving,
-                &side(other, then),
-                None,
-                &organ.is_base,
-                offset,
-                &mut list,
-            );
+            rim_contacts(&moving, &side(other, then), None, offset, &mut list);
         }
         let locality = organ.locality();
-        rim_contacts(
-            &moving,
-            &moving,
-            Some(&locality),
-            &organ.is_base,
-            offset,
-            &mut list,
-        );
+        rim_contacts(&moving, &moving, Some(&locality), offset, &mut list);
         list
     }
 }

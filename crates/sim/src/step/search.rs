@@ -27,6 +27,15 @@ impl Simulation {
     /// ([`Violated::MoveAll`]; [`Simulation::contacts`] gives each organ's
     /// list, moved half way where both organs give way).
     pub(crate) fn search(&self, geometry: &mut [Option<Geometry>]) -> Found {
+        self.search_with(geometry, false)
+    }
+
+    /// [`Simulation::search`], with each organ's rim contacts if `rims`
+    /// (see `collide::rim`; after growth none are looked for: where a
+    /// margin grew through a neighbour's rim, the particle contacts and
+    /// the organs' settling part them, and the searches after settling
+    /// hold what is left apart).
+    pub(crate) fn search_with(&self, geometry: &mut [Option<Geometry>], rims: bool) -> Found {
         let mut parts = vec![Vec::new(); self.organs.len()];
         self.obstacle_contacts(&mut parts, &vec![true; self.organs.len()]);
         self.drop_base_contacts(&mut parts);
@@ -38,7 +47,11 @@ impl Simulation {
             });
         let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
         let selves = self.self_contacts(&geometry);
-        let rims = self.rim_contacts(&geometry);
+        let rims = if rims {
+            self.rim_contacts(&geometry)
+        } else {
+            vec![Vec::new(); self.organs.len()]
+        };
         let free = self
             .free
             .par_iter()
