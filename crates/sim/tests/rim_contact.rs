@@ -8,8 +8,8 @@
 mod common;
 
 use anthesis_flower::{Flower, Organ, Overlap, Placement, Project, SimulationSettings};
-use anthesis_sim::fixtures::petal_template;
 use anthesis_sim::Selection;
+use anthesis_sim::fixtures::petal_template;
 use common::run_all_warned;
 use glam::DVec3;
 
@@ -86,7 +86,11 @@ fn assert_margins_kept_apart(apart: f64, rule: bool) {
     let last = keyframes.last().expect("keyframes");
     let closest = last.positions_in_world[0]
         .iter()
-        .flat_map(|a| last.positions_in_world[1].iter().map(move |b| a.distance(*b)))
+        .flat_map(|a| {
+            last.positions_in_world[1]
+                .iter()
+                .map(move |b| a.distance(*b))
+        })
         .fold(f64::INFINITY, f64::min);
     assert!(closest < 0.65, "the margins never met: {closest}");
 }

@@ -15,10 +15,11 @@
 //! rim edge of the other. So each pair of edges of which one is a rim edge
 //! and which come within reach of each other gets a contact: the nearest
 //! points of the two edges are kept `RIM_OFFSET` of the collision offset
-//! apart, along the line between them, or, where the edges have passed
-//! through each other since the last keyframe ended (the side of one's
-//! line the other lies on changed, and they met on the way), back along
-//! their common normal to the side they were on.
+//! apart, along the line between them, or, where one edge now passes
+//! through a triangle at the other and the side of each other's line they
+//! lie on (along their common normal) changed since the last keyframe
+//! ended, back along the common normal to the side they were on (a pair
+//! that passes through but kept its side is left to the others).
 //!
 //! The contact acts on the moving organ's edge at the point nearest the
 //! other edge, `P(s) = (1 - s) a + s b`: it is given to the two ends as two
@@ -343,4 +344,83 @@ pub fn rim_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
         k = n;
     }
     rim
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_nearest_points_of_two_segments_are_those_a_fine_search_finds() {
+        let segments = [
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(0.5, -1.0, 0.3),
+                DVec3::new(0.5, 1.0, 0.3),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(2.0, 0.5, 0.0),
+                DVec3::new(3.0, 0.5, 1.0),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(0.2, 0.1, 0.0),
+                DVec3::new(0.9, 0.1, 0.0),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(-1.0, 0.0, 1.0),
+                DVec3::new(-0.5, 2.0, 0.0),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::ZERO,
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(1.0, -1.0, 0.0),
+            ],
+        ];
+        for [a, b, c, d] in segments {
+            let (s, t) = closest_between_segments(a, b, c, d);
+            let found = (a + (b - a) * s).distance(c + (d - c) * t);
+            let n = 400;
+            let mut best = f64::INFINITY;
+            for i in 0..=n {
+                for j in 0..=n {
+                    let (s, t) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+                    best = best.min((a + (b - a) * s).distance(c + (d - c) * t));
+                }
+            }
+            assert!(found <= best + 1e-12, "{found} against {best}");
+            assert!(found > best - 1e-2, "{found} against {best}");
+        }
+    }
+
+    #[test]
+    fn a_square_of_two_triangles_has_four_rim_edges() {
+        assert_eq!(
+            rim_edges(&[[0, 1, 2], [0, 2, 3]]),
+            vec![[0, 1], [0, 3], [1, 2], [2, 3]]
+        );
+    }
+
+    #[test]
+    fn an_edge_turned_past_a_rim_edge_changed_its_side_and_is_sent_back() {
+        // The rim edge along x; an edge across it above (z = 0.1) at the
+        // last keyframe, now below (z = -0.1): sent back up.
+        let (c, d) = (DVec3::ZERO, DVec3::X);
+        let (a0, b0) = (DVec3::new(0.5, -0.5, 0.1), DVec3::new(0.5, 0.5, 0.1));
+        let (a, b) = (a0 - 0.2 * DVec3::Z, b0 - 0.2 * DVec3::Z);
+        let normal = side_changed(a0, b0, c, d, a, b, c, d).expect("changed");
+        assert!((normal - DVec3::Z).length() < 1e-12, "{normal}");
+        // Still above: not changed.
+        assert_eq!(
+            side_changed(a0, b0, c, d, a0, b0 + 0.05 * DVec3::Z, c, d),
+            None
+        );
+    }
 }
