@@ -22,7 +22,7 @@ use anthesis_physics::Contact;
 use glam::{DVec2, DVec3};
 
 mod rim;
-pub use rim::{RimSide, closest_between_segments, rim_contacts, rim_edges};
+pub use rim::{RimSide, SelfNear, closest_between_segments, rim_contacts, rim_edges};
 
 /// One organ's current geometry as collisions see it.
 pub struct Surface<'a> {

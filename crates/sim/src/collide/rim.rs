@@ -36,10 +36,15 @@ use glam::DVec3;
 use super::{Locality, Surface, Tracker};
 
 /// The distance two edges are kept apart, as a fraction of the collision
-/// offset: less than the particle contacts' whole offset, so that where a
+/// offset: under the particle contacts' whole offset, so that where a
 /// margin rests on a neighbour the particle contacts hold it and these
-/// stay slack.
-pub const RIM_OFFSET: f64 = 0.5;
+/// stay slack. At half the offset an organ whose joint is driven through
+/// its neighbour's base (`collisions.rs`) was squeezed against the
+/// neighbour's margin until an edge shrank to 0.81 of its bud length, and
+/// Maite Lady took 578 iterations instead of 402; at a quarter margins
+/// driven rim on rim 9 or 10 apart (`rim_contact.rs`) still cross by a
+/// triangle pair or three, which they did not at a half.
+pub const RIM_OFFSET: f64 = 0.25;
 
 /// Edge pairs nearer than this, in mean edges (the larger organ's), get a
 /// contact (held fixed, like the particle contacts, while the organs
@@ -58,22 +63,43 @@ pub struct RimSide<'a> {
     pub tracker: &'a Tracker,
     /// Its boundary edges, each `[low, high]`.
     pub rim_edges: &'a [[u32; 2]],
-    /// Its base particles, which attachment places: no edge from one gets
-    /// a rim contact, nor is held off by one.
+    /// Its base particles, which attachment places, and those next to
+    /// them: no edge from one gets a rim contact, nor is held off by one.
     pub base: &'a [bool],
+}
+
+/// Where an organ is near itself along its surface, for its rim contacts
+/// against itself: its neighbourhood in the scaled UV layout
+/// (`locality`), or less than `bud_near` apart in the bud (`bud`): a
+/// petal narrowing to its base has its two margins a few edges apart there
+/// but the whole width apart in UV.
+pub struct SelfNear<'a> {
+    /// The organ's neighbourhood in its scaled UV layout.
+    pub locality: Locality<'a>,
+    /// Its particles in the bud.
+    pub bud: &'a [DVec3],
+    /// Particles nearer than this in the bud are near.
+    pub bud_near: f64,
+}
+
+impl SelfNear<'_> {
+    fn near(&self, a: usize, b: usize) -> bool {
+        self.locality.near(a, b)
+            || self.bud[a].distance_squared(self.bud[b]) < self.bud_near * self.bud_near
+    }
 }
 
 /// The rim contacts of the edges of `moving` against `other` (see the
 /// module): pairs of an edge of `moving` and a rim edge of `other`, and of
 /// a rim edge of `moving` and an edge of `other`. For an organ against
-/// itself (`locality`: its neighbourhood) pairs with an end in each
+/// itself (`locality`: where it is near itself) pairs with an end in each
 /// other's neighbourhood are left out, and so are edges with a base
 /// particle at an end (the bases of organs meet on the receptacle by
 /// design). `offset` is the collision offset.
 pub fn rim_contacts(
     moving: &RimSide,
     other: &RimSide,
-    locality: Option<&Locality>,
+    locality: Option<&SelfNear>,
     offset: f64,
     out: &mut Vec<Contact>,
 ) {
@@ -130,7 +156,7 @@ fn edges_near(
     positions: &[DVec3],
     q: [u32; 2],
     reach: f64,
-    locality: Option<&Locality>,
+    locality: Option<&SelfNear>,
     out: &mut Vec<[u32; 2]>,
 ) {
     let (c, d) = (positions[q[0] as usize], positions[q[1] as usize]);

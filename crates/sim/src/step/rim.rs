@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::search::Geometry;
 use crate::Simulation;
-use crate::collide::{RimSide, rim_contacts};
+use crate::collide::{RimSide, SelfNear, rim_contacts};
 
 impl Simulation {
     /// Every organ's rim contacts where the organs are (`geometry`: each
@@ -46,7 +46,7 @@ impl Simulation {
             previous,
             tracker: &geometry[k].tracker,
             rim_edges: self.organs[k].rim_edges(),
-            base: &self.organs[k].is_base,
+            base: self.organs[k].near_base(),
         };
         let moving = side(i, previous);
         let offset = self.settings.collision_offset;
@@ -61,7 +61,12 @@ impl Simulation {
             rim_contacts(&moving, &side(other, then), None, offset, &mut list);
         }
         let locality = organ.locality();
-        rim_contacts(&moving, &moving, Some(&locality), offset, &mut list);
+        let near = SelfNear {
+            bud_near: 0.5 * locality.local,
+            locality,
+            bud: &organ.initial,
+        };
+        rim_contacts(&moving, &moving, Some(&near), offset, &mut list);
         list
     }
 }
