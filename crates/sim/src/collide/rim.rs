@@ -49,7 +49,7 @@ pub const RIM_OFFSET: f64 = 0.25;
 /// Edge pairs nearer than this, in mean edges (the larger organ's), get a
 /// contact (held fixed, like the particle contacts, while the organs
 /// settle).
-pub const RIM_REACH: f64 = 1.0;
+pub const RIM_REACH: f64 = 0.5;
 
 /// One organ as the rim search sees it: where it is, where it was when
 /// the last keyframe ended, its nearest-particle lookup where it is and its
@@ -80,6 +80,9 @@ pub struct SelfNear<'a> {
     pub bud: &'a [DVec3],
     /// Particles nearer than this in the bud are near.
     pub bud_near: f64,
+    /// The organ's tracker's cells' bounds of `locality.uv`
+    /// ([`Tracker::cell_bounds`]).
+    pub cells: Vec<(glam::DVec2, glam::DVec2)>,
 }
 
 impl SelfNear<'_> {
@@ -106,7 +109,36 @@ pub fn rim_contacts(
     let reach = RIM_REACH * moving.surface.mean_edge.max(other.surface.mean_edge);
     let mut pairs: Vec<([u32; 2], [u32; 2])> = Vec::new();
     let mut near = Vec::new();
-    for &q in other.rim_edges {
+    // Against itself, only rim edges with an end that has a particle
+    // beyond its neighbourhood within the tracker's reach (two mean
+    // edges) can have a pair (a smooth sheet's rim has none: one look-up
+    // per rim particle, skipping the cells wholly in the neighbourhood).
+    let beyond = |k: u32| {
+        locality.is_none_or(|l| {
+            moving
+                .tracker
+                .nearest_beyond(
+                    moving.surface.positions[k as usize],
+                    moving.surface.positions,
+                    &l.cells,
+                    &l.locality,
+                    k as usize,
+                )
+                .is_some()
+        })
+    };
+    let mut rims_near: Vec<[u32; 2]> = Vec::new();
+    let (other_rims, moving_rims) = if locality.is_some() {
+        let mut flagged = std::collections::BTreeMap::new();
+        rims_near.extend(moving.rim_edges.iter().copied().filter(|e| {
+            e.iter()
+                .any(|&k| *flagged.entry(k).or_insert_with(|| beyond(k)))
+        }));
+        (rims_near.as_slice(), rims_near.as_slice())
+    } else {
+        (other.rim_edges, moving.rim_edges)
+    };
+    for &q in other_rims {
         near.clear();
         edges_near(
             moving,
@@ -118,7 +150,7 @@ pub fn rim_contacts(
         );
         pairs.extend(near.iter().map(|&p| (p, q)));
     }
-    for &p in moving.rim_edges {
+    for &p in moving_rims {
         near.clear();
         edges_near(
             other,

@@ -63,6 +63,7 @@ impl Simulation {
         let locality = organ.locality();
         let near = SelfNear {
             bud_near: 0.5 * locality.local,
+            cells: geometry[i].tracker.cell_bounds(locality.uv),
             locality,
             bud: &organ.initial,
         };
