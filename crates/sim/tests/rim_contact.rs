@@ -98,9 +98,9 @@ fn assert_margins_kept_apart(apart: f64, rule: bool) {
 #[test]
 fn margins_driven_through_each_other_rim_on_rim_are_kept_apart() {
     // Without rim contacts the margins crossed from keyframe 21 on (1 to
-    // 3 crossing triangle pairs in every keyframe after). (9 and 10 apart
-    // they still cross from keyframe 16 and 17, where they crossed from 17
-    // and 13 without: see `RIM_OFFSET`.)
+    // 3 crossing triangle pairs in every keyframe after). (9, 9.8 and 10
+    // apart they still cross, by 1 to 3 pairs from keyframe 16 or 17,
+    // where they crossed from 17, 12 and 13 without: see `RIM_OFFSET`.)
     assert_margins_kept_apart(9.5, true);
 }
 

@@ -42,8 +42,8 @@ use super::{Locality, Surface, Tracker};
 /// its neighbour's base (`collisions.rs`) was squeezed against the
 /// neighbour's margin until an edge shrank to 0.81 of its bud length, and
 /// Maite Lady took 578 iterations instead of 402; at a quarter margins
-/// driven rim on rim 9 or 10 apart (`rim_contact.rs`) still cross by a
-/// triangle pair or three, which they did not at a half.
+/// driven rim on rim 9, 9.8 or 10 apart (`rim_contact.rs`) still cross by
+/// a triangle pair or three, which they did not at a half.
 pub const RIM_OFFSET: f64 = 0.25;
 
 /// Edge pairs nearer than this, in mean edges (the larger organ's), get a
