@@ -16,7 +16,9 @@
 //! Eustoma Maite Lady at half its thickness) and `lily-random-SEED` for
 //! seeds 1 to 3 (the lily's e_in maps replaced by smooth random fields);
 //! and `lily-petals-e-x0.9`, a modest edit: the lily's petals' e-growth
-//! maps times 0.9 (their margins graze the sepals' from keyframe 33).
+//! maps times 0.9 (their margins graze the sepals' from keyframe 33);
+//! and `five-petal-wide-sketch`, the five-petal flower with the wide petal
+//! the window's sketch test draws (its petals of one whorl meet).
 
 use anthesis_flower::Project;
 use anthesis_garden::flowers::{EDGE_SCALE, flower_at_resolution};
@@ -25,7 +27,8 @@ use anthesis_sim::batch::step_through;
 use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::{Selection, Simulation};
 
-const CASES: [&str; 8] = [
+const CASES: [&str; 9] = [
+    "five-petal-wide-sketch",
     "lily-petals-e-x0.9",
     "lily-e-in-x2",
     "petal-e-in-x2",
@@ -81,6 +84,10 @@ fn stress_case(name: &str, scale: f64) -> (Project, Selection) {
             }
             (project, Selection::All)
         }
+        "five-petal-wide-sketch" => (
+            anthesis_garden::five_petal::five_petal_wide_sketch().expect("the sketch builds"),
+            Selection::All,
+        ),
         "lily-e-in-x2" => (e_in_doubled(flower("lily")), Selection::All),
         "petal-e-in-x2" => (e_in_doubled(flower("lily")), Selection::Only(0)),
         "lily-maps-x2" => {
@@ -191,6 +198,19 @@ fn random_e_in(project: &mut Project, seed: u64) {
 fn run_case(name: &str, project: &Project, selection: &Selection) -> String {
     let mut sim = Simulation::new(project, selection).expect("the case simulates");
     sim.on_crossing(OnCrossing::Warn);
+    let bud = sim.bud();
+    let bodies: Vec<anthesis_mesh::crossing::Body> = bud
+        .positions_in_world
+        .iter()
+        .enumerate()
+        .map(|(i, positions)| anthesis_mesh::crossing::Body {
+            positions,
+            triangles: sim.triangles(i),
+        })
+        .collect();
+    let bud_pairs = anthesis_mesh::crossing::CrossingSearch::new()
+        .find(&bodies, 1.0, &|_, _| true)
+        .len();
     let mut contacts = 0u64;
     let last = sim.keyframe_count();
     let stepped = step_through(&mut sim, last, &|| false, &mut |_, k| {
@@ -207,7 +227,7 @@ fn run_case(name: &str, project: &Project, selection: &Selection) -> String {
         .first()
         .map_or("none".to_string(), |c| c.to_string());
     format!(
-        "{name}: {keyframes} keyframes in {seconds:.2} s, {} with crossings ({pairs} crossing triangle pairs), contact particles summed {contacts}, self-contacts summed {}; first: {first}; {ended}",
+        "{name}: bud {bud_pairs} crossing triangle pairs; {keyframes} keyframes in {seconds:.2} s, {} with crossings ({pairs} crossing triangle pairs), contact particles summed {contacts}, self-contacts summed {}; first: {first}; {ended}",
         crossed.len(),
         sim.self_contact_count(),
     )

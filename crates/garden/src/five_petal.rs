@@ -154,3 +154,50 @@ pub(crate) fn five_petal_at(edge_scale: f64) -> Result<Project, GardenError> {
         settings: SimulationSettings::default(),
     })
 }
+
+/// The five-petal flower with its petal replaced by a wide sketched one,
+/// as a user draws it in the window's sketch editor
+/// (`app/tests/xvfb-sketch-petal.sh`): outline strokes through
+/// (∓1, 0), (∓4, 5), (∓6, 10), (∓5, 15), (∓2, 18.5), the vein along
+/// x = 0 up to 19 and one cross-section sagging towards the base from
+/// (-6.5, 10.8) through (0, 8.6) to (6.5, 10.8), each stroke through its
+/// points six mouse moves a segment, applied at the template's own mean
+/// edge (the Shape section's remesh edge). Each petal spans more than a
+/// fifth of the circle, so neighbours of the one whorl meet as they open
+/// (issue 35).
+pub fn five_petal_wide_sketch() -> Result<Project, GardenError> {
+    let stroke = |points: &[f64]| -> Vec<DVec2> {
+        let corners: Vec<DVec2> = points.chunks(2).map(|p| DVec2::new(p[0], p[1])).collect();
+        let mut out = vec![corners[0]];
+        for pair in corners.windows(2) {
+            for s in 1..=6 {
+                out.push(pair[0] + (pair[1] - pair[0]) * (f64::from(s) / 6.0));
+            }
+        }
+        out
+    };
+    let sketch = anthesis_bud::PetalSketch {
+        left: stroke(&[-1.0, 0.0, -4.0, 5.0, -6.0, 10.0, -5.0, 15.0, -2.0, 18.5]),
+        right: stroke(&[1.0, 0.0, 4.0, 5.0, 6.0, 10.0, 5.0, 15.0, 2.0, 18.5]),
+        vein: stroke(&[0.0, 0.0, 0.0, 6.0, 0.0, 12.0, 0.0, 19.0]),
+        sections: vec![stroke(&[
+            -6.5, 10.8, -3.0, 9.2, 0.0, 8.6, 3.0, 9.2, 6.5, 10.8,
+        ])],
+    }
+    .sorted();
+    let sketch_error = |e: &dyn std::fmt::Display| GardenError::Sketch(e.to_string());
+    let petal = sketch.build().map_err(|e| sketch_error(&e))?;
+    let mut project = five_petal()?;
+    let edge = anthesis_bud::quality(&project.flower.templates[0].mesh).mean_edge;
+    let bud = anthesis_bud::build_organ(&petal.surface, &anthesis_bud::RemeshOptions::new(edge))
+        .map_err(|e| sketch_error(&e))?;
+    project.flower = project
+        .flower
+        .with_shape(
+            0,
+            bud.mesh,
+            anthesis_flower::TemplateSource::Sketch { sketch, edge },
+        )
+        .map_err(|e| sketch_error(&e))?;
+    Ok(project)
+}

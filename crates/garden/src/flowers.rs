@@ -39,6 +39,9 @@ pub enum GardenError {
     /// the message says which organs and why.
     #[error("{0}")]
     Arrangement(String),
+    /// A sketched petal could not be built, meshed or used.
+    #[error("the sketched petal: {0}")]
+    Sketch(String),
 }
 
 /// The names of the default flowers (folder names under `assets/flowers/`):

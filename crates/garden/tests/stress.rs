@@ -70,3 +70,42 @@ fn the_lily_petal_painted_to_roll_into_a_scroll_never_shows_a_crossing() {
         error.map_or("the end".to_string(), |e| e.to_string())
     );
 }
+
+/// The five-petal flower with the wide petal the window's sketch test
+/// draws (`five_petal_wide_sketch`, issue 35): each petal spans more than
+/// the fifth of the circle the whorl gives it, so in the bud already
+/// every petal passes through both its neighbours near the base. No
+/// contact can part organs that start through each other (each keeps the
+/// side it was on); the run says so at the first keyframe, naming the
+/// five neighbouring pairs, instead of running on (the window, which goes
+/// on, stopped at keyframe 17, "not converged", caught between petals).
+#[test]
+fn a_sketched_petal_too_wide_for_its_whorl_crosses_its_neighbours_from_the_bud_and_is_stopped_there()
+ {
+    let project = anthesis_garden::five_petal::five_petal_wide_sketch().expect("the sketch builds");
+    let mut sim = Simulation::new(&project, &Selection::All).expect("valid");
+    let bud = sim.bud();
+    let bodies: Vec<anthesis_mesh::crossing::Body> = bud
+        .positions_in_world
+        .iter()
+        .enumerate()
+        .map(|(i, positions)| anthesis_mesh::crossing::Body {
+            positions,
+            triangles: sim.triangles(i),
+        })
+        .collect();
+    let in_bud = anthesis_mesh::crossing::CrossingSearch::new().find(&bodies, 1.0, &|_, _| true);
+    let mut pairs: Vec<(u32, u32)> = in_bud.iter().map(|c| (c.a.body, c.b.body)).collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    assert_eq!(pairs, vec![(0, 1), (0, 4), (1, 2), (2, 3), (3, 4)]);
+    match sim.step(&|| false, &mut |_| {}) {
+        Err(SimError::Crossed(found)) => {
+            assert_eq!(found.keyframe, 1);
+            assert_eq!(found.organs, vec![0, 1, 2, 3, 4]);
+            assert_eq!(found.between.len(), 5);
+        }
+        Err(other) => panic!("the first keyframe stopped otherwise: {other}"),
+        Ok(k) => panic!("keyframe {} was not stopped at its crossing", k.index),
+    }
+}

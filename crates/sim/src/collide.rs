@@ -21,6 +21,9 @@ use anthesis_mesh::nearest::{TriangleRings, closest_point_on_triangle, on_rim, p
 use anthesis_physics::Contact;
 use glam::{DVec2, DVec3};
 
+mod rim;
+pub use rim::{RimSide, SelfNear, closest_between_segments, rim_contacts, rim_edges};
+
 /// One organ's current geometry as collisions see it.
 pub struct Surface<'a> {
     /// The organ's particle positions, in the world frame.

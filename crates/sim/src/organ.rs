@@ -37,6 +37,9 @@ const MIN_STIFFNESS_MAP: f64 = 0.01;
 const ANCHOR_FACTOR: f64 = 1000.0;
 /// Contact penalty stiffness relative to the mean spring stiffness.
 const CONTACT_STIFFNESS_FACTOR: f64 = 1000.0;
+/// Rings of triangles around the base region where rim contacts do not act
+/// (see `OrganSim::near_base`).
+const NEAR_BASE_RINGS: usize = 3;
 
 /// A time key's maps, sampled where the simulation needs them: growth values
 /// per triangle (paper eq. 1) and stiffness values per edge (mean of the
@@ -141,6 +144,13 @@ pub(crate) struct OrganSim {
     rings: TriangleRings,
     /// Whether each particle is on the organ's rim.
     rim: Vec<bool>,
+    /// The organ's rim edges, each `[low, high]` (rim contacts, issue 35).
+    rim_edges: Vec<[u32; 2]>,
+    /// The base particles and those sharing a triangle with one: no edge
+    /// with an end here gets a rim contact (attachment places the base,
+    /// and turned through a neighbour's base the edges next to it were
+    /// crushed).
+    near_base: Vec<bool>,
     placement: Placement,
     schedule: Vec<anthesis_flower::JointRamp>,
     base: Vec<u32>,
@@ -275,6 +285,20 @@ impl OrganSim {
                 .collect(),
             rings: TriangleRings::new(&template.mesh.triangles, template.mesh.vertex_count()),
             rim: topology.boundary_vertices(template.mesh.vertex_count()),
+            rim_edges: crate::collide::rim_edges(&template.mesh.triangles),
+            near_base: {
+                let mut near = vec![false; template.mesh.vertex_count()];
+                base.iter().for_each(|&k| near[k as usize] = true);
+                for _ in 0..NEAR_BASE_RINGS {
+                    let before = near.clone();
+                    for t in &template.mesh.triangles {
+                        if t.iter().any(|&k| before[k as usize]) {
+                            t.iter().for_each(|&k| near[k as usize] = true);
+                        }
+                    }
+                }
+                near
+            },
             placement: organ.placement,
             schedule: template.joint_schedule.clone(),
             base_current: Vec::with_capacity(base.len()),
@@ -487,6 +511,17 @@ impl OrganSim {
             rim: &self.rim,
             mean_edge: self.mean_edge,
         }
+    }
+
+    /// The organ's rim edges, each `[low, high]`, sorted.
+    pub fn rim_edges(&self) -> &[[u32; 2]] {
+        &self.rim_edges
+    }
+
+    /// Whether each particle is a base particle or shares a triangle with
+    /// one (no rim contacts there).
+    pub fn near_base(&self) -> &[bool] {
+        &self.near_base
     }
 
     /// Which of this organ's particles are each other's neighbourhood,

@@ -50,8 +50,9 @@ fn a_petal_pressing_a_coarse_neighbour_pushes_it_away_without_passing_through() 
     // The petals press from keyframe 5. With one-sided contacts the inner
     // one's particles go through the outer one's triangles there: nothing
     // pushes the outer one aside where only the inner one's particles
-    // reach it.
-    assert_eq!(one_sided_crossings.first().map(|c| c.keyframe), Some(5));
+    // reach it (from keyframe 6 since rim contacts hold the inner one's
+    // edges off the outer one's rim a keyframe longer).
+    assert_eq!(one_sided_crossings.first().map(|c| c.keyframe), Some(6));
     let first = crossings.first().map(|c| c.keyframe);
     assert!(
         first.is_none_or(|k| k > 8),
@@ -68,9 +69,12 @@ fn a_petal_pressing_a_coarse_neighbour_pushes_it_away_without_passing_through() 
             .map(|(p, q)| p.z - q.z)
             .fold(0.0, f64::max)
     };
+    // (Rim contacts push it one-sided too, where the inner one's edges
+    // meet its rim: 0.47 edges one-sided, 0.53 two-sided; 0.1 edges more
+    // was asked before them.)
     let (two, one) = (pushed(&both), pushed(&one_sided));
     assert!(
-        two > one + 0.1 * edge,
+        two > one + 0.05 * edge,
         "the pressed petal moved out by {:.3} edges, one-sided {:.3}",
         two / edge,
         one / edge

@@ -22,6 +22,7 @@ mod grow;
 mod guard;
 mod push_back;
 mod record;
+mod rim;
 pub(crate) mod search;
 mod settle;
 
@@ -89,7 +90,7 @@ impl Simulation {
             // there, particles jumped and left spikes; instead, while some
             // particle lies deep on the wrong side, the organs settle again
             // against contacts found where they are now.
-            let next = self.search(&mut geometry);
+            let next = self.search_with(&mut geometry, true);
             let fresh = self.contacts(&next, Violated::MoveHalf, true);
             let deepest = self
                 .organs

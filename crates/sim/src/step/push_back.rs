@@ -25,6 +25,9 @@ struct Pushing {
     side_clear: Vec<Option<(u32, u32)>>,
     free_clear: Vec<Option<(u32, u32)>>,
     self_clear: Vec<Option<u32>>,
+    /// Per organ, the pushes of all organs together when its rim
+    /// contacts last pushed nothing.
+    rim_clear: Vec<Option<u32>>,
     /// The last search against the parts, per organ, per side, per free
     /// pair and per organ against itself; at first those of the search
     /// made before anything was pushed.
@@ -84,6 +87,7 @@ impl Simulation {
             side_clear: vec![None; 2 * self.overlaps.len()],
             free_clear: vec![None; self.free.len()],
             self_clear: vec![None; organs],
+            rim_clear: vec![None; organs],
             found,
             parts_given: vec![true; organs],
             side_at: self
@@ -99,7 +103,8 @@ impl Simulation {
             let pushed_in_pass = self.push_off_parts(&mut state, geometry)
                 + self.push_sides(&mut state, geometry)
                 + self.push_free(&mut state, geometry)
-                + self.push_selves(&mut state, geometry);
+                + self.push_selves(&mut state, geometry)
+                + self.push_rims(&mut state, geometry);
             if pushed_in_pass == 0 {
                 settled = true;
                 break;
@@ -266,6 +271,35 @@ impl Simulation {
             let now = state.pushes[i];
             state.pushed(i, pushed, geometry, &mut clear, now);
             state.self_clear[i] = clear;
+            pushed_in_pass += pushed;
+        }
+        pushed_in_pass
+    }
+
+    /// One pass of each organ's rim contacts: the search made before the
+    /// push-back while nothing has been pushed, else where the organs are.
+    /// Returns the particles pushed.
+    fn push_rims(&mut self, state: &mut Pushing, geometry: &mut [Option<Geometry>]) -> usize {
+        let mut pushed_in_pass = 0;
+        for i in 0..self.organs.len() {
+            let all_pushes: u32 = state.pushes.iter().sum();
+            if self.organs[i].is_kinematic() || state.rim_clear[i] == Some(all_pushes) {
+                continue;
+            }
+            let given = std::mem::take(&mut state.found.rims[i]);
+            let list = if all_pushes == 0 && state.rim_clear[i].is_none() {
+                given
+            } else {
+                for (k, known) in geometry.iter_mut().enumerate() {
+                    known.get_or_insert_with(|| Geometry::of(&self.organs[k]));
+                }
+                let known: Vec<&Geometry> = geometry.iter().flatten().collect();
+                self.rim_contacts_of(i, &known)
+            };
+            let pushed = push_back(&mut self.organs[i].positions, &list, &mut state.moved[i]);
+            let mut clear = state.rim_clear[i];
+            state.pushed(i, pushed, geometry, &mut clear, all_pushes);
+            state.rim_clear[i] = clear;
             pushed_in_pass += pushed;
         }
         pushed_in_pass

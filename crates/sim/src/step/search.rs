@@ -39,6 +39,15 @@ impl Simulation {
     /// ([`Violated::MoveAll`]; [`Simulation::contacts`] gives each organ's
     /// list, moved half way where both organs give way).
     pub(crate) fn search(&self, geometry: &mut [Option<Geometry>]) -> Found {
+        self.search_with(geometry, false)
+    }
+
+    /// [`Simulation::search`], with each organ's rim contacts if `rims`
+    /// (see `collide::rim`; after growth none are looked for: where a
+    /// margin grew through a neighbour's rim, the particle contacts and
+    /// the organs' settling part them, and the searches after settling
+    /// hold what is left apart).
+    pub(crate) fn search_with(&self, geometry: &mut [Option<Geometry>], rims: bool) -> Found {
         let mut parts = vec![Vec::new(); self.organs.len()];
         self.obstacle_contacts(&mut parts, &vec![true; self.organs.len()]);
         self.drop_base_contacts(&mut parts);
@@ -50,6 +59,11 @@ impl Simulation {
             });
         let geometry: Vec<&Geometry> = geometry.iter().flatten().collect();
         let selves = self.self_contacts(&geometry);
+        let rims = if rims {
+            self.rim_contacts(&geometry)
+        } else {
+            vec![Vec::new(); self.organs.len()]
+        };
         let free = self
             .free
             .par_iter()
@@ -93,6 +107,7 @@ impl Simulation {
             parts,
             sides,
             selves,
+            rims,
             free,
             side_held,
             free_held,
@@ -251,6 +266,12 @@ impl Simulation {
         if selves {
             for ((list, own), organ) in contacts.iter_mut().zip(&found.selves).zip(&self.organs) {
                 list.extend(own.iter().map(|&c| match violated {
+                    Violated::MoveHalf => move_half(c, organ.positions[c.particle as usize]),
+                    Violated::MoveAll => c,
+                }));
+            }
+            for ((list, rims), organ) in contacts.iter_mut().zip(&found.rims).zip(&self.organs) {
+                list.extend(rims.iter().map(|&c| match violated {
                     Violated::MoveHalf => move_half(c, organ.positions[c.particle as usize]),
                     Violated::MoveAll => c,
                 }));
@@ -488,6 +509,9 @@ pub(crate) struct Found {
     pub(crate) sides: Vec<Vec<Contact>>,
     /// Each organ's contacts against itself.
     pub(crate) selves: Vec<Vec<Contact>>,
+    /// Each organ's rim contacts (see `collide::rim`), appended after its
+    /// self-contacts.
+    pub(crate) rims: Vec<Vec<Contact>>,
     /// Each free pair's contacts (`Simulation::free`, same order).
     pub(crate) free: Vec<Vec<Contact>>,
     /// Where the violated contacts of each side press on the other organ

@@ -1,0 +1,484 @@
+//! Rim contacts (issue 35): edge–edge proximity between an organ's edges
+//! and the rim (boundary) edges of a neighbour or of itself, the way cloth
+//! simulators keep edges apart (Bridson, Fedkiw and Anderson, "Robust
+//! treatment of collisions, contact and friction for cloth animation",
+//! 2002: point–triangle and edge–edge proximities).
+//!
+//! Particle contacts hold each particle off the neighbour's surface where
+//! it lies over it; a particle beside the neighbour's rim has no point of
+//! its surface under it, so nothing holds it, and an edge from it to a
+//! held particle could pass through the neighbour's rim triangles (a margin
+//! through a margin, rim on rim) while every particle stayed on its side.
+//! Where two surfaces cross, the line they cross along either closes on
+//! itself (then particles of one lie past the other, which the particle
+//! contacts see) or ends on a rim, where an edge of one passes through a
+//! rim edge of the other. So each pair of edges of which one is a rim edge
+//! and which come within reach of each other gets a contact: the nearest
+//! points of the two edges are kept `RIM_OFFSET` of the collision offset
+//! apart, along the line between them, or, where one edge now passes
+//! through a triangle at the other and the side of each other's line they
+//! lie on (along their common normal) changed since the last keyframe
+//! ended, back along the common normal to the side they were on (a pair
+//! that passes through but kept its side is left to the others).
+//!
+//! The contact acts on the moving organ's edge at the point nearest the
+//! other edge, `P(s) = (1 - s) a + s b`: it is given to the two ends as two
+//! particle contacts on one plane moved along with the edge, of weights
+//! `1 - s` and `s`, so their forces sum to the edge point's (the same
+//! gradient; the Hessian leaves out the coupling of the two ends) and the
+//! push-back, moving each end by the edge point's violation, moves the
+//! edge onto its side.
+
+use anthesis_mesh::crossing::segment_through_triangle;
+use anthesis_physics::Contact;
+use glam::DVec3;
+
+use super::{Locality, Surface, Tracker};
+
+/// The distance two edges are kept apart, as a fraction of the collision
+/// offset: under the particle contacts' whole offset, so that where a
+/// margin rests on a neighbour the particle contacts hold it and these
+/// stay slack. At half the offset an organ whose joint is driven through
+/// its neighbour's base (`collisions.rs`) was squeezed against the
+/// neighbour's margin until an edge shrank to 0.81 of its bud length, and
+/// Maite Lady took 578 iterations instead of 402; at a quarter margins
+/// driven rim on rim 9, 9.8 or 10 apart (`rim_contact.rs`) still cross by
+/// a triangle pair or three, which they did not at a half.
+pub const RIM_OFFSET: f64 = 0.25;
+
+/// Edge pairs nearer than this, in mean edges (the larger organ's), get a
+/// contact (held fixed, like the particle contacts, while the organs
+/// settle).
+pub const RIM_REACH: f64 = 0.5;
+
+/// One organ as the rim search sees it: where it is, where it was when
+/// the last keyframe ended, its nearest-particle lookup where it is and its
+/// rim edges (each `[low, high]`).
+pub struct RimSide<'a> {
+    /// The organ where it is.
+    pub surface: Surface<'a>,
+    /// Its positions at the end of the last keyframe.
+    pub previous: &'a [DVec3],
+    /// Its nearest-particle lookup where it is.
+    pub tracker: &'a Tracker,
+    /// Its boundary edges, each `[low, high]`.
+    pub rim_edges: &'a [[u32; 2]],
+    /// Its base particles, which attachment places, and those next to
+    /// them: no edge from one gets a rim contact, nor is held off by one.
+    pub base: &'a [bool],
+}
+
+/// Where an organ is near itself along its surface, for its rim contacts
+/// against itself: its neighbourhood in the scaled UV layout
+/// (`locality`), or less than `bud_near` apart in the bud (`bud`): a
+/// petal narrowing to its base has its two margins a few edges apart there
+/// but the whole width apart in UV.
+pub struct SelfNear<'a> {
+    /// The organ's neighbourhood in its scaled UV layout.
+    pub locality: Locality<'a>,
+    /// Its particles in the bud.
+    pub bud: &'a [DVec3],
+    /// Particles nearer than this in the bud are near.
+    pub bud_near: f64,
+    /// The organ's tracker's cells' bounds of `locality.uv`
+    /// ([`Tracker::cell_bounds`]).
+    pub cells: Vec<(glam::DVec2, glam::DVec2)>,
+}
+
+impl SelfNear<'_> {
+    fn near(&self, a: usize, b: usize) -> bool {
+        self.locality.near(a, b)
+            || self.bud[a].distance_squared(self.bud[b]) < self.bud_near * self.bud_near
+    }
+}
+
+/// The rim contacts of the edges of `moving` against `other` (see the
+/// module): pairs of an edge of `moving` and a rim edge of `other`, and of
+/// a rim edge of `moving` and an edge of `other`. For an organ against
+/// itself (`locality`: where it is near itself) pairs with an end in each
+/// other's neighbourhood are left out, and so are edges with a base
+/// particle at an end (the bases of organs meet on the receptacle by
+/// design). `offset` is the collision offset.
+pub fn rim_contacts(
+    moving: &RimSide,
+    other: &RimSide,
+    locality: Option<&SelfNear>,
+    offset: f64,
+    out: &mut Vec<Contact>,
+) {
+    let reach = RIM_REACH * moving.surface.mean_edge.max(other.surface.mean_edge);
+    let mut pairs: Vec<([u32; 2], [u32; 2])> = Vec::new();
+    let mut near = Vec::new();
+    // Against itself, only rim edges with an end that has a particle
+    // beyond its neighbourhood within the tracker's reach (two mean
+    // edges) can have a pair (a smooth sheet's rim has none: one look-up
+    // per rim particle, skipping the cells wholly in the neighbourhood).
+    let beyond = |k: u32| {
+        locality.is_none_or(|l| {
+            moving
+                .tracker
+                .nearest_beyond(
+                    moving.surface.positions[k as usize],
+                    moving.surface.positions,
+                    &l.cells,
+                    &l.locality,
+                    k as usize,
+                )
+                .is_some()
+        })
+    };
+    let mut rims_near: Vec<[u32; 2]> = Vec::new();
+    let (other_rims, moving_rims) = if locality.is_some() {
+        let mut flagged = std::collections::BTreeMap::new();
+        rims_near.extend(moving.rim_edges.iter().copied().filter(|e| {
+            e.iter()
+                .any(|&k| *flagged.entry(k).or_insert_with(|| beyond(k)))
+        }));
+        (rims_near.as_slice(), rims_near.as_slice())
+    } else {
+        (other.rim_edges, moving.rim_edges)
+    };
+    for &q in other_rims {
+        near.clear();
+        edges_near(
+            moving,
+            other.surface.positions,
+            q,
+            reach,
+            locality,
+            &mut near,
+        );
+        pairs.extend(near.iter().map(|&p| (p, q)));
+    }
+    for &p in moving_rims {
+        near.clear();
+        edges_near(
+            other,
+            moving.surface.positions,
+            p,
+            reach,
+            locality,
+            &mut near,
+        );
+        pairs.extend(near.iter().map(|&q| (p, q)));
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    for (p, q) in pairs {
+        if p.iter().any(|&k| moving.base[k as usize]) || q.iter().any(|&k| other.base[k as usize]) {
+            continue;
+        }
+        if let Some(locality) = locality
+            && p.iter().any(|&a| {
+                q.iter()
+                    .any(|&c| a == c || locality.near(a as usize, c as usize))
+            })
+        {
+            continue;
+        }
+        edge_contact(moving, other, p, q, reach, RIM_OFFSET * offset, out);
+    }
+}
+
+/// The edges (each `[low, high]`, perhaps twice) of `side` within `reach`
+/// of the segment `q` of the organ at `positions`; for an organ against
+/// itself (`locality`), none with an end in the neighbourhood of `q`'s.
+fn edges_near(
+    side: &RimSide,
+    positions: &[DVec3],
+    q: [u32; 2],
+    reach: f64,
+    locality: Option<&SelfNear>,
+    out: &mut Vec<[u32; 2]>,
+) {
+    let (c, d) = (positions[q[0] as usize], positions[q[1] as usize]);
+    let tracker = side.tracker;
+    // Nothing of `side` within a cell or two of the segment: a look-up
+    // per end and the middle.
+    let far = |x: DVec3| {
+        tracker
+            .flat(tracker.cell_of(x))
+            .is_none_or(|cell| !tracker.near[cell])
+    };
+    if far(c) && far(d) && far(0.5 * (c + d)) {
+        return;
+    }
+    // An edge within reach has an end within reach and an edge of it.
+    let within = reach + side.surface.mean_edge;
+    let lo = tracker.cell_of(c.min(d) - DVec3::splat(within));
+    let hi = tracker.cell_of(c.max(d) + DVec3::splat(within));
+    if (0..3).any(|k| hi[k] < 0 || lo[k] >= tracker.dims[k]) {
+        return;
+    }
+    let clamp = |v: i64, k: usize| v.clamp(0, tracker.dims[k] - 1);
+    let own = side.surface.positions;
+    let local = |i: u32| {
+        locality
+            .is_some_and(|l| l.near(i as usize, q[0] as usize) || l.near(i as usize, q[1] as usize))
+    };
+    for z in clamp(lo[2], 2)..=clamp(hi[2], 2) {
+        for y in clamp(lo[1], 1)..=clamp(hi[1], 1) {
+            let (Some(first), Some(last)) = (
+                tracker.flat([clamp(lo[0], 0), y, z]),
+                tracker.flat([clamp(hi[0], 0), y, z]),
+            ) else {
+                continue;
+            };
+            let range = tracker.cell_start[first] as usize..tracker.cell_start[last + 1] as usize;
+            for &i in &tracker.items[range] {
+                let x = own[i as usize];
+                let (_, t) = closest_between_segments(x, x, c, d);
+                if x.distance_squared(c + (d - c) * t) > within * within || local(i) {
+                    continue;
+                }
+                for &tri in side.surface.rings.around(i) {
+                    for k in side.surface.triangles[tri as usize] {
+                        // Each edge of the ring once from this end (the
+                        // triangles around `i` share them in pairs).
+                        if k == i || local(k) {
+                            continue;
+                        }
+                        let y = own[k as usize];
+                        let (s, t) = closest_between_segments(x, y, c, d);
+                        let gap = (x + (y - x) * s).distance_squared(c + (d - c) * t);
+                        if gap <= reach * reach {
+                            out.push([i.min(k), i.max(k)]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The contact of edge `p` of `moving` against edge `q` of `other`, if
+/// they are within `reach` (see the module), kept `apart` apart.
+#[allow(clippy::too_many_arguments)]
+fn edge_contact(
+    moving: &RimSide,
+    other: &RimSide,
+    p: [u32; 2],
+    q: [u32; 2],
+    reach: f64,
+    apart: f64,
+    out: &mut Vec<Contact>,
+) {
+    let ends =
+        |positions: &[DVec3], e: [u32; 2]| (positions[e[0] as usize], positions[e[1] as usize]);
+    let (a, b) = ends(moving.surface.positions, p);
+    let (c, d) = ends(other.surface.positions, q);
+    let (s, t) = closest_between_segments(a, b, c, d);
+    let (on_p, on_q) = (a + (b - a) * s, c + (d - c) * t);
+    let between = on_p - on_q;
+    let distance = between.length();
+    if distance > reach {
+        return;
+    }
+    let through = passes_through(moving, p, other, q) || passes_through(other, q, moving, p);
+    let normal = if through {
+        // Crossed: back to the side of each other's line they were on
+        // when the last keyframe ended, if they were on the other side
+        // then (else this pair is not where they crossed).
+        let (a0, b0) = ends(moving.previous, p);
+        let (c0, d0) = ends(other.previous, q);
+        match side_changed(a0, b0, c0, d0, a, b, c, d) {
+            Some(normal) => normal,
+            None => return,
+        }
+    } else if distance > 1e-9 * reach {
+        between / distance
+    } else {
+        return;
+    };
+    for (k, weight) in [(p[0], 1.0 - s), (p[1], s)] {
+        if weight <= 0.0 {
+            continue;
+        }
+        let x = moving.surface.positions[k as usize];
+        out.push(Contact {
+            particle: k,
+            // The plane through the other edge's point, moved with the
+            // edge: this end is as far past it as the edge's point.
+            point: on_q + normal * (x - on_p).dot(normal),
+            normal,
+            offset: apart,
+            weight,
+        });
+    }
+}
+
+/// Whether edge `p` of `first` passes through a triangle of `second`
+/// with edge `q`.
+fn passes_through(first: &RimSide, p: [u32; 2], second: &RimSide, q: [u32; 2]) -> bool {
+    let (a, b) = (
+        first.surface.positions[p[0] as usize],
+        first.surface.positions[p[1] as usize],
+    );
+    let surface = &second.surface;
+    surface.rings.around(q[0]).iter().any(|&t| {
+        let tri = surface.triangles[t as usize];
+        tri.contains(&q[1])
+            && segment_through_triangle(a, b, &tri.map(|k| surface.positions[k as usize])).is_some()
+    })
+}
+
+/// Whether segment `a b` lies on the other side of segment `c d`'s line
+/// (along their common normal) than `a0 b0` of `c0 d0`'s when the last
+/// keyframe ended. If so, the unit common normal now pointing to the side
+/// `a b` was on (the normals turn little in a keyframe; turned by more
+/// than a right angle, nothing is trusted).
+#[allow(clippy::too_many_arguments)]
+fn side_changed(
+    a0: DVec3,
+    b0: DVec3,
+    c0: DVec3,
+    d0: DVec3,
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    d: DVec3,
+) -> Option<DVec3> {
+    let normal = (b - a).cross(d - c).try_normalize()?;
+    let then = (b0 - a0).cross(d0 - c0);
+    let turned = then.dot(normal);
+    let was = then.dot(a0 - c0) * turned.signum();
+    let is = normal.dot(a - c);
+    (turned != 0.0 && was != 0.0 && was.signum() != is.signum()).then_some(normal * was.signum())
+}
+
+/// The parameters `(s, t)` in `[0, 1]` of the nearest points of segments
+/// `a b` and `c d` (`a + s (b - a)`, `c + t (d - c)`); a segment of no
+/// length is its point.
+pub fn closest_between_segments(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
+    let (u, v, w) = (b - a, d - c, a - c);
+    let (uu, vv) = (u.dot(u), v.dot(v));
+    let (uv, uw, vw) = (u.dot(v), u.dot(w), v.dot(w));
+    let tiny = 1e-300;
+    if uu <= tiny && vv <= tiny {
+        return (0.0, 0.0);
+    }
+    if uu <= tiny {
+        return (0.0, (vw / vv).clamp(0.0, 1.0));
+    }
+    if vv <= tiny {
+        return ((-uw / uu).clamp(0.0, 1.0), 0.0);
+    }
+    let denominator = uu * vv - uv * uv;
+    let mut s = if denominator > 1e-14 * uu * vv {
+        ((uv * vw - vv * uw) / denominator).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (uv * s + vw) / vv;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-uw / uu).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((uv - uw) / uu).clamp(0.0, 1.0);
+    }
+    (s, t)
+}
+
+/// The rim edges of a mesh of `triangles`: those of one triangle only,
+/// each `[low, high]`, sorted.
+pub fn rim_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut all: Vec<[u32; 2]> = triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[i, j]| [i.min(j), i.max(j)])
+        .collect();
+    all.sort_unstable();
+    let mut rim = Vec::new();
+    let mut k = 0;
+    while k < all.len() {
+        let mut n = k + 1;
+        while n < all.len() && all[n] == all[k] {
+            n += 1;
+        }
+        if n - k == 1 {
+            rim.push(all[k]);
+        }
+        k = n;
+    }
+    rim
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_nearest_points_of_two_segments_are_those_a_fine_search_finds() {
+        let segments = [
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(0.5, -1.0, 0.3),
+                DVec3::new(0.5, 1.0, 0.3),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(2.0, 0.5, 0.0),
+                DVec3::new(3.0, 0.5, 1.0),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(0.2, 0.1, 0.0),
+                DVec3::new(0.9, 0.1, 0.0),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(-1.0, 0.0, 1.0),
+                DVec3::new(-0.5, 2.0, 0.0),
+            ],
+            [
+                DVec3::ZERO,
+                DVec3::ZERO,
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(1.0, -1.0, 0.0),
+            ],
+        ];
+        for [a, b, c, d] in segments {
+            let (s, t) = closest_between_segments(a, b, c, d);
+            let found = (a + (b - a) * s).distance(c + (d - c) * t);
+            let n = 400;
+            let mut best = f64::INFINITY;
+            for i in 0..=n {
+                for j in 0..=n {
+                    let (s, t) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+                    best = best.min((a + (b - a) * s).distance(c + (d - c) * t));
+                }
+            }
+            assert!(found <= best + 1e-12, "{found} against {best}");
+            assert!(found > best - 1e-2, "{found} against {best}");
+        }
+    }
+
+    #[test]
+    fn a_square_of_two_triangles_has_four_rim_edges() {
+        assert_eq!(
+            rim_edges(&[[0, 1, 2], [0, 2, 3]]),
+            vec![[0, 1], [0, 3], [1, 2], [2, 3]]
+        );
+    }
+
+    #[test]
+    fn an_edge_turned_past_a_rim_edge_changed_its_side_and_is_sent_back() {
+        // The rim edge along x; an edge across it above (z = 0.1) at the
+        // last keyframe, now below (z = -0.1): sent back up.
+        let (c, d) = (DVec3::ZERO, DVec3::X);
+        let (a0, b0) = (DVec3::new(0.5, -0.5, 0.1), DVec3::new(0.5, 0.5, 0.1));
+        let (a, b) = (a0 - 0.2 * DVec3::Z, b0 - 0.2 * DVec3::Z);
+        let normal = side_changed(a0, b0, c, d, a, b, c, d).expect("changed");
+        assert!((normal - DVec3::Z).length() < 1e-12, "{normal}");
+        // Still above: not changed.
+        assert_eq!(
+            side_changed(a0, b0, c, d, a0, b0 + 0.05 * DVec3::Z, c, d),
+            None
+        );
+    }
+}
