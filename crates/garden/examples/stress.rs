@@ -209,7 +209,7 @@ fn run_case(name: &str, project: &Project, selection: &Selection) -> String {
         })
         .collect();
     let bud_pairs = anthesis_mesh::crossing::CrossingSearch::new()
-        .find(&bodies, 1.0, &|_, _| true)
+        .find(&bodies, &|_, _| true)
         .len();
     let mut contacts = 0u64;
     let last = sim.keyframe_count();

@@ -94,7 +94,7 @@ fn a_sketched_petal_too_wide_for_its_whorl_crosses_its_neighbours_from_the_bud_a
             triangles: sim.triangles(i),
         })
         .collect();
-    let in_bud = anthesis_mesh::crossing::CrossingSearch::new().find(&bodies, 1.0, &|_, _| true);
+    let in_bud = anthesis_mesh::crossing::CrossingSearch::new().find(&bodies, &|_, _| true);
     let mut pairs: Vec<(u32, u32)> = in_bud.iter().map(|c| (c.a.body, c.b.body)).collect();
     pairs.sort_unstable();
     pairs.dedup();
