@@ -10,8 +10,9 @@
 # sketch-canvas.png (the empty large canvas), sketch-drawn.png (the
 # strokes), sketch-applied.png and sketched.png (the flower with the
 # sketched petals, the large canvas closed) and bud.png (keyframe 0).
-# Fails when the large canvas is not found or the viewport did not change
-# (fewer than 20000 pixels).
+# Fails when the large canvas is not found, the viewport did not change
+# (fewer than 20000 pixels), or the log names a crossing or a failed run
+# (the petal, 4.8 wide on 19, fits the whorl's fifth of the circle).
 #
 #   app/tests/xvfb-sketch-petal.sh [--binary PATH] [OUT_DIR]
 #
@@ -89,12 +90,16 @@ if [ "${1:-}" = "--in-xvfb" ]; then
     done
     sleep 0.3; xdotool mouseup 1; sleep 1.5
   }
-  # A wide, rounded petal 19 long: left and right outlines, the vein,
-  # then a cross-section sagging towards the base (a cupped petal).
-  draw -1 0 -4 5 -6 10 -5 15 -2 18.5
-  draw 1 0 4 5 6 10 5 15 2 18.5
+  # A rounded petal 19 long and 4.8 wide: left and right outlines, the
+  # vein, then a cross-section sagging towards the base (a cupped petal).
+  # It is anthesis_garden::five_petal::five_petal_sketch(0.4), about the
+  # widest whose five petals do not cross in the bud nor as they open (the
+  # petal 6 wide a side this script drew before crossed its neighbours
+  # from the bud on, issue 35).
+  draw -0.4 0 -1.6 5 -2.4 10 -2 15 -0.8 18.5
+  draw 0.4 0 1.6 5 2.4 10 2 15 0.8 18.5
   draw 0 0 0 6 0 12 0 19
-  draw -6.5 10.8 -3 9.2 0 8.6 3 9.2 6.5 10.8
+  draw -2.6 10.8 -1.2 10.16 0 9.92 1.2 10.16 2.6 10.8
   sleep 2
   xdotool mousemove 800 10; sleep 1
   "$import" -window root "$out/sketch-drawn.png"
@@ -135,4 +140,9 @@ changed=$("$compare" -metric AE -fuzz 10% "$work/before-view.png" "$work/sketche
   null: 2>&1 || true)
 echo "viewport pixels changed: $changed"
 [ "${changed%%.*}" -gt 20000 ] || { echo "FAIL: the flower did not change" >&2; exit 1; }
+# The sketched petals fit their whorl: the run names no crossing (an
+# organ that "passes through" another) and does not fail.
+if grep -E "passes through|^anthesis error" "$work/app.log" >&2; then
+  echo "FAIL: the sketched flower's run crossed or failed (the log above)" >&2; exit 1
+fi
 echo "screenshots in $out"

@@ -18,7 +18,9 @@
 //! and `lily-petals-e-x0.9`, a modest edit: the lily's petals' e-growth
 //! maps times 0.9 (their margins graze the sepals' from keyframe 33);
 //! and `five-petal-wide-sketch`, the five-petal flower with the wide petal
-//! the window's sketch test draws (its petals of one whorl meet).
+//! the window's sketch test drew before (its petals of one whorl meet);
+//! `five-petal-sketch-W` is that petal with its strokes' x times W (the
+//! window's sketch test draws `five_petal::SKETCH_WIDTH_THAT_FITS`).
 
 use anthesis_flower::Project;
 use anthesis_garden::flowers::{EDGE_SCALE, flower_at_resolution};
@@ -88,6 +90,15 @@ fn stress_case(name: &str, scale: f64) -> (Project, Selection) {
             anthesis_garden::five_petal::five_petal_wide_sketch().expect("the sketch builds"),
             Selection::All,
         ),
+        other if other.starts_with("five-petal-sketch-") => {
+            let width: f64 = other["five-petal-sketch-".len()..]
+                .parse()
+                .unwrap_or_else(|_| panic!("five-petal-sketch-W: W a width factor, not {other}"));
+            (
+                anthesis_garden::five_petal::five_petal_sketch(width).expect("the sketch builds"),
+                Selection::All,
+            )
+        }
         "lily-e-in-x2" => (e_in_doubled(flower("lily")), Selection::All),
         "petal-e-in-x2" => (e_in_doubled(flower("lily")), Selection::Only(0)),
         "lily-maps-x2" => {

@@ -156,16 +156,67 @@ pub(crate) fn five_petal_at(edge_scale: f64) -> Result<Project, GardenError> {
 }
 
 /// The five-petal flower with its petal replaced by a wide sketched one,
-/// as a user draws it in the window's sketch editor
-/// (`app/tests/xvfb-sketch-petal.sh`): outline strokes through
-/// (∓1, 0), (∓4, 5), (∓6, 10), (∓5, 15), (∓2, 18.5), the vein along
-/// x = 0 up to 19 and one cross-section sagging towards the base from
-/// (-6.5, 10.8) through (0, 8.6) to (6.5, 10.8), each stroke through its
-/// points six mouse moves a segment, applied at the template's own mean
-/// edge (the Shape section's remesh edge). Each petal spans more than a
-/// fifth of the circle, so neighbours of the one whorl meet as they open
+/// as a user draws it in the window's sketch editor (what
+/// `app/tests/xvfb-sketch-petal.sh` drew before issue 40): outline strokes
+/// through (∓1, 0), (∓4, 5), (∓6, 10), (∓5, 15), (∓2, 18.5), the vein
+/// along x = 0 up to 19 and one cross-section sagging towards the base
+/// from (-6.5, 10.8) through (0, 8.6) to (6.5, 10.8), each stroke through
+/// its points six mouse moves a segment, applied at the template's own
+/// mean edge (the Shape section's remesh edge). Each petal spans more than
+/// a fifth of the circle, so neighbours of the one whorl meet as they open
 /// (issue 35).
 pub fn five_petal_wide_sketch() -> Result<Project, GardenError> {
+    five_petal_of_strokes(
+        &[-1.0, 0.0, -4.0, 5.0, -6.0, 10.0, -5.0, 15.0, -2.0, 18.5],
+        &[1.0, 0.0, 4.0, 5.0, 6.0, 10.0, 5.0, 15.0, 2.0, 18.5],
+        &[0.0, 0.0, 0.0, 6.0, 0.0, 12.0, 0.0, 19.0],
+        &[-6.5, 10.8, -3.0, 9.2, 0.0, 8.6, 3.0, 9.2, 6.5, 10.8],
+    )
+}
+
+/// The width factor of [`five_petal_sketch`] the window's sketch test
+/// (`app/tests/xvfb-sketch-petal.sh`) draws: a half width of 2.4 on a
+/// length of 19. Its five-petal flower has no crossing in the bud and
+/// opens to its last keyframe without one (`crates/garden/tests/stress.rs`);
+/// 0.42 is the widest that does (0.43 crosses in the bud), so the few
+/// hundredths below leave room for the window's strokes, which land on
+/// whole pixels.
+pub const SKETCH_WIDTH_THAT_FITS: f64 = 0.4;
+
+/// [`five_petal_wide_sketch`]'s petal scaled across by `width`: every
+/// stroke point's x times `width`, and the cross-section's sag below its
+/// ends (8.6 at the vein, 10.8 at the margins) too, so the petal keeps its
+/// rounded outline and its cup's shape (the margins raised in proportion
+/// to the width); the vein and the length unchanged.
+pub fn five_petal_sketch(width: f64) -> Result<Project, GardenError> {
+    let across = |points: &[f64]| -> Vec<f64> {
+        points
+            .chunks(2)
+            .flat_map(|p| [p[0] * width, p[1]])
+            .collect()
+    };
+    let section: Vec<f64> = across(&[-6.5, 10.8, -3.0, 9.2, 0.0, 8.6, 3.0, 9.2, 6.5, 10.8])
+        .chunks(2)
+        .flat_map(|p| [p[0], 10.8 - (10.8 - p[1]) * width])
+        .collect();
+    five_petal_of_strokes(
+        &across(&[-1.0, 0.0, -4.0, 5.0, -6.0, 10.0, -5.0, 15.0, -2.0, 18.5]),
+        &across(&[1.0, 0.0, 4.0, 5.0, 6.0, 10.0, 5.0, 15.0, 2.0, 18.5]),
+        &[0.0, 0.0, 0.0, 6.0, 0.0, 12.0, 0.0, 19.0],
+        &section,
+    )
+}
+
+/// The five-petal flower with its petal sketched by strokes through the
+/// corners `left`, `right`, `vein` and `section` (x, y pairs), six mouse
+/// moves a corner-to-corner segment, applied at the template's own mean
+/// edge.
+fn five_petal_of_strokes(
+    left: &[f64],
+    right: &[f64],
+    vein: &[f64],
+    section: &[f64],
+) -> Result<Project, GardenError> {
     let stroke = |points: &[f64]| -> Vec<DVec2> {
         let corners: Vec<DVec2> = points.chunks(2).map(|p| DVec2::new(p[0], p[1])).collect();
         let mut out = vec![corners[0]];
@@ -177,12 +228,10 @@ pub fn five_petal_wide_sketch() -> Result<Project, GardenError> {
         out
     };
     let sketch = anthesis_bud::PetalSketch {
-        left: stroke(&[-1.0, 0.0, -4.0, 5.0, -6.0, 10.0, -5.0, 15.0, -2.0, 18.5]),
-        right: stroke(&[1.0, 0.0, 4.0, 5.0, 6.0, 10.0, 5.0, 15.0, 2.0, 18.5]),
-        vein: stroke(&[0.0, 0.0, 0.0, 6.0, 0.0, 12.0, 0.0, 19.0]),
-        sections: vec![stroke(&[
-            -6.5, 10.8, -3.0, 9.2, 0.0, 8.6, 3.0, 9.2, 6.5, 10.8,
-        ])],
+        left: stroke(left),
+        right: stroke(right),
+        vein: stroke(vein),
+        sections: vec![stroke(section)],
     }
     .sorted();
     let sketch_error = |e: &dyn std::fmt::Display| GardenError::Sketch(e.to_string());

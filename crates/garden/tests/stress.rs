@@ -5,7 +5,9 @@
 //! (checked here by testing every pair), and end either at its last
 //! keyframe or with a stop that names the crossing; it used to go on
 //! through itself to keyframe 100 and end with success. The other cases run
-//! with `cargo run --release -p anthesis-garden --example stress`.
+//! with `cargo run --release -p anthesis-garden --example stress`. Also the
+//! five-petal flower with the wide sketched petal (stopped at the bud) and
+//! with the one the window's sketch test now draws (opens with none).
 
 use anthesis_garden::flowers::flower_at_resolution;
 use anthesis_maps::MapKind;
@@ -107,5 +109,66 @@ fn a_sketched_petal_too_wide_for_its_whorl_crosses_its_neighbours_from_the_bud_a
         }
         Err(other) => panic!("the first keyframe stopped otherwise: {other}"),
         Ok(k) => panic!("keyframe {} was not stopped at its crossing", k.index),
+    }
+}
+
+/// Every crossing among `sim`'s organs at `positions` (per organ, in world
+/// space), each organ with itself and with the others.
+fn crossings_among(
+    sim: &Simulation,
+    positions: &[Vec<glam::DVec3>],
+) -> Vec<anthesis_mesh::crossing::Crossing> {
+    let bodies: Vec<anthesis_mesh::crossing::Body> = positions
+        .iter()
+        .enumerate()
+        .map(|(i, positions)| anthesis_mesh::crossing::Body {
+            positions,
+            triangles: sim.triangles(i),
+        })
+        .collect();
+    anthesis_mesh::crossing::CrossingSearch::new().find(&bodies, &|_, _| true)
+}
+
+/// The petal the window's sketch test draws
+/// (`app/tests/xvfb-sketch-petal.sh`): the wide one above scaled across to
+/// `SKETCH_WIDTH_THAT_FITS` (a half width of 2.4 on a length of 19, its cup
+/// in proportion). Its five-petal flower has no crossing in the bud and
+/// none at any keyframe up to the last, which it reaches; a petal 0.05
+/// wider already passes through its neighbours in the bud (the chosen one
+/// is about the widest that fits).
+#[test]
+fn the_sketched_petal_the_window_draws_fits_its_whorl_and_opens_without_a_crossing() {
+    use anthesis_garden::five_petal::{SKETCH_WIDTH_THAT_FITS, five_petal_sketch};
+    let wider = five_petal_sketch(SKETCH_WIDTH_THAT_FITS + 0.05).expect("the sketch builds");
+    let sim = Simulation::new(&wider, &Selection::All).expect("valid");
+    assert!(
+        !crossings_among(&sim, &sim.bud().positions_in_world).is_empty(),
+        "a petal 0.05 wider than the chosen one fits its whorl too: choose it"
+    );
+
+    let project = five_petal_sketch(SKETCH_WIDTH_THAT_FITS).expect("the sketch builds");
+    let mut sim = Simulation::new(&project, &Selection::All).expect("valid");
+    let bud = sim.bud();
+    assert_eq!(bud.positions_in_world.len(), 5);
+    assert_eq!(
+        crossings_among(&sim, &bud.positions_in_world).len(),
+        0,
+        "the bud has crossings"
+    );
+    while !sim.finished() {
+        let k = sim
+            .step(&|| false, &mut |_| {})
+            .unwrap_or_else(|e| panic!("the run stopped: {e}"));
+        let found = crossings_among(&sim, &k.positions_in_world);
+        assert!(
+            found.is_empty(),
+            "keyframe {}: {} crossing triangle pairs, the first {:?}",
+            k.index,
+            found.len(),
+            found[0]
+        );
+        if sim.finished() {
+            assert_eq!(k.index, project.settings.keyframes);
+        }
     }
 }
