@@ -149,12 +149,7 @@ pub fn checked_with<N: egui::emath::Numeric>(
                 } else {
                     read_typed(text, &parse_range)
                 };
-                let value = match read {
-                    Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
-                    Typed::Refused(_) | Typed::NotWhole(_) => None,
-                };
-                *typed.borrow_mut() = Some(read);
-                value
+                keep_typed(read, &typed)
             }),
     ));
     let outside = outside_note(label, value.to_f64(), &range_f64);
@@ -273,15 +268,7 @@ pub fn checked_slider<N: egui::emath::Numeric>(
             // drawn: a value loaded or picked outside it is kept instead
             // (and marked below); a drag or a typed value stays inside.
             .clamping(egui::SliderClamping::Edits)
-            .custom_parser(|text| {
-                let read = read_typed(text, &parse_range);
-                let value = match read {
-                    Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
-                    Typed::Refused(_) | Typed::NotWhole(_) => None,
-                };
-                *typed.borrow_mut() = Some(read);
-                value
-            }),
+            .custom_parser(|text| keep_typed(read_typed(text, &parse_range), &typed)),
     );
     let outside = outside_note(label, value.to_f64(), &range_f64);
     mark_typed(
@@ -401,6 +388,18 @@ pub fn values_at_limits(project: &anthesis_flower::Project) -> Vec<String> {
         }
     }
     said
+}
+
+/// What a field's parser hands egui for `read` (the number the field holds,
+/// or none when the text is refused), kept in `typed` so the field can be
+/// marked and the edit logged after the frame.
+fn keep_typed(read: Typed, typed: &RefCell<Option<Typed>>) -> Option<f64> {
+    let value = match read {
+        Typed::Taken(v) | Typed::Clamped { to: v, .. } => Some(v),
+        Typed::Refused(_) | Typed::NotWhole(_) => None,
+    };
+    *typed.borrow_mut() = Some(read);
+    value
 }
 
 #[cfg(test)]
