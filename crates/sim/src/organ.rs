@@ -16,7 +16,7 @@ use anthesis_physics::{
 };
 use anthesis_twostate::TwoState;
 use std::collections::VecDeque;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::{DQuat, DVec2, DVec3};
 
@@ -180,6 +180,9 @@ pub(crate) struct OrganSim {
     /// Positions at the end of the last (up to) three keyframes, oldest
     /// first, for [`OrganSim::predict`]; shared with the saved states.
     history: VecDeque<Arc<Vec<DVec3>>>,
+    /// The vertex normals of the last of `history`, made on first use:
+    /// every contact search of a keyframe (three to five) asks for them.
+    previous_normals: OnceLock<Vec<DVec3>>,
     /// The current positions as [`OrganSim::save`] stored them, so the next
     /// keyframe's history shares them instead of copying.
     saved: Option<Arc<Vec<DVec3>>>,
@@ -325,6 +328,7 @@ impl OrganSim {
             rates: Vec::new(),
             rotation_guess: DQuat::IDENTITY,
             history: VecDeque::with_capacity(3),
+            previous_normals: OnceLock::new(),
             saved: None,
             settled: None,
             attached_positions: Vec::new(),
@@ -439,6 +443,7 @@ impl OrganSim {
             self.history.pop_front();
         }
         self.history.push_back(latest);
+        self.previous_normals = OnceLock::new();
         let h = &self.history;
         let predicted: Vec<DVec3> = match h.len() {
             3 => (0..self.positions.len())
@@ -540,6 +545,15 @@ impl OrganSim {
     /// it; the bud before the first), if the organ has been grown.
     pub fn previous(&self) -> Option<&[DVec3]> {
         self.history.back().map(|p| p.as_slice())
+    }
+
+    /// The vertex normals of [`OrganSim::previous`].
+    pub fn previous_normals(&self) -> Option<&[DVec3]> {
+        let previous = self.previous()?;
+        Some(
+            self.previous_normals
+                .get_or_init(|| anthesis_mesh::vertex_normals(previous, &self.mesh.triangles)),
+        )
     }
 
     /// One Newton iteration with the base held where the receptacle and the
@@ -705,6 +719,7 @@ impl OrganSim {
         self.elastic.rest_angles.clone_from(&state.rest_angles);
         self.rotation_guess = state.rotation_guess;
         self.history.clone_from(&state.history);
+        self.previous_normals = OnceLock::new();
     }
 
     /// The elastic energy (0 for a kinematic organ, which has none: its

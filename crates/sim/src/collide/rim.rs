@@ -80,9 +80,9 @@ pub struct SelfNear<'a> {
     pub bud: &'a [DVec3],
     /// Particles nearer than this in the bud are near.
     pub bud_near: f64,
-    /// The organ's tracker's cells' bounds of `locality.uv`
-    /// ([`Tracker::cell_bounds`]).
-    pub cells: Vec<(glam::DVec2, glam::DVec2)>,
+    /// Per particle, its nearest particle beyond its neighbourhood within
+    /// the organ's tracker's reach ([`Tracker::nearest_beyond_each`]).
+    pub beyond: &'a [Option<u32>],
 }
 
 impl SelfNear<'_> {
@@ -94,11 +94,11 @@ impl SelfNear<'_> {
 
 /// The rim contacts of the edges of `moving` against `other` (see the
 /// module): pairs of an edge of `moving` and a rim edge of `other`, and of
-/// a rim edge of `moving` and an edge of `other`. For an organ against
-/// itself (`locality`: where it is near itself) pairs with an end in each
-/// other's neighbourhood are left out, and so are edges with a base
-/// particle at an end (the bases of organs meet on the receptacle by
-/// design). `offset` is the collision offset.
+/// a rim edge of `moving` and an edge of `other` ([`rim_pairs`]). For an
+/// organ against itself (`locality`: where it is near itself) pairs with
+/// an end in each other's neighbourhood are left out, and so are edges
+/// with a base particle at an end (the bases of organs meet on the
+/// receptacle by design). `offset` is the collision offset.
 pub fn rim_contacts(
     moving: &RimSide,
     other: &RimSide,
@@ -106,34 +106,34 @@ pub fn rim_contacts(
     offset: f64,
     out: &mut Vec<Contact>,
 ) {
-    let reach = RIM_REACH * moving.surface.mean_edge.max(other.surface.mean_edge);
+    let pairs = rim_pairs(moving, other, locality);
+    rim_contacts_of_pairs(moving, other, &pairs, locality, offset, out);
+}
+
+/// The pairs of an edge of `moving` and an edge of `other` (each
+/// `[low, high]`), one of them a rim edge, that come within reach of each
+/// other (see [`rim_contacts`]), sorted. Those of `other` against `moving`
+/// are these, each turned round: the same edges are measured the same way.
+pub fn rim_pairs(
+    moving: &RimSide,
+    other: &RimSide,
+    locality: Option<&SelfNear>,
+) -> Vec<([u32; 2], [u32; 2])> {
+    let reach = rim_reach(moving, other);
     let mut pairs: Vec<([u32; 2], [u32; 2])> = Vec::new();
     let mut near = Vec::new();
     // Against itself, only rim edges with an end that has a particle
     // beyond its neighbourhood within the tracker's reach (two mean
-    // edges) can have a pair (a smooth sheet's rim has none: one look-up
-    // per rim particle, skipping the cells wholly in the neighbourhood).
-    let beyond = |k: u32| {
-        locality.is_none_or(|l| {
-            moving
-                .tracker
-                .nearest_beyond(
-                    moving.surface.positions[k as usize],
-                    moving.surface.positions,
-                    &l.cells,
-                    &l.locality,
-                    k as usize,
-                )
-                .is_some()
-        })
-    };
+    // edges) can have a pair (a smooth sheet's rim has none).
     let mut rims_near: Vec<[u32; 2]> = Vec::new();
-    let (other_rims, moving_rims) = if locality.is_some() {
-        let mut flagged = std::collections::BTreeMap::new();
-        rims_near.extend(moving.rim_edges.iter().copied().filter(|e| {
-            e.iter()
-                .any(|&k| *flagged.entry(k).or_insert_with(|| beyond(k)))
-        }));
+    let (other_rims, moving_rims) = if let Some(l) = locality {
+        rims_near.extend(
+            moving
+                .rim_edges
+                .iter()
+                .copied()
+                .filter(|e| e.iter().any(|&k| l.beyond[k as usize].is_some())),
+        );
         (rims_near.as_slice(), rims_near.as_slice())
     } else {
         (other.rim_edges, moving.rim_edges)
@@ -164,7 +164,26 @@ pub fn rim_contacts(
     }
     pairs.sort_unstable();
     pairs.dedup();
-    for (p, q) in pairs {
+    pairs
+}
+
+/// Edge pairs nearer than this get a contact: [`RIM_REACH`] mean edges of
+/// the larger organ.
+fn rim_reach(moving: &RimSide, other: &RimSide) -> f64 {
+    RIM_REACH * moving.surface.mean_edge.max(other.surface.mean_edge)
+}
+
+/// [`rim_contacts`] of the edge pairs `pairs` ([`rim_pairs`]).
+pub fn rim_contacts_of_pairs(
+    moving: &RimSide,
+    other: &RimSide,
+    pairs: &[([u32; 2], [u32; 2])],
+    locality: Option<&SelfNear>,
+    offset: f64,
+    out: &mut Vec<Contact>,
+) {
+    let reach = rim_reach(moving, other);
+    for &(p, q) in pairs {
         if p.iter().any(|&k| moving.base[k as usize]) || q.iter().any(|&k| other.base[k as usize]) {
             continue;
         }
@@ -193,6 +212,10 @@ fn edges_near(
 ) {
     let (c, d) = (positions[q[0] as usize], positions[q[1] as usize]);
     let tracker = side.tracker;
+    let within = reach + side.surface.mean_edge;
+    if !tracker.box_within(c.min(d), c.max(d), within) {
+        return;
+    }
     // Nothing of `side` within a cell or two of the segment: a look-up
     // per end and the middle.
     let far = |x: DVec3| {
@@ -203,8 +226,8 @@ fn edges_near(
     if far(c) && far(d) && far(0.5 * (c + d)) {
         return;
     }
-    // An edge within reach has an end within reach and an edge of it.
-    let within = reach + side.surface.mean_edge;
+    // An edge within reach has an end within `within` (reach and an
+    // edge of it).
     let lo = tracker.cell_of(c.min(d) - DVec3::splat(within));
     let hi = tracker.cell_of(c.max(d) + DVec3::splat(within));
     if (0..3).any(|k| hi[k] < 0 || lo[k] >= tracker.dims[k]) {
@@ -215,6 +238,22 @@ fn edges_near(
     let local = |i: u32| {
         locality
             .is_some_and(|l| l.near(i as usize, q[0] as usize) || l.near(i as usize, q[1] as usize))
+    };
+    // A particle outside the segment's box grown by `within` is farther.
+    let (box_lo, box_hi) = (c.min(d) - within, c.max(d) + within);
+    // Rounding allowance of the bound below (it never drops an edge the
+    // exact test keeps).
+    let slack = 1e-9 * (within + side.surface.mean_edge);
+    let mut seen: Vec<u32> = Vec::with_capacity(16);
+    // The squared distance of a particle at `x` to the segment, if within
+    // `within`.
+    let end_gap = |x: DVec3| {
+        if x.cmplt(box_lo).any() || x.cmpgt(box_hi).any() {
+            return None;
+        }
+        let (_, t) = closest_between_segments(x, x, c, d);
+        let gap = x.distance_squared(c + (d - c) * t);
+        (gap <= within * within).then_some(gap)
     };
     for z in clamp(lo[2], 2)..=clamp(hi[2], 2) {
         for y in clamp(lo[1], 1)..=clamp(hi[1], 1) {
@@ -227,18 +266,38 @@ fn edges_near(
             let range = tracker.cell_start[first] as usize..tracker.cell_start[last + 1] as usize;
             for &i in &tracker.items[range] {
                 let x = own[i as usize];
-                let (_, t) = closest_between_segments(x, x, c, d);
-                if x.distance_squared(c + (d - c) * t) > within * within || local(i) {
+                let Some(gap_x) = end_gap(x) else {
+                    continue;
+                };
+                if local(i) {
                     continue;
                 }
+                let gap_x = gap_x.sqrt();
+                // Each edge of the ring once from this end (the triangles
+                // around `i` share them in pairs).
+                seen.clear();
                 for &tri in side.surface.rings.around(i) {
                     for k in side.surface.triangles[tri as usize] {
-                        // Each edge of the ring once from this end (the
-                        // triangles around `i` share them in pairs).
-                        if k == i || local(k) {
+                        if k == i || seen.contains(&k) {
+                            continue;
+                        }
+                        seen.push(k);
+                        if local(k) {
                             continue;
                         }
                         let y = own[k as usize];
+                        let gap_y = end_gap(y);
+                        // Both ends are looked at: the lower one tests it.
+                        if k < i && gap_y.is_some() {
+                            continue;
+                        }
+                        // The edge's point nearest the segment lies within
+                        // half its length of an end, so the edge lies at
+                        // least the nearer end's distance less that.
+                        let gap_end = gap_y.map_or(gap_x, |g| gap_x.min(g.sqrt()));
+                        if gap_end - 0.5 * x.distance(y) > reach + slack {
+                            continue;
+                        }
                         let (s, t) = closest_between_segments(x, y, c, d);
                         let gap = (x + (y - x) * s).distance_squared(c + (d - c) * t);
                         if gap <= reach * reach {
@@ -456,6 +515,105 @@ mod tests {
             assert!(found <= best + 1e-12, "{found} against {best}");
             assert!(found > best - 1e-2, "{found} against {best}");
         }
+    }
+
+    /// A sheet of `columns` by `rows` quads, `surface` of its UV square.
+    fn sheet(surface: impl Fn(glam::DVec2) -> DVec3) -> anthesis_mesh::Mesh {
+        anthesis_mesh::generate::parametric_grid(14, 9, surface)
+    }
+
+    #[test]
+    fn the_rim_pairs_are_every_edge_pair_within_reach_and_the_same_either_way() {
+        use anthesis_mesh::nearest::TriangleRings;
+        // Two wavy sheets, the second turned and lifted so that its rim
+        // lies on the first here and there, passes through it and stands
+        // off it elsewhere.
+        let a = sheet(|p| DVec3::new(p.x * 4.0, p.y * 3.0, 0.15 * (5.0 * p.x).sin()));
+        let b = sheet(|p| {
+            let (x, y) = (p.x * 4.0 - 1.0, p.y * 3.0 + 1.2);
+            DVec3::new(
+                0.9 * x + 0.3 * y,
+                y - 0.2 * x,
+                0.1 + 0.3 * (3.0 * p.y).cos() * p.x,
+            )
+        });
+        let mean_edge = 4.0 / 14.0;
+        let parts: Vec<_> = [&a, &b]
+            .iter()
+            .map(|m| {
+                (
+                    TriangleRings::new(&m.triangles, m.vertex_count()),
+                    Tracker::new(&m.positions, 2.0 * mean_edge),
+                    rim_edges(&m.triangles),
+                    vec![false; m.vertex_count()],
+                )
+            })
+            .collect();
+        fn side<'a>(
+            m: &'a anthesis_mesh::Mesh,
+            part: &'a (TriangleRings, Tracker, Vec<[u32; 2]>, Vec<bool>),
+            mean_edge: f64,
+        ) -> RimSide<'a> {
+            RimSide {
+                surface: Surface {
+                    positions: &m.positions,
+                    normals: &[],
+                    triangles: &m.triangles,
+                    rings: &part.0,
+                    rim: &[],
+                    mean_edge,
+                },
+                previous: &m.positions,
+                tracker: &part.1,
+                rim_edges: &part.2,
+                base: &part.3,
+            }
+        }
+        let (first, second) = (
+            side(&a, &parts[0], mean_edge),
+            side(&b, &parts[1], mean_edge),
+        );
+        let found = rim_pairs(&first, &second, None);
+        let mut turned: Vec<_> = rim_pairs(&second, &first, None)
+            .into_iter()
+            .map(|(p, q)| (q, p))
+            .collect();
+        turned.sort_unstable();
+        assert_eq!(found, turned);
+        // Every pair of an edge and a rim edge (either way) within reach.
+        let edges = |m: &anthesis_mesh::Mesh| {
+            let mut all: Vec<[u32; 2]> = m
+                .triangles
+                .iter()
+                .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+                .map(|[i, j]| [i.min(j), i.max(j)])
+                .collect();
+            all.sort_unstable();
+            all.dedup();
+            all
+        };
+        let reach = RIM_REACH * mean_edge;
+        let rim_a = &parts[0].2;
+        let rim_b = &parts[1].2;
+        let mut brute = Vec::new();
+        for p in edges(&a) {
+            for q in edges(&b) {
+                if !(rim_a.contains(&p) || rim_b.contains(&q)) {
+                    continue;
+                }
+                let ends = |m: &anthesis_mesh::Mesh, e: [u32; 2]| {
+                    (m.positions[e[0] as usize], m.positions[e[1] as usize])
+                };
+                let ((x, y), (c, d)) = (ends(&a, p), ends(&b, q));
+                let (s, t) = closest_between_segments(x, y, c, d);
+                if (x + (y - x) * s).distance(c + (d - c) * t) <= reach {
+                    brute.push((p, q));
+                }
+            }
+        }
+        brute.sort_unstable();
+        assert!(brute.len() > 10, "{} pairs", brute.len());
+        assert_eq!(found, brute);
     }
 
     #[test]

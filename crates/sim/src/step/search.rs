@@ -8,6 +8,7 @@ use anthesis_physics::Contact;
 use anthesis_physics::solver::same_position_bits;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 use crate::Simulation;
 use crate::collide::{
@@ -149,10 +150,18 @@ impl Simulation {
         ) else {
             return list;
         };
-        let previous_normals = anthesis_mesh::vertex_normals(previous_other, &o.mesh.triangles);
+        // A kinematic organ has no history: its shape now stands for then.
+        let computed;
+        let previous_normals = match o.previous_normals() {
+            Some(normals) => normals,
+            None => {
+                computed = anthesis_mesh::vertex_normals(previous_other, &o.mesh.triangles);
+                &computed
+            }
+        };
         let then = Surface {
             positions: previous_other,
-            ..o.surface(&previous_normals)
+            ..o.surface(previous_normals)
         };
         kept_side_contacts(
             &m.surface(&[]),
@@ -206,16 +215,13 @@ impl Simulation {
             return list;
         };
         let locality = organ.locality();
-        let cells = known.tracker.cell_bounds(locality.uv);
-        let previous_normals = anthesis_mesh::vertex_normals(previous, &organ.mesh.triangles);
         let then = Surface {
             positions: previous,
-            ..organ.surface(&previous_normals)
+            ..organ.surface(organ.previous_normals().unwrap_or(&[]))
         };
         self_contacts(
             &organ.surface(&known.normals),
-            &known.tracker,
-            &cells,
+            known.beyond(organ),
             &locality,
             &then,
             &organ.is_base,
@@ -527,6 +533,10 @@ pub(crate) struct Found {
 pub(crate) struct Geometry {
     pub(crate) normals: Vec<DVec3>,
     pub(crate) tracker: Tracker,
+    /// Per particle, its nearest particle beyond its neighbourhood
+    /// (self-contact and the rim contacts against itself ask for it),
+    /// made on first use.
+    beyond: OnceLock<Vec<Option<u32>>>,
 }
 
 impl Geometry {
@@ -534,7 +544,20 @@ impl Geometry {
         Geometry {
             normals: anthesis_mesh::vertex_normals(&organ.positions, &organ.mesh.triangles),
             tracker: Tracker::new(&organ.positions, 2.0 * organ.mean_edge),
+            beyond: OnceLock::new(),
         }
+    }
+
+    /// Per particle of `organ` (where this geometry was made), its nearest
+    /// particle within the tracker's reach beyond its neighbourhood
+    /// ([`Tracker::nearest_beyond_each`]).
+    pub(crate) fn beyond(&self, organ: &OrganSim) -> &[Option<u32>] {
+        self.beyond.get_or_init(|| {
+            let locality = organ.locality();
+            let cells = self.tracker.cell_bounds(locality.uv);
+            self.tracker
+                .nearest_beyond_each(&organ.positions, &cells, &locality)
+        })
     }
 }
 
