@@ -1064,6 +1064,7 @@ mod tests {
                 pairs: 4,
                 between: vec![(organ(0, "petal-1"), organ(1, "petal-2"), 4)],
                 organs: vec![0, 1],
+                from_bud: false,
             });
             assert!(session.accept(Event::Crossed { run, crossings }, &mut Vec::new()));
         }

@@ -79,8 +79,9 @@ fn the_lily_petal_painted_to_roll_into_a_scroll_never_shows_a_crossing() {
 /// every petal passes through both its neighbours near the base. No
 /// contact can part organs that start through each other (each keeps the
 /// side it was on); the run says so at the first keyframe, naming the
-/// five neighbouring pairs, instead of running on (the window, which goes
-/// on, stopped at keyframe 17, "not converged", caught between petals).
+/// five neighbouring pairs and that they cross already in the bud,
+/// instead of running on (the window, which goes on, stopped at keyframe
+/// 17, "not converged", caught between petals).
 #[test]
 fn a_sketched_petal_too_wide_for_its_whorl_crosses_its_neighbours_from_the_bud_and_is_stopped_there()
  {
@@ -106,6 +107,10 @@ fn a_sketched_petal_too_wide_for_its_whorl_crosses_its_neighbours_from_the_bud_a
             assert_eq!(found.keyframe, 1);
             assert_eq!(found.organs, vec![0, 1, 2, 3, 4]);
             assert_eq!(found.between.len(), 5);
+            // And says why: they start through each other.
+            assert!(found.from_bud);
+            let said = found.to_string();
+            assert!(said.contains("cross already in the bud"), "{said}");
         }
         Err(other) => panic!("the first keyframe stopped otherwise: {other}"),
         Ok(k) => panic!("keyframe {} was not stopped at its crossing", k.index),

@@ -89,6 +89,11 @@ pub struct Crossings {
     /// The simulated organs taking part in some crossing (their indices,
     /// ascending): those a view outlines.
     pub organs: Vec<usize>,
+    /// Whether some of these organs already cross each other (or
+    /// themselves) in the bud, keyframe 0: contacts keep each organ on the
+    /// side it starts on, so nothing parts organs that start through each
+    /// other; the bud must change (set only at keyframe 1).
+    pub from_bud: bool,
 }
 
 impl fmt::Display for Crossings {
@@ -119,6 +124,15 @@ impl fmt::Display for Crossings {
             .collect();
         if !rest.is_empty() {
             write!(f, "; also {}", rest.join(", "))?;
+        }
+        if self.from_bud {
+            write!(
+                f,
+                ". They cross already in the bud, and contacts keep each organ on the side \
+                 it starts on, so nothing can part them: make the organs narrower, or place \
+                 them farther apart (a whorl sets its organs side by side around the \
+                 receptacle, not overlapping in turn)"
+            )?;
         }
         Ok(())
     }

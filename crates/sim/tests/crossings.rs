@@ -102,6 +102,8 @@ fn organs_driven_through_each_other_stop_the_run_at_the_first_crossing_keyframe(
         );
     }
     assert_eq!(found.organs, vec![0, 1]);
+    // Clean in the bud: nothing said about it.
+    assert!(!found.from_bud);
     let message = SimError::Crossed(found.clone()).to_string();
     assert!(
         message.starts_with(&format!("keyframe {}: `inner` at uv (", found.keyframe))

@@ -123,11 +123,53 @@ impl Simulation {
             .collect();
         crossing_organs.sort_unstable();
         crossing_organs.dedup();
+        // The first keyframe after the bud: do they cross there already?
+        let from_bud = step == 1 && {
+            let in_bud = self.crossing_pairs_in_bud();
+            between.iter().any(|(key, ..)| in_bud.contains(key))
+        };
         Some(Crossings {
             keyframe: step,
             pairs: found.len(),
             between: between.into_iter().map(|(_, a, b, n)| (a, b, n)).collect(),
             organs: crossing_organs,
+            from_bud,
         })
+    }
+
+    /// The pairs of bodies (organs, then parts, as in
+    /// [`Simulation::find_crossings`]) that cross in the bud, at keyframe
+    /// 0's pose; the parts are put back at keyframe 1's after.
+    fn crossing_pairs_in_bud(&mut self) -> Vec<(u32, u32)> {
+        for obstacle in &mut self.obstacles {
+            obstacle.move_to(0);
+        }
+        let organs = self.organs.len();
+        let bodies: Vec<Body<'_>> = self
+            .organs
+            .iter()
+            .map(|o| Body {
+                positions: &o.initial,
+                triangles: &o.mesh.triangles,
+            })
+            .chain(self.obstacles.iter().map(|o| {
+                let s = o.surface();
+                Body {
+                    positions: s.positions,
+                    triangles: s.triangles,
+                }
+            }))
+            .collect();
+        let mut pairs: Vec<(u32, u32)> = self
+            .crossing_search
+            .find(&bodies, &|i, j| i.min(j) < organs)
+            .iter()
+            .map(|c| (c.a.body, c.b.body))
+            .collect();
+        pairs.dedup();
+        for obstacle in &mut self.obstacles {
+            obstacle.move_to(1);
+        }
+        pairs
     }
 }
