@@ -1151,6 +1151,123 @@ mod tests {
         assert!(from_axis < radius + offset + 0.1 * dip, "{from_axis}");
     }
 
+    /// One organ of two flat sheets far apart along its surface (a blade
+    /// on z = 0 and a tip, as a rolled petal's): a grid `columns` by 7,
+    /// edge 1, through `place` (x, y of the grid, from -3); the tip's UVs
+    /// 100 away.
+    fn two_sheets(tip: impl Fn(f64, f64) -> DVec3) -> (anthesis_mesh::Mesh, Vec<DVec2>, usize) {
+        let sheet = |columns: usize, place: &dyn Fn(f64, f64) -> DVec3| {
+            anthesis_mesh::generate::parametric_grid(columns, 7, |uv| {
+                place(-3.0 + uv.x * (columns - 1) as f64, -3.0 + 6.0 * uv.y)
+            })
+        };
+        let blade = sheet(7, &|x, y| DVec3::new(x, y, 0.0));
+        let tip = sheet(4, &tip);
+        let n = blade.positions.len();
+        let mut mesh = blade.clone();
+        mesh.positions.extend(&tip.positions);
+        mesh.triangles
+            .extend(tip.triangles.iter().map(|t| t.map(|k| k + n as u32)));
+        let uv = blade
+            .positions
+            .iter()
+            .map(|p| DVec2::new(p.x, p.y))
+            .chain(
+                tip.uvs
+                    .iter()
+                    .map(|u| DVec2::new(100.0 + 3.0 * u.x, 6.0 * u.y)),
+            )
+            .collect();
+        (mesh, uv, n)
+    }
+
+    #[test]
+    fn a_particle_the_fold_slid_over_keeps_the_side_the_fold_was_on_against_it() {
+        // At the last keyframe the tip came down on the blade tilted, its
+        // margin at x = 0, 0.3 over the blade, rising to the left; the blade
+        // particle at x = 1 lay beside that margin, a mean edge sideways of
+        // it and above the plane of the tilted tip. Now the tip lies flat
+        // 0.05 over the blade and has slid right over that particle: the
+        // particle belongs under the tip, where the blade under the tip was.
+        let (before, uv, blade) = two_sheets(|x, y| DVec3::new(x, y, 0.3 - 0.5 * x));
+        let (now, _, _) = two_sheets(|x, y| DVec3::new(x + 1.5, y, 0.05));
+        let triangles = &now.triangles;
+        let count = now.positions.len();
+        let orient = |positions: &[DVec3]| {
+            let mut normals = anthesis_mesh::vertex_normals(positions, triangles);
+            // Both sheets' inner sides up, as turns of a roll.
+            if normals[0].z < 0.0 {
+                normals.iter_mut().for_each(|n| *n = -*n);
+            }
+            normals
+        };
+        let (normals_before, normals_now) = (orient(&before.positions), orient(&now.positions));
+        let rings = TriangleRings::new(triangles, count);
+        let mut rim = vec![false; count];
+        for e in rim_edges(triangles) {
+            rim[e[0] as usize] = true;
+            rim[e[1] as usize] = true;
+        }
+        let surface = |positions, normals| Surface {
+            positions,
+            normals,
+            triangles,
+            rings: &rings,
+            rim: &rim,
+            mean_edge: 1.0,
+        };
+        let (then, here) = (
+            surface(&before.positions, &normals_before),
+            surface(&now.positions, &normals_now),
+        );
+        let locality = Locality {
+            uv: &uv,
+            local: 6.0,
+        };
+        let tracker = Tracker::new(here.positions, 2.0);
+        let cells = tracker.cell_bounds(&uv);
+        let mut contacts = Vec::new();
+        self_contacts(
+            &here,
+            &tracker,
+            &cells,
+            &locality,
+            &then,
+            &vec![false; count],
+            0.01,
+            Violated::MoveAll,
+            &mut contacts,
+        );
+        // The blade particle at (1, 0, 0).
+        let particle = (0..blade)
+            .find(|&i| now.positions[i].distance(DVec3::new(1.0, 0.0, 0.0)) < 1e-9)
+            .expect("a grid point");
+        let contact = contacts
+            .iter()
+            .find(|c| c.particle as usize == particle)
+            .expect("held off the tip over it");
+        // Measured beside the tilted margin it was above that plane (the
+        // side it used to keep, through the tip); it is held under the tip.
+        assert!(contact.normal.z < -0.9, "held along {}", contact.normal);
+        let mut positions = now.positions.clone();
+        push_back(&mut positions, &[*contact], &mut vec![false; count]);
+        assert!(
+            positions[particle].z <= 0.05 - 0.01 + 1e-9,
+            "pushed to {}",
+            positions[particle]
+        );
+        // The tip's particles over the blade, which lay over it then too,
+        // are held above it.
+        for c in contacts.iter().filter(|c| c.particle as usize >= blade) {
+            assert!(
+                c.normal.z > 0.9,
+                "tip particle {} held along {}",
+                c.particle,
+                c.normal
+            );
+        }
+    }
+
     #[test]
     fn push_back_puts_particles_offset_past_the_surface() {
         let mut positions = vec![DVec3::new(0.0, 0.0, -0.3), DVec3::new(1.0, 0.0, 0.5)];

@@ -648,6 +648,34 @@ mod tests {
     }
 
     #[test]
+    fn a_self_contact_lets_each_turn_close_half_the_gap_while_settling() {
+        // The other turn's plane z = 0, held 0.01 off; two turns closing
+        // on each other from 0.41 apart meet at the offset in the middle
+        // (each allowed 0.2 of the 0.4 left), not each at the other's
+        // place.
+        let c = Contact {
+            particle: 0,
+            point: DVec3::ZERO,
+            normal: DVec3::Z,
+            offset: 0.01,
+            weight: 1.0,
+        };
+        let x = DVec3::new(0.3, -0.2, 0.41);
+        let held = half_gap(c, x);
+        assert!(
+            (held.violation(x) + 0.2).abs() < 1e-12,
+            "{}",
+            held.violation(x)
+        );
+        assert!((held.violation(DVec3::new(1.0, 2.0, 0.21)) - 0.0).abs() < 1e-12);
+        assert_eq!(held.normal, c.normal);
+        // One already 0.1 through goes back half way, as against another
+        // organ.
+        let through = DVec3::new(0.0, 0.0, -0.1);
+        assert_eq!(half_gap(c, through), move_half(c, through));
+    }
+
+    #[test]
     fn two_petals_pressed_together_push_each_other_equally_and_oppositely() {
         let keyframes = 12;
         let project = pressed_together(keyframes);
