@@ -31,18 +31,18 @@
 //! - the rest state keeps the growth ([`LengthBase::Rest`]: the rest
 //!   lengths are the bud's grown by the cumulative growth, not regrown from
 //!   the current shape each step, so the margin's excess length is stored
-//!   rather than forgotten), and the sheet is thin in bending: as thick
-//!   as the template's `thickness` (0.2 units, Table 1), so
-//!   `Kb = Ks (t/2)² = Ks / 100` ([`LilyEdge::bend_ratio`], against Table
-//!   1's `Kb = Ks`; the consistent model's plate has the bending thickness
-//!   `2√(Kb/Ks)`, a length no mesh changes), and the stored excess buckles
-//!   the margin into ripples (README, "Edge growth"). The buckling makes
+//!   rather than forgotten), and the sheet is thin in bending:
+//!   `Kb = Ks / 100` ([`LilyEdge::bend_ratio`], against Table 1's
+//!   `Kb = Ks`; the consistent model's sheet is a plate whose bending
+//!   thickness is `√(8 Kb/Ks)`, here 0.28 units, a length no mesh
+//!   changes), and the stored excess buckles the margin into ripples
+//!   (README, "Edge growth"). The buckling makes
 //!   the Newton iterations slower to settle, so the solver may take up to
 //!   200 per keyframe;
 //! - the mesh resolves that sheet: a mean edge of 0.59 (edge scale
-//!   [`LILY_EDGE_SCALE`], under three thicknesses), where the ripples'
+//!   [`LILY_EDGE_SCALE`], about two thicknesses), where the ripples'
 //!   constant is that of finer meshes. A sheet thinner than the mesh can
-//!   resolve (`Kb = Ks / 1000`, 0.063 thick, before) ripples in a constant
+//!   resolve (`Kb = Ks / 1000`, 0.089 thick, before) ripples in a constant
 //!   that falls with every refinement.
 
 use anthesis_flower::Project;
@@ -63,7 +63,7 @@ pub const LILY_EDGE_DG: f64 = 0.006;
 
 /// The built-in's mean edge as a fraction of Table 1's (0.59 units; the
 /// other flowers: [`EDGE_SCALE`](crate::flowers::EDGE_SCALE), 0.78): fine enough to resolve the sheet
-/// ([`LilyEdge::MARGIN`]'s bending thickness 0.2 units), where the ripples'
+/// ([`LilyEdge::MARGIN`]'s bending thickness 0.28 units), where the ripples'
 /// constant `c` is that of the finer meshes (README, "Edge growth").
 pub const LILY_EDGE_SCALE: f64 = 0.45;
 
@@ -97,7 +97,7 @@ pub struct LilyEdge {
     pub soft_midrib: bool,
     /// Each template's bend stiffness `Kb` over its stretch stiffness `Ks`
     /// (Table 1: 1; small: a sheet thin in bending). A length squared: the
-    /// sheet's bending thickness is `2√bend_ratio` project units.
+    /// sheet's bending thickness is `√(8 bend_ratio)` project units.
     pub bend_ratio: f64,
 }
 
