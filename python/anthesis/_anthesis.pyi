@@ -96,11 +96,22 @@ class Project:
         self, template: str, name: str, key: int = 0
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """(u, v) of the map's pixel centres, each of the map's [h, w] shape."""
-    def get_parameter(self, name: str, template: str | None = None) -> float | int | None: ...
+    def get_parameter(
+        self, name: str, template: str | None = None
+    ) -> float | int | str | None:
+        """A template parameter (``template=``: dg, thickness, stretch_stiffness,
+        bend_stiffness) or a simulation setting (keyframes, relative_tolerance,
+        max_iterations, collision_offset, mean_edge, lengths_from, bend_from).
+        ``lengths_from`` is ``"shape"`` (each step grows every triangle as it
+        is now) or ``"rest"`` (its rest triangle: the rest state accumulates
+        the growth); ``bend_from`` is ``"dihedral"`` or ``"rest_angle"``."""
     def set_parameter(
-        self, name: str, value: float | int | None, template: str | None = None
-    ) -> None: ...
-    def parameters(self, template: str | None = None) -> dict[str, float | int | None]: ...
+        self, name: str, value: float | int | str | None, template: str | None = None
+    ) -> None:
+        """Set a parameter (names and values as in ``get_parameter``); ValueError
+        for a value out of range or not one of the choices, TypeError for a
+        value of the wrong kind; nothing changes then."""
+    def parameters(self, template: str | None = None) -> dict[str, float | int | str | None]: ...
     def copy(self) -> Project: ...
     def __copy__(self) -> Project: ...
     def __deepcopy__(self, memo: Any) -> Project: ...

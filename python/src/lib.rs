@@ -14,6 +14,7 @@ use std::sync::{Arc, Mutex};
 use anthesis_export::{Encoding, GlbOptions, Timing, UsdOptions};
 use anthesis_flower::{MAX_KEYFRAMES, Project, Resolution};
 use anthesis_maps::{DirectionMap, MapKind, ScalarMap};
+use anthesis_physics::{BendBase, LengthBase};
 use anthesis_sim::crossing::OnCrossing;
 use anthesis_sim::memory::KeyframeCost;
 use anthesis_sim::{KeyframeStats, Selection, SimError, Simulation};
@@ -173,6 +174,8 @@ enum Parameter {
     MaxIterations,
     CollisionOffset,
     MeanEdge,
+    LengthsFrom,
+    BendFrom,
 }
 
 const TEMPLATE_PARAMETERS: [(&str, Parameter); 4] = [
@@ -182,13 +185,51 @@ const TEMPLATE_PARAMETERS: [(&str, Parameter); 4] = [
     ("bend_stiffness", Parameter::BendStiffness),
 ];
 
-const SIMULATION_PARAMETERS: [(&str, Parameter); 5] = [
+const SIMULATION_PARAMETERS: [(&str, Parameter); 7] = [
     ("keyframes", Parameter::Keyframes),
     ("relative_tolerance", Parameter::RelativeTolerance),
     ("max_iterations", Parameter::MaxIterations),
     ("collision_offset", Parameter::CollisionOffset),
     ("mean_edge", Parameter::MeanEdge),
+    ("lengths_from", Parameter::LengthsFrom),
+    ("bend_from", Parameter::BendFrom),
 ];
+
+/// `lengths_from`'s values, as in the project file's [simulation].
+const LENGTHS_FROM: [(&str, LengthBase); 2] =
+    [("shape", LengthBase::Shape), ("rest", LengthBase::Rest)];
+
+/// `bend_from`'s values, as in the project file's [simulation].
+const BEND_FROM: [(&str, BendBase); 2] = [
+    ("dihedral", BendBase::Dihedral),
+    ("rest_angle", BendBase::RestAngle),
+];
+
+/// The file's name of `value` in `choices`.
+fn choice_name<T: PartialEq>(choices: &[(&'static str, T)], value: &T) -> &'static str {
+    choices
+        .iter()
+        .find(|(_, v)| v == value)
+        .map_or("", |(name, _)| *name)
+}
+
+/// The value `value` (a string) names in `choices`, or a TypeError or
+/// ValueError that lists the choices.
+fn choice<T: Copy>(name: &str, choices: &[(&str, T)], value: &Bound<'_, PyAny>) -> PyResult<T> {
+    let names = choices
+        .iter()
+        .map(|(n, _)| format!("\"{n}\""))
+        .collect::<Vec<_>>()
+        .join(" or ");
+    let text: String = value
+        .extract()
+        .map_err(|_| PyTypeError::new_err(format!("`{name}` takes a string: {names}")))?;
+    choices
+        .iter()
+        .find(|(n, _)| *n == text)
+        .map(|(_, v)| *v)
+        .ok_or_else(|| PyValueError::new_err(format!("`{name}` must be {names}, got \"{text}\"")))
+}
 
 fn parameter_names(list: &[(&str, Parameter)]) -> String {
     list.iter()
@@ -485,8 +526,15 @@ impl PyProject {
     /// A parameter: with `template`, one of dg, thickness,
     /// stretch_stiffness, bend_stiffness (as in the project file's
     /// [[templates]]); without, one of keyframes, relative_tolerance,
-    /// max_iterations, collision_offset, mean_edge ([simulation]; mean_edge
-    /// is None for the meshes as built).
+    /// max_iterations, collision_offset, mean_edge, lengths_from, bend_from
+    /// ([simulation]; mean_edge is None for the meshes as built).
+    ///
+    /// lengths_from is "shape" (the paper's rule: each step grows every
+    /// triangle as it is now, so growth the shape could not take is
+    /// forgotten) or "rest" (each step grows every triangle's rest triangle,
+    /// so the rest state accumulates the growth; builtin:lily-edge);
+    /// bend_from is "dihedral" (a hinge's growth adds to its current
+    /// dihedral angle) or "rest_angle" (to its rest angle).
     #[pyo3(signature = (name, template = None))]
     fn get_parameter(
         &self,
@@ -514,6 +562,14 @@ impl PyProject {
                 Some(edge) => value(edge),
                 None => Ok(py.None()),
             },
+            (Parameter::LengthsFrom, _) => Ok(choice_name(&LENGTHS_FROM, &settings.length_base)
+                .into_pyobject(py)?
+                .into_any()
+                .unbind()),
+            (Parameter::BendFrom, _) => Ok(choice_name(&BEND_FROM, &settings.bend_base)
+                .into_pyobject(py)?
+                .into_any()
+                .unbind()),
             (p, Some(template)) => {
                 let t = &self.project.flower.templates[self.template_index(template)?];
                 value(match p {
@@ -529,9 +585,11 @@ impl PyProject {
         }
     }
 
-    /// Sets a parameter (names as in `get_parameter`), checked by the rules
-    /// of the project file: a ValueError says what is wrong and nothing
-    /// changes.
+    /// Sets a parameter (names and values as in `get_parameter`: numbers,
+    /// None for mean_edge, strings for lengths_from and bend_from), checked
+    /// by the rules of the project file: a ValueError (a value out of range
+    /// or not one of the choices) or TypeError (a value of the wrong kind)
+    /// says what is wrong and nothing changes.
     #[pyo3(signature = (name, value, template = None))]
     fn set_parameter(
         &mut self,
@@ -602,6 +660,20 @@ impl PyProject {
                 let v = real(value)?;
                 self.edit(|p| {
                     p.settings.collision_offset = v;
+                    Ok(())
+                })
+            }
+            Parameter::LengthsFrom => {
+                let base = choice(name, &LENGTHS_FROM, value)?;
+                self.edit(|p| {
+                    p.settings.length_base = base;
+                    Ok(())
+                })
+            }
+            Parameter::BendFrom => {
+                let base = choice(name, &BEND_FROM, value)?;
+                self.edit(|p| {
+                    p.settings.bend_base = base;
                     Ok(())
                 })
             }

@@ -52,6 +52,47 @@ def test_a_map_changes_the_run(five_petal):
     assert not np.array_equal(run.positions(0)[-1], base.positions(0)[-1])
 
 
+def test_the_growth_rules_are_settings_that_change_the_run(five_petal, tmp_path):
+    """`lengths_from` and `bend_from` (the project file's [simulation]) are
+    read and set as strings; each other rule changes the run, and going back
+    to the default gives the default run bit for bit."""
+    assert five_petal.get_parameter("lengths_from") == "shape"
+    assert five_petal.get_parameter("bend_from") == "dihedral"
+    assert anthesis.load("builtin:lily-edge").get_parameter("lengths_from") == "rest"
+    assert {"lengths_from", "bend_from"} <= set(five_petal.parameters())
+    base = five_petal.simulate(keyframes=3, organ="petal-1").positions(0)
+    for name, other, default in (("lengths_from", "rest", "shape"),
+                                 ("bend_from", "rest_angle", "dihedral")):
+        project = five_petal.copy()
+        project.set_parameter(name, other)
+        assert project.get_parameter(name) == other
+        changed = project.simulate(keyframes=3, organ="petal-1").positions(0)
+        # The bud is the same; the grown keyframes are not.
+        assert changed[0].tobytes() == base[0].tobytes()
+        assert np.abs(changed[-1] - base[-1]).max() > 1e-3, name
+        project.set_parameter(name, default)
+        again = project.simulate(keyframes=3, organ="petal-1").positions(0)
+        assert again.tobytes() == base.tobytes(), name
+    # Saved as the project file says, and read back.
+    project = five_petal.copy()
+    project.set_parameter("lengths_from", "rest")
+    project.save(tmp_path / "rest.anthesis.toml")
+    text = (tmp_path / "rest.anthesis.toml").read_text()
+    assert 'lengths_from = "rest"' in text and "version = 10" in text
+    assert anthesis.load(tmp_path / "rest.anthesis.toml").get_parameter("lengths_from") == "rest"
+    # Refused values name the choices and change nothing.
+    with pytest.raises(ValueError, match='`lengths_from` must be "shape" or "rest", got "rest_length"'):
+        project.set_parameter("lengths_from", "rest_length")
+    with pytest.raises(ValueError, match='`bend_from` must be "dihedral" or "rest_angle", got "rest"'):
+        project.set_parameter("bend_from", "rest")
+    with pytest.raises(TypeError, match='`lengths_from` takes a string: "shape" or "rest"'):
+        project.set_parameter("lengths_from", 1)
+    with pytest.raises(KeyError, match="is a simulation setting"):
+        project.set_parameter("lengths_from", "rest", template="petal")
+    assert project.get_parameter("lengths_from") == "rest"
+    assert project.get_parameter("bend_from") == "dihedral"
+
+
 def test_progress_is_reported_and_cancel_stops_the_run(five_petal):
     seen = []
     five_petal.simulate(keyframes=3, progress=lambda k, total: seen.append((k, total)))

@@ -6,7 +6,7 @@
 //! `cargo run --release -p anthesis-garden --example lily_edge -- EDGE_SCALE OUT_FOLDER [--soft-midrib] [--every N] [--only ORGAN] [--bend-ratio R] [--keyframes N] [--profile-power P] [--layer SHARE POWER] [--lengths-from-shape|--lengths-from-rest] [--bend-from-rest|--bend-from-dihedral] [--max-iterations N] [--no-parts]`
 //!
 //! `--bend-ratio R` sets each template's bend stiffness `Kb` to `R` times
-//! its stretch stiffness `Ks` (the built-in: 0.001); `--keyframes N`
+//! its stretch stiffness `Ks` (the built-in: 0.01); `--keyframes N`
 //! the same opening in `N` steps (`anthesis_garden::retime`: larger steps
 //! of growth, each one's excess at the margin larger); `--profile-power P`
 //! the exponent of the e-growth profile across the width (2 in the
@@ -20,7 +20,7 @@
 //! `--no-parts` the flower without its stamens and pistil.
 //!
 //! `EDGE_SCALE` is the mean edge as a fraction of the paper's (Table 1;
-//! the built-in is 0.6). Prints the particles per organ and the run time.
+//! the built-in is 0.45). Prints the particles per organ and the run time.
 
 use std::io::BufWriter;
 use std::path::PathBuf;

@@ -31,21 +31,26 @@
 //! - the rest state keeps the growth ([`LengthBase::Rest`]: the rest
 //!   lengths are the bud's grown by the cumulative growth, not regrown from
 //!   the current shape each step, so the margin's excess length is stored
-//!   rather than forgotten), and the sheet is thin in bending
-//!   ([`LilyEdge::bend_ratio`]: `Kb = Ks / 1000`, against Table 1's
-//!   `Kb = Ks`), so the stored excess buckles the margin into ripples
-//!   several mesh edges long (README, "Edge growth"). The buckling makes
+//!   rather than forgotten), and the sheet is thin in bending:
+//!   `Kb = Ks / 100` ([`LilyEdge::bend_ratio`], against Table 1's
+//!   `Kb = Ks`; the consistent model's sheet is a plate whose bending
+//!   thickness is `√(8 Kb/Ks)`, here 0.28 units, a length no mesh
+//!   changes), and the stored excess buckles the margin into ripples
+//!   (README, "Edge growth"). The buckling makes
 //!   the Newton iterations slower to settle, so the solver may take up to
-//!   200 per keyframe.
+//!   200 per keyframe;
+//! - the mesh resolves that sheet: a mean edge of 0.59 (edge scale
+//!   [`LILY_EDGE_SCALE`], about two thicknesses), where the ripples'
+//!   constant is that of finer meshes. A sheet thinner than the mesh can
+//!   resolve (`Kb = Ks / 1000`, 0.089 thick, before) ripples in a constant
+//!   that falls with every refinement.
 
 use anthesis_flower::Project;
 use anthesis_maps::{KeyedMaps, MapError};
 use anthesis_physics::LengthBase;
 use glam::DVec2;
 
-use crate::flowers::{
-    EDGE_SCALE, GardenError, LILY_BASE_V, LILY_MIDRIB_HALF_WIDTH, keyed, lily_at,
-};
+use crate::flowers::{GardenError, LILY_BASE_V, LILY_MIDRIB_HALF_WIDTH, keyed, lily_at};
 use crate::paint::{Painting, above_base, midrib_band, smoothstep};
 
 /// The built-in name of the edge-growth lily.
@@ -55,6 +60,12 @@ pub const LILY_EDGE_NAME: &str = "lily-edge";
 /// margin's map value stays below 1 (a map value `m` grows a length by
 /// `1 + 0.006·m` per step).
 pub const LILY_EDGE_DG: f64 = 0.006;
+
+/// The built-in's mean edge as a fraction of Table 1's (0.59 units; the
+/// other flowers: [`EDGE_SCALE`](crate::flowers::EDGE_SCALE), 0.78): fine enough to resolve the sheet
+/// ([`LilyEdge::MARGIN`]'s bending thickness 0.28 units), where the ripples'
+/// constant `c` is that of the finer meshes (README, "Edge growth").
+pub const LILY_EDGE_SCALE: f64 = 0.45;
 
 /// The Newton iterations a keyframe of the edge-growth lily may take (the
 /// other flowers: 50): while the margins buckle the iterations settle
@@ -85,7 +96,8 @@ pub struct LilyEdge {
     /// The midrib band is no stiffer than the lamina.
     pub soft_midrib: bool,
     /// Each template's bend stiffness `Kb` over its stretch stiffness `Ks`
-    /// (Table 1: 1; small: a sheet thin in bending).
+    /// (Table 1: 1; small: a sheet thin in bending). A length squared: the
+    /// sheet's bending thickness is `√(8 bend_ratio)` project units.
     pub bend_ratio: f64,
 }
 
@@ -102,7 +114,7 @@ impl LilyEdge {
         layer_power: 16.0,
         lamina_stiffness: 0.3,
         soft_midrib: false,
-        bend_ratio: 0.001,
+        bend_ratio: 0.01,
     };
 
     /// The same growth with the midrib band as soft as the lamina (the
@@ -153,9 +165,9 @@ pub fn lily_edge_maps(edge: LilyEdge) -> Result<KeyedMaps, MapError> {
     keyed(vec![(0, maps)])
 }
 
-/// The built-in `lily-edge` ([`LilyEdge::MARGIN`]).
+/// The built-in `lily-edge` ([`LilyEdge::MARGIN`] at [`LILY_EDGE_SCALE`]).
 pub fn lily_edge() -> Result<Project, GardenError> {
-    lily_edge_of(LilyEdge::MARGIN, EDGE_SCALE)
+    lily_edge_of(LilyEdge::MARGIN, LILY_EDGE_SCALE)
 }
 
 /// The lily's bud, organs, colours and parts at `edge_scale` times Table

@@ -61,6 +61,10 @@ pub const FLOWER_NAMES: [&str; 8] = [
 
 /// Builds the default flower called `name` (one of [`FLOWER_NAMES`]).
 pub fn flower(name: &str) -> Option<Result<Project, GardenError>> {
+    if name == crate::edge::LILY_EDGE_NAME {
+        // Finer than the others: it resolves its thin sheet.
+        return Some(crate::edge::lily_edge());
+    }
     flower_at_resolution(name, EDGE_SCALE)
 }
 

@@ -101,6 +101,65 @@ mod tests {
     }
 
     #[test]
+    fn the_consistent_hinges_are_a_plate_of_bending_stiffness_three_eighths_kb_h_squared() {
+        // Equilateral triangles of edge h wrapped on a cylinder of
+        // curvature k: the hinges hold (3/16) Kb h² k² per area, the
+        // ½ D k² of a plate with D = (3/8) Kb h² (so, with the membrane's
+        // Y = Ks h² / 2 and ν = 1/3, a bending thickness √(8 Kb/Ks)).
+        use crate::hinge::dihedral_angle;
+        use glam::DVec3;
+        let (h, k, kb, n) = (0.5, 0.05, 3.0, 40usize);
+        let lattice = |i: usize, j: usize| {
+            let x = (i as f64 + 0.5 * (j % 2) as f64) * h;
+            let y = j as f64 * h * 3f64.sqrt() / 2.0;
+            DVec3::new((k * x).sin() / k, y, (1.0 - (k * x).cos()) / k)
+        };
+        let area = 3f64.sqrt() / 4.0 * h * h;
+        let mut energy = 0.0;
+        let mut hinges = 0usize;
+        // Each interior hinge of the lattice once: the edge (p, q) with its
+        // opposite corners (left, right).
+        for j in 1..n - 1 {
+            for i in 1..n - 1 {
+                let o = j % 2;
+                let p = lattice(i, j);
+                let stencils = [
+                    // along x: the corners above and below
+                    [
+                        p,
+                        lattice(i + 1, j),
+                        lattice(i + o, j + 1),
+                        lattice(i + o, j - 1),
+                    ],
+                    // up to the right, and up to the left
+                    [
+                        p,
+                        lattice(i + o, j + 1),
+                        lattice(i + 1, j),
+                        lattice(i + o - 1, j + 1),
+                    ],
+                    [
+                        p,
+                        lattice(i + o - 1, j + 1),
+                        lattice(i + o, j + 1),
+                        lattice(i - 1, j),
+                    ],
+                ];
+                for x in stencils {
+                    let theta = dihedral_angle(x);
+                    let stiffness = Model::Consistent.hinge_stiffness(kb, h, area, h);
+                    energy += 0.5 * stiffness * theta * theta;
+                    hinges += 1;
+                }
+            }
+        }
+        // Three hinges per two triangles.
+        let per_area = energy / (hinges as f64 * 2.0 / 3.0 * area);
+        let plate = 0.5 * (3.0 / 8.0) * kb * h * h * k * k;
+        assert!((per_area / plate - 1.0).abs() < 0.01, "{per_area} {plate}");
+    }
+
+    #[test]
     fn the_consistent_weight_depends_on_the_hinge_shape_as_the_curvature_does() {
         // A hinge twice as long with the same area has triangles half as
         // deep: the same curvature makes half the angle, so it needs four
