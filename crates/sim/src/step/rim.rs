@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::search::Geometry;
 use crate::Simulation;
-use crate::collide::{RimSide, SelfNear, rim_contacts, rim_contacts_of_pairs, rim_pairs};
+use crate::collide::{RimSide, SelfNear, rim_contacts_of_pairs, rim_pairs};
 
 impl Simulation {
     /// Every organ's rim contacts where the organs are (`geometry`: each
@@ -99,7 +99,7 @@ impl Simulation {
         i: usize,
         geometry: &[&Geometry],
         others: &[usize],
-        known: impl Fn(usize) -> Option<Pairs>,
+        known: impl Fn(usize) -> Option<Pairs> + Sync,
     ) -> Vec<Contact> {
         let organ = &self.organs[i];
         let mut list = Vec::new();
@@ -110,13 +110,6 @@ impl Simulation {
             return list;
         };
         let offset = self.settings.collision_offset;
-        for &other in others {
-            let Some(side) = self.rim_side(other, geometry) else {
-                continue;
-            };
-            let pairs = known(other).unwrap_or_else(|| rim_pairs(&moving, &side, None));
-            rim_contacts_of_pairs(&moving, &side, &pairs, None, offset, &mut list);
-        }
         let locality = organ.locality();
         let near = SelfNear {
             bud_near: 0.5 * locality.local,
@@ -124,7 +117,26 @@ impl Simulation {
             locality,
             bud: &organ.initial,
         };
-        rim_contacts(&moving, &moving, Some(&near), offset, &mut list);
+        // The edge pairs against each organ and itself on rayon's threads
+        // (the push-back asks for one organ's at a time); the contacts
+        // from them in order.
+        let (against, own) = rayon::join(
+            || {
+                others
+                    .par_iter()
+                    .map(|&other| {
+                        let side = self.rim_side(other, geometry)?;
+                        let pairs = known(other).unwrap_or_else(|| rim_pairs(&moving, &side, None));
+                        Some((side, pairs))
+                    })
+                    .collect::<Vec<_>>()
+            },
+            || rim_pairs(&moving, &moving, Some(&near)),
+        );
+        for (side, pairs) in against.iter().flatten() {
+            rim_contacts_of_pairs(&moving, side, pairs, None, offset, &mut list);
+        }
+        rim_contacts_of_pairs(&moving, &moving, &own, Some(&near), offset, &mut list);
         list
     }
 }
