@@ -119,8 +119,8 @@ park="700 850"
 canvas_x=1330
 keyframe_54="863 926"
 keyframe_100="1588 926"
-key_40="1357 84"
-key_50="1424 84"
+key_40="1400 107"
+key_50="1472 107"
 preview_box="15 199"
 # The same for the first launch, in the window's default 1400x900 size
 # (the viewport spans x 270-1059, y 25-680).
