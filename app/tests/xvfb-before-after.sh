@@ -78,7 +78,7 @@ changed() {
 
 idle
 click "863 926"   # keyframe 54 on the scrubber
-click "1424 84"   # the step-50 key
+click "1472 107"  # the step-50 key
 canvas_x=1330; y=300
 xdotool mousemove $canvas_x $y; sleep 0.3; xdotool mousedown 1; sleep 0.4
 for s in 1 2 3 4 5 6 7 8 9 10; do
