@@ -2,7 +2,7 @@
 //! and no triangle of an organ crosses another organ's, a part's or its
 //! own (see [`crate::crossing`]).
 
-use anthesis_mesh::crossing::Body;
+use anthesis_mesh::crossing::{Body, Crossing};
 
 use super::search::Found;
 use crate::crossing::{Crossed, Crossings, OnCrossing};
@@ -58,29 +58,8 @@ impl Simulation {
     /// Where the triangles of the organs where they are now cross each
     /// other, themselves or the parts at step `step`'s pose, if anywhere.
     pub(crate) fn find_crossings(&mut self, step: u32) -> Option<Crossings> {
-        for obstacle in &mut self.obstacles {
-            obstacle.move_to(step);
-        }
         let organs = self.organs.len();
-        let bodies: Vec<Body<'_>> = self
-            .organs
-            .iter()
-            .map(|o| Body {
-                positions: &o.positions,
-                triangles: &o.mesh.triangles,
-            })
-            .chain(self.obstacles.iter().map(|o| {
-                let s = o.surface();
-                Body {
-                    positions: s.positions,
-                    triangles: s.triangles,
-                }
-            }))
-            .collect();
-        // Parts against parts are not tested: they overlap by design.
-        let found = self
-            .crossing_search
-            .find(&bodies, &|i, j| i.min(j) < organs);
+        let found = self.search_crossings(step, false);
         if found.is_empty() {
             return None;
         }
@@ -141,15 +120,31 @@ impl Simulation {
     /// [`Simulation::find_crossings`]) that cross in the bud, at keyframe
     /// 0's pose; the parts are put back at keyframe 1's after.
     fn crossing_pairs_in_bud(&mut self) -> Vec<(u32, u32)> {
+        let mut pairs: Vec<(u32, u32)> = self
+            .search_crossings(0, true)
+            .iter()
+            .map(|c| (c.a.body, c.b.body))
+            .collect();
+        pairs.dedup();
         for obstacle in &mut self.obstacles {
-            obstacle.move_to(0);
+            obstacle.move_to(1);
+        }
+        pairs
+    }
+
+    /// Every crossing among the organs (where they are, or in the bud if
+    /// `in_bud`) and the parts at step `step`'s pose; bodies are the
+    /// organs, then the parts.
+    fn search_crossings(&mut self, step: u32, in_bud: bool) -> Vec<Crossing> {
+        for obstacle in &mut self.obstacles {
+            obstacle.move_to(step);
         }
         let organs = self.organs.len();
         let bodies: Vec<Body<'_>> = self
             .organs
             .iter()
             .map(|o| Body {
-                positions: &o.initial,
+                positions: if in_bud { &o.initial } else { &o.positions },
                 triangles: &o.mesh.triangles,
             })
             .chain(self.obstacles.iter().map(|o| {
@@ -160,16 +155,8 @@ impl Simulation {
                 }
             }))
             .collect();
-        let mut pairs: Vec<(u32, u32)> = self
-            .crossing_search
+        // Parts against parts are not tested: they overlap by design.
+        self.crossing_search
             .find(&bodies, &|i, j| i.min(j) < organs)
-            .iter()
-            .map(|c| (c.a.body, c.b.body))
-            .collect();
-        pairs.dedup();
-        for obstacle in &mut self.obstacles {
-            obstacle.move_to(1);
-        }
-        pairs
     }
 }
