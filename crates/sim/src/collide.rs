@@ -23,8 +23,7 @@ use glam::{DVec2, DVec3};
 
 mod rim;
 pub use rim::{
-    RimSide, SelfNear, closest_between_segments, rim_contacts, rim_contacts_of_pairs, rim_edges,
-    rim_pairs,
+    RimSide, SelfNear, closest_between_segments, rim_contacts_of_pairs, rim_edges, rim_pairs,
 };
 
 /// One organ's current geometry as collisions see it.
@@ -464,7 +463,7 @@ impl Locality<'_> {
 /// the contact is then as against another organ ([`contacts_against`]).
 ///
 /// The side a particle was on is known where it lay over the surface
-/// then ([`side_then`]). A particle that lay beside it (beside the fold's
+/// then (`side_then`). A particle that lay beside it (beside the fold's
 /// margin, or where the fold has since slid along under it) takes the side
 /// the fold's particle nearest it now was on against it then, turned
 /// through their normals (two sheets over each other: the one is on the

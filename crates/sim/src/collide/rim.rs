@@ -92,27 +92,9 @@ impl SelfNear<'_> {
     }
 }
 
-/// The rim contacts of the edges of `moving` against `other` (see the
-/// module): pairs of an edge of `moving` and a rim edge of `other`, and of
-/// a rim edge of `moving` and an edge of `other` ([`rim_pairs`]). For an
-/// organ against itself (`locality`: where it is near itself) pairs with
-/// an end in each other's neighbourhood are left out, and so are edges
-/// with a base particle at an end (the bases of organs meet on the
-/// receptacle by design). `offset` is the collision offset.
-pub fn rim_contacts(
-    moving: &RimSide,
-    other: &RimSide,
-    locality: Option<&SelfNear>,
-    offset: f64,
-    out: &mut Vec<Contact>,
-) {
-    let pairs = rim_pairs(moving, other, locality);
-    rim_contacts_of_pairs(moving, other, &pairs, locality, offset, out);
-}
-
 /// The pairs of an edge of `moving` and an edge of `other` (each
 /// `[low, high]`), one of them a rim edge, that come within reach of each
-/// other (see [`rim_contacts`]), sorted. Those of `other` against `moving`
+/// other (see the module), sorted. Those of `other` against `moving`
 /// are these, each turned round: the same edges are measured the same way.
 pub fn rim_pairs(
     moving: &RimSide,
@@ -173,7 +155,12 @@ fn rim_reach(moving: &RimSide, other: &RimSide) -> f64 {
     RIM_REACH * moving.surface.mean_edge.max(other.surface.mean_edge)
 }
 
-/// [`rim_contacts`] of the edge pairs `pairs` ([`rim_pairs`]).
+/// The rim contacts of the edges of `moving` against `other` (see the
+/// module) from their edge pairs `pairs` ([`rim_pairs`]). For an organ
+/// against itself (`locality`: where it is near itself) pairs with an end
+/// in each other's neighbourhood are left out, and so are edges with a
+/// base particle at an end (the bases of organs meet on the receptacle by
+/// design). `offset` is the collision offset.
 pub fn rim_contacts_of_pairs(
     moving: &RimSide,
     other: &RimSide,
