@@ -210,3 +210,45 @@ pub fn stroke_near_tip(project: &mut Project, template: usize, key: usize) {
         dab_scalar(map, &brush, glam::DVec2::new(0.5, v), 0.0);
     }
 }
+
+/// Two petals at the same azimuth, one inside the other, the inner
+/// one's joint driven 40 degrees over `keyframes` into the outer one
+/// (driven 10), in the default settings.
+pub fn pressed_together(keyframes: u32) -> Project {
+    let ramp = |angle_deg: f64| {
+        vec![JointRamp {
+            from_step: 0,
+            to_step: keyframes,
+            angle_deg,
+        }]
+    };
+    let mut inner = petal_template("inner petal", 8, 14);
+    inner.joint_schedule = ramp(40.0);
+    let mut outer = petal_template("outer petal", 8, 14);
+    outer.joint_schedule = ramp(10.0);
+    let organ = |name: &str, template: usize, from_axis: f64, joint_angle_deg: f64| Organ {
+        name: name.to_string(),
+        template,
+        placement: Placement {
+            position: DVec3::new(0.0, 0.0, from_axis),
+            azimuth_deg: 0.0,
+            joint_angle_deg,
+            orientation: glam::DQuat::IDENTITY,
+        },
+    };
+    Project {
+        name: "pressed together".into(),
+        flower: Flower {
+            templates: vec![inner, outer],
+            organs: vec![organ("inner", 0, 0.5, 12.0), organ("outer", 1, 2.0, 18.0)],
+            overlaps: vec![Overlap { inner: 0, outer: 1 }],
+            structure: None,
+            parts: Vec::new(),
+            unit: None,
+        },
+        settings: SimulationSettings {
+            keyframes,
+            ..SimulationSettings::default()
+        },
+    }
+}

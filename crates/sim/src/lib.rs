@@ -120,6 +120,13 @@ pub struct Simulation {
     /// Particles held off their own organ by a self-contact while the
     /// organs settled, summed over the keyframes computed.
     self_pressed: u64,
+    /// Test only: the push-back checks each piece of the rim contacts it
+    /// keeps against one made again where the organs are.
+    #[cfg(test)]
+    check_rim_pieces: bool,
+    /// Test only: the rim pieces the push-back kept.
+    #[cfg(test)]
+    kept_rim_pieces: usize,
     /// Per organ, its template's values outside the range the solver is
     /// made for, named when a run stops at it (see
     /// [`error::values_out_of_range`]).
@@ -199,6 +206,10 @@ impl Simulation {
             crossings: Vec::new(),
             two_sided: false,
             self_pressed: 0,
+            #[cfg(test)]
+            check_rim_pieces: false,
+            #[cfg(test)]
+            kept_rim_pieces: 0,
             out_of_range,
             #[cfg(all(feature = "fault-hook", not(test)))]
             fault: fault::Fault::from_env(),

@@ -12,10 +12,11 @@ use crate::collide::{RimSide, SelfNear, rim_contacts_of_pairs, rim_pairs};
 
 impl Simulation {
     /// Every organ's rim contacts where the organs are (`geometry`: each
-    /// organ's), each to be put all the way. The edge pairs of two organs
-    /// that each have contacts with the other are found once, for both
-    /// (half the rim search's time on the whole lily).
-    pub(crate) fn rim_contacts(&self, geometry: &[&Geometry]) -> Vec<Vec<Contact>> {
+    /// organ's), each to be put all the way, in pieces ([`RimPieces`]).
+    /// The edge pairs of two organs that each have contacts with the other
+    /// are found once, for both (half the rim search's time on the whole
+    /// lily).
+    pub(crate) fn rim_contacts(&self, geometry: &[&Geometry]) -> Vec<RimPieces> {
         let others: Vec<Vec<usize>> = (0..self.organs.len()).map(|i| self.rim_others(i)).collect();
         // Each pair of organs once, lower first.
         let mut shared: Vec<(usize, usize)> = others
@@ -35,7 +36,9 @@ impl Simulation {
         (0..self.organs.len())
             .into_par_iter()
             .map(|i| {
-                self.rim_contacts_with(i, geometry, &others[i], |other| {
+                let pieces: Vec<Option<usize>> =
+                    others[i].iter().copied().map(Some).chain([None]).collect();
+                let lists = self.rim_pieces(i, geometry, &pieces, |other| {
                     let at = shared.binary_search(&(i.min(other), i.max(other))).ok()?;
                     let pairs = found[at].as_ref()?;
                     Some(if i < other {
@@ -45,20 +48,16 @@ impl Simulation {
                         turned.sort_unstable();
                         turned
                     })
-                })
+                });
+                RimPieces { pieces, lists }
             })
             .collect()
     }
 
-    /// Organ `i`'s rim contacts where the organs are: against each organ
-    /// it has contacts with, then against itself.
-    pub(crate) fn rim_contacts_of(&self, i: usize, geometry: &[&Geometry]) -> Vec<Contact> {
-        self.rim_contacts_with(i, geometry, &self.rim_others(i), |_| None)
-    }
-
     /// The organs organ `i` has contacts with (an overlap side or a free
-    /// pair), in order.
-    fn rim_others(&self, i: usize) -> Vec<usize> {
+    /// pair), in order: its rim pieces against other organs, before the
+    /// one against itself.
+    pub(crate) fn rim_others(&self, i: usize) -> Vec<usize> {
         let mut others: Vec<usize> = self
             .sides()
             .filter(|&(_, moving, _, _)| moving == i)
@@ -92,54 +91,78 @@ impl Simulation {
         })
     }
 
-    /// [`Simulation::rim_contacts_of`] against `others`, with the edge
-    /// pairs against another organ from `known` where it has them.
-    fn rim_contacts_with(
+    /// Organ `i`'s rim contacts against each of `pieces` (another organ,
+    /// or itself for `None`), one list each in that order, each piece on
+    /// rayon's threads (the push-back asks for one organ's at a time); the
+    /// edge pairs against another organ from `known` where it has them.
+    pub(crate) fn rim_pieces(
         &self,
         i: usize,
         geometry: &[&Geometry],
-        others: &[usize],
+        pieces: &[Option<usize>],
         known: impl Fn(usize) -> Option<Pairs> + Sync,
-    ) -> Vec<Contact> {
+    ) -> Vec<Vec<Contact>> {
         let organ = &self.organs[i];
-        let mut list = Vec::new();
-        if organ.is_kinematic() || organ.previous().is_none() {
-            return list;
-        }
-        let Some(moving) = self.rim_side(i, geometry) else {
-            return list;
+        let moving = self
+            .rim_side(i, geometry)
+            .filter(|_| !organ.is_kinematic() && organ.previous().is_some());
+        let Some(moving) = moving else {
+            return vec![Vec::new(); pieces.len()];
         };
         let offset = self.settings.collision_offset;
-        let locality = organ.locality();
-        let near = SelfNear {
-            bud_near: 0.5 * locality.local,
-            beyond: geometry[i].beyond(organ),
-            locality,
-            bud: &organ.initial,
-        };
-        // The edge pairs against each organ and itself on rayon's threads
-        // (the push-back asks for one organ's at a time); the contacts
-        // from them in order.
-        let (against, own) = rayon::join(
-            || {
-                others
-                    .par_iter()
-                    .map(|&other| {
-                        let side = self.rim_side(other, geometry)?;
-                        let pairs = known(other).unwrap_or_else(|| rim_pairs(&moving, &side, None));
-                        Some((side, pairs))
-                    })
-                    .collect::<Vec<_>>()
-            },
-            || rim_pairs(&moving, &moving, Some(&near)),
-        );
-        for (side, pairs) in against.iter().flatten() {
-            rim_contacts_of_pairs(&moving, side, pairs, None, offset, &mut list);
-        }
-        rim_contacts_of_pairs(&moving, &moving, &own, Some(&near), offset, &mut list);
-        list
+        pieces
+            .par_iter()
+            .map(|&piece| {
+                let mut list = Vec::new();
+                match piece {
+                    Some(other) => {
+                        if let Some(side) = self.rim_side(other, geometry) {
+                            let pairs =
+                                known(other).unwrap_or_else(|| rim_pairs(&moving, &side, None));
+                            rim_contacts_of_pairs(&moving, &side, &pairs, None, offset, &mut list);
+                        }
+                    }
+                    None => {
+                        let locality = organ.locality();
+                        let near = SelfNear {
+                            bud_near: 0.5 * locality.local,
+                            beyond: geometry[i].beyond(organ),
+                            locality,
+                            bud: &organ.initial,
+                        };
+                        let own = rim_pairs(&moving, &moving, Some(&near));
+                        rim_contacts_of_pairs(
+                            &moving,
+                            &moving,
+                            &own,
+                            Some(&near),
+                            offset,
+                            &mut list,
+                        );
+                    }
+                }
+                list
+            })
+            .collect()
+    }
+}
+
+/// One organ's rim contacts in pieces: against each organ it has contacts
+/// with (`Some`), then against itself (`None`). A piece depends only on
+/// where its two organs are, so the push-back makes again only the pieces
+/// of organs it moved.
+#[derive(Clone, Default)]
+pub(crate) struct RimPieces {
+    pub(crate) pieces: Vec<Option<usize>>,
+    pub(crate) lists: Vec<Vec<Contact>>,
+}
+
+impl RimPieces {
+    /// Every contact, piece after piece.
+    pub(crate) fn all(&self) -> impl Iterator<Item = &Contact> {
+        self.lists.iter().flatten()
     }
 }
 
 /// Edge pairs of two organs ([`rim_pairs`]).
-type Pairs = Vec<([u32; 2], [u32; 2])>;
+pub(crate) type Pairs = Vec<([u32; 2], [u32; 2])>;

@@ -10,6 +10,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
+use super::rim::RimPieces;
 use crate::Simulation;
 use crate::collide::{
     Held, Surface, Tracker, Violated, contacts_against, contacts_of, held_where,
@@ -63,7 +64,7 @@ impl Simulation {
         let rims = if rims {
             self.rim_contacts(&geometry)
         } else {
-            vec![Vec::new(); self.organs.len()]
+            vec![RimPieces::default(); self.organs.len()]
         };
         let free = self
             .free
@@ -277,7 +278,7 @@ impl Simulation {
                 }));
             }
             for ((list, rims), organ) in contacts.iter_mut().zip(&found.rims).zip(&self.organs) {
-                list.extend(rims.iter().map(|&c| match violated {
+                list.extend(rims.all().map(|&c| match violated {
                     Violated::MoveHalf => move_half(c, organ.positions[c.particle as usize]),
                     Violated::MoveAll => c,
                 }));
@@ -541,7 +542,7 @@ pub(crate) struct Found {
     pub(crate) selves: Vec<Vec<Contact>>,
     /// Each organ's rim contacts (see `collide::rim`), appended after its
     /// self-contacts.
-    pub(crate) rims: Vec<Vec<Contact>>,
+    pub(crate) rims: Vec<RimPieces>,
     /// Each free pair's contacts (`Simulation::free`, same order).
     pub(crate) free: Vec<Vec<Contact>>,
     /// Where the violated contacts of each side press on the other organ
@@ -613,56 +614,10 @@ pub(crate) fn unknown_geometry(organs: usize) -> Vec<Option<Geometry>> {
 
 #[cfg(test)]
 mod tests {
-    use anthesis_flower::{
-        Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings,
-    };
-
     use super::*;
     use crate::Selection;
     use crate::collide::Violated;
-    use crate::fixtures::petal_template;
-
-    /// Two petals at the same azimuth, one inside the other, the inner
-    /// one's joint driven 40 degrees over `keyframes` into the outer one
-    /// (driven 10), in the default settings.
-    fn pressed_together(keyframes: u32) -> Project {
-        let ramp = |angle_deg: f64| {
-            vec![JointRamp {
-                from_step: 0,
-                to_step: keyframes,
-                angle_deg,
-            }]
-        };
-        let mut inner = petal_template("inner petal", 8, 14);
-        inner.joint_schedule = ramp(40.0);
-        let mut outer = petal_template("outer petal", 8, 14);
-        outer.joint_schedule = ramp(10.0);
-        let organ = |name: &str, template: usize, from_axis: f64, joint_angle_deg: f64| Organ {
-            name: name.to_string(),
-            template,
-            placement: Placement {
-                position: DVec3::new(0.0, 0.0, from_axis),
-                azimuth_deg: 0.0,
-                joint_angle_deg,
-                orientation: glam::DQuat::IDENTITY,
-            },
-        };
-        Project {
-            name: "pressed together".into(),
-            flower: Flower {
-                templates: vec![inner, outer],
-                organs: vec![organ("inner", 0, 0.5, 12.0), organ("outer", 1, 2.0, 18.0)],
-                overlaps: vec![Overlap { inner: 0, outer: 1 }],
-                structure: None,
-                parts: Vec::new(),
-                unit: None,
-            },
-            settings: SimulationSettings {
-                keyframes,
-                ..SimulationSettings::default()
-            },
-        }
-    }
+    use crate::fixtures::pressed_together;
 
     /// The penalty force `c` puts on a particle at `x`, over the contact
     /// stiffness.
