@@ -691,10 +691,13 @@ impl eframe::App for AnthesisApp {
         if self.playback.playing {
             ctx.request_repaint();
         } else if self.session.is_running() || self.export.is_running() {
-            // The worker wakes the window on every event; this keeps the
-            // elapsed time moving without drawing (and taking a core from
-            // the solver) at full frame rate.
-            ctx.request_repaint_after(std::time::Duration::from_millis(250));
+            // The worker wakes the window for the viewed keyframe and a
+            // run's start and end at once, for the rest at most every half
+            // second (`anthesis_sim::worker::PROGRESS_WAKE_EVERY`); this
+            // keeps the elapsed time moving through a long iteration. Each
+            // redraw takes about 0.1 s of a core on a software renderer,
+            // from the solver.
+            ctx.request_repaint_after(std::time::Duration::from_millis(1000));
         }
     }
 

@@ -211,12 +211,18 @@ impl Mailbox {
 
 type Wake = Box<dyn Fn() + Send + Sync>;
 
-/// Shortest time between two wakes for `Progress` events alone.
-pub const PROGRESS_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(100);
+/// Shortest time between two wakes for `Progress` events alone. A wake
+/// is a redraw, about a tenth of a second of a core on a software
+/// renderer: woken every 100 ms (and for other keyframes every 250 ms) the
+/// window's drawing took as much CPU as the solver on two cores, and an
+/// early-key stroke's rerun reached the screen 27 % later than at 500 ms
+/// (measured from the screen's pixels, `app/tests/xvfb-edit-latency.sh`).
+pub const PROGRESS_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(500);
 
 /// Shortest time between two wakes for keyframes other than the one the
-/// owner views (see [`Worker::set_viewed_keyframe`]).
-pub const OTHER_KEYFRAME_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(250);
+/// owner views (see [`Worker::set_viewed_keyframe`]); paced as
+/// [`PROGRESS_WAKE_EVERY`] for the same reason.
+pub const OTHER_KEYFRAME_WAKE_EVERY: std::time::Duration = std::time::Duration::from_millis(500);
 
 /// How long after a run with a proxy starts only the viewed keyframe and
 /// the run's start and end wake the owner: the proxy's latency budget for
@@ -823,27 +829,30 @@ mod tests {
         let mut gate = WakeGate::default();
         let t0 = Instant::now();
         let at = |ms| t0 + Duration::from_millis(ms);
-        // Progress: at most every tenth of a second.
+        let progress = PROGRESS_WAKE_EVERY.as_millis() as u64;
+        let other = OTHER_KEYFRAME_WAKE_EVERY.as_millis() as u64;
+        // Progress: at most every PROGRESS_WAKE_EVERY.
         assert!(gate.wakes(Wakes::Progress, None, at(0)), "the first wakes");
         assert!(!gate.wakes(Wakes::Progress, None, at(30)));
-        assert!(!gate.wakes(Wakes::Progress, None, at(99)));
+        assert!(!gate.wakes(Wakes::Progress, None, at(progress - 1)));
         assert!(
-            gate.wakes(Wakes::Lifecycle, None, at(99)),
+            gate.wakes(Wakes::Lifecycle, None, at(progress - 1)),
             "a start or end always wakes"
         );
         assert!(
-            !gate.wakes(Wakes::Progress, None, at(150)),
+            !gate.wakes(Wakes::Progress, None, at(progress + 50)),
             "counted from the last wake"
         );
-        assert!(gate.wakes(Wakes::Progress, None, at(199)));
+        let t = 2 * progress - 1;
+        assert!(gate.wakes(Wakes::Progress, None, at(t)));
         // Keyframes: every one when nothing in particular is viewed.
-        assert!(gate.wakes(Wakes::Keyframe(3), None, at(200)));
-        assert!(gate.wakes(Wakes::Keyframe(4), None, at(201)));
-        // The viewed one at once; others a quarter second apart.
-        assert!(!gate.wakes(Wakes::Keyframe(5), Some(54), at(300)));
-        assert!(gate.wakes(Wakes::Keyframe(54), Some(54), at(301)));
-        assert!(!gate.wakes(Wakes::Keyframe(55), Some(54), at(500)));
-        assert!(gate.wakes(Wakes::Keyframe(56), Some(54), at(551)));
+        assert!(gate.wakes(Wakes::Keyframe(3), None, at(t + 1)));
+        assert!(gate.wakes(Wakes::Keyframe(4), None, at(t + 2)));
+        // The viewed one at once; others OTHER_KEYFRAME_WAKE_EVERY apart.
+        assert!(!gate.wakes(Wakes::Keyframe(5), Some(54), at(t + 100)));
+        assert!(gate.wakes(Wakes::Keyframe(54), Some(54), at(t + 101)));
+        assert!(!gate.wakes(Wakes::Keyframe(55), Some(54), at(t + 100 + other)));
+        assert!(gate.wakes(Wakes::Keyframe(56), Some(54), at(t + 101 + other)));
     }
 
     #[test]
@@ -859,12 +868,14 @@ mod tests {
         assert!(gate.wakes(Wakes::Keyframe(100), Some(100), at(400)));
         assert!(!gate.wakes(Wakes::Progress, Some(100), at(quiet - 1)));
         // A slow proxy gets the usual pacing once the quiet is over.
-        assert!(gate.wakes(Wakes::Progress, Some(100), at(quiet + 1)));
+        let paced = quiet.max(400 + PROGRESS_WAKE_EVERY.as_millis() as u64);
+        assert!(gate.wakes(Wakes::Progress, Some(100), at(paced + 1)));
         // The proxy's end ends the quiet at once.
         assert!(gate.wakes(Wakes::ProxyRunStarted, Some(100), at(2000)));
         assert!(!gate.wakes(Wakes::Keyframe(3), Some(100), at(2300)));
         assert!(gate.wakes(Wakes::Lifecycle, Some(100), at(2310)));
-        assert!(gate.wakes(Wakes::Keyframe(4), Some(100), at(2560)));
+        let other = OTHER_KEYFRAME_WAKE_EVERY.as_millis() as u64;
+        assert!(gate.wakes(Wakes::Keyframe(4), Some(100), at(2310 + other)));
     }
 
     #[test]
@@ -879,8 +890,9 @@ mod tests {
         let run = worker.start(Arc::new(whorl(1, 4, 6, 40)), Selection::All);
         let events = collect_until_end(&worker, run);
         let keyframes = keyframes_of(&events).len();
-        // The start, the end, keyframe 40, and the others at most four
-        // times a second (the small run takes well under a second).
+        // The start, the end, keyframe 40, and the others at most every
+        // OTHER_KEYFRAME_WAKE_EVERY (the small run takes well under a
+        // second).
         let deadline = Instant::now() + Duration::from_secs(10);
         while wakes.load(Ordering::SeqCst) < 3 && Instant::now() < deadline {
             std::thread::sleep(Duration::from_millis(1));
