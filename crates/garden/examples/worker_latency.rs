@@ -1,13 +1,14 @@
-//! What the worker takes, without a window, for the late-key stroke the
-//! window's latency script paints (`app/tests/xvfb-edit-latency.sh`): the
-//! built-in lily run once, then strokes on the petals' late key, each run
-//! with its proxy while keyframe 54 is viewed, as the window does. Prints,
-//! per stroke, the milliseconds from the start to the proxy's keyframe 54
-//! and 100, the converged keyframes 40 (the first the stroke changes) and
-//! 54, and the run's end.
+//! What the worker takes, without a window, for the strokes the window's
+//! latency script paints (`app/tests/xvfb-edit-latency.sh`): the built-in
+//! lily run once, then strokes on the petals' late key while keyframe 54
+//! is viewed (or, with `early`, on the early key while keyframe 100 is),
+//! each run with its proxy, as the window does. Prints, per stroke, the
+//! milliseconds from the start to the proxy's and the converged keyframes
+//! 54 and 100, the converged keyframe 40 (the first the late key changes)
+//! and the run's end.
 //!
 //! ```text
-//! cargo run --release -p anthesis-garden --example worker_latency [STROKES]
+//! cargo run --release -p anthesis-garden --example worker_latency [STROKES] [early]
 //! ```
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -16,19 +17,21 @@ use anthesis_sim::Selection;
 use anthesis_sim::fixtures::stroke_near_tip;
 use anthesis_sim::worker::{Event, Worker};
 
-/// The keyframe the window views in the latency script's late stroke.
-const VIEWED: u32 = 54;
-
 fn main() {
     let strokes: usize = std::env::args()
         .nth(1)
         .map_or(5, |n| n.parse().expect("a number of strokes"));
     let project = anthesis_garden::builtin_lily().expect("the built-in lily");
     let proxy = anthesis_flower::resolution::proxy(&project).expect("the lily has a proxy");
+    let early = std::env::args().nth(2).is_some_and(|a| a == "early");
     let worker = Worker::spawn(|| {}).expect("a worker thread");
-    worker.set_viewed_keyframe(Some(VIEWED));
+    worker.set_viewed_keyframe(Some(if early { 100 } else { 54 }));
     let template = project.flower.organs[0].template;
-    let late = project.flower.templates[template].maps.keys().len() - 1;
+    let key = if early {
+        0
+    } else {
+        project.flower.templates[template].maps.keys().len() - 1
+    };
     worker.start_with_proxy(
         Arc::new(project.clone()),
         Some(Arc::new(proxy.clone())),
@@ -38,7 +41,7 @@ fn main() {
     let mut current = project;
     for stroke in 1..=strokes {
         let mut painted = current.clone();
-        stroke_near_tip(&mut painted, template, late);
+        stroke_near_tip(&mut painted, template, key);
         // The window's proxy: the proxy meshes with the painted maps.
         let mut painted_proxy = proxy.clone();
         for (coarse, fine) in painted_proxy
@@ -66,10 +69,10 @@ fn wait_for_end(worker: &Worker, started: Instant) -> String {
     let mut line = String::new();
     loop {
         match worker.wait_event(Duration::from_secs(300)) {
-            Some(Event::Proxy { keyframe, .. }) if [VIEWED, 100].contains(&keyframe.index) => {
+            Some(Event::Proxy { keyframe, .. }) if [54, 100].contains(&keyframe.index) => {
                 line += &format!("proxy {} at {:.0} ms, ", keyframe.index, ms());
             }
-            Some(Event::Keyframe { keyframe, .. }) if [40, VIEWED].contains(&keyframe.index) => {
+            Some(Event::Keyframe { keyframe, .. }) if [40, 54, 100].contains(&keyframe.index) => {
                 line += &format!("converged {} at {:.0} ms, ", keyframe.index, ms());
             }
             Some(Event::Finished { .. }) => return line + &format!("end at {:.0} ms", ms()),
