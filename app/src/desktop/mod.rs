@@ -96,6 +96,10 @@ fn autosave_interval(settings: &Settings) -> std::time::Duration {
     std::time::Duration::from_secs(seconds)
 }
 
+/// How soon after the worker wakes the window it draws: not at once, so
+/// that egui draws one frame, not two (see where the worker is made).
+const WAKE_DELAY: std::time::Duration = std::time::Duration::from_millis(1);
+
 /// The key under which [`Settings`] are stored.
 const SETTINGS_KEY: &str = "anthesis-settings";
 
@@ -281,7 +285,11 @@ impl AnthesisApp {
         };
         let session = if startup.live {
             let wake = ctx.clone();
-            match SimSession::with_worker(move || wake.request_repaint()) {
+            // One frame per wake: egui answers `request_repaint` with two
+            // ("to give some things time to settle"), a delayed request with
+            // one, and each frame takes about 0.1 s of a core on a software
+            // renderer, from the solver.
+            match SimSession::with_worker(move || wake.request_repaint_after(WAKE_DELAY)) {
                 Ok(session) => session,
                 Err(e) => {
                     log.error(format!("cannot start the simulation thread: {e}"));
