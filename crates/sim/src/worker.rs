@@ -811,51 +811,15 @@ fn run_job(
         };
         ProxyPass::start(run, proxy, lane, first_computed, kept, emit)
     });
-    let keep = |kept: &mut Kept, sim, keyframes, pass: Option<ProxyPass>| {
-        if let Some(pass) = pass {
-            pass.keep(kept);
-        }
-        kept.put(LastRun {
-            project: Arc::clone(&request.project),
-            lane: lane.clone(),
-            sim,
-            keyframes,
-        });
-    };
-    // The viewed keyframe first (converged), if the proxy has one to
-    // show before it.
-    let ahead =
-        viewed.filter(|&v| pass.is_some() && v >= first_computed && v < sim.keyframe_count());
-    let mut steps = Steps::Finished;
-    if let (Some(last), Some(p)) = (ahead, pass.as_mut()) {
-        if !p.step_until(last, &stale, emit) {
-            emit(Event::Cancelled { run });
-            keep(kept, sim, keyframes, pass);
-            return;
-        }
-        steps = step_until(
-            &mut sim,
-            &mut keyframes,
-            last,
-            run,
-            &stale,
-            emit,
-            &|keyframe| Event::Keyframe { run, keyframe },
-        );
-    }
-    if let (Steps::Finished, Some(p)) = (&steps, pass.as_mut())
-        && !p.ended
-        && !p.step_until(u32::MAX, &stale, emit)
-    {
-        emit(Event::Cancelled { run });
-        keep(kept, sim, keyframes, pass);
-        return;
-    }
-    if let Steps::Finished = steps {
-        steps = step_to_end(&mut sim, &mut keyframes, run, &stale, emit, &|keyframe| {
-            Event::Keyframe { run, keyframe }
-        });
-    }
+    let steps = converged_after_proxy(
+        &mut sim,
+        &mut keyframes,
+        pass.as_mut(),
+        viewed.filter(|&v| v >= first_computed),
+        run,
+        &stale,
+        emit,
+    );
     match steps {
         Steps::Finished => emit(Event::Finished {
             run,
@@ -865,7 +829,48 @@ fn run_job(
         Steps::Cancelled => emit(Event::Cancelled { run }),
         Steps::Failed(error) => emit(Event::Failed { run, error }),
     }
-    keep(kept, sim, keyframes, pass);
+    if let Some(pass) = pass {
+        pass.keep(kept);
+    }
+    kept.put(LastRun {
+        project: Arc::clone(&request.project),
+        lane,
+        sim,
+        keyframes,
+    });
+}
+
+/// The converged keyframes of a run after its proxy `pass` (if any): with
+/// a keyframe `viewed` before the end, the proxy and then the converged
+/// run to it first, then the rest of the proxy and of the converged run.
+/// `Cancelled` when the run was cancelled during the proxy too.
+fn converged_after_proxy(
+    sim: &mut Simulation,
+    keyframes: &mut Vec<Arc<Keyframe>>,
+    mut pass: Option<&mut ProxyPass>,
+    viewed: Option<u32>,
+    run: RunId,
+    stale: &(dyn Fn() -> bool + Sync),
+    emit: &dyn Fn(Event),
+) -> Steps {
+    let converged = |keyframe| Event::Keyframe { run, keyframe };
+    let ahead = viewed.filter(|&v| v < sim.keyframe_count());
+    if let (Some(last), Some(p)) = (ahead, pass.as_deref_mut()) {
+        if !p.step_until(last, stale, emit) {
+            return Steps::Cancelled;
+        }
+        let steps = step_until(sim, keyframes, last, run, stale, emit, &converged);
+        if !matches!(steps, Steps::Finished) {
+            return steps;
+        }
+    }
+    if let Some(p) = pass
+        && !p.ended
+        && !p.step_until(u32::MAX, stale, emit)
+    {
+        return Steps::Cancelled;
+    }
+    step_to_end(sim, keyframes, run, stale, emit, &converged)
 }
 
 #[cfg(test)]
