@@ -1319,18 +1319,8 @@ mod tests {
         ));
         // The bud (converged), the proxy's keyframes 1-6, the end of the
         // proxy, then the converged keyframes 1-6.
-        let order: Vec<String> = events
-            .iter()
-            .filter_map(|e| match e {
-                Event::Keyframe { keyframe, .. } => Some(format!("k{}", keyframe.index)),
-                Event::Proxy { keyframe, .. } => Some(format!("p{}", keyframe.index)),
-                Event::ProxyEnded { error: None, .. } => Some("end".to_string()),
-                Event::ProxyEnded { error: Some(e), .. } => Some(format!("failed: {e}")),
-                _ => None,
-            })
-            .collect();
         assert_eq!(
-            order.join(" "),
+            order_from(&events, 0),
             "k0 p1 p2 p3 p4 p5 p6 end k1 k2 k3 k4 k5 k6"
         );
         let coarse_counts: Vec<usize> = (0..2)
@@ -1346,21 +1336,30 @@ mod tests {
         }
     }
 
-    #[test]
-    fn an_edit_with_a_proxy_keeps_the_unchanged_keyframes_and_redoes_the_proxy_from_the_first_change()
-     {
+    /// A small whorl of 44 keyframes, and the same with a stroke on its
+    /// step-40 key (which changes keyframes from 40 on).
+    fn late_key_edit() -> (Project, Project) {
         let before = whorl(2, 6, 10, 44);
         let mut after = before.clone();
         crate::fixtures::stroke_near_tip(&mut after, 0, 1);
-        let coarse = |fine: &Project| {
-            let mut coarse = whorl(2, 4, 6, 44);
-            coarse.flower.templates[0].maps = fine.flower.templates[0].maps.clone();
-            Arc::new(coarse)
-        };
+        (before, after)
+    }
+
+    /// The proxy of a [`late_key_edit`] project: coarser meshes, its maps.
+    fn coarse_of(fine: &Project) -> Arc<Project> {
+        let mut coarse = whorl(2, 4, 6, 44);
+        coarse.flower.templates[0].maps = fine.flower.templates[0].maps.clone();
+        Arc::new(coarse)
+    }
+
+    #[test]
+    fn an_edit_with_a_proxy_keeps_the_unchanged_keyframes_and_redoes_the_proxy_from_the_first_change()
+     {
+        let (before, after) = late_key_edit();
         let worker = Worker::spawn(|| {}).expect("thread");
         let mut last = Vec::new();
         for project in [before, after] {
-            let proxy = coarse(&project);
+            let proxy = coarse_of(&project);
             let run = worker.start_with_proxy(Arc::new(project), Some(proxy), Selection::All);
             last = collect_until_end(&worker, run);
         }
@@ -1404,14 +1403,7 @@ mod tests {
 
     #[test]
     fn the_viewed_keyframe_comes_converged_before_the_rest_of_the_proxy() {
-        let before = whorl(2, 6, 10, 44);
-        let mut after = before.clone();
-        crate::fixtures::stroke_near_tip(&mut after, 0, 1);
-        let coarse = |fine: &Project| {
-            let mut coarse = whorl(2, 4, 6, 44);
-            coarse.flower.templates[0].maps = fine.flower.templates[0].maps.clone();
-            Arc::new(coarse)
-        };
+        let (before, after) = late_key_edit();
         let plain = Worker::spawn(|| {}).expect("thread");
         let run = plain.start(Arc::new(after.clone()), Selection::All);
         let expected = keyframes_of(&collect_until_end(&plain, run));
@@ -1420,7 +1412,7 @@ mod tests {
         worker.set_viewed_keyframe(Some(3));
         let run = worker.start_with_proxy(
             Arc::new(before.clone()),
-            Some(coarse(&before)),
+            Some(coarse_of(&before)),
             Selection::All,
         );
         let first = collect_until_end(&worker, run);
@@ -1434,7 +1426,7 @@ mod tests {
         worker.set_viewed_keyframe(Some(42));
         let run = worker.start_with_proxy(
             Arc::new(after.clone()),
-            Some(coarse(&after)),
+            Some(coarse_of(&after)),
             Selection::All,
         );
         let last = collect_until_end(&worker, run);
@@ -1452,7 +1444,7 @@ mod tests {
         worker.set_viewed_keyframe(Some(44));
         let run = worker.start_with_proxy(
             Arc::new(before.clone()),
-            Some(coarse(&before)),
+            Some(coarse_of(&before)),
             Selection::All,
         );
         assert_eq!(

@@ -284,6 +284,15 @@ impl Simulation {
         pushed_in_pass
     }
 
+    /// What is known of every organ where it is, made where missing.
+    fn every_geometry<'a>(&self, geometry: &'a mut [Option<Geometry>]) -> Vec<&'a Geometry> {
+        geometry
+            .iter_mut()
+            .zip(&self.organs)
+            .map(|(known, organ)| &*known.get_or_insert_with(|| Geometry::of(organ)))
+            .collect()
+    }
+
     /// One pass of each organ's rim contacts. Each piece (against one
     /// organ, or itself) is the one the search made before the push-back,
     /// or the last one made, while neither of its organs has been pushed
@@ -302,10 +311,7 @@ impl Simulation {
                 .filter(|&k| state.rim_made[i][k] != stamp(rims.pieces[k]))
                 .collect();
             if !stale.is_empty() {
-                for (k, known) in geometry.iter_mut().enumerate() {
-                    known.get_or_insert_with(|| Geometry::of(&self.organs[k]));
-                }
-                let known: Vec<&Geometry> = geometry.iter().flatten().collect();
+                let known = self.every_geometry(geometry);
                 let pieces: Vec<Option<usize>> = stale.iter().map(|&k| rims.pieces[k]).collect();
                 let lists = self.rim_pieces(i, &known, &pieces, |_| None);
                 for (&k, list) in stale.iter().zip(lists) {
@@ -316,10 +322,7 @@ impl Simulation {
             #[cfg(test)]
             if self.check_rim_pieces {
                 self.kept_rim_pieces += rims.pieces.len() - stale.len();
-                for (k, known) in geometry.iter_mut().enumerate() {
-                    known.get_or_insert_with(|| Geometry::of(&self.organs[k]));
-                }
-                let known: Vec<&Geometry> = geometry.iter().flatten().collect();
+                let known = self.every_geometry(geometry);
                 let made = self.rim_pieces(i, &known, &rims.pieces, |_| None);
                 assert_eq!(rims.lists, made, "organ {i}'s kept rim pieces");
             }
@@ -336,7 +339,7 @@ impl Simulation {
 
 #[cfg(test)]
 mod tests {
-    use crate::fixtures::pressed_together;
+    use crate::fixtures::inner_driven_into_outer_by;
     use crate::{Selection, Simulation};
 
     #[test]
@@ -344,7 +347,8 @@ mod tests {
         // The inner petal driven into the outer one: the push-back moves
         // one at a time, so pieces of the other are kept. Each kept piece
         // is compared with one made again where the organs are.
-        let mut sim = Simulation::new(&pressed_together(12), &Selection::All).expect("valid");
+        let mut sim = Simulation::new(&inner_driven_into_outer_by(12, true, 40.0), &Selection::All)
+            .expect("valid");
         sim.check_rim_pieces = true;
         while !sim.finished() {
             sim.step(&|| false, &mut |_| {}).expect("the run goes on");

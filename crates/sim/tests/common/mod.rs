@@ -1,10 +1,13 @@
 //! Helpers shared by the simulation's integration tests.
 #![allow(dead_code)]
 
+use anthesis_flower::Project;
 use anthesis_flower::parts::{Part, PartShape, Tube};
-use anthesis_flower::{Flower, JointRamp, Organ, Overlap, Placement, Project, SimulationSettings};
 use anthesis_sim::crossing::{Crossings, OnCrossing};
-use anthesis_sim::fixtures::petal_template;
+// Each test crate uses some of the helpers; the two petals driven into
+// each other live with the fixtures, since unit tests use them too.
+#[allow(unused_imports)]
+pub use anthesis_sim::fixtures::{inner_driven_into_outer, inner_driven_into_outer_by};
 use anthesis_sim::{Keyframe, Selection, SimError, Simulation, run};
 use glam::DVec3;
 
@@ -95,62 +98,6 @@ pub fn particles_over(
         });
     }
     over
-}
-
-/// Two petals at the same azimuth, one inside the other (bases 1.5 apart,
-/// so that attachment never presses the bases together), whose
-/// joint schedules drive the inner one through the outer one (20 degrees
-/// against 10 over `keyframes` steps). With `overlap`, the flower says the
-/// first lies inside the second.
-pub fn inner_driven_into_outer(keyframes: u32, overlap: bool) -> Project {
-    inner_driven_into_outer_by(keyframes, overlap, 20.0)
-}
-
-/// [`inner_driven_into_outer`] with the inner petal's joint driven by
-/// `inner_drive_deg` (the outer one's still by 10 degrees): the larger the
-/// drive, the deeper the inner organ is pushed into the outer one.
-pub fn inner_driven_into_outer_by(keyframes: u32, overlap: bool, inner_drive_deg: f64) -> Project {
-    let ramp = |angle_deg: f64| {
-        vec![JointRamp {
-            from_step: 0,
-            to_step: keyframes,
-            angle_deg,
-        }]
-    };
-    let mut inner = petal_template("inner petal", 8, 14);
-    inner.joint_schedule = ramp(inner_drive_deg);
-    let mut outer = petal_template("outer petal", 8, 14);
-    outer.joint_schedule = ramp(10.0);
-    let organ =
-        |name: &str, template: usize, distance_from_axis: f64, joint_angle_deg: f64| Organ {
-            name: name.to_string(),
-            template,
-            placement: Placement {
-                position: DVec3::new(0.0, 0.0, distance_from_axis),
-                azimuth_deg: 0.0,
-                joint_angle_deg,
-                orientation: glam::DQuat::IDENTITY,
-            },
-        };
-    Project {
-        name: "inner driven into outer".into(),
-        flower: Flower {
-            templates: vec![inner, outer],
-            organs: vec![organ("inner", 0, 0.5, 12.0), organ("outer", 1, 2.0, 18.0)],
-            overlaps: if overlap {
-                vec![Overlap { inner: 0, outer: 1 }]
-            } else {
-                Vec::new()
-            },
-            structure: None,
-            parts: Vec::new(),
-            unit: None,
-        },
-        settings: SimulationSettings {
-            keyframes,
-            ..SimulationSettings::default()
-        },
-    }
 }
 
 /// Every keyframe of a run (the bud first), or the error that stopped it
