@@ -96,8 +96,10 @@ fn autosave_interval(settings: &Settings) -> std::time::Duration {
     std::time::Duration::from_secs(seconds)
 }
 
-/// How soon after the worker wakes the window it draws: not at once, so
-/// that egui draws one frame, not two (see where the worker is made).
+/// How soon after the worker wakes the window it draws: not at once, since
+/// egui answers `request_repaint` with two frames ("to give some things
+/// time to settle") and a delayed request with one, and each frame takes
+/// about 0.1 s of a core from the solver on a software renderer.
 const WAKE_DELAY: std::time::Duration = std::time::Duration::from_millis(1);
 
 /// The key under which [`Settings`] are stored.
@@ -285,10 +287,7 @@ impl AnthesisApp {
         };
         let session = if startup.live {
             let wake = ctx.clone();
-            // One frame per wake: egui answers `request_repaint` with two
-            // ("to give some things time to settle"), a delayed request with
-            // one, and each frame takes about 0.1 s of a core on a software
-            // renderer, from the solver.
+            // One frame per wake (see `WAKE_DELAY`).
             match SimSession::with_worker(move || wake.request_repaint_after(WAKE_DELAY)) {
                 Ok(session) => session,
                 Err(e) => {
